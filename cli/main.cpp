@@ -1,0 +1,206 @@
+// seamcl: the command-line front end. Each subcommand gathers its flags, hands them to the
+// library (the same option parser the HTTP service uses) and prints a result.
+// Exit codes: 0 success, 2 bad usage or input (one line naming the field), 1 other failures.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "cl_runtime.h"
+#include "errors.h"
+#include "image_io.h"
+#include "render_options.h"
+#include "renderer.h"
+#include "scene_generators.h"
+#include "scene_json.h"
+
+namespace {
+
+using nlohmann::json;
+using namespace seamcl;
+
+struct RenderArgs {
+  std::optional<std::string> scene, method, size, shading;
+  std::optional<int> msaa, aniso, frame, frames;
+  bool centroid = false;
+  bool tint = false;
+  std::string output;
+  bool json_out = false;
+  int repeat = 1;
+};
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// The flags given on the command line as the JSON request the shared parser reads.
+json render_request(const RenderArgs& a) {
+  json request = json::object();
+  if (a.scene) request["scene"] = *a.scene;
+  if (a.method) request["method"] = *a.method;
+  if (a.msaa) request["msaa"] = *a.msaa;
+  if (a.aniso) request["aniso"] = *a.aniso;
+  if (a.size) request["size"] = *a.size;
+  if (a.shading) request["shading"] = *a.shading;
+  if (a.centroid) request["centroid"] = true;
+  if (a.frame) request["frame"] = *a.frame;
+  if (a.frames) request["frames"] = *a.frames;
+  if (a.tint) request["tint"] = true;
+  return request;
+}
+
+int run_render(const RenderArgs& args, const std::string& device) {
+  // Validate everything before any work, so bad input changes nothing.
+  const RenderOptions options = parse_render_options(render_request(args));
+  if (!args.output.empty()) image_format_for_path(args.output, "output");
+  if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
+
+  const auto scene_start = std::chrono::steady_clock::now();
+  GeneratorOptions generator_options;
+  generator_options.tint = options.tint;
+  const Scene scene = load_scene(options.scene, generator_options);
+  const Camera camera = options.frame ? orbit_camera(scene, *options.frame, options.frames) : scene.camera;
+  const double scene_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - scene_start).count();
+
+  ClRuntime runtime(device);
+  Renderer renderer(runtime);
+  renderer.load_scene(scene);
+  std::vector<RenderResult> runs;
+  for (int i = 0; i < args.repeat; ++i) runs.push_back(renderer.render(camera, options));
+  const RenderResult& result = runs.back();
+  if (!args.output.empty()) write_image(args.output, result.width, result.height, result.pixels);
+
+  auto stage_median = [&](double StageTimes::*stage) {
+    std::vector<double> values;
+    for (const RenderResult& r : runs) values.push_back(r.ms.*stage);
+    return median(values);
+  };
+  const json ms = {{"total", stage_median(&StageTimes::total)},     {"setup", stage_median(&StageTimes::setup)},
+                   {"binning", stage_median(&StageTimes::binning)}, {"raster", stage_median(&StageTimes::raster)},
+                   {"shade", stage_median(&StageTimes::shade)},     {"readback", stage_median(&StageTimes::readback)}};
+  if (args.json_out) {
+    json out = {{"device", runtime.device_description()},
+                {"options", to_json(options)},
+                {"ms", ms},
+                {"runs", args.repeat},
+                {"kernel_build_ms", runtime.program_build_ms()},
+                {"scene_ms", scene_ms},
+                {"triangles", scene.triangle_count()},
+                {"visible_triangles", result.stats.visible_triangles},
+                {"fragments", result.stats.fragments},
+                {"texture_bytes", renderer.packed_scene().texture_bytes()},
+                {"bin_entries", result.stats.bin_entries}};
+    if (!args.output.empty()) out["output"] = args.output;
+    std::cout << out.dump(2) << "\n";
+  } else {
+    std::printf("%s: %dx%d msaa %d, %.2f ms (setup %.2f, binning %.2f, raster %.2f, shade %.2f), %u fragments%s%s\n",
+                scene.name.c_str(), result.width, result.height, options.msaa, ms["total"].get<double>(),
+                ms["setup"].get<double>(), ms["binning"].get<double>(), ms["raster"].get<double>(),
+                ms["shade"].get<double>(), result.stats.fragments, args.output.empty() ? "" : " -> ",
+                args.output.c_str());
+  }
+  return 0;
+}
+
+int run_scenes(bool json_out) {
+  if (json_out) {
+    json list = json::array();
+    for (const GeneratorInfo& g : scene_generators()) list.push_back({{"name", g.name}, {"description", g.description}});
+    std::cout << list.dump(2) << "\n";
+  } else {
+    for (const GeneratorInfo& g : scene_generators()) std::printf("%-8s %s\n", g.name.c_str(), g.description.c_str());
+  }
+  return 0;
+}
+
+int run_devices(const std::string& device) {
+  const std::vector<DeviceInfo> devices = list_devices();
+  if (devices.empty()) {
+    std::printf("no OpenCL devices\n");
+    return 1;
+  }
+  std::string chosen;
+  try {
+    chosen = ClRuntime(device).info().name;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "seamcl: %s\n", e.what());
+  }
+  for (const DeviceInfo& d : devices) {
+    std::printf("%s %s [%s] %s, %d compute units (%s)\n", d.name == chosen ? "*" : " ", d.name.c_str(), d.type.c_str(),
+                d.version.c_str(), d.compute_units, d.platform.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"seamcl: render per-face textured scenes with OpenCL and compare texture seam methods"};
+  app.require_subcommand(0, 1);
+  std::string device;
+  app.add_option("--device", device, "OpenCL device: a substring of 'platform device' (default $SEAMCL_DEVICE, else the first GPU, else the first CPU)");
+  bool show_version = false;
+  app.add_flag("--version", show_version, "Print the version and the OpenCL device, then exit");
+
+  RenderArgs render_args;
+  CLI::App* render = app.add_subcommand("render", "Render one frame of a scene to PNG (sRGB 8-bit) or EXR (linear)");
+  render->add_option("--scene", render_args.scene, "Built-in scene name (see 'seamcl scenes') or a scene JSON file [paper]");
+  render->add_option("--method", render_args.method, "Seam method: " + [] {
+    std::string s;
+    for (const auto& n : method_names()) s += (s.empty() ? "" : ", ") + n;
+    return s;
+  }() + " [clamp]");
+  render->add_option("--msaa", render_args.msaa, "Samples per pixel: 1, 2, 4, 8 or 16 [1]");
+  render->add_option("--aniso", render_args.aniso, "Maximum anisotropy, 1..16 [16]");
+  render->add_option("--size", render_args.size, "Image size WIDTHxHEIGHT [480x540]");
+  render->add_option("--frame", render_args.frame, "Orbit frame K (0-based) of --frames");
+  render->add_option("--frames", render_args.frames, "Frames in the orbit [60]");
+  render->add_option("--shading", render_args.shading, "Where to shade: pixel, centroid or sample [pixel]");
+  render->add_flag("--centroid", render_args.centroid, "Shade at the centroid of the covered samples (same as --shading centroid)");
+  render->add_flag("--tint", render_args.tint, "Built-in scenes: tint each face a different base colour");
+  render->add_option("-o,--output", render_args.output, "Output image, .png or .exr (none: render and time only)");
+  render->add_flag("--json", render_args.json_out, "Print one JSON object: device, options, ms per stage, triangles, fragments");
+  render->add_option("--repeat", render_args.repeat, "Render N times and report the median time per stage [1]");
+
+  bool scenes_json = false;
+  CLI::App* scenes = app.add_subcommand("scenes", "List the built-in scenes");
+  scenes->add_flag("--json", scenes_json, "Print a JSON array");
+  CLI::App* devices = app.add_subcommand("devices", "List OpenCL devices (* marks the one seamcl would use)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "seamcl: %s\n", e.what());
+    return 2;
+  }
+
+  try {
+    if (show_version) {
+      std::printf("seamcl %s\n", SEAMCL_VERSION);
+      std::printf("device: %s\n", ClRuntime(device).device_description().c_str());
+      return 0;
+    }
+    if (render->parsed()) return run_render(render_args, device);
+    if (scenes->parsed()) return run_scenes(scenes_json);
+    if (devices->parsed()) return run_devices(device);
+    std::fputs(app.help().c_str(), stdout);
+    return 2;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "seamcl: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "seamcl: %s\n", describe_cl_exception(e).c_str());
+    return 1;
+  }
+}

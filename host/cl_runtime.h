@@ -1,0 +1,59 @@
+// The OpenCL runtime: device choice, one context, one in-order profiling queue, the program.
+// Errors carry the failing call, the CL error name and, for builds, each device's build log.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CL/opencl.hpp>
+
+namespace seamcl {
+
+struct DeviceInfo {
+  std::string platform;
+  std::string name;
+  std::string type;     // "GPU", "CPU", ...
+  std::string version;  // OpenCL version string
+  int compute_units = 0;
+};
+
+// Every device of every platform, in platform order.
+std::vector<DeviceInfo> list_devices();
+
+// CL_SUCCESS -> "CL_SUCCESS", -5 -> "CL_OUT_OF_RESOURCES", unknown -> "CL_ERROR(<code>)".
+std::string cl_error_name(int code);
+
+// A cl::Error, cl::BuildError or other exception rewritten as one readable line (plus build logs).
+std::string describe_cl_exception(const std::exception& error);
+
+class ClRuntime {
+ public:
+  // device_filter: case-insensitive substring of "platform device" to pick; empty means
+  // $SEAMCL_DEVICE, and when that is empty too the first GPU, else the first CPU device.
+  // Throws std::runtime_error naming the filter when nothing matches.
+  explicit ClRuntime(const std::string& device_filter = "");
+
+  const cl::Context& context() const { return context_; }
+  const cl::Device& device() const { return device_; }
+  cl::CommandQueue& queue() { return queue_; }
+  const DeviceInfo& info() const { return info_; }
+  std::string device_description() const;  // "<device> (<platform>, <version>)"
+
+  // Builds program_source() once (later calls return the same program). Milliseconds the build
+  // took are kept for --json and the first-start figure.
+  const cl::Program& program();
+  double program_build_ms() const { return build_ms_; }
+
+ private:
+  cl::Context context_;
+  cl::Device device_;
+  cl::CommandQueue queue_;
+  DeviceInfo info_;
+  std::unique_ptr<cl::Program> program_;
+  double build_ms_ = 0.0;
+};
+
+// Milliseconds between an event's start and end (from CL_QUEUE_PROFILING_ENABLE).
+double event_milliseconds(const cl::Event& event);
+
+}  // namespace seamcl

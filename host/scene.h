@@ -1,0 +1,110 @@
+// The scene model, as small as a scene needs: quad patches over shared vertices, one texture
+// (with its own mip chain) per face, a pinhole camera with an optional orbit, one directional light.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace seamcl {
+
+// One mip level, texels in linear RGBA, row-major, row 0 at v = 0.
+struct TextureLevel {
+  int width = 0;
+  int height = 0;
+  std::vector<glm::vec4> texels;
+  const glm::vec4& at(int i, int j) const { return texels[static_cast<size_t>(j) * width + i]; }
+};
+
+// A face's texture: level 0 is width x height (powers of two, not necessarily equal); each next
+// level is a 2x2 box (2x1 or 1x2 once a side reaches 1) of the one before, down to 1x1. No data
+// from neighbouring faces.
+struct MipChain {
+  std::vector<TextureLevel> levels;
+  int width() const { return levels.empty() ? 0 : levels.front().width; }
+  int height() const { return levels.empty() ? 0 : levels.front().height; }
+};
+
+// Builds the whole chain from level 0 (must be power-of-two sized).
+MipChain build_mip_chain(TextureLevel level0);
+
+// A quad patch. Vertices are counter-clockwise seen from the front and carry uv (0,0), (1,0),
+// (1,1), (0,1) in order; it renders as triangles (v0,v1,v2) and (v0,v2,v3).
+struct Face {
+  std::array<uint32_t, 4> vertices{};
+  MipChain texture;
+};
+
+// The point of the face at (u, v), piecewise linear over its two triangles exactly as rendered,
+// so that texture content baked from a function of this point is continuous across shared edges.
+glm::vec3 face_point(const std::array<glm::vec3, 4>& corners, float u, float v);
+
+// Level 0 of a face texture of the given size, each texel the function at its centre's surface
+// point (face_point at ((i+.5)/w, (j+.5)/h)).
+TextureLevel bake_face_texture(const std::array<glm::vec3, 4>& corners, int width, int height,
+                               const std::function<glm::vec4(glm::vec3)>& surface_color);
+
+struct Camera {
+  glm::vec3 eye{0, 0, 5};
+  glm::vec3 target{0, 0, 0};
+  glm::vec3 up{0, 1, 0};
+  float fov_y_degrees = 45.0f;  // vertical field of view
+};
+
+// Frame k of n puts the eye on a circle around `center`: angle = start_degrees + 360 k / n,
+// at `radius` from the vertical axis through center and `height` above it, looking at center.
+struct Orbit {
+  glm::vec3 center{0, 0, 0};
+  float radius = 5.0f;
+  float height = 1.0f;
+  float start_degrees = 0.0f;
+};
+
+struct Light {
+  glm::vec3 to_light = glm::normalize(glm::vec3(0.4f, 1.0f, 0.3f));  // unit, towards the light
+  glm::vec3 color{1, 1, 1};
+  float ambient = 0.25f;  // lighting = color * (ambient + (1 - ambient) * max(0, n.l))
+};
+
+struct Scene {
+  std::string name;
+  std::vector<glm::vec3> positions;
+  std::vector<Face> faces;
+  Camera camera;
+  std::optional<Orbit> orbit;  // needed for --frame
+  Light light;
+  glm::vec3 background{0.02f, 0.02f, 0.03f};  // linear RGB
+
+  size_t triangle_count() const { return faces.size() * 2; }
+  std::array<glm::vec3, 4> corners(const Face& f) const;
+  glm::vec3 face_normal(const Face& f) const;  // unit normal of the quad (cross of diagonals)
+  size_t texel_count() const;                  // all levels of all faces
+};
+
+// The camera of frame `frame` of `frames` of the scene's orbit. Throws InputError (field "frame")
+// when the scene has no orbit or frame is outside [0, frames).
+Camera orbit_camera(const Scene& scene, int frame, int frames);
+
+// Checks every invariant the renderer relies on (indices in range, power-of-two textures with a
+// full chain, finite positions and camera, non-degenerate camera); throws InputError naming the
+// field on the first violation.
+void validate_scene(const Scene& scene);
+
+}  // namespace seamcl
+
+namespace seamcl {
+
+// Replaces every face's texture by one of the same size (full chain) filled with `color`: shows
+// coverage and lighting without any texture content, and so without any seam.
+void set_constant_textures(Scene& scene, glm::vec4 color);
+
+// The colour (linear RGB in [0.05, 0.95], alpha 1) the generators paint at world point p: one
+// smooth, colourful function of the 3D point with features 0.2 to 0.5 units wide, so a texture
+// baked from it is continuous across every shared edge and any seam error shows.
+glm::vec4 surface_pattern(glm::vec3 p);
+
+}  // namespace seamcl

@@ -1,0 +1,89 @@
+/* Structs that cross the host/kernel boundary. Compiled both as OpenCL C 1.2 (first file of the
+ * program) and as C++ (host/gpu_types.h adds static_asserts on every size and offset).
+ * Only 4- and 8-byte scalars, no vector types: the layout is then the same on both sides. */
+#ifndef SEAMCL_TYPES_H
+#define SEAMCL_TYPES_H
+
+#ifdef __OPENCL_C_VERSION__
+/* No fused multiply-add contraction: the scalar C++ twins (built with -ffp-contract=off) then
+ * round exactly as the kernels do. */
+#pragma OPENCL FP_CONTRACT OFF
+typedef uint cl_uint;
+typedef int cl_int;
+typedef long cl_long;
+typedef float cl_float;
+#else
+#include <CL/cl_platform.h>
+#endif
+
+#define SEAMCL_TILE_SIZE 16          /* pixels per side of a binning tile */
+#define SEAMCL_SUBPIXEL_BITS 8       /* fixed-point vertex snapping: 1/256 pixel */
+#define SEAMCL_SUBPIXEL_ONE 256
+#define SEAMCL_MAX_SAMPLES 16
+#define SEAMCL_CLIP_SLOTS 6          /* a triangle clipped by 5 planes is a fan of at most 6 */
+#define SEAMCL_NO_TRIANGLE 0xffffffffu
+
+/* shading_mode */
+#define SEAMCL_SHADE_PIXEL 0    /* once per pixel and triangle, at the pixel centre */
+#define SEAMCL_SHADE_CENTROID 1 /* once per pixel and triangle, at the mean of its covered samples */
+#define SEAMCL_SHADE_SAMPLE 2   /* every sample (supersampling) */
+
+/* Per frame, read-only in every kernel. Screen space: pixels, origin at the top-left corner of
+ * the image, y down; pixel (x, y) spans [x, x+1) x [y, y+1), its centre at (x+0.5, y+0.5). */
+typedef struct {
+  cl_float view_proj[16];   /* world -> clip, column-major (glm layout) */
+  cl_int width, height;     /* image size in pixels */
+  cl_int tiles_x, tiles_y;  /* ceil(size / SEAMCL_TILE_SIZE) */
+  cl_int sample_count;      /* 1, 2, 4, 8 or 16 */
+  cl_int shading_mode;      /* SEAMCL_SHADE_* */
+  cl_int input_triangles;   /* 2 per face: (v0,v1,v2) and (v0,v2,v3) */
+  cl_uint bin_capacity;     /* entries in the tile lists buffer */
+  cl_float near_w;          /* clip plane w >= near_w (view-space distance) */
+  cl_float guard_x, guard_y;/* clip planes |x| <= guard_x * w, |y| <= guard_y * w */
+  cl_float light_dir[3];    /* unit vector towards the light, world space */
+  cl_float light_color[3];
+  cl_float ambient;         /* lighting = light_color * (ambient + (1-ambient) * max(0, n.l)) */
+  cl_float background[3];   /* linear RGB of samples no triangle covers */
+  cl_int pad0;
+} FrameParams;
+
+/* One quad patch. Texture texels of all faces live in one buffer; level l of a face starts at
+ * level_offsets[level_table + l] and holds max(w >> l, 1) x max(h >> l, 1) texels, row-major,
+ * row 0 at v = 0. Texel (i, j) of a level of size W x H has its centre at ((i+.5)/W, (j+.5)/H). */
+typedef struct {
+  cl_uint vertex[4];        /* uv (0,0), (1,0), (1,1), (0,1); counter-clockwise seen from the front */
+  cl_uint level_table;      /* index of level 0's entry in level_offsets */
+  cl_int width, height;     /* level 0 size in texels, powers of two */
+  cl_int level_count;       /* down to 1x1 */
+  cl_float normal[3];       /* unit, world space, towards the front */
+  cl_int pad0;
+} FaceGpu;
+
+/* Output of triangle setup, one per clip slot (input triangle * SEAMCL_CLIP_SLOTS + k).
+ * Edge functions over fixed-point positions P (SEAMCL_SUBPIXEL_BITS fraction bits):
+ *   E_i(P) = edge_a[i] * P.x + edge_b[i] * P.y + edge_c[i]
+ * with the top-left rule folded into edge_c (non-top-left edges are biased by -1), so a sample
+ * is covered iff E_i >= 0 for i = 0, 1, 2. An empty slot has bbox_max_x < bbox_min_x.
+ * Planes over float pixel coordinates: value(x, y) = p[0] + p[1] * (x - ref_x) + p[2] * (y - ref_y)
+ * for 1/w, u/w and v/w (perspective-correct interpolation). */
+typedef struct {
+  cl_long edge_c[3];
+  cl_int edge_a[3];
+  cl_int edge_b[3];
+  cl_int bbox_min_x, bbox_min_y, bbox_max_x, bbox_max_y; /* pixels, inclusive, inside the image */
+  cl_uint face;
+  cl_float ref_x, ref_y;
+  cl_float inv_w[3];
+  cl_float u_over_w[3];
+  cl_float v_over_w[3];
+} TriangleSetup;
+
+/* Counters the host reads back after a frame. */
+typedef struct {
+  cl_uint bin_entries;      /* tile-list entries needed (may exceed bin_capacity: then re-run) */
+  cl_uint fragments;        /* (pixel, triangle) pairs shaded; samples in SEAMCL_SHADE_SAMPLE */
+  cl_uint visible_triangles;/* clip slots that produced a non-empty triangle */
+  cl_uint pad0;
+} FrameStats;
+
+#endif

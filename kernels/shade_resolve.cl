@@ -1,0 +1,115 @@
+/* Stage 4: shade and resolve. One work-item per pixel, work-groups of one tile.
+ *
+ * SEAMCL_SHADE_PIXEL / _CENTROID: each distinct triangle among the pixel's samples is shaded once,
+ * at the pixel centre (or the mean of the positions of the samples it covers), and its colour
+ * counts for the samples it covers; samples no triangle covers count the background. A centre
+ * where the triangle's plane has 1/w <= 0 (extrapolated past the horizon) falls back to the
+ * centroid, whose samples lie inside the triangle. SEAMCL_SHADE_SAMPLE shades every sample at its
+ * own position. Resolve: box filter (mean over samples) into linear RGBA float, alpha 1.
+ * Shading: uv and d(uv)/d(pixel) analytically from the 1/w, u/w, v/w planes, one texture lookup,
+ * and lighting = light_color * (ambient + (1 - ambient) * max(0, n.l)) with the face normal.
+ * Host guarantees: sample_triangle from raster of this frame. Twin: host/shade_resolve.cpp. */
+
+typedef struct {
+  float u, v, dudx, dvdx, dudy, dvdy;
+} SurfaceUv;
+
+inline SurfaceUv interpolate_uv(__global const TriangleSetup* t, float x, float y) {
+  const float dx = x - t->ref_x;
+  const float dy = y - t->ref_y;
+  const float inv_w = t->inv_w[0] + t->inv_w[1] * dx + t->inv_w[2] * dy;
+  const float u_w = t->u_over_w[0] + t->u_over_w[1] * dx + t->u_over_w[2] * dy;
+  const float v_w = t->v_over_w[0] + t->v_over_w[1] * dx + t->v_over_w[2] * dy;
+  const float w = 1.0f / inv_w;
+  SurfaceUv r;
+  r.u = u_w * w;
+  r.v = v_w * w;
+  /* quotient rule: d(a/b) = (da - (a/b) db) / b */
+  r.dudx = (t->u_over_w[1] - r.u * t->inv_w[1]) * w;
+  r.dudy = (t->u_over_w[2] - r.u * t->inv_w[2]) * w;
+  r.dvdx = (t->v_over_w[1] - r.v * t->inv_w[1]) * w;
+  r.dvdy = (t->v_over_w[2] - r.v * t->inv_w[2]) * w;
+  return r;
+}
+
+inline float plane_inv_w(__global const TriangleSetup* t, float x, float y) {
+  return t->inv_w[0] + t->inv_w[1] * (x - t->ref_x) + t->inv_w[2] * (y - t->ref_y);
+}
+
+inline float3 shade_fragment(__constant FrameParams* frame, __global const TriangleSetup* t,
+                             __global const FaceGpu* faces, __global const uint* level_offsets,
+                             __global const uint* texels, __global const float* srgb_to_linear,
+                             float x, float y) {
+  const SurfaceUv s = interpolate_uv(t, x, y);
+  const FaceGpu face = faces[t->face];
+  const float4 albedo = sample_trilinear_clamp(&face, level_offsets, texels, srgb_to_linear, s.u, s.v,
+                                               s.dudx, s.dvdx, s.dudy, s.dvdy);
+  const float n_dot_l = face.normal[0] * frame->light_dir[0] + face.normal[1] * frame->light_dir[1] +
+                        face.normal[2] * frame->light_dir[2];
+  const float lighting = frame->ambient + (1.0f - frame->ambient) * fmax(n_dot_l, 0.0f);
+  return (float3)(albedo.x * frame->light_color[0], albedo.y * frame->light_color[1],
+                  albedo.z * frame->light_color[2]) * lighting;
+}
+
+__kernel void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* setups,
+                            __global const FaceGpu* faces, __global const uint* level_offsets,
+                            __global const uint* texels, __global const float* srgb_to_linear,
+                            __global const uint* sample_triangle, __global float4* image,
+                            __global FrameStats* stats) {
+  __local uint group_fragments;
+  if (get_local_id(0) == 0 && get_local_id(1) == 0) group_fragments = 0;
+  barrier(CLK_LOCAL_MEM_FENCE);
+
+  const int x = (int)get_global_id(0);
+  const int y = (int)get_global_id(1);
+  uint fragments = 0;
+  if (x < frame->width && y < frame->height) {
+    const int samples = frame->sample_count;
+    const int row = sample_pattern_row(samples);
+    __global const uint* ids = sample_triangle + ((size_t)y * (size_t)frame->width + (size_t)x) * (size_t)samples;
+    const float3 background = (float3)(frame->background[0], frame->background[1], frame->background[2]);
+    float3 sum = (float3)(0.0f);
+    for (int s = 0; s < samples; ++s) {
+      const uint slot = ids[s];
+      if (slot == SEAMCL_NO_TRIANGLE) {
+        sum += background;
+        continue;
+      }
+      const float sample_x = (float)sample_fixed_x(x, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
+      const float sample_y = (float)sample_fixed_y(y, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
+      if (frame->shading_mode == SEAMCL_SHADE_SAMPLE) {
+        sum += shade_fragment(frame, setups + slot, faces, level_offsets, texels, srgb_to_linear, sample_x, sample_y);
+        ++fragments;
+        continue;
+      }
+      int first = 1;
+      for (int r = 0; r < s; ++r) first &= ids[r] != slot;
+      if (!first) continue;
+      /* First sample of this triangle: count its samples and their centroid. */
+      int covered = 0;
+      float centroid_x = 0.0f, centroid_y = 0.0f;
+      for (int r = s; r < samples; ++r) {
+        if (ids[r] != slot) continue;
+        ++covered;
+        centroid_x += (float)sample_fixed_x(x, row, r) * (1.0f / SEAMCL_SUBPIXEL_ONE);
+        centroid_y += (float)sample_fixed_y(y, row, r) * (1.0f / SEAMCL_SUBPIXEL_ONE);
+      }
+      centroid_x /= (float)covered;
+      centroid_y /= (float)covered;
+      float shade_x = (float)x + 0.5f;
+      float shade_y = (float)y + 0.5f;
+      if (frame->shading_mode == SEAMCL_SHADE_CENTROID || !(plane_inv_w(setups + slot, shade_x, shade_y) > 0.0f)) {
+        shade_x = centroid_x;
+        shade_y = centroid_y;
+      }
+      sum += shade_fragment(frame, setups + slot, faces, level_offsets, texels, srgb_to_linear, shade_x, shade_y) *
+             (float)covered;
+      ++fragments;
+    }
+    const float3 color = sum / (float)samples;
+    image[(size_t)y * (size_t)frame->width + (size_t)x] = (float4)(color, 1.0f);
+  }
+  atomic_add(&group_fragments, fragments);
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (get_local_id(0) == 0 && get_local_id(1) == 0 && group_fragments > 0) atomic_add(&stats->fragments, group_fragments);
+}

@@ -1,0 +1,196 @@
+/* Stage 1: triangle setup. One work-item per input triangle t (face t/2; t even: quad corners
+ * 0,1,2, t odd: 0,2,3), writing SEAMCL_CLIP_SLOTS TriangleSetup records at t*SEAMCL_CLIP_SLOTS.
+ *
+ * Inputs: positions (world, xyz of float4), faces, frame (view_proj, image size, clip planes).
+ * Steps: transform to clip space; clip against w >= near_w and the guard band |x| <= guard_x w,
+ * |y| <= guard_y w (Sutherland-Hodgman; the host sizes the guard band so that snapped coordinates
+ * and edge-function products fit in 64 bits); project to screen (pixels, y down); snap to
+ * 1/SEAMCL_SUBPIXEL_ONE pixel; cull back faces (front = counter-clockwise in NDC, y up) and zero
+ * area; build edge functions with the top-left rule and perspective-correct attribute planes.
+ * A new vertex on an edge is always computed from the edge's inside end, so two triangles that
+ * share the edge create bit-identical vertices: clipping keeps the mesh watertight.
+ * Twin: host/triangle_setup.cpp. */
+
+typedef struct {
+  float x, y, w; /* clip space (z is not needed: depth is 1/w) */
+  float u, v;
+} ClipVertex;
+
+inline float clip_distance(ClipVertex p, int plane, __constant FrameParams* frame) {
+  switch (plane) {
+    case 0: return p.w - frame->near_w;
+    case 1: return frame->guard_x * p.w - p.x;
+    case 2: return frame->guard_x * p.w + p.x;
+    case 3: return frame->guard_y * p.w - p.y;
+    default: return frame->guard_y * p.w + p.y;
+  }
+}
+
+inline ClipVertex clip_lerp(ClipVertex inside, ClipVertex outside, float d_inside, float d_outside) {
+  const float t = d_inside / (d_inside - d_outside);
+  ClipVertex r;
+  r.x = inside.x + t * (outside.x - inside.x);
+  r.y = inside.y + t * (outside.y - inside.y);
+  r.w = inside.w + t * (outside.w - inside.w);
+  r.u = inside.u + t * (outside.u - inside.u);
+  r.v = inside.v + t * (outside.v - inside.v);
+  return r;
+}
+
+inline long floor_div_subpixel(long value) {
+  /* floor(value / SEAMCL_SUBPIXEL_ONE) for negative values too */
+  return value >= 0 ? value / SEAMCL_SUBPIXEL_ONE : -((-value + SEAMCL_SUBPIXEL_ONE - 1) / SEAMCL_SUBPIXEL_ONE);
+}
+
+inline TriangleSetup empty_setup(uint face) {
+  TriangleSetup s;
+  for (int i = 0; i < 3; ++i) {
+    s.edge_a[i] = 0;
+    s.edge_b[i] = 0;
+    s.edge_c[i] = -1;
+    s.inv_w[i] = 0.0f;
+    s.u_over_w[i] = 0.0f;
+    s.v_over_w[i] = 0.0f;
+  }
+  s.bbox_min_x = 0;
+  s.bbox_min_y = 0;
+  s.bbox_max_x = -1;
+  s.bbox_max_y = -1;
+  s.face = face;
+  s.ref_x = 0.0f;
+  s.ref_y = 0.0f;
+  return s;
+}
+
+/* Setup of one screen triangle from three clip-space vertices; empty if culled. */
+inline TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, ClipVertex c2, uint face,
+                                           __constant FrameParams* frame) {
+  ClipVertex c[3] = {c0, c1, c2};
+  long X[3], Y[3];
+  float inv_w[3];
+  for (int i = 0; i < 3; ++i) {
+    inv_w[i] = 1.0f / c[i].w;
+    const float sx = (c[i].x * inv_w[i] * 0.5f + 0.5f) * (float)frame->width;
+    const float sy = (0.5f - c[i].y * inv_w[i] * 0.5f) * (float)frame->height;
+    X[i] = (long)rint(sx * (float)SEAMCL_SUBPIXEL_ONE);
+    Y[i] = (long)rint(sy * (float)SEAMCL_SUBPIXEL_ONE);
+  }
+  long area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
+  /* Counter-clockwise in NDC (y up) is clockwise on screen (y down): negative area. */
+  if (area2 >= 0) return empty_setup(face);
+  {
+    /* Make the interior positive for all three edge functions. */
+    long tx = X[1]; X[1] = X[2]; X[2] = tx;
+    long ty = Y[1]; Y[1] = Y[2]; Y[2] = ty;
+    float tw = inv_w[1]; inv_w[1] = inv_w[2]; inv_w[2] = tw;
+    ClipVertex tc = c[1]; c[1] = c[2]; c[2] = tc;
+    area2 = -area2;
+  }
+  TriangleSetup s;
+  s.face = face;
+  long min_x = X[0], max_x = X[0], min_y = Y[0], max_y = Y[0];
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    const long a = Y[i] - Y[j];
+    const long b = X[j] - X[i];
+    const int top_left = a > 0 || (a == 0 && b > 0);
+    s.edge_a[i] = (int)a;
+    s.edge_b[i] = (int)b;
+    s.edge_c[i] = -(a * X[i] + b * Y[i]) - (top_left ? 0 : 1);
+    min_x = min(min_x, X[i]);
+    max_x = max(max_x, X[i]);
+    min_y = min(min_y, Y[i]);
+    max_y = max(max_y, Y[i]);
+  }
+  /* Samples of pixel p lie in [p*ONE, p*ONE + ONE - 16] (D3D offsets are -8..7 sixteenths). */
+  const int sample_span = SEAMCL_SUBPIXEL_ONE - 16;
+  s.bbox_min_x = (int)max(floor_div_subpixel(min_x - sample_span + SEAMCL_SUBPIXEL_ONE - 1), 0L);
+  s.bbox_min_y = (int)max(floor_div_subpixel(min_y - sample_span + SEAMCL_SUBPIXEL_ONE - 1), 0L);
+  s.bbox_max_x = (int)min(floor_div_subpixel(max_x), (long)frame->width - 1);
+  s.bbox_max_y = (int)min(floor_div_subpixel(max_y), (long)frame->height - 1);
+
+  /* Attribute planes over the snapped positions, relative to vertex 0 for precision. */
+  const float scale = 1.0f / (float)SEAMCL_SUBPIXEL_ONE;
+  const float x0 = (float)X[0] * scale, y0 = (float)Y[0] * scale;
+  const float dx1 = (float)(X[1] - X[0]) * scale, dy1 = (float)(Y[1] - Y[0]) * scale;
+  const float dx2 = (float)(X[2] - X[0]) * scale, dy2 = (float)(Y[2] - Y[0]) * scale;
+  const float inv_det = 1.0f / ((float)area2 * scale * scale);
+  s.ref_x = x0;
+  s.ref_y = y0;
+  float attr[3][3];
+  for (int i = 0; i < 3; ++i) {
+    attr[0][i] = inv_w[i];
+    attr[1][i] = c[i].u * inv_w[i];
+    attr[2][i] = c[i].v * inv_w[i];
+  }
+  float plane[3][3];
+  for (int k = 0; k < 3; ++k) {
+    const float d1 = attr[k][1] - attr[k][0];
+    const float d2 = attr[k][2] - attr[k][0];
+    plane[k][0] = attr[k][0];
+    plane[k][1] = (d1 * dy2 - d2 * dy1) * inv_det;
+    plane[k][2] = (d2 * dx1 - d1 * dx2) * inv_det;
+  }
+  for (int i = 0; i < 3; ++i) {
+    s.inv_w[i] = plane[0][i];
+    s.u_over_w[i] = plane[1][i];
+    s.v_over_w[i] = plane[2][i];
+  }
+  return s;
+}
+
+__kernel void triangle_setup(__constant FrameParams* frame, __global const float4* positions,
+                             __global const FaceGpu* faces, __global TriangleSetup* out,
+                             __global FrameStats* stats) {
+  const int t = (int)get_global_id(0);
+  if (t >= frame->input_triangles) return;
+  const uint face_index = (uint)(t / 2);
+  const FaceGpu face = faces[face_index];
+  const int corner[3] = {0, (t & 1) ? 2 : 1, (t & 1) ? 3 : 2};
+  const float corner_u[4] = {0.0f, 1.0f, 1.0f, 0.0f};
+  const float corner_v[4] = {0.0f, 0.0f, 1.0f, 1.0f};
+
+  ClipVertex polygon[3 + 5];
+  int count = 3;
+  for (int i = 0; i < 3; ++i) {
+    const float4 p = positions[face.vertex[corner[i]]];
+    const __constant float* m = frame->view_proj;
+    /* column-major: clip = M * (p, 1) */
+    polygon[i].x = m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12];
+    polygon[i].y = m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13];
+    polygon[i].w = m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15];
+    polygon[i].u = corner_u[corner[i]];
+    polygon[i].v = corner_v[corner[i]];
+  }
+
+  for (int plane = 0; plane < 5 && count > 0; ++plane) {
+    float d[8];
+    int outside = 0;
+    for (int i = 0; i < count; ++i) {
+      d[i] = clip_distance(polygon[i], plane, frame);
+      outside += d[i] < 0.0f;
+    }
+    if (outside == 0) continue;
+    ClipVertex clipped[3 + 5];
+    int n = 0;
+    for (int i = 0; i < count; ++i) {
+      const int j = (i + 1) % count;
+      if (d[i] >= 0.0f) clipped[n++] = polygon[i];
+      if ((d[i] >= 0.0f) != (d[j] >= 0.0f)) {
+        clipped[n++] = d[i] >= 0.0f ? clip_lerp(polygon[i], polygon[j], d[i], d[j])
+                                    : clip_lerp(polygon[j], polygon[i], d[j], d[i]);
+      }
+    }
+    count = n;
+    for (int i = 0; i < count; ++i) polygon[i] = clipped[i];
+  }
+
+  uint visible = 0;
+  for (int k = 0; k < SEAMCL_CLIP_SLOTS; ++k) {
+    TriangleSetup s = empty_setup(face_index);
+    if (k + 2 < count) s = setup_screen_triangle(polygon[0], polygon[k + 1], polygon[k + 2], face_index, frame);
+    visible += s.bbox_max_x >= s.bbox_min_x && s.bbox_max_y >= s.bbox_min_y;
+    out[t * SEAMCL_CLIP_SLOTS + k] = s;
+  }
+  if (visible > 0) atomic_add(&stats->visible_triangles, visible);
+}

@@ -1,0 +1,88 @@
+// The option parser shared by the CLI and the HTTP service: defaults, accepted forms, and every
+// refusal naming its field.
+#include <gtest/gtest.h>
+
+#include "errors.h"
+#include "render_options.h"
+
+using nlohmann::json;
+using namespace seamcl;
+
+TEST(RenderOptions, DefaultsWhenEmpty) {
+  const RenderOptions o = parse_render_options(json::object());
+  EXPECT_EQ(o.scene, "paper");
+  EXPECT_EQ(o.method, Method::Clamp);
+  EXPECT_EQ(o.msaa, 1);
+  EXPECT_EQ(o.aniso, 16);
+  EXPECT_EQ(o.width, 480);
+  EXPECT_EQ(o.height, 540);
+  EXPECT_EQ(o.shading, ShadingMode::Pixel);
+  EXPECT_FALSE(o.frame.has_value());
+}
+
+TEST(RenderOptions, ReadsEveryKey) {
+  const RenderOptions o = parse_render_options(json{{"scene", "quad2"}, {"method", "clamp"}, {"msaa", 8}, {"aniso", 4},
+                                                    {"size", "64x32"}, {"centroid", true}, {"frame", 3}, {"frames", 10}});
+  EXPECT_EQ(o.scene, "quad2");
+  EXPECT_EQ(o.msaa, 8);
+  EXPECT_EQ(o.aniso, 4);
+  EXPECT_EQ(o.width, 64);
+  EXPECT_EQ(o.height, 32);
+  EXPECT_EQ(o.shading, ShadingMode::Centroid);
+  EXPECT_EQ(o.frame, 3);
+  EXPECT_EQ(o.frames, 10);
+  // Round trip through to_json gives the same options.
+  const RenderOptions again = parse_render_options(to_json(o));
+  EXPECT_EQ(to_json(again), to_json(o));
+}
+
+TEST(RenderOptions, EnumNamesRoundTrip) {
+  for (const std::string& name : method_names()) EXPECT_EQ(to_string(*parse_method(name)), name);
+  for (const std::string& name : shading_mode_names()) EXPECT_EQ(to_string(*parse_shading_mode(name)), name);
+  EXPECT_FALSE(parse_method("Clamp").has_value());
+  EXPECT_FALSE(parse_shading_mode("").has_value());
+}
+
+struct BadOption {
+  json request;
+  std::string field;
+  std::string message_part;
+};
+
+TEST(RenderOptions, RefusalsNameTheField) {
+  const std::vector<BadOption> cases = {
+      {{{"msaa", 3}}, "msaa", "1, 2, 4, 8 or 16"},
+      {{{"msaa", 0}}, "msaa", "1..16"},
+      {{{"msaa", 32}}, "msaa", "1..16"},
+      {{{"msaa", "4"}}, "msaa", "integer"},
+      {{{"msaa", 4.5}}, "msaa", "integer"},
+      {{{"aniso", 17}}, "aniso", "1..16"},
+      {{{"size", "0x0"}}, "size", "WIDTHxHEIGHT"},
+      {{{"size", "480"}}, "size", "WIDTHxHEIGHT"},
+      {{{"size", "-4x4"}}, "size", "WIDTHxHEIGHT"},
+      {{{"size", "16385x4"}}, "size", "WIDTHxHEIGHT"},
+      {{{"size", "4x4x"}}, "size", "WIDTHxHEIGHT"},
+      {{{"size", 480}}, "size", "string"},
+      {{{"size", "16384x16384"}, {"msaa", 16}}, "size", "exceeds"},
+      {{{"method", "bogus"}}, "method", "unknown method 'bogus'"},
+      {{{"method", 1}}, "method", "string"},
+      {{{"shading", "quad"}}, "shading", "unknown shading mode"},
+      {{{"centroid", "yes"}}, "centroid", "true or false"},
+      {{{"shading", "sample"}, {"centroid", true}}, "centroid", "cannot be combined"},
+      {{{"frame", 5}, {"frames", 5}}, "frame", "less than frames"},
+      {{{"frame", -1}}, "frame", "0.."},
+      {{{"frames", 0}}, "frames", "1.."},
+      {{{"scene", ""}}, "scene", "empty"},
+      {{{"colour", "red"}}, "colour", "unknown option"},
+  };
+  for (const BadOption& c : cases) {
+    try {
+      parse_render_options(c.request);
+      ADD_FAILURE() << "accepted " << c.request.dump();
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), c.field) << c.request.dump();
+      EXPECT_NE(std::string(e.what()).find(c.message_part), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(parse_render_options(json::array()), InputError);
+}
