@@ -1,0 +1,93 @@
+#include "shade_resolve.h"
+
+#include <algorithm>
+
+#include "raster.h"
+#include "sample_pattern.h"
+#include "texture_sample.h"
+
+namespace seamcl {
+
+SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y) {
+  const float dx = x - t.ref_x;
+  const float dy = y - t.ref_y;
+  const float inv_w = t.inv_w[0] + t.inv_w[1] * dx + t.inv_w[2] * dy;
+  const float u_w = t.u_over_w[0] + t.u_over_w[1] * dx + t.u_over_w[2] * dy;
+  const float v_w = t.v_over_w[0] + t.v_over_w[1] * dx + t.v_over_w[2] * dy;
+  const float w = 1.0f / inv_w;
+  SurfaceUv r{};
+  r.u = u_w * w;
+  r.v = v_w * w;
+  // u = (u/w) / (1/w): quotient rule for the derivatives.
+  r.dudx = (t.u_over_w[1] - r.u * t.inv_w[1]) * w;
+  r.dudy = (t.u_over_w[2] - r.u * t.inv_w[2]) * w;
+  r.dvdx = (t.v_over_w[1] - r.v * t.inv_w[1]) * w;
+  r.dvdy = (t.v_over_w[2] - r.v * t.inv_w[2]) * w;
+  return r;
+}
+
+glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& f, const TriangleSetup& t, float x, float y) {
+  const SurfaceUv s = interpolate_uv(t, x, y);
+  const glm::vec4 albedo =
+      sample_trilinear_clamp_reference(scene.textures(), t.face, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
+  const FaceGpu& face = scene.faces.at(t.face);
+  const float n_dot_l = face.normal[0] * f.light_dir[0] + face.normal[1] * f.light_dir[1] + face.normal[2] * f.light_dir[2];
+  const float lighting = f.ambient + (1.0f - f.ambient) * std::fmax(n_dot_l, 0.0f);
+  return glm::vec3(albedo.x * f.light_color[0], albedo.y * f.light_color[1], albedo.z * f.light_color[2]) * lighting;
+}
+
+ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& f,
+                                         const std::vector<TriangleSetup>& setups,
+                                         const std::vector<uint32_t>& sample_triangle) {
+  const int samples = f.sample_count;
+  const std::vector<SampleOffset>& pattern = sample_pattern(samples);
+  constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
+  ResolveReference out;
+  out.pixels.resize(static_cast<size_t>(f.width) * f.height);
+  const glm::vec3 background(f.background[0], f.background[1], f.background[2]);
+  for (int y = 0; y < f.height; ++y) {
+    for (int x = 0; x < f.width; ++x) {
+      const uint32_t* ids = &sample_triangle[(static_cast<size_t>(y) * f.width + x) * samples];
+      auto sample_x = [&](int s) { return static_cast<float>(sample_fixed_x(x, pattern[s])) * to_pixels; };
+      auto sample_y = [&](int s) { return static_cast<float>(sample_fixed_y(y, pattern[s])) * to_pixels; };
+      glm::vec3 sum(0.0f);
+      for (int s = 0; s < samples; ++s) {
+        const uint32_t slot = ids[s];
+        if (slot == SEAMCL_NO_TRIANGLE) {
+          sum += background;
+          continue;
+        }
+        const TriangleSetup& t = setups.at(slot);
+        if (f.shading_mode == SEAMCL_SHADE_SAMPLE) {
+          sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s));
+          ++out.fragments;
+          continue;
+        }
+        if (std::find(ids, ids + s, slot) != ids + s) continue;  // shaded at its first sample
+        int covered = 0;
+        float centroid_x = 0.0f, centroid_y = 0.0f;
+        for (int r = s; r < samples; ++r) {
+          if (ids[r] != slot) continue;
+          ++covered;
+          centroid_x += sample_x(r);
+          centroid_y += sample_y(r);
+        }
+        centroid_x /= static_cast<float>(covered);
+        centroid_y /= static_cast<float>(covered);
+        float shade_x = static_cast<float>(x) + 0.5f;
+        float shade_y = static_cast<float>(y) + 0.5f;
+        // The centroid also stands in for a centre beyond the plane's horizon (1/w <= 0).
+        if (f.shading_mode == SEAMCL_SHADE_CENTROID || !(plane_inv_w(t, shade_x, shade_y) > 0.0f)) {
+          shade_x = centroid_x;
+          shade_y = centroid_y;
+        }
+        sum += shade_fragment_reference(scene, f, t, shade_x, shade_y) * static_cast<float>(covered);
+        ++out.fragments;
+      }
+      out.pixels[static_cast<size_t>(y) * f.width + x] = glm::vec4(sum / static_cast<float>(samples), 1.0f);
+    }
+  }
+  return out;
+}
+
+}  // namespace seamcl

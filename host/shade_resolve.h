@@ -1,0 +1,31 @@
+// Scalar twin of kernels/shade_resolve.cl: shading once per pixel and triangle (or per sample)
+// and the box resolve.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gpu_types.h"
+#include "packed_scene.h"
+
+namespace seamcl {
+
+// uv and its screen derivatives at a pixel-space point, perspective-correct from the planes.
+struct SurfaceUv {
+  float u, v, dudx, dvdx, dudy, dvdy;
+};
+SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y);
+
+// Colour of one fragment: texture lookup times the face's Lambert lighting.
+glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& frame, const TriangleSetup& t, float x, float y);
+
+struct ResolveReference {
+  std::vector<glm::vec4> pixels;  // linear RGBA
+  uint32_t fragments = 0;
+};
+ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& frame,
+                                         const std::vector<TriangleSetup>& setups,
+                                         const std::vector<uint32_t>& sample_triangle);
+
+}  // namespace seamcl
