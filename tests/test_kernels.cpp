@@ -1,0 +1,276 @@
+// Every kernel held to its scalar C++ twin: each stage's twin is fed the GPU's input to that
+// stage (so a difference points at one stage) on built-in scenes and on random ones.
+// Tolerances: integers (edge functions, boxes, bins, winners, fragment counts) must match
+// exactly; floats within a few ulps (the kernels build with FP_CONTRACT OFF, so they round as
+// the twins do; a tolerance only absorbs the device's math-library builtins such as log2).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "binning.h"
+#include "cl_runtime.h"
+#include "frame_params.h"
+#include "raster.h"
+#include "renderer.h"
+#include "sample_pattern.h"
+#include "scene_generators.h"
+#include "shade_resolve.h"
+#include "texture_sample.h"
+#include "triangle_setup.h"
+
+using namespace seamcl;
+
+namespace {
+
+ClRuntime& runtime() {
+  static ClRuntime rt;
+  return rt;
+}
+
+float random_float(std::mt19937& rng, float lo, float hi) {
+  return lo + (hi - lo) * static_cast<float>(rng() % 1000001u) / 1000000.0f;
+}
+
+TextureLevel random_level(std::mt19937& rng, int width, int height) {
+  TextureLevel level{width, height, {}};
+  for (int i = 0; i < width * height; ++i) {
+    level.texels.emplace_back(random_float(rng, 0, 1), random_float(rng, 0, 1), random_float(rng, 0, 1), 1.0f);
+  }
+  return level;
+}
+
+// Quads of random size, orientation and texture size scattered around the origin, some facing
+// away, some crossing the camera's near plane, some far outside the view.
+Scene random_scene(uint32_t seed, int quads) {
+  std::mt19937 rng(seed);
+  Scene scene;
+  scene.name = "random";
+  for (int q = 0; q < quads; ++q) {
+    const glm::vec3 center(random_float(rng, -6, 6), random_float(rng, -6, 6), random_float(rng, -6, 6));
+    const glm::vec3 a = glm::normalize(glm::vec3(random_float(rng, -1, 1), random_float(rng, -1, 1), random_float(rng, -1, 1)) + 1e-3f);
+    glm::vec3 b = glm::cross(a, glm::normalize(glm::vec3(random_float(rng, -1, 1), random_float(rng, -1, 1), 1.0f)));
+    b = glm::normalize(b);
+    const float su = random_float(rng, 0.05f, 4.0f), sv = random_float(rng, 0.002f, 4.0f);  // slivers too
+    const uint32_t base = static_cast<uint32_t>(scene.positions.size());
+    scene.positions.push_back(center - a * su - b * sv);
+    scene.positions.push_back(center + a * su - b * sv);
+    scene.positions.push_back(center + a * su + b * sv);
+    scene.positions.push_back(center - a * su + b * sv);
+    Face face;
+    face.vertices = {base, base + 1, base + 2, base + 3};
+    face.texture = build_mip_chain(random_level(rng, 1 << (rng() % 6), 1 << (rng() % 6)));
+    scene.faces.push_back(std::move(face));
+  }
+  scene.camera.eye = glm::vec3(random_float(rng, -4, 4), random_float(rng, -4, 4), random_float(rng, 3, 8));
+  scene.camera.target = glm::vec3(0.0f);
+  scene.camera.fov_y_degrees = random_float(rng, 30, 90);
+  return scene;
+}
+
+void expect_plane_near(const cl_float* gpu, const cl_float* twin, const char* what, size_t slot) {
+  for (int i = 0; i < 3; ++i) {
+    const float scale = std::max({std::fabs(twin[i]), std::fabs(gpu[i]), 1e-6f});
+    EXPECT_LE(std::fabs(gpu[i] - twin[i]) / scale, 1e-5f) << what << "[" << i << "] of slot " << slot;
+  }
+}
+
+struct Case {
+  std::string name;
+  Scene scene;
+  RenderOptions options;
+};
+
+std::vector<Case> cases() {
+  std::vector<Case> out;
+  auto options = [](int w, int h, int msaa, ShadingMode shading) {
+    RenderOptions o;
+    o.width = w;
+    o.height = h;
+    o.msaa = msaa;
+    o.shading = shading;
+    return o;
+  };
+  out.push_back({"paper", generate_scene("paper", {}), options(120, 135, 4, ShadingMode::Pixel)});
+  out.push_back({"quad2", generate_scene("quad2", {}), options(67, 45, 8, ShadingMode::Centroid)});
+  out.push_back({"plane", generate_scene("plane", {}), options(96, 64, 2, ShadingMode::Pixel)});
+  out.push_back({"cube", generate_scene("cube", {}), options(50, 50, 16, ShadingMode::Sample)});
+  for (uint32_t seed = 1; seed <= 6; ++seed) {
+    const int msaa = 1 << (seed % 5);
+    out.push_back({"random" + std::to_string(seed), random_scene(seed, 40),
+                   options(40 + static_cast<int>(seed) * 13, 37 + static_cast<int>(seed) * 7, msaa,
+                           static_cast<ShadingMode>(seed % 3))});
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(KernelVsTwin, EveryStageOnBuiltInAndRandomScenes) {
+  Renderer renderer(runtime());
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    renderer.load_scene(c.scene);
+    const RenderResult result = renderer.render(c.scene.camera, c.options);
+    const FrameParams frame = renderer.last_frame_params();
+    const PackedScene& packed = renderer.packed_scene();
+
+    // Setup: integers exact, planes within a few ulps.
+    const std::vector<TriangleSetup> gpu_setups = renderer.read_setups();
+    const std::vector<TriangleSetup> twin_setups = setup_triangles_reference(packed, frame);
+    ASSERT_EQ(gpu_setups.size(), twin_setups.size());
+    uint32_t non_empty = 0;
+    for (size_t slot = 0; slot < gpu_setups.size(); ++slot) {
+      const TriangleSetup& g = gpu_setups[slot];
+      const TriangleSetup& t = twin_setups[slot];
+      ASSERT_EQ(setup_is_empty(g), setup_is_empty(t)) << "slot " << slot;
+      if (setup_is_empty(g)) continue;
+      ++non_empty;
+      for (int i = 0; i < 3; ++i) {
+        ASSERT_EQ(g.edge_a[i], t.edge_a[i]) << "slot " << slot;
+        ASSERT_EQ(g.edge_b[i], t.edge_b[i]) << "slot " << slot;
+        ASSERT_EQ(g.edge_c[i], t.edge_c[i]) << "slot " << slot;
+      }
+      ASSERT_EQ(g.bbox_min_x, t.bbox_min_x);
+      ASSERT_EQ(g.bbox_min_y, t.bbox_min_y);
+      ASSERT_EQ(g.bbox_max_x, t.bbox_max_x);
+      ASSERT_EQ(g.bbox_max_y, t.bbox_max_y);
+      ASSERT_EQ(g.face, t.face);
+      EXPECT_EQ(g.ref_x, t.ref_x);
+      EXPECT_EQ(g.ref_y, t.ref_y);
+      expect_plane_near(g.inv_w, t.inv_w, "inv_w", slot);
+      expect_plane_near(g.u_over_w, t.u_over_w, "u_over_w", slot);
+      expect_plane_near(g.v_over_w, t.v_over_w, "v_over_w", slot);
+    }
+    EXPECT_EQ(result.stats.visible_triangles, non_empty);
+    EXPECT_GT(non_empty, 0u);
+
+    // Binning, from the GPU's setups: same counts, offsets the exclusive scan, same sets.
+    const auto twin_bins = bin_triangles_reference(gpu_setups, frame);
+    const std::vector<uint32_t> counts = renderer.read_tile_counts();
+    const std::vector<uint32_t> offsets = renderer.read_tile_offsets();
+    const std::vector<uint32_t> lists = renderer.read_tile_lists();
+    ASSERT_EQ(counts.size(), twin_bins.size());
+    uint32_t running = 0;
+    for (size_t tile = 0; tile < twin_bins.size(); ++tile) {
+      ASSERT_EQ(counts[tile], twin_bins[tile].size()) << "tile " << tile;
+      ASSERT_EQ(offsets[tile], running) << "tile " << tile;
+      std::vector<uint32_t> gpu_list(lists.begin() + offsets[tile], lists.begin() + offsets[tile] + counts[tile]);
+      std::sort(gpu_list.begin(), gpu_list.end());
+      ASSERT_EQ(gpu_list, twin_bins[tile]) << "tile " << tile;
+      running += counts[tile];
+    }
+    EXPECT_EQ(result.stats.bin_entries, running);
+
+    // Raster, from the GPU's setups: the same winner for every sample.
+    const std::vector<uint32_t> gpu_winners = renderer.read_sample_triangles();
+    const std::vector<uint32_t> twin_winners = raster_reference(gpu_setups, frame);
+    ASSERT_EQ(gpu_winners.size(), twin_winners.size());
+    size_t mismatches = 0, covered = 0;
+    for (size_t i = 0; i < gpu_winners.size(); ++i) {
+      mismatches += gpu_winners[i] != twin_winners[i];
+      covered += twin_winners[i] != SEAMCL_NO_TRIANGLE;
+    }
+    EXPECT_EQ(mismatches, 0u);
+    EXPECT_GT(covered, 0u);
+
+    // Shade and resolve, from the GPU's setups and winners.
+    const ResolveReference twin_image = shade_resolve_reference(packed, frame, gpu_setups, gpu_winners);
+    EXPECT_EQ(result.stats.fragments, twin_image.fragments);
+    float worst = 0.0f;
+    for (size_t p = 0; p < twin_image.pixels.size(); ++p) {
+      for (int ch = 0; ch < 4; ++ch) {
+        ASSERT_TRUE(std::isfinite(result.pixels[p][ch])) << "pixel " << p;
+        worst = std::max(worst, std::fabs(result.pixels[p][ch] - twin_image.pixels[p][ch]));
+      }
+    }
+    EXPECT_LE(worst, 2e-5f);
+  }
+}
+
+TEST(KernelVsTwin, TrilinearClampLookupsIncludingExtremeCoordinates) {
+  std::mt19937 rng(7);
+  Scene scene = random_scene(11, 8);
+  Renderer renderer(runtime());  // packs the scene exactly as a render would
+  renderer.load_scene(scene);
+  const PackedScene& packed = renderer.packed_scene();
+
+  std::vector<float> lookups;
+  const int count = 4096;
+  for (int i = 0; i < count; ++i) {
+    const float face = static_cast<float>(rng() % packed.faces.size());
+    // Coordinates far outside [0,1], and derivatives from zero to huge.
+    const float u = random_float(rng, -3, 4), v = random_float(rng, -3, 4);
+    const float scale = std::pow(10.0f, random_float(rng, -7, 3)) * (i % 17 == 0 ? 0.0f : 1.0f);
+    lookups.insert(lookups.end(), {face, u, v, random_float(rng, -1, 1) * scale, random_float(rng, -1, 1) * scale,
+                                   random_float(rng, -1, 1) * scale, random_float(rng, -1, 1) * scale});
+  }
+  lookups.insert(lookups.end(), {0, 1e30f, -1e30f, INFINITY, 0, 0, NAN});  // never NaN out
+  const int total = count + 1;
+
+  cl::Kernel kernel(runtime().program(), "texture_lookup_batch");
+  auto buffer = [&](const auto& data) {
+    using T = typename std::decay_t<decltype(data)>::value_type;
+    return cl::Buffer(runtime().context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data.size() * sizeof(T),
+                      const_cast<T*>(data.data()));
+  };
+  const auto& table = srgb_to_linear_table();
+  std::vector<float> srgb(table.begin(), table.end());
+  cl::Buffer out(runtime().context(), CL_MEM_WRITE_ONLY, sizeof(cl_float4) * total);
+  // Kernel arguments do not keep buffers alive: hold them until the kernel has run.
+  const cl::Buffer faces = buffer(packed.faces), level_offsets = buffer(packed.level_offsets),
+                   texels = buffer(packed.texels), srgb_table = buffer(srgb), queries = buffer(lookups);
+  kernel.setArg(0, faces);
+  kernel.setArg(1, level_offsets);
+  kernel.setArg(2, texels);
+  kernel.setArg(3, srgb_table);
+  kernel.setArg(4, queries);
+  kernel.setArg(5, static_cast<cl_uint>(total));
+  kernel.setArg(6, out);
+  runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(static_cast<size_t>(total)));
+  std::vector<glm::vec4> gpu(static_cast<size_t>(total));
+  runtime().queue().enqueueReadBuffer(out, CL_TRUE, 0, sizeof(cl_float4) * total, gpu.data());
+
+  for (int i = 0; i < total; ++i) {
+    const float* q = &lookups[static_cast<size_t>(i) * 7];
+    const glm::vec4 twin = sample_trilinear_clamp_reference(packed.textures(), static_cast<uint32_t>(q[0]), q[1], q[2],
+                                                            q[3], q[4], q[5], q[6]);
+    for (int ch = 0; ch < 4; ++ch) {
+      ASSERT_TRUE(std::isfinite(gpu[i][ch])) << "lookup " << i;
+      // log2 may differ by an ulp between the device and libm: that moves the lod by ~1e-7.
+      ASSERT_NEAR(gpu[i][ch], twin[ch], 1e-5f) << "lookup " << i << " channel " << ch;
+    }
+  }
+}
+
+TEST(SamplePattern, HostAndKernelTablesAreTheD3D11StandardPatterns) {
+  // D3D11_STANDARD_MULTISAMPLE_PATTERN, in 1/16 pixel from the centre (D3D11.3 spec 3.5.6.1),
+  // written out here independently of host/sample_pattern.cpp.
+  const std::vector<std::vector<std::pair<int, int>>> standard = {
+      {{0, 0}},
+      {{4, 4}, {-4, -4}},
+      {{-2, -6}, {6, -2}, {-6, 2}, {2, 6}},
+      {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, 7}, {7, -7}},
+      {{1, 1}, {-1, -3}, {-3, 2}, {4, -1}, {-5, -2}, {2, 5}, {5, 3}, {3, -5},
+       {-2, 6}, {0, -7}, {-4, -6}, {-6, 4}, {-8, 0}, {7, -4}, {6, 7}, {-7, -8}}};
+  cl::Kernel kernel(runtime().program(), "sample_pattern");
+  cl::Buffer out(runtime().context(), CL_MEM_WRITE_ONLY, sizeof(cl_int) * 2 * SEAMCL_MAX_SAMPLES);
+  for (size_t row = 0; row < standard.size(); ++row) {
+    const int count = 1 << row;
+    const auto& host = sample_pattern(count);
+    ASSERT_EQ(host.size(), standard[row].size());
+    kernel.setArg(0, static_cast<cl_int>(count));
+    kernel.setArg(1, out);
+    runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(1));
+    std::vector<cl_int> device(2 * static_cast<size_t>(count));
+    runtime().queue().enqueueReadBuffer(out, CL_TRUE, 0, sizeof(cl_int) * device.size(), device.data());
+    for (int s = 0; s < count; ++s) {
+      EXPECT_EQ(host[s].x, standard[row][s].first) << count << "x sample " << s;
+      EXPECT_EQ(host[s].y, standard[row][s].second) << count << "x sample " << s;
+      EXPECT_EQ(device[2 * s], standard[row][s].first) << count << "x sample " << s;
+      EXPECT_EQ(device[2 * s + 1], standard[row][s].second) << count << "x sample " << s;
+    }
+  }
+  EXPECT_THROW(sample_pattern(3), std::invalid_argument);
+}
