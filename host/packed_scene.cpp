@@ -10,6 +10,7 @@ PackedScene pack_scene(const Scene& scene) {
   out.positions.reserve(scene.positions.size());
   for (const glm::vec3& p : scene.positions) out.positions.push_back({{p.x, p.y, p.z, 1.0f}});
   out.faces.reserve(scene.faces.size());
+  out.texels.reserve(scene.texel_count());
   for (const Face& face : scene.faces) {
     FaceGpu gpu{};
     for (int i = 0; i < 4; ++i) gpu.vertex[i] = face.vertices[i];

@@ -17,6 +17,10 @@ std::vector<T> read_buffer(cl::CommandQueue& queue, const cl::Buffer& buffer, si
   return out;
 }
 
+// Fixed local sizes: PoCL compiles a kernel once per local size, so a size that never changes is
+// compiled once (at warm-up) instead of once per new image or scene size.
+constexpr size_t kLinearGroup = 64;
+
 size_t round_up(size_t value, size_t multiple) { return (value + multiple - 1) / multiple * multiple; }
 
 }  // namespace
@@ -109,8 +113,8 @@ struct Renderer::Impl {
       setup_kernel.setArg(2, faces);
       setup_kernel.setArg(3, setups);
       setup_kernel.setArg(4, stats);
-      queue.enqueueNDRangeKernel(setup_kernel, cl::NullRange, cl::NDRange(round_up(static_cast<size_t>(p.input_triangles), 64)),
-                                 cl::NullRange, nullptr, next(ev.setup));
+      queue.enqueueNDRangeKernel(setup_kernel, cl::NullRange, cl::NDRange(round_up(static_cast<size_t>(p.input_triangles), kLinearGroup)),
+                                 cl::NDRange(kLinearGroup), nullptr, next(ev.setup));
     }
     const size_t tiles = static_cast<size_t>(p.tiles_x) * p.tiles_y;
     queue.enqueueFillBuffer(tile_counts, cl_uint{0}, 0, tiles * sizeof(cl_uint), nullptr, next(ev.binning));
@@ -118,7 +122,7 @@ struct Renderer::Impl {
       bin_count_kernel.setArg(0, frame_params);
       bin_count_kernel.setArg(1, setups);
       bin_count_kernel.setArg(2, tile_counts);
-      queue.enqueueNDRangeKernel(bin_count_kernel, cl::NullRange, cl::NDRange(round_up(slots, 64)), cl::NullRange, nullptr,
+      queue.enqueueNDRangeKernel(bin_count_kernel, cl::NullRange, cl::NDRange(round_up(slots, kLinearGroup)), cl::NDRange(kLinearGroup), nullptr,
                                  next(ev.binning));
     }
     bin_scan_kernel.setArg(0, frame_params);
@@ -132,7 +136,7 @@ struct Renderer::Impl {
       bin_fill_kernel.setArg(1, setups);
       bin_fill_kernel.setArg(2, tile_cursors);
       bin_fill_kernel.setArg(3, tile_lists);
-      queue.enqueueNDRangeKernel(bin_fill_kernel, cl::NullRange, cl::NDRange(round_up(slots, 64)), cl::NullRange, nullptr,
+      queue.enqueueNDRangeKernel(bin_fill_kernel, cl::NullRange, cl::NDRange(round_up(slots, kLinearGroup)), cl::NDRange(kLinearGroup), nullptr,
                                  next(ev.binning));
     }
     const cl::NDRange tile_grid(static_cast<size_t>(p.tiles_x) * SEAMCL_TILE_SIZE, static_cast<size_t>(p.tiles_y) * SEAMCL_TILE_SIZE);
@@ -220,6 +224,13 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     result.ms.total = static_cast<double>(last - first) * 1e-6;
     return result;
   }
+}
+
+void Renderer::warm_up() {
+  RenderOptions tiny;
+  tiny.width = SEAMCL_TILE_SIZE;
+  tiny.height = SEAMCL_TILE_SIZE;
+  render(scene().camera, tiny);
 }
 
 FrameParams Renderer::last_frame_params() const { return impl_->last_params; }

@@ -50,6 +50,10 @@ class Renderer {
 
   RenderResult render(const Camera& camera, const RenderOptions& options);
 
+  // Renders one tiny frame of the loaded scene so that PoCL compiles every kernel for its local
+  // size now (20-250 ms each, cold) rather than inside the first timed frame.
+  void warm_up();
+
   // The intermediate buffers of the last frame, for the kernel tests.
   FrameParams last_frame_params() const;
   std::vector<TriangleSetup> read_setups();
