@@ -25,7 +25,7 @@ using nlohmann::json;
 using namespace seamcl;
 
 struct RenderArgs {
-  std::optional<std::string> scene, method, size, shading;
+  std::optional<std::string> scene, method, filter, zero_coverage, texels, size, shading;
   std::optional<int> msaa, aniso, frame, frames;
   bool centroid = false;
   bool tint = false;
@@ -45,6 +45,9 @@ json render_request(const RenderArgs& a) {
   json request = json::object();
   if (a.scene) request["scene"] = *a.scene;
   if (a.method) request["method"] = *a.method;
+  if (a.filter) request["filter"] = *a.filter;
+  if (a.zero_coverage) request["zero_coverage"] = *a.zero_coverage;
+  if (a.texels) request["texels"] = *a.texels;
   if (a.msaa) request["msaa"] = *a.msaa;
   if (a.aniso) request["aniso"] = *a.aniso;
   if (a.size) request["size"] = *a.size;
@@ -71,7 +74,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
 
   ClRuntime runtime(device);
   Renderer renderer(runtime);
-  renderer.load_scene(scene);
+  renderer.load_scene(scene, options.texels);
   renderer.warm_up();
   std::vector<RenderResult> runs;
   for (int i = 0; i < args.repeat; ++i) runs.push_back(renderer.render(camera, options));
@@ -153,11 +156,16 @@ int main(int argc, char** argv) {
   RenderArgs render_args;
   CLI::App* render = app.add_subcommand("render", "Render one frame of a scene to PNG (sRGB 8-bit) or EXR (linear)");
   render->add_option("--scene", render_args.scene, "Built-in scene name (see 'seamcl scenes') or a scene JSON file [paper]");
-  render->add_option("--method", render_args.method, "Seam method: " + [] {
+  auto listed = [](const std::vector<std::string>& names) {
     std::string s;
-    for (const auto& n : method_names()) s += (s.empty() ? "" : ", ") + n;
+    for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
     return s;
-  }() + " [clamp]");
+  };
+  render->add_option("--method", render_args.method, "Seam method: " + listed(method_names()) + " [discard]");
+  render->add_option("--filter", render_args.filter, "Texture filter: " + listed(filter_names()) + " [aniso]");
+  render->add_option("--zero-coverage", render_args.zero_coverage,
+                     "discard with every tap outside the face: clamp (a clamped lookup) or nan (the raw 0/0) [clamp]");
+  render->add_option("--texels", render_args.texels, "Texel storage: " + listed(texel_format_names()) + " [rgba8]");
   render->add_option("--msaa", render_args.msaa, "Samples per pixel: 1, 2, 4, 8 or 16 [1]");
   render->add_option("--aniso", render_args.aniso, "Maximum anisotropy, 1..16 [16]");
   render->add_option("--size", render_args.size, "Image size WIDTHxHEIGHT [480x540]");

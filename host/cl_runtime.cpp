@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
-#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
@@ -200,17 +199,22 @@ std::string ClRuntime::device_description() const {
   return info_.name + " (" + info_.platform + ", " + info_.version + ")";
 }
 
-const cl::Program& ClRuntime::program() {
-  static std::mutex build_mutex;
-  std::lock_guard<std::mutex> lock(build_mutex);
-  if (!program_) {
+const cl::Program& ClRuntime::program(const std::string& options) {
+  std::lock_guard<std::mutex> lock(programs_mutex_);
+  std::unique_ptr<cl::Program>& slot = programs_[options];
+  if (!slot) {
     const auto start = std::chrono::steady_clock::now();
     auto program = std::make_unique<cl::Program>(context_, program_source());
-    program->build(std::vector<cl::Device>{device_}, "-cl-std=CL1.2");
-    build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    program_ = std::move(program);
+    program->build(std::vector<cl::Device>{device_}, ("-cl-std=CL1.2 " + options).c_str());
+    build_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    slot = std::move(program);
   }
-  return *program_;
+  return *slot;
+}
+
+double ClRuntime::program_build_ms() const {
+  std::lock_guard<std::mutex> lock(programs_mutex_);
+  return build_ms_;
 }
 
 double event_milliseconds(const cl::Event& event) {

@@ -1,7 +1,9 @@
 // The OpenCL runtime: device choice, one context, one in-order profiling queue, the program.
 // Errors carry the failing call, the CL error name and, for builds, each device's build log.
 #pragma once
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -39,18 +41,20 @@ class ClRuntime {
   const DeviceInfo& info() const { return info_; }
   std::string device_description() const;  // "<device> (<platform>, <version>)"
 
-  // Builds program_source() once (later calls return the same program). Milliseconds the build
-  // took are kept for --json and the first-start figure.
-  const cl::Program& program();
-  double program_build_ms() const { return build_ms_; }
+  // Builds program_source() with `options` (e.g. "-DSEAMCL_TEXELS_F32=1") once per distinct
+  // options; later calls return the same program. Thread-safe. The milliseconds the builds took
+  // are kept for --json and the first-start figure.
+  const cl::Program& program(const std::string& options = "");
+  double program_build_ms() const;
 
  private:
   cl::Context context_;
   cl::Device device_;
   cl::CommandQueue queue_;
   DeviceInfo info_;
-  std::unique_ptr<cl::Program> program_;
+  std::map<std::string, std::unique_ptr<cl::Program>> programs_;
   double build_ms_ = 0.0;
+  mutable std::mutex programs_mutex_;
 };
 
 // Milliseconds between an event's start and end (from CL_QUEUE_PROFILING_ENABLE).

@@ -39,6 +39,7 @@ FrameParams make_frame_params(const Scene& scene, const Camera& camera, const Re
     p.background[i] = scene.background[i];
   }
   p.ambient = scene.light.ambient;
+  p.sampler = sampler_params(options);
   return p;
 }
 

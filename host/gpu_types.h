@@ -5,7 +5,9 @@
 
 #include "seamcl_types.h"
 
-static_assert(sizeof(FrameParams) == 152, "FrameParams layout");
+static_assert(sizeof(SamplerParams) == 32, "SamplerParams layout");
+static_assert(sizeof(FrameParams) == 184, "FrameParams layout");
+static_assert(offsetof(FrameParams, sampler) == 152);
 static_assert(offsetof(FrameParams, width) == 64);
 static_assert(offsetof(FrameParams, near_w) == 96);
 static_assert(offsetof(FrameParams, light_dir) == 108);

@@ -5,12 +5,18 @@
 
 namespace seamcl {
 
-PackedScene pack_scene(const Scene& scene) {
+PackedScene pack_scene(const Scene& scene, TexelFormat format) {
   PackedScene out;
+  out.format = format;
   out.positions.reserve(scene.positions.size());
   for (const glm::vec3& p : scene.positions) out.positions.push_back({{p.x, p.y, p.z, 1.0f}});
   out.faces.reserve(scene.faces.size());
-  out.texels.reserve(scene.texel_count());
+  if (format == TexelFormat::Rgba8) {
+    out.texels8.reserve(scene.texel_count());
+  } else {
+    out.texels32.reserve(scene.texel_count() * 4);
+  }
+  size_t texels = 0;
   for (const Face& face : scene.faces) {
     FaceGpu gpu{};
     for (int i = 0; i < 4; ++i) gpu.vertex[i] = face.vertices[i];
@@ -23,11 +29,19 @@ PackedScene pack_scene(const Scene& scene) {
     gpu.normal[1] = n.y;
     gpu.normal[2] = n.z;
     for (const TextureLevel& level : face.texture.levels) {
-      if (out.texels.size() + level.texels.size() > std::numeric_limits<uint32_t>::max()) {
-        throw std::length_error("scene textures exceed 2^32 texels");
+      // Offsets are 32-bit texel indices (and 4x that for float texels).
+      if ((texels + level.texels.size()) * 4 > std::numeric_limits<uint32_t>::max()) {
+        throw std::length_error("scene textures exceed 2^30 texels");
       }
-      out.level_offsets.push_back(static_cast<uint32_t>(out.texels.size()));
-      for (const glm::vec4& texel : level.texels) out.texels.push_back(encode_srgb8(texel));
+      out.level_offsets.push_back(static_cast<uint32_t>(texels));
+      texels += level.texels.size();
+      for (const glm::vec4& texel : level.texels) {
+        if (format == TexelFormat::Rgba8) {
+          out.texels8.push_back(encode_srgb8(texel));
+        } else {
+          out.texels32.insert(out.texels32.end(), {texel.r, texel.g, texel.b, texel.a});
+        }
+      }
     }
     out.faces.push_back(gpu);
   }

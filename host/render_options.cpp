@@ -32,7 +32,14 @@ std::vector<std::string> enum_names(const std::array<std::pair<Enum, const char*
   return out;
 }
 
-constexpr std::array<std::pair<Method, const char*>, 1> kMethods{{{Method::Clamp, "clamp"}}};
+constexpr std::array<std::pair<Method, const char*>, 3> kMethods{
+    {{Method::Clamp, "clamp"}, {Method::Black, "black"}, {Method::Discard, "discard"}}};
+constexpr std::array<std::pair<Filter, const char*>, 4> kFilters{
+    {{Filter::Bilinear, "bilinear"}, {Filter::Trilinear, "trilinear"}, {Filter::Aniso, "aniso"}, {Filter::Ewa, "ewa"}}};
+constexpr std::array<std::pair<ZeroCoverage, const char*>, 2> kZeroCoverage{
+    {{ZeroCoverage::Clamp, "clamp"}, {ZeroCoverage::Nan, "nan"}}};
+constexpr std::array<std::pair<TexelFormat, const char*>, 2> kTexelFormats{
+    {{TexelFormat::Rgba8, "rgba8"}, {TexelFormat::Rgba32f, "rgba32f"}}};
 constexpr std::array<std::pair<ShadingMode, const char*>, 3> kShadingModes{
     {{ShadingMode::Pixel, "pixel"}, {ShadingMode::Centroid, "centroid"}, {ShadingMode::Sample, "sample"}}};
 constexpr std::array<std::pair<ImageFormat, const char*>, 2> kFormats{{{ImageFormat::Png, "png"}, {ImageFormat::Exr, "exr"}}};
@@ -65,6 +72,15 @@ std::string string_field(const nlohmann::json& value, const std::string& field) 
   return value.get<std::string>();
 }
 
+template <typename Enum, size_t N>
+Enum enum_field(const nlohmann::json& value, const std::string& field, const char* what,
+                const std::array<std::pair<Enum, const char*>, N>& table) {
+  const std::string name = string_field(value, field);
+  const auto parsed = parse_enum(name, table);
+  if (!parsed) throw InputError(field, std::string("unknown ") + what + " '" + name + "' (known: " + joined(enum_names(table)) + ")");
+  return *parsed;
+}
+
 bool bool_field(const nlohmann::json& value, const std::string& field) {
   if (!value.is_boolean()) throw InputError(field, "must be true or false, got " + value.dump());
   return value.get<bool>();
@@ -80,6 +96,29 @@ std::string to_string(ShadingMode mode) { return enum_name(mode, kShadingModes);
 std::vector<std::string> shading_mode_names() { return enum_names(kShadingModes); }
 std::optional<ImageFormat> parse_image_format(std::string_view name) { return parse_enum(name, kFormats); }
 std::string to_string(ImageFormat format) { return enum_name(format, kFormats); }
+
+std::optional<Filter> parse_filter(std::string_view name) { return parse_enum(name, kFilters); }
+std::string to_string(Filter filter) { return enum_name(filter, kFilters); }
+std::vector<std::string> filter_names() { return enum_names(kFilters); }
+std::optional<ZeroCoverage> parse_zero_coverage(std::string_view name) { return parse_enum(name, kZeroCoverage); }
+std::string to_string(ZeroCoverage mode) { return enum_name(mode, kZeroCoverage); }
+std::vector<std::string> zero_coverage_names() { return enum_names(kZeroCoverage); }
+std::optional<TexelFormat> parse_texel_format(std::string_view name) { return parse_enum(name, kTexelFormats); }
+std::string to_string(TexelFormat format) { return enum_name(format, kTexelFormats); }
+std::vector<std::string> texel_format_names() { return enum_names(kTexelFormats); }
+
+SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCoverage zero_coverage) {
+  SamplerParams p{};
+  p.filter = filter == Filter::Bilinear    ? SEAMCL_FILTER_BILINEAR
+             : filter == Filter::Trilinear ? SEAMCL_FILTER_TRILINEAR
+             : filter == Filter::Aniso     ? SEAMCL_FILTER_ANISO
+                                           : SEAMCL_FILTER_EWA;
+  p.address = method == Method::Clamp ? SEAMCL_ADDRESS_CLAMP : SEAMCL_ADDRESS_BORDER;
+  p.renormalize = method == Method::Discard ? 1 : 0;
+  p.max_aniso = max_aniso;
+  p.zero_coverage = zero_coverage == ZeroCoverage::Clamp ? SEAMCL_ZERO_COVERAGE_CLAMP : SEAMCL_ZERO_COVERAGE_NAN;
+  return p;
+}
 
 std::pair<int, int> parse_size(const std::string& text, const std::string& field) {
   const size_t x = text.find('x');
@@ -106,10 +145,13 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
       options.scene = string_field(value, key);
       if (options.scene.empty()) throw InputError(key, "must not be empty");
     } else if (key == "method") {
-      const std::string name = string_field(value, key);
-      const auto method = parse_method(name);
-      if (!method) throw InputError(key, "unknown method '" + name + "' (known: " + joined(method_names()) + ")");
-      options.method = *method;
+      options.method = enum_field(value, key, "method", kMethods);
+    } else if (key == "filter") {
+      options.filter = enum_field(value, key, "filter", kFilters);
+    } else if (key == "zero_coverage") {
+      options.zero_coverage = enum_field(value, key, "zero_coverage mode", kZeroCoverage);
+    } else if (key == "texels") {
+      options.texels = enum_field(value, key, "texel format", kTexelFormats);
     } else if (key == "msaa") {
       options.msaa = int_field(value, key, 1, 16);
       if ((options.msaa & (options.msaa - 1)) != 0) {
@@ -120,10 +162,7 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
     } else if (key == "size") {
       std::tie(options.width, options.height) = parse_size(string_field(value, key), key);
     } else if (key == "shading") {
-      const std::string name = string_field(value, key);
-      const auto mode = parse_shading_mode(name);
-      if (!mode) throw InputError(key, "unknown shading mode '" + name + "' (known: " + joined(shading_mode_names()) + ")");
-      options.shading = *mode;
+      options.shading = enum_field(value, key, "shading mode", kShadingModes);
     } else if (key == "centroid") {
       centroid = bool_field(value, key);
     } else if (key == "frame") {
@@ -153,6 +192,9 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
 nlohmann::json to_json(const RenderOptions& options) {
   nlohmann::json out = {{"scene", options.scene},
                         {"method", to_string(options.method)},
+                        {"filter", to_string(options.filter)},
+                        {"zero_coverage", to_string(options.zero_coverage)},
+                        {"texels", to_string(options.texels)},
                         {"msaa", options.msaa},
                         {"aniso", options.aniso},
                         {"size", std::to_string(options.width) + "x" + std::to_string(options.height)},

@@ -9,11 +9,19 @@
 
 #include <nlohmann/json.hpp>
 
+#include "texture_sample.h"
+
 namespace seamcl {
 
-// How a lookup treats taps outside the face. The sampler issue adds black, discard, traverse and
-// guardband; until then every lookup is a trilinear one with clamp.
-enum class Method { Clamp };
+// How a lookup treats taps outside the face (the seam method):
+//   clamp   - taps read the nearest edge texel (seams show);
+//   black   - taps outside weigh zero, no renormalisation (Ptex's black border: edges darken);
+//   discard - taps outside weigh zero and the rest are renormalised (Toth 2013).
+enum class Method { Clamp, Black, Discard };
+// The filter of one lookup: bilinear (level 0), trilinear, aniso (hardware-style probes), ewa.
+enum class Filter { Bilinear, Trilinear, Aniso, Ewa };
+// Discard with every tap outside: a clamped lookup (the paper's fix) or the raw 0/0 (NaN).
+enum class ZeroCoverage { Clamp, Nan };
 // Where a fragment is shaded: the pixel centre, the centroid of its covered samples, or every
 // sample (supersampling).
 enum class ShadingMode { Pixel, Centroid, Sample };
@@ -27,15 +35,27 @@ std::string to_string(ShadingMode mode);
 std::vector<std::string> shading_mode_names();
 std::optional<ImageFormat> parse_image_format(std::string_view name);
 std::string to_string(ImageFormat format);
+std::optional<Filter> parse_filter(std::string_view name);
+std::string to_string(Filter filter);
+std::vector<std::string> filter_names();
+std::optional<ZeroCoverage> parse_zero_coverage(std::string_view name);
+std::string to_string(ZeroCoverage mode);
+std::vector<std::string> zero_coverage_names();
+std::optional<TexelFormat> parse_texel_format(std::string_view name);
+std::string to_string(TexelFormat format);
+std::vector<std::string> texel_format_names();
 
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr long long kMaxSamplesPerImage = 1LL << 28;  // width * height * msaa
 
 struct RenderOptions {
   std::string scene = "paper";  // built-in name or scene file
-  Method method = Method::Clamp;
+  Method method = Method::Discard;
+  Filter filter = Filter::Aniso;
+  ZeroCoverage zero_coverage = ZeroCoverage::Clamp;
+  TexelFormat texels = TexelFormat::Rgba8;
   int msaa = 1;                 // 1, 2, 4, 8 or 16 samples per pixel
-  int aniso = 16;               // maximum anisotropy, 1..16 (used by the aniso filter)
+  int aniso = 16;               // maximum anisotropy, 1..16 (aniso and ewa filters)
   int width = 480;
   int height = 540;
   ShadingMode shading = ShadingMode::Pixel;
@@ -45,10 +65,17 @@ struct RenderOptions {
 };
 
 // Reads the keys present in `request` over the defaults. Throws InputError naming the key on a
-// wrong type, an out-of-range value or an unknown key. Keys: scene, method, msaa, aniso,
-// size ("WxH"), shading, centroid (bool, same as shading=centroid), frame, frames, tint.
+// wrong type, an out-of-range value or an unknown key. Keys: scene, method, filter, msaa, aniso,
+// size ("WxH"), shading, centroid (bool, same as shading=centroid), zero_coverage, texels,
+// frame, frames, tint.
 RenderOptions parse_render_options(const nlohmann::json& request);
 nlohmann::json to_json(const RenderOptions& options);
+
+// The sampler settings a method stands for (see SamplerParams in kernels/seamcl_types.h).
+SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCoverage zero_coverage);
+inline SamplerParams sampler_params(const RenderOptions& o) {
+  return sampler_params(o.method, o.filter, o.aniso, o.zero_coverage);
+}
 
 // "480x540" -> {480, 540}; throws InputError(field) unless both are integers in 1..kMaxImageSide.
 std::pair<int, int> parse_size(const std::string& text, const std::string& field = "size");

@@ -41,18 +41,33 @@ struct Renderer::Impl {
   FrameParams last_params{};
 
   explicit Impl(ClRuntime& rt) : runtime(rt) {
-    const cl::Program& program = runtime.program();
+    create_kernels(TexelFormat::Rgba8);
+    const auto& table = srgb_to_linear_table();
+    srgb_table = cl::Buffer(runtime.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(float) * table.size(),
+                            const_cast<float*>(table.data()));
+    frame_params = cl::Buffer(runtime.context(), CL_MEM_READ_ONLY, sizeof(FrameParams));
+    stats = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, sizeof(FrameStats));
+  }
+
+  // The program variant for a texel format (the texel buffer's type differs).
+  void create_kernels(TexelFormat format) {
+    const cl::Program& program = runtime.program(program_options(format));
     setup_kernel = cl::Kernel(program, "triangle_setup");
     bin_count_kernel = cl::Kernel(program, "bin_count");
     bin_scan_kernel = cl::Kernel(program, "bin_scan");
     bin_fill_kernel = cl::Kernel(program, "bin_fill");
     raster_kernel = cl::Kernel(program, "raster");
     shade_kernel = cl::Kernel(program, "shade_resolve");
-    const auto& table = srgb_to_linear_table();
-    srgb_table = cl::Buffer(runtime.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(float) * table.size(),
-                            const_cast<float*>(table.data()));
-    frame_params = cl::Buffer(runtime.context(), CL_MEM_READ_ONLY, sizeof(FrameParams));
-    stats = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, sizeof(FrameStats));
+  }
+
+  // Packs and uploads the loaded scene in `format`, with the kernels that read it.
+  void pack_and_upload(TexelFormat format) {
+    packed = pack_scene(*scene, format);
+    positions = upload(packed.positions);
+    faces = upload(packed.faces);
+    level_offsets = upload(packed.level_offsets);
+    texels = format == TexelFormat::Rgba8 ? upload(packed.texels8) : upload(packed.texels32);
+    create_kernels(format);
   }
 
   template <typename T>
@@ -170,14 +185,10 @@ struct Renderer::Impl {
 Renderer::Renderer(ClRuntime& runtime) : impl_(std::make_unique<Impl>(runtime)) {}
 Renderer::~Renderer() = default;
 
-void Renderer::load_scene(const Scene& scene) {
+void Renderer::load_scene(const Scene& scene, TexelFormat format) {
   validate_scene(scene);
-  impl_->packed = pack_scene(scene);
-  impl_->positions = impl_->upload(impl_->packed.positions);
-  impl_->faces = impl_->upload(impl_->packed.faces);
-  impl_->level_offsets = impl_->upload(impl_->packed.level_offsets);
-  impl_->texels = impl_->upload(impl_->packed.texels);
   impl_->scene = std::make_unique<Scene>(scene);
+  impl_->pack_and_upload(format);
   // Start the tile lists at a few entries per triangle slot; render() grows them when needed.
   impl_->bin_capacity = std::max<uint32_t>(impl_->bin_capacity, static_cast<uint32_t>(std::min<size_t>(
                                                                       scene.triangle_count() * 8 + 65536, 1u << 30)));
@@ -193,6 +204,7 @@ const PackedScene& Renderer::packed_scene() const { return impl_->packed; }
 
 RenderResult Renderer::render(const Camera& camera, const RenderOptions& options) {
   if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
+  if (options.texels != impl_->packed.format) impl_->pack_and_upload(options.texels);
   RenderResult result;
   result.width = options.width;
   result.height = options.height;
@@ -226,8 +238,13 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   }
 }
 
+std::string program_options(TexelFormat format) {
+  return format == TexelFormat::Rgba32f ? "-DSEAMCL_TEXELS_F32=1" : "";
+}
+
 void Renderer::warm_up() {
   RenderOptions tiny;
+  tiny.texels = impl_->packed.format;
   tiny.width = SEAMCL_TILE_SIZE;
   tiny.height = SEAMCL_TILE_SIZE;
   render(scene().camera, tiny);

@@ -36,6 +36,9 @@ struct RenderResult {
   int attempts = 1;               // > 1 when the tile lists had to grow
 };
 
+// The build options of the program variant that reads `format` texels.
+std::string program_options(TexelFormat format);
+
 class Renderer {
  public:
   explicit Renderer(ClRuntime& runtime);
@@ -43,8 +46,9 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Packs and uploads the scene (validated first). Later renders use it until the next call.
-  void load_scene(const Scene& scene);
+  // Packs and uploads the scene (validated first). Later renders use it until the next call; a
+  // render asking for another texel format packs it again.
+  void load_scene(const Scene& scene, TexelFormat format = TexelFormat::Rgba8);
   const Scene& scene() const;
   const PackedScene& packed_scene() const;
 

@@ -29,7 +29,7 @@ SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y) {
 glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& f, const TriangleSetup& t, float x, float y) {
   const SurfaceUv s = interpolate_uv(t, x, y);
   const glm::vec4 albedo =
-      sample_trilinear_clamp_reference(scene.textures(), t.face, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
+      sample_texture_reference(scene.textures(), t.face, f.sampler, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
   const FaceGpu& face = scene.faces.at(t.face);
   const float n_dot_l = face.normal[0] * f.light_dir[0] + face.normal[1] * f.light_dir[1] + face.normal[2] * f.light_dir[2];
   const float lighting = f.ambient + (1.0f - f.ambient) * std::fmax(n_dot_l, 0.0f);

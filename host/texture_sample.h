@@ -1,4 +1,5 @@
-// Texel encoding and the scalar twin of kernels/texture_sample.cl.
+// Texel encoding and the scalar twin of kernels/texture_sample.cl: the sampler every seam
+// method is a setting of (filter, address mode, renormalisation).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -16,15 +17,31 @@ const std::array<float, 256>& srgb_to_linear_table();
 uint32_t encode_srgb8(const glm::vec4& linear);
 glm::vec4 decode_srgb8(uint32_t packed);
 
-// The textures as the kernels see them (see FaceGpu in kernels/seamcl_types.h).
+enum class TexelFormat { Rgba8, Rgba32f };
+
+// The textures as the kernels see them (see FaceGpu in kernels/seamcl_types.h): one of the two
+// texel arrays is used, as `format` says.
 struct TextureView {
   const std::vector<FaceGpu>* faces;
   const std::vector<uint32_t>* level_offsets;
-  const std::vector<uint32_t>* texels;
+  TexelFormat format;
+  const std::vector<uint32_t>* texels8;   // RGBA8 sRGB
+  const std::vector<float>* texels32;     // linear RGBA32F, 4 floats a texel
 };
 
-float trilinear_lod_reference(const FaceGpu& face, float dudx, float dvdx, float dudy, float dvdy);
-glm::vec4 sample_trilinear_clamp_reference(const TextureView& textures, uint32_t face, float u, float v,
-                                           float dudx, float dvdx, float dudy, float dvdy);
+// Filtered colour and the summed weight of the taps inside the face (1 unless border).
+struct FilterSum {
+  glm::vec4 color{0.0f};
+  float weight = 0.0f;
+};
+
+// log2 within 5e-6 for x > 0, the polynomial the kernels use.
+float approx_log2(float x);
+
+FilterSum filter_texture_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler,
+                                   int address, float u, float v, float dudx, float dvdx, float dudy, float dvdy);
+// The lookup as a seam method asks for it (renormalisation and zero-coverage rule included).
+glm::vec4 sample_texture_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler, float u,
+                                   float v, float dudx, float dvdx, float dudy, float dvdy);
 
 }  // namespace seamcl

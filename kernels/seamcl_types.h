@@ -28,6 +28,30 @@ typedef float cl_float;
 #define SEAMCL_SHADE_CENTROID 1 /* once per pixel and triangle, at the mean of its covered samples */
 #define SEAMCL_SHADE_SAMPLE 2   /* every sample (supersampling) */
 
+/* SamplerParams.filter */
+#define SEAMCL_FILTER_BILINEAR 0  /* level 0 only */
+#define SEAMCL_FILTER_TRILINEAR 1 /* two levels around log2 of the longer screen axis */
+#define SEAMCL_FILTER_ANISO 2     /* up to max_aniso trilinear probes along the major axis */
+#define SEAMCL_FILTER_EWA 3       /* elliptical Gaussian over the texels of two levels */
+/* SamplerParams.address: where taps outside the level read */
+#define SEAMCL_ADDRESS_CLAMP 0    /* the nearest edge texel */
+#define SEAMCL_ADDRESS_WRAP 1     /* the texture repeats */
+#define SEAMCL_ADDRESS_BORDER 2   /* colour 0 and weight 0 (border-zero) */
+/* SamplerParams.zero_coverage: a renormalised lookup whose taps all fall outside */
+#define SEAMCL_ZERO_COVERAGE_CLAMP 0 /* clamped trilinear lookup at the centre clamped to the face */
+#define SEAMCL_ZERO_COVERAGE_NAN 1   /* the raw division 0/0 (the paper's failure case) */
+
+/* How one texture lookup filters. The seam methods are settings of it: clamp = address clamp;
+ * black = address border; discard = address border + renormalize. */
+typedef struct {
+  cl_int filter;         /* SEAMCL_FILTER_* */
+  cl_int address;        /* SEAMCL_ADDRESS_* */
+  cl_int renormalize;    /* 1: divide by the summed weight of the taps inside */
+  cl_int max_aniso;      /* 1..16, for aniso and ewa */
+  cl_int zero_coverage;  /* SEAMCL_ZERO_COVERAGE_*, when renormalize and no tap is inside */
+  cl_int pad0, pad1, pad2;
+} SamplerParams;
+
 /* Per frame, read-only in every kernel. Screen space: pixels, origin at the top-left corner of
  * the image, y down; pixel (x, y) spans [x, x+1) x [y, y+1), its centre at (x+0.5, y+0.5). */
 typedef struct {
@@ -45,6 +69,7 @@ typedef struct {
   cl_float ambient;         /* lighting = light_color * (ambient + (1-ambient) * max(0, n.l)) */
   cl_float background[3];   /* linear RGB of samples no triangle covers */
   cl_int pad0;
+  SamplerParams sampler;
 } FrameParams;
 
 /* One quad patch. Texture texels of all faces live in one buffer; level l of a face starts at

@@ -6,8 +6,8 @@
  * where the triangle's plane has 1/w <= 0 (extrapolated past the horizon) falls back to the
  * centroid, whose samples lie inside the triangle. SEAMCL_SHADE_SAMPLE shades every sample at its
  * own position. Resolve: box filter (mean over samples) into linear RGBA float, alpha 1.
- * Shading: uv and d(uv)/d(pixel) analytically from the 1/w, u/w, v/w planes, one texture lookup,
- * and lighting = light_color * (ambient + (1 - ambient) * max(0, n.l)) with the face normal.
+ * Shading: uv and d(uv)/d(pixel) analytically from the 1/w, u/w, v/w planes, one texture lookup
+ * (sample_texture with frame->sampler: the seam method), and lighting = light_color * (ambient + (1 - ambient) * max(0, n.l)) with the face normal.
  * Host guarantees: sample_triangle from raster of this frame. Twin: host/shade_resolve.cpp. */
 
 typedef struct {
@@ -38,12 +38,12 @@ inline float plane_inv_w(__global const TriangleSetup* t, float x, float y) {
 
 inline float3 shade_fragment(__constant FrameParams* frame, __global const TriangleSetup* t,
                              __global const FaceGpu* faces, __global const uint* level_offsets,
-                             __global const uint* texels, __global const float* srgb_to_linear,
+                             TEXEL_BUFFER texels, __global const float* srgb_to_linear,
                              float x, float y) {
   const SurfaceUv s = interpolate_uv(t, x, y);
   const FaceGpu face = faces[t->face];
-  const float4 albedo = sample_trilinear_clamp(&face, level_offsets, texels, srgb_to_linear, s.u, s.v,
-                                               s.dudx, s.dvdx, s.dudy, s.dvdy);
+  const float4 albedo = sample_texture(&face, level_offsets, texels, srgb_to_linear, frame->sampler, s.u, s.v,
+                                       s.dudx, s.dvdx, s.dudy, s.dvdy);
   const float n_dot_l = face.normal[0] * frame->light_dir[0] + face.normal[1] * frame->light_dir[1] +
                         face.normal[2] * frame->light_dir[2];
   const float lighting = frame->ambient + (1.0f - frame->ambient) * fmax(n_dot_l, 0.0f);
@@ -53,7 +53,7 @@ inline float3 shade_fragment(__constant FrameParams* frame, __global const Trian
 
 __kernel void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* setups,
                             __global const FaceGpu* faces, __global const uint* level_offsets,
-                            __global const uint* texels, __global const float* srgb_to_linear,
+                            TEXEL_BUFFER texels, __global const float* srgb_to_linear,
                             __global const uint* sample_triangle, __global float4* image,
                             __global FrameStats* stats) {
   __local uint group_fragments;

@@ -1,77 +1,329 @@
-/* Texture lookups over the per-face texel buffer (not a stage of its own: the shade stage calls it).
+/* Texture lookups over the per-face texel buffer (not a stage of its own: shading calls it).
  *
- * Inputs: a FaceGpu (level sizes and the index of its level table), level_offsets (first texel of
- * each level in `texels`), texels as RGBA8 sRGB packed r | g << 8 | b << 16 | a << 24, and a
- * 256-entry table of the sRGB-to-linear decode (the host fills it: one definition of the decode).
- * Coordinates: uv in face space, texel (i, j) of a W x H level centred at ((i+.5)/W, (j+.5)/H);
- * derivatives are d(uv)/d(pixel). Filtering happens in linear RGB.
- * Host guarantees: every face has a full chain down to 1x1; the offsets are in range.
+ * Inputs: a FaceGpu (level-0 size, level count, index of its level table), level_offsets (first
+ * texel of each level), the texels, and SamplerParams. Texels are RGBA8 with sRGB-encoded RGB
+ * (packed r | g << 8 | b << 16 | a << 24, decoded through the host's 256-entry table) or, when
+ * the program is built with -DSEAMCL_TEXELS_F32=1, linear RGBA32F. Filtering is in linear RGB.
+ * Coordinates: uv in face space; texel (i, j) of a W x H level is centred at ((i+.5)/W, (j+.5)/H);
+ * derivatives are d(uv)/d(pixel).
+ * Result: a FilterSum, the filtered colour and the summed weight of the taps that read inside the
+ * level (1 unless the address mode is border). One place turns it into a colour: resolve_sum.
+ * Host guarantees: full chains down to 1x1, power-of-two sizes, offsets in range. Only texels of
+ * the face's own levels are ever read, whatever the coordinates (NaN and infinities included).
+ * Written for PoCL's vectoriser: scalar channels, no floor/log2 builtins, no float4 arithmetic.
  * Twin: host/texture_sample.cpp. */
 
-inline float4 decode_texel(uint packed, __global const float* srgb_to_linear) {
-  return (float4)(srgb_to_linear[packed & 0xffu], srgb_to_linear[(packed >> 8) & 0xffu],
-                  srgb_to_linear[(packed >> 16) & 0xffu], (float)(packed >> 24) * (1.0f / 255.0f));
+#ifndef SEAMCL_TEXELS_F32
+#define SEAMCL_TEXELS_F32 0
+#endif
+#if SEAMCL_TEXELS_F32
+#define TEXEL_BUFFER __global const float*
+#else
+#define TEXEL_BUFFER __global const uint*
+#endif
+
+typedef struct {
+  float r, g, b, a;  /* sum of weight * texel over taps inside */
+  float weight;      /* sum of weight over taps inside */
+} FilterSum;
+
+typedef struct {
+  uint offset;       /* first texel */
+  int width, height;
+} Level;
+
+inline Level face_level(const FaceGpu* face, __global const uint* level_offsets, int level) {
+  Level l;
+  l.offset = level_offsets[face->level_table + (uint)level];
+  l.width = max(face->width >> level, 1);
+  l.height = max(face->height >> level, 1);
+  return l;
 }
 
-/* Bilinear at (u, v) on one level, taps clamped to the level's edge texels. */
-inline float4 bilinear_clamp(__global const uint* texels, __global const float* srgb_to_linear,
-                             uint level_offset, int width, int height, float u, float v) {
-  /* Keep far-away coordinates finite and in int range; clamping makes them equivalent. */
-  const float x = fmin(fmax(u * (float)width - 0.5f, -1.0f), (float)width);
-  const float y = fmin(fmax(v * (float)height - 0.5f, -1.0f), (float)height);
-  const float x_floor = floor(x);
-  const float y_floor = floor(y);
+/* log2 for x > 0, within 5e-6: a polynomial on the mantissa (the builtin does not vectorise). */
+inline float approx_log2(float x) {
+  const int bits = as_int(x);
+  const float exponent = (float)(((bits >> 23) & 255) - 127);
+  const float m = as_float((bits & 0x007fffff) | 0x3f800000) - 1.0f;
+  const float p = m * (1.442517034f + m * (-0.7178983813f + m * (0.4568941740f + m * (-0.2773650501f +
+                  m * (0.1219141394f + m * -0.02606630148f)))));
+  return exponent + p;
+}
+
+inline void add_texel(FilterSum* sum, TEXEL_BUFFER texels, __global const float* srgb_to_linear, uint index,
+                      float weight) {
+#if SEAMCL_TEXELS_F32
+  sum->r += weight * texels[4 * index];
+  sum->g += weight * texels[4 * index + 1];
+  sum->b += weight * texels[4 * index + 2];
+  sum->a += weight * texels[4 * index + 3];
+#else
+  const uint packed = texels[index];
+  sum->r += weight * srgb_to_linear[packed & 0xffu];
+  sum->g += weight * srgb_to_linear[(packed >> 8) & 0xffu];
+  sum->b += weight * srgb_to_linear[(packed >> 16) & 0xffu];
+  sum->a += weight * ((float)(packed >> 24) * (1.0f / 255.0f));
+#endif
+  sum->weight += weight;
+}
+
+/* Texel index along one axis of size n for address mode `address`; *inside is 0 for a border tap. */
+inline int address_texel(int i, int n, int address, float* inside) {
+  const int clamped = clamp(i, 0, n - 1);
+  *inside = (address != SEAMCL_ADDRESS_BORDER || i == clamped) ? 1.0f : 0.0f;
+  return address == SEAMCL_ADDRESS_WRAP ? (i & (n - 1)) : clamped;
+}
+
+/* Texel-space coordinate of u on an axis of n texels, finite whatever u is. */
+inline float texel_coordinate(float u, int n, int address) {
+  if (address == SEAMCL_ADDRESS_WRAP) u = u - __builtin_floorf(u);
+  /* Two texels beyond either edge is as far as any address mode can tell apart. */
+  return fmin(fmax(u * (float)n - 0.5f, -2.0f), (float)n + 1.0f);
+}
+
+/* weight * bilinear(level, u, v) into sum. */
+inline void accumulate_bilinear(FilterSum* sum, TEXEL_BUFFER texels, __global const float* srgb_to_linear,
+                                Level level, float u, float v, float weight, int address) {
+  const float x = texel_coordinate(u, level.width, address);
+  const float y = texel_coordinate(v, level.height, address);
+  const float x_floor = __builtin_floorf(x);
+  const float y_floor = __builtin_floorf(y);
   const float fx = x - x_floor;
   const float fy = y - y_floor;
-  const int x0 = clamp((int)x_floor, 0, width - 1);
-  const int x1 = clamp((int)x_floor + 1, 0, width - 1);
-  const int y0 = clamp((int)y_floor, 0, height - 1);
-  const int y1 = clamp((int)y_floor + 1, 0, height - 1);
-  const float4 t00 = decode_texel(texels[level_offset + (uint)(y0 * width + x0)], srgb_to_linear);
-  const float4 t10 = decode_texel(texels[level_offset + (uint)(y0 * width + x1)], srgb_to_linear);
-  const float4 t01 = decode_texel(texels[level_offset + (uint)(y1 * width + x0)], srgb_to_linear);
-  const float4 t11 = decode_texel(texels[level_offset + (uint)(y1 * width + x1)], srgb_to_linear);
-  return (t00 * (1.0f - fx) + t10 * fx) * (1.0f - fy) + (t01 * (1.0f - fx) + t11 * fx) * fy;
+  float in_x0, in_x1, in_y0, in_y1;
+  const int x0 = address_texel((int)x_floor, level.width, address, &in_x0);
+  const int x1 = address_texel((int)x_floor + 1, level.width, address, &in_x1);
+  const int y0 = address_texel((int)y_floor, level.height, address, &in_y0);
+  const int y1 = address_texel((int)y_floor + 1, level.height, address, &in_y1);
+  const uint row0 = level.offset + (uint)(y0 * level.width);
+  const uint row1 = level.offset + (uint)(y1 * level.width);
+  add_texel(sum, texels, srgb_to_linear, row0 + (uint)x0, weight * (1.0f - fx) * (1.0f - fy) * in_x0 * in_y0);
+  add_texel(sum, texels, srgb_to_linear, row0 + (uint)x1, weight * fx * (1.0f - fy) * in_x1 * in_y0);
+  add_texel(sum, texels, srgb_to_linear, row1 + (uint)x0, weight * (1.0f - fx) * fy * in_x0 * in_y1);
+  add_texel(sum, texels, srgb_to_linear, row1 + (uint)x1, weight * fx * fy * in_x1 * in_y1);
 }
 
-/* Level of detail of a footprint: log2 of the longer screen axis in level-0 texels, clamped to
- * [0, level_count - 1]. NaN or infinite derivatives select the coarsest level. */
-inline float trilinear_lod(const FaceGpu* face, float dudx, float dvdx, float dudy, float dvdy) {
-  const float w = (float)face->width;
-  const float h = (float)face->height;
-  const float len_x = (dudx * w) * (dudx * w) + (dvdx * h) * (dvdx * h);
-  const float len_y = (dudy * w) * (dudy * w) + (dvdy * h) * (dvdy * h);
-  const float rho_squared = fmax(len_x, len_y);
-  const float max_lod = (float)(face->level_count - 1);
-  if (!(rho_squared < INFINITY)) return max_lod;
-  /* log2(rho) = 0.5 * log2(rho^2) */
-  return fmin(fmax(0.5f * log2(fmax(rho_squared, 1e-30f)), 0.0f), max_lod);
-}
-
-/* Trilinear lookup with clamp addressing: the baseline the method issue replaces. */
-inline float4 sample_trilinear_clamp(const FaceGpu* face, __global const uint* level_offsets,
-                                     __global const uint* texels, __global const float* srgb_to_linear,
-                                     float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
-  const float lod = trilinear_lod(face, dudx, dvdx, dudy, dvdy);
+/* weight * trilinear at `lod` (clamped to the chain) into sum. */
+inline void accumulate_trilinear(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
+                                 TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
+                                 float lod, float weight, int address) {
+  lod = fmin(fmax(lod, 0.0f), (float)(face->level_count - 1));
   const int level0 = (int)lod;
   const int level1 = min(level0 + 1, face->level_count - 1);
   const float t = lod - (float)level0;
-  const float4 c0 = bilinear_clamp(texels, srgb_to_linear, level_offsets[face->level_table + (uint)level0],
-                                   max(face->width >> level0, 1), max(face->height >> level0, 1), u, v);
-  if (t == 0.0f) return c0;
-  const float4 c1 = bilinear_clamp(texels, srgb_to_linear, level_offsets[face->level_table + (uint)level1],
-                                   max(face->width >> level1, 1), max(face->height >> level1, 1), u, v);
-  return c0 * (1.0f - t) + c1 * t;
+  accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level0), u, v, weight * (1.0f - t), address);
+  accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level1), u, v, weight * t, address);
 }
 
-/* Batch of lookups for tests and benchmarks: one per work-item.
- * lookups[i] = (face, u, v, dudx, dvdx, dudy, dvdy) as 7 floats (face stored as a float index). */
+/* Screen axes of the footprint in level-0 texels, squared lengths. A non-finite footprint
+ * (NaN or infinite derivatives) reads as infinitely large: the coarsest level. */
+typedef struct {
+  float ax_u, ax_v, ay_u, ay_v; /* d(uv)/dx and d(uv)/dy in uv units */
+  float len2_x, len2_y;         /* squared lengths in level-0 texels */
+  int finite;
+} Footprint;
+
+inline Footprint footprint(const FaceGpu* face, float dudx, float dvdx, float dudy, float dvdy) {
+  Footprint f;
+  const float w = (float)face->width, h = (float)face->height;
+  f.ax_u = dudx;
+  f.ax_v = dvdx;
+  f.ay_u = dudy;
+  f.ay_v = dvdy;
+  f.len2_x = (dudx * w) * (dudx * w) + (dvdx * h) * (dvdx * h);
+  f.len2_y = (dudy * w) * (dudy * w) + (dvdy * h) * (dvdy * h);
+  f.finite = f.len2_x < INFINITY && f.len2_y < INFINITY;
+  return f;
+}
+
+/* lod of a footprint whose longer axis has squared length len2 texels (level 0). */
+inline float lod_of(float len2) {
+  return 0.5f * approx_log2(fmax(len2, 1e-30f));
+}
+
+inline void accumulate_aniso(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
+                             TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
+                             Footprint f, int max_aniso, int address) {
+  const int x_major = f.len2_x >= f.len2_y;
+  const float major2 = x_major ? f.len2_x : f.len2_y;
+  const float minor2 = x_major ? f.len2_y : f.len2_x;
+  /* N = min(ceil(major / minor), max_aniso) probes; ratio computed on squares, then sqrt. */
+  const float ratio = minor2 > 0.0f ? sqrt(major2 / minor2) : (float)max_aniso;
+  const int probes = f.finite ? clamp((int)__builtin_ceilf(fmin(ratio, 16.0f)), 1, max_aniso) : 1;
+  const float inv_probes = 1.0f / (float)probes;
+  /* Each probe is trilinear at log2(major / N). */
+  const float lod = f.finite ? lod_of(major2) - approx_log2((float)probes) : (float)(face->level_count - 1);
+  const float step_u = (x_major ? f.ax_u : f.ay_u) * inv_probes;
+  const float step_v = (x_major ? f.ax_v : f.ay_v) * inv_probes;
+  /* Probe i sits at (i + 0.5) / N - 0.5 of the major axis from the centre. */
+  float pu = u + step_u * (0.5f - 0.5f * (float)probes);
+  float pv = v + step_v * (0.5f - 0.5f * (float)probes);
+  if (!f.finite) {
+    pu = u;
+    pv = v;
+  }
+  for (int i = 0; i < probes; ++i) {
+    accumulate_trilinear(sum, face, level_offsets, texels, srgb_to_linear, pu, pv, lod, inv_probes, address);
+    pu += step_u;
+    pv += step_v;
+  }
+}
+
+/* EWA over one level (pbrt-v4's MIPMap::EWA, Gaussian alpha = 2): the weights are divided by
+ * their total over the whole ellipse, so sum.weight is the fraction of it inside the face. */
+inline void accumulate_ewa_level(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
+                                 TEXEL_BUFFER texels, __global const float* srgb_to_linear, int level_index,
+                                 float u, float v, float a_u, float a_v, float b_u, float b_v, float weight,
+                                 int address) {
+  const Level level = face_level(face, level_offsets, level_index);
+  const float w = (float)level.width, h = (float)level.height;
+  float s = u, t = v;
+  if (address == SEAMCL_ADDRESS_WRAP) {
+    s = s - __builtin_floorf(s);
+    t = t - __builtin_floorf(t);
+  }
+  /* Centre and axes in texels of this level; the centre kept within two widths of the level. */
+  const float cs = fmin(fmax(s * w - 0.5f, -2.0f * w - 2.0f), 3.0f * w + 2.0f);
+  const float ct = fmin(fmax(t * h - 0.5f, -2.0f * h - 2.0f), 3.0f * h + 2.0f);
+  const float x0 = a_u * w, y0 = a_v * h, x1 = b_u * w, y1 = b_v * h;
+  float A = y0 * y0 + y1 * y1 + 1.0f;
+  float B = -2.0f * (x0 * y0 + x1 * y1);
+  float C = x0 * x0 + x1 * x1 + 1.0f;
+  const float inv_f = 1.0f / (A * C - B * B * 0.25f);
+  A *= inv_f;
+  B *= inv_f;
+  C *= inv_f;
+  const float det = -B * B + 4.0f * A * C;
+  const float inv_det = 1.0f / det;
+  const float u_extent = 2.0f * inv_det * sqrt(det * C);
+  const float v_extent = 2.0f * inv_det * sqrt(A * det);
+  /* Bounded to two level widths around the level: a wider ellipse only repeats what it holds. */
+  const int s0 = (int)fmax(__builtin_ceilf(cs - u_extent), -2.0f * w - 2.0f);
+  const int s1 = (int)fmin(__builtin_floorf(cs + u_extent), 3.0f * w + 2.0f);
+  const int t0 = (int)fmax(__builtin_ceilf(ct - v_extent), -2.0f * h - 2.0f);
+  const int t1 = (int)fmin(__builtin_floorf(ct + v_extent), 3.0f * h + 2.0f);
+  FilterSum level_sum = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  float total = 0.0f;
+  for (int it = t0; it <= t1; ++it) {
+    const float tt = (float)it - ct;
+    float in_y;
+    const int iy = address_texel(it, level.height, address, &in_y);
+    for (int is = s0; is <= s1; ++is) {
+      const float ss = (float)is - cs;
+      const float r2 = A * ss * ss + B * ss * tt + C * tt * tt;
+      if (r2 >= 1.0f) continue;
+      const float gauss = exp(-2.0f * r2) - exp(-2.0f);
+      float in_x;
+      const int ix = address_texel(is, level.width, address, &in_x);
+      total += gauss;
+      add_texel(&level_sum, texels, srgb_to_linear, level.offset + (uint)(iy * level.width + ix), gauss * in_x * in_y);
+    }
+  }
+  const float scale = total > 0.0f ? weight / total : 0.0f;
+  sum->r += level_sum.r * scale;
+  sum->g += level_sum.g * scale;
+  sum->b += level_sum.b * scale;
+  sum->a += level_sum.a * scale;
+  sum->weight += level_sum.weight * scale;
+}
+
+inline void accumulate_ewa(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
+                           TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
+                           Footprint f, int max_aniso, int address) {
+  if (!f.finite) {
+    accumulate_trilinear(sum, face, level_offsets, texels, srgb_to_linear, u, v, (float)(face->level_count - 1), 1.0f, address);
+    return;
+  }
+  /* Major axis first; clamp the eccentricity to max_aniso by growing the minor axis. */
+  const int x_major = f.len2_x >= f.len2_y;
+  float a_u = x_major ? f.ax_u : f.ay_u, a_v = x_major ? f.ax_v : f.ay_v;
+  float b_u = x_major ? f.ay_u : f.ax_u, b_v = x_major ? f.ay_v : f.ax_v;
+  const float major2 = x_major ? f.len2_x : f.len2_y;
+  float minor2 = x_major ? f.len2_y : f.len2_x;
+  const float limit = (float)(max_aniso * max_aniso);
+  if (minor2 * limit < major2 && minor2 > 0.0f) {
+    const float scale = sqrt(major2 / (minor2 * limit));
+    b_u *= scale;
+    b_v *= scale;
+    minor2 = major2 / limit;
+  }
+  if (!(minor2 > 0.0f)) {
+    accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, 0), u, v, 1.0f, address);
+    return;
+  }
+  /* The level where the minor axis spans about one texel. */
+  const float lod = fmin(fmax(lod_of(minor2), 0.0f), (float)(face->level_count - 1));
+  const int level0 = (int)lod;
+  const int level1 = min(level0 + 1, face->level_count - 1);
+  const float t = lod - (float)level0;
+  accumulate_ewa_level(sum, face, level_offsets, texels, srgb_to_linear, level0, u, v, a_u, a_v, b_u, b_v, 1.0f - t, address);
+  if (t > 0.0f) {
+    accumulate_ewa_level(sum, face, level_offsets, texels, srgb_to_linear, level1, u, v, a_u, a_v, b_u, b_v, t, address);
+  }
+}
+
+/* The filtered sum of one lookup, before any renormalisation. */
+inline FilterSum filter_texture(const FaceGpu* face, __global const uint* level_offsets, TEXEL_BUFFER texels,
+                                __global const float* srgb_to_linear, SamplerParams sampler, int address,
+                                float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
+  FilterSum sum = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  const Footprint f = footprint(face, dudx, dvdx, dudy, dvdy);
+  if (sampler.filter == SEAMCL_FILTER_BILINEAR) {
+    accumulate_bilinear(&sum, texels, srgb_to_linear, face_level(face, level_offsets, 0), u, v, 1.0f, address);
+  } else if (sampler.filter == SEAMCL_FILTER_TRILINEAR) {
+    const float lod = f.finite ? lod_of(fmax(f.len2_x, f.len2_y)) : (float)(face->level_count - 1);
+    accumulate_trilinear(&sum, face, level_offsets, texels, srgb_to_linear, u, v, lod, 1.0f, address);
+  } else if (sampler.filter == SEAMCL_FILTER_ANISO) {
+    accumulate_aniso(&sum, face, level_offsets, texels, srgb_to_linear, u, v, f, sampler.max_aniso, address);
+  } else {
+    accumulate_ewa(&sum, face, level_offsets, texels, srgb_to_linear, u, v, f, sampler.max_aniso, address);
+  }
+  return sum;
+}
+
+/* One texture lookup as a seam method asks for it: the one place where a FilterSum becomes a
+ * colour. Without renormalisation the sum is the colour (border taps added black). With it
+ * (discard), colour = sum / weight over the taps inside; when no tap is inside, zero_coverage
+ * decides: a clamped trilinear lookup at the centre clamped to the face, or the raw 0/0. */
+inline float4 sample_texture(const FaceGpu* face, __global const uint* level_offsets, TEXEL_BUFFER texels,
+                             __global const float* srgb_to_linear, SamplerParams sampler,
+                             float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
+  FilterSum sum = filter_texture(face, level_offsets, texels, srgb_to_linear, sampler, sampler.address,
+                                 u, v, dudx, dvdx, dudy, dvdy);
+  if (!sampler.renormalize) return (float4)(sum.r, sum.g, sum.b, sum.a);
+  if (sum.weight == 0.0f && sampler.zero_coverage == SEAMCL_ZERO_COVERAGE_CLAMP) {
+    SamplerParams fallback = sampler;
+    fallback.filter = SEAMCL_FILTER_TRILINEAR;
+    sum = filter_texture(face, level_offsets, texels, srgb_to_linear, fallback, SEAMCL_ADDRESS_CLAMP,
+                         fmin(fmax(u, 0.0f), 1.0f), fmin(fmax(v, 0.0f), 1.0f), dudx, dvdx, dudy, dvdy);
+  }
+  const float inv_weight = 1.0f / sum.weight;
+  return (float4)(sum.r * inv_weight, sum.g * inv_weight, sum.b * inv_weight, sum.a * inv_weight);
+}
+
+/* Lookups for tests and benchmarks, one per work-item: lookups[7 i ..] = face (as a float), u, v,
+ * dudx, dvdx, dudy, dvdy; out[i] = the lookup's colour. */
 __kernel void texture_lookup_batch(__global const FaceGpu* faces, __global const uint* level_offsets,
-                                   __global const uint* texels, __global const float* srgb_to_linear,
+                                   TEXEL_BUFFER texels, __global const float* srgb_to_linear, SamplerParams sampler,
                                    __global const float* lookups, uint count, __global float4* out) {
   const uint i = get_global_id(0);
   if (i >= count) return;
   __global const float* q = lookups + 7 * i;
   const FaceGpu face = faces[(uint)q[0]];
-  out[i] = sample_trilinear_clamp(&face, level_offsets, texels, srgb_to_linear, q[1], q[2], q[3], q[4], q[5], q[6]);
+  out[i] = sample_texture(&face, level_offsets, texels, srgb_to_linear, sampler, q[1], q[2], q[3], q[4], q[5], q[6]);
+}
+
+/* The same lookups' FilterSum before renormalisation: (r, g, b, a) and the weight inside. */
+__kernel void texture_filter_batch(__global const FaceGpu* faces, __global const uint* level_offsets,
+                                   TEXEL_BUFFER texels, __global const float* srgb_to_linear, SamplerParams sampler,
+                                   __global const float* lookups, uint count, __global float4* out,
+                                   __global float* weights) {
+  const uint i = get_global_id(0);
+  if (i >= count) return;
+  __global const float* q = lookups + 7 * i;
+  const FaceGpu face = faces[(uint)q[0]];
+  const FilterSum sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, sampler, sampler.address, q[1], q[2],
+                                       q[3], q[4], q[5], q[6]);
+  out[i] = (float4)(sum.r, sum.g, sum.b, sum.a);
+  weights[i] = sum.weight;
 }

@@ -11,7 +11,10 @@ using namespace seamcl;
 TEST(RenderOptions, DefaultsWhenEmpty) {
   const RenderOptions o = parse_render_options(json::object());
   EXPECT_EQ(o.scene, "paper");
-  EXPECT_EQ(o.method, Method::Clamp);
+  EXPECT_EQ(o.method, Method::Discard);
+  EXPECT_EQ(o.filter, Filter::Aniso);
+  EXPECT_EQ(o.zero_coverage, ZeroCoverage::Clamp);
+  EXPECT_EQ(o.texels, TexelFormat::Rgba8);
   EXPECT_EQ(o.msaa, 1);
   EXPECT_EQ(o.aniso, 16);
   EXPECT_EQ(o.width, 480);
@@ -21,9 +24,14 @@ TEST(RenderOptions, DefaultsWhenEmpty) {
 }
 
 TEST(RenderOptions, ReadsEveryKey) {
-  const RenderOptions o = parse_render_options(json{{"scene", "quad2"}, {"method", "clamp"}, {"msaa", 8}, {"aniso", 4},
-                                                    {"size", "64x32"}, {"centroid", true}, {"frame", 3}, {"frames", 10}});
+  const RenderOptions o = parse_render_options(json{{"scene", "quad2"}, {"method", "black"}, {"msaa", 8}, {"aniso", 4},
+                                                    {"size", "64x32"}, {"centroid", true}, {"frame", 3}, {"frames", 10},
+                                                    {"filter", "ewa"}, {"zero_coverage", "nan"}, {"texels", "rgba32f"}});
   EXPECT_EQ(o.scene, "quad2");
+  EXPECT_EQ(o.method, Method::Black);
+  EXPECT_EQ(o.filter, Filter::Ewa);
+  EXPECT_EQ(o.zero_coverage, ZeroCoverage::Nan);
+  EXPECT_EQ(o.texels, TexelFormat::Rgba32f);
   EXPECT_EQ(o.msaa, 8);
   EXPECT_EQ(o.aniso, 4);
   EXPECT_EQ(o.width, 64);
@@ -39,6 +47,11 @@ TEST(RenderOptions, ReadsEveryKey) {
 TEST(RenderOptions, EnumNamesRoundTrip) {
   for (const std::string& name : method_names()) EXPECT_EQ(to_string(*parse_method(name)), name);
   for (const std::string& name : shading_mode_names()) EXPECT_EQ(to_string(*parse_shading_mode(name)), name);
+  for (const std::string& name : filter_names()) EXPECT_EQ(to_string(*parse_filter(name)), name);
+  for (const std::string& name : zero_coverage_names()) EXPECT_EQ(to_string(*parse_zero_coverage(name)), name);
+  for (const std::string& name : texel_format_names()) EXPECT_EQ(to_string(*parse_texel_format(name)), name);
+  EXPECT_EQ(method_names(), (std::vector<std::string>{"clamp", "black", "discard"}));
+  EXPECT_EQ(filter_names(), (std::vector<std::string>{"bilinear", "trilinear", "aniso", "ewa"}));
   EXPECT_FALSE(parse_method("Clamp").has_value());
   EXPECT_FALSE(parse_shading_mode("").has_value());
 }
@@ -48,6 +61,22 @@ struct BadOption {
   std::string field;
   std::string message_part;
 };
+
+TEST(RenderOptions, MethodsAreSamplerSettings) {
+  const SamplerParams clamp = sampler_params(Method::Clamp, Filter::Aniso, 16, ZeroCoverage::Clamp);
+  EXPECT_EQ(clamp.address, SEAMCL_ADDRESS_CLAMP);
+  EXPECT_EQ(clamp.renormalize, 0);
+  const SamplerParams black = sampler_params(Method::Black, Filter::Trilinear, 4, ZeroCoverage::Clamp);
+  EXPECT_EQ(black.address, SEAMCL_ADDRESS_BORDER);
+  EXPECT_EQ(black.renormalize, 0);
+  EXPECT_EQ(black.filter, SEAMCL_FILTER_TRILINEAR);
+  const SamplerParams discard = sampler_params(Method::Discard, Filter::Ewa, 8, ZeroCoverage::Nan);
+  EXPECT_EQ(discard.address, SEAMCL_ADDRESS_BORDER);
+  EXPECT_EQ(discard.renormalize, 1);
+  EXPECT_EQ(discard.filter, SEAMCL_FILTER_EWA);
+  EXPECT_EQ(discard.max_aniso, 8);
+  EXPECT_EQ(discard.zero_coverage, SEAMCL_ZERO_COVERAGE_NAN);
+}
 
 TEST(RenderOptions, RefusalsNameTheField) {
   const std::vector<BadOption> cases = {
@@ -74,6 +103,9 @@ TEST(RenderOptions, RefusalsNameTheField) {
       {{{"frames", 0}}, "frames", "1.."},
       {{{"scene", ""}}, "scene", "empty"},
       {{{"colour", "red"}}, "colour", "unknown option"},
+      {{{"filter", "box"}}, "filter", "unknown filter 'box'"},
+      {{{"zero_coverage", "zero"}}, "zero_coverage", "unknown zero_coverage mode"},
+      {{{"texels", "rgba16"}}, "texels", "unknown texel format"},
   };
   for (const BadOption& c : cases) {
     try {

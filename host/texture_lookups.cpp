@@ -1,0 +1,90 @@
+#include "texture_lookups.h"
+
+#include <algorithm>
+
+#include "renderer.h"
+
+namespace seamcl {
+namespace {
+
+template <typename T>
+cl::Buffer read_only_buffer(const cl::Context& context, const std::vector<T>& data) {
+  // One element of padding keeps empty arrays legal (OpenCL refuses zero-sized buffers).
+  std::vector<T> padded = data;
+  if (padded.empty()) padded.resize(1);
+  return cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, padded.size() * sizeof(T), padded.data());
+}
+
+}  // namespace
+
+TextureLookups::TextureLookups(ClRuntime& runtime, const PackedScene& textures) : runtime_(runtime) {
+  const cl::Program& program = runtime.program(program_options(textures.format));
+  sample_kernel_ = cl::Kernel(program, "texture_lookup_batch");
+  filter_kernel_ = cl::Kernel(program, "texture_filter_batch");
+  const cl::Context& context = runtime.context();
+  faces_ = read_only_buffer(context, textures.faces);
+  level_offsets_ = read_only_buffer(context, textures.level_offsets);
+  texels_ = textures.format == TexelFormat::Rgba8 ? read_only_buffer(context, textures.texels8)
+                                                  : read_only_buffer(context, textures.texels32);
+  const auto& table = srgb_to_linear_table();
+  srgb_table_ = read_only_buffer(context, std::vector<float>(table.begin(), table.end()));
+}
+
+void TextureLookups::set_lookups(const std::vector<Lookup>& lookups) {
+  std::vector<float> packed;
+  packed.reserve(lookups.size() * 7);
+  for (const Lookup& l : lookups) {
+    packed.insert(packed.end(), {static_cast<float>(l.face), l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy});
+  }
+  count_ = lookups.size();
+  lookups_ = read_only_buffer(runtime_.context(), packed);
+  colors_ = cl::Buffer(runtime_.context(), CL_MEM_WRITE_ONLY, std::max<size_t>(count_, 1) * sizeof(cl_float4));
+  weights_ = cl::Buffer(runtime_.context(), CL_MEM_WRITE_ONLY, std::max<size_t>(count_, 1) * sizeof(cl_float));
+}
+
+std::vector<glm::vec4> TextureLookups::sample(const SamplerParams& sampler, double* kernel_ms) {
+  std::vector<glm::vec4> out(count_);
+  if (count_ == 0) return out;
+  cl::Kernel& k = sample_kernel_;
+  k.setArg(0, faces_);
+  k.setArg(1, level_offsets_);
+  k.setArg(2, texels_);
+  k.setArg(3, srgb_table_);
+  k.setArg(4, sampler);
+  k.setArg(5, lookups_);
+  k.setArg(6, static_cast<cl_uint>(count_));
+  k.setArg(7, colors_);
+  cl::Event event;
+  const size_t group = 64;
+  runtime_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange((count_ + group - 1) / group * group),
+                                        cl::NDRange(group), nullptr, &event);
+  runtime_.queue().enqueueReadBuffer(colors_, CL_TRUE, 0, count_ * sizeof(cl_float4), out.data());
+  if (kernel_ms != nullptr) *kernel_ms = event_milliseconds(event);
+  return out;
+}
+
+std::vector<FilterSum> TextureLookups::filter(const SamplerParams& sampler) {
+  std::vector<FilterSum> out(count_);
+  if (count_ == 0) return out;
+  cl::Kernel& k = filter_kernel_;
+  k.setArg(0, faces_);
+  k.setArg(1, level_offsets_);
+  k.setArg(2, texels_);
+  k.setArg(3, srgb_table_);
+  k.setArg(4, sampler);
+  k.setArg(5, lookups_);
+  k.setArg(6, static_cast<cl_uint>(count_));
+  k.setArg(7, colors_);
+  k.setArg(8, weights_);
+  const size_t group = 64;
+  runtime_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange((count_ + group - 1) / group * group),
+                                        cl::NDRange(group));
+  std::vector<glm::vec4> colors(count_);
+  std::vector<float> weights(count_);
+  runtime_.queue().enqueueReadBuffer(colors_, CL_TRUE, 0, count_ * sizeof(cl_float4), colors.data());
+  runtime_.queue().enqueueReadBuffer(weights_, CL_TRUE, 0, count_ * sizeof(cl_float), weights.data());
+  for (size_t i = 0; i < count_; ++i) out[i] = {colors[i], weights[i]};
+  return out;
+}
+
+}  // namespace seamcl

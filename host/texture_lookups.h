@@ -1,0 +1,39 @@
+// Batches of texture lookups on the device (kernels texture_lookup_batch and
+// texture_filter_batch): the sampler on its own, for its tests and its benchmark.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "cl_runtime.h"
+#include "packed_scene.h"
+
+namespace seamcl {
+
+struct Lookup {
+  uint32_t face = 0;
+  float u = 0, v = 0;                         // face space
+  float dudx = 0, dvdx = 0, dudy = 0, dvdy = 0;  // per pixel
+};
+
+class TextureLookups {
+ public:
+  // Uploads the packed textures (in the packed format) once.
+  TextureLookups(ClRuntime& runtime, const PackedScene& textures);
+
+  // Uploads the lookups; later calls run them.
+  void set_lookups(const std::vector<Lookup>& lookups);
+  // The colours sample_texture returns for each lookup; `kernel_ms` gets the kernel's time.
+  std::vector<glm::vec4> sample(const SamplerParams& sampler, double* kernel_ms = nullptr);
+  // The FilterSums before renormalisation (colour sums and the weight inside the face).
+  std::vector<FilterSum> filter(const SamplerParams& sampler);
+
+ private:
+  ClRuntime& runtime_;
+  cl::Kernel sample_kernel_, filter_kernel_;
+  cl::Buffer faces_, level_offsets_, texels_, srgb_table_, lookups_, colors_, weights_;
+  size_t count_ = 0;
+};
+
+}  // namespace seamcl
