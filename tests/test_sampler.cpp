@@ -1,0 +1,261 @@
+// The sampler (kernels/texture_sample.cl) against its twin for every filter, address mode,
+// storage and method, and the properties Discard rests on: a constant texture stays exactly
+// constant, weights sum to one, nothing outside a face is read, NaN only where every tap is out.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "cl_runtime.h"
+#include "packed_scene.h"
+#include "render_options.h"
+#include "texture_lookups.h"
+#include "texture_sample.h"
+
+using namespace seamcl;
+
+namespace {
+
+ClRuntime& runtime() {
+  static ClRuntime rt;
+  return rt;
+}
+
+float uniform(std::mt19937& rng, float lo, float hi) {
+  return lo + (hi - lo) * static_cast<float>(rng() % 1000001u) / 1000000.0f;
+}
+
+// Faces side by side, each with its own texture; `fill` gives level 0's texel (face, i, j).
+template <typename Fill>
+Scene texture_scene(const std::vector<std::pair<int, int>>& sizes, Fill fill) {
+  Scene scene;
+  scene.name = "textures";
+  for (size_t f = 0; f < sizes.size(); ++f) {
+    const auto base = static_cast<uint32_t>(scene.positions.size());
+    const float x = static_cast<float>(f) * 2.0f;
+    scene.positions.insert(scene.positions.end(), {{x, 0, 0}, {x + 1, 0, 0}, {x + 1, 1, 0}, {x, 1, 0}});
+    TextureLevel level{sizes[f].first, sizes[f].second, {}};
+    for (int j = 0; j < level.height; ++j) {
+      for (int i = 0; i < level.width; ++i) level.texels.push_back(fill(static_cast<int>(f), i, j));
+    }
+    Face face;
+    face.vertices = {base, base + 1, base + 2, base + 3};
+    face.texture = build_mip_chain(std::move(level));
+    scene.faces.push_back(std::move(face));
+  }
+  return scene;
+}
+
+Scene random_texture_scene(uint32_t seed) {
+  std::mt19937 rng(seed);
+  return texture_scene({{64, 64}, {32, 8}, {1, 16}, {128, 32}, {1, 1}}, [&](int, int, int) {
+    return glm::vec4(uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0.5f, 1));
+  });
+}
+
+// Coordinates near and far outside [0,1]^2, derivatives from zero through tiny to huge, any
+// orientation; a few non-finite ones.
+std::vector<Lookup> random_lookups(std::mt19937& rng, uint32_t faces, int count) {
+  std::vector<Lookup> out;
+  for (int i = 0; i < count; ++i) {
+    Lookup l;
+    l.face = rng() % faces;
+    const bool far = i % 11 == 0;
+    l.u = far ? uniform(rng, -50, 50) : uniform(rng, -0.3f, 1.3f);
+    l.v = far ? uniform(rng, -50, 50) : uniform(rng, -0.3f, 1.3f);
+    const float scale = i % 13 == 0 ? 0.0f : std::pow(10.0f, uniform(rng, -6, 1));
+    const float angle = uniform(rng, 0, 6.2831853f);
+    const float ratio = uniform(rng, 1, 24);
+    l.dudx = std::cos(angle) * scale;
+    l.dvdx = std::sin(angle) * scale;
+    l.dudy = -std::sin(angle) * scale / ratio;
+    l.dvdy = std::cos(angle) * scale / ratio;
+    out.push_back(l);
+  }
+  out.push_back({0, NAN, 0.5f, 0.01f, 0, 0, 0.01f});
+  out.push_back({1, 0.5f, 0.5f, INFINITY, 0, 0, 1});
+  out.push_back({2, 0.5f, 0.5f, NAN, NAN, NAN, NAN});
+  out.push_back({3, 1e30f, -1e30f, 1e20f, -1e20f, 1e20f, 1e20f});
+  return out;
+}
+
+bool near(float gpu, float twin, float tolerance) {
+  if (std::isnan(twin) || std::isnan(gpu)) return std::isnan(twin) && std::isnan(gpu);
+  return std::fabs(gpu - twin) <= tolerance * std::max(1.0f, std::fabs(twin));
+}
+
+const SamplerParams kDiscard = sampler_params(Method::Discard, Filter::Aniso, 16, ZeroCoverage::Clamp);
+
+SamplerParams with_filter(SamplerParams p, int filter) {
+  p.filter = filter;
+  return p;
+}
+
+}  // namespace
+
+TEST(KernelVsTwin, SamplerEveryFilterAddressModeStorageAndMethod) {
+  std::mt19937 rng(5);
+  const Scene scene = random_texture_scene(3);
+  const std::vector<Lookup> lookups = random_lookups(rng, static_cast<uint32_t>(scene.faces.size()), 3000);
+  for (TexelFormat format : {TexelFormat::Rgba8, TexelFormat::Rgba32f}) {
+    const PackedScene packed = pack_scene(scene, format);
+    TextureLookups device(runtime(), packed);
+    device.set_lookups(lookups);
+    for (int filter : {SEAMCL_FILTER_BILINEAR, SEAMCL_FILTER_TRILINEAR, SEAMCL_FILTER_ANISO, SEAMCL_FILTER_EWA}) {
+      for (int address : {SEAMCL_ADDRESS_CLAMP, SEAMCL_ADDRESS_WRAP, SEAMCL_ADDRESS_BORDER}) {
+        for (int renormalize : {0, 1}) {
+          for (int zero_coverage : {SEAMCL_ZERO_COVERAGE_CLAMP, SEAMCL_ZERO_COVERAGE_NAN}) {
+            if (zero_coverage == SEAMCL_ZERO_COVERAGE_NAN && !renormalize) continue;
+            SamplerParams sampler{};
+            sampler.filter = filter;
+            sampler.address = address;
+            sampler.renormalize = renormalize;
+            sampler.max_aniso = 1 + static_cast<int>(rng() % 16);
+            sampler.zero_coverage = zero_coverage;
+            SCOPED_TRACE(testing::Message() << "format " << to_string(format) << " filter " << filter << " address "
+                                            << address << " renormalize " << renormalize << " zero_coverage "
+                                            << zero_coverage << " max_aniso " << sampler.max_aniso);
+            const std::vector<glm::vec4> gpu = device.sample(sampler);
+            const std::vector<FilterSum> gpu_sums = device.filter(sampler);
+            size_t bad = 0;
+            for (size_t i = 0; i < lookups.size(); ++i) {
+              const Lookup& l = lookups[i];
+              const glm::vec4 twin =
+                  sample_texture_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+              const FilterSum twin_sum = filter_texture_reference(packed.textures(), l.face, sampler, sampler.address, l.u,
+                                                                  l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+              // 1e-5: the kernels round as the twin does except in the exp and sqrt builtins (EWA, aniso).
+              bool ok = near(gpu_sums[i].weight, twin_sum.weight, 1e-5f);
+              for (int c = 0; c < 4; ++c) {
+                ok &= near(gpu[i][c], twin[c], 1e-5f) && near(gpu_sums[i].color[c], twin_sum.color[c], 1e-5f);
+              }
+              if (!ok && bad++ < 3) {
+                ADD_FAILURE() << "lookup " << i << " face " << l.face << " uv " << l.u << "," << l.v << " d " << l.dudx
+                              << "," << l.dvdx << "," << l.dudy << "," << l.dvdy << ": gpu " << gpu[i].r << " twin "
+                              << twin.r << " weight " << gpu_sums[i].weight << " / " << twin_sum.weight;
+              }
+            }
+            EXPECT_EQ(bad, 0u);
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(Discard, ConstantTextureIsReturnedExactlyEverywhere) {
+  const glm::vec4 constant(0.3f, 0.6f, 0.9f, 1.0f);
+  const Scene scene = texture_scene({{64, 64}, {16, 128}, {1, 4}, {8, 8}}, [&](int, int, int) { return constant; });
+  std::mt19937 rng(9);
+  // Footprints that straddle edges and corners: centres near the border, wide derivatives.
+  std::vector<Lookup> lookups;
+  for (int i = 0; i < 4000; ++i) {
+    const float edge = uniform(rng, -0.05f, 0.05f);
+    Lookup l;
+    l.face = rng() % 4;
+    l.u = i % 2 ? edge : uniform(rng, -0.1f, 1.1f);
+    l.v = i % 3 ? 1.0f + edge : uniform(rng, -0.1f, 1.1f);
+    const float scale = std::pow(10.0f, uniform(rng, -4, 0));
+    l.dudx = scale * uniform(rng, -1, 1);
+    l.dvdx = scale * uniform(rng, -1, 1);
+    l.dudy = scale * uniform(rng, -1, 1) * 0.1f;
+    l.dvdy = scale * uniform(rng, -1, 1);
+    lookups.push_back(l);
+  }
+  for (TexelFormat format : {TexelFormat::Rgba32f, TexelFormat::Rgba8}) {
+    const PackedScene packed = pack_scene(scene, format);
+    // RGBA8 stores the constant after an sRGB round trip; that is the constant it must return.
+    const glm::vec4 stored = format == TexelFormat::Rgba8 ? decode_srgb8(encode_srgb8(constant)) : constant;
+    TextureLookups device(runtime(), packed);
+    device.set_lookups(lookups);
+    for (int filter : {SEAMCL_FILTER_BILINEAR, SEAMCL_FILTER_TRILINEAR, SEAMCL_FILTER_ANISO, SEAMCL_FILTER_EWA}) {
+      SCOPED_TRACE(testing::Message() << to_string(format) << " filter " << filter);
+      const std::vector<glm::vec4> colors = device.sample(with_filter(kDiscard, filter));
+      const std::vector<FilterSum> sums = device.filter(with_filter(kDiscard, filter));
+      size_t partial = 0;
+      for (size_t i = 0; i < lookups.size(); ++i) {
+        for (int c = 0; c < 4; ++c) ASSERT_NEAR(colors[i][c], stored[c], 1e-6f) << "lookup " << i;
+        partial += sums[i].weight > 0.0f && sums[i].weight < 0.999f;
+      }
+      EXPECT_GT(partial, lookups.size() / 10) << "the cases must straddle edges for the test to mean anything";
+      // Black (no renormalisation) on the same lookups darkens wherever taps fell outside.
+      const std::vector<glm::vec4> black =
+          device.sample(sampler_params(Method::Black, static_cast<Filter>(filter), 16, ZeroCoverage::Clamp));
+      size_t darker = 0;
+      for (size_t i = 0; i < lookups.size(); ++i) darker += black[i].g < stored.g - 1e-3f;
+      EXPECT_GE(darker, partial / 2);
+    }
+  }
+}
+
+TEST(Discard, WeightsSumToOneInsideAndWithClampOrWrap) {
+  const Scene scene = random_texture_scene(4);
+  const PackedScene packed = pack_scene(scene, TexelFormat::Rgba32f);
+  TextureLookups device(runtime(), packed);
+  std::mt19937 rng(12);
+  std::vector<Lookup> lookups = random_lookups(rng, static_cast<uint32_t>(scene.faces.size()), 3000);
+  device.set_lookups(lookups);
+  for (int filter : {SEAMCL_FILTER_BILINEAR, SEAMCL_FILTER_TRILINEAR, SEAMCL_FILTER_ANISO, SEAMCL_FILTER_EWA}) {
+    for (int address : {SEAMCL_ADDRESS_CLAMP, SEAMCL_ADDRESS_WRAP, SEAMCL_ADDRESS_BORDER}) {
+      SamplerParams sampler = with_filter(kDiscard, filter);
+      sampler.address = address;
+      const std::vector<FilterSum> sums = device.filter(sampler);
+      for (size_t i = 0; i < lookups.size(); ++i) {
+        if (address == SEAMCL_ADDRESS_BORDER) {
+          EXPECT_GE(sums[i].weight, 0.0f);
+          EXPECT_LE(sums[i].weight, 1.0f + 1e-5f);
+        } else {
+          EXPECT_NEAR(sums[i].weight, 1.0f, 1e-5f) << "filter " << filter << " address " << address << " lookup " << i;
+        }
+      }
+    }
+  }
+}
+
+TEST(Discard, NaNInNeighbouringMemoryNeverLeaks) {
+  // Faces 0 and 2 are all NaN; face 1, between them in memory, is finite. No lookup on face 1,
+  // whatever its coordinates, may read its neighbours.
+  const Scene scene = texture_scene({{16, 16}, {32, 8}, {16, 16}}, [](int face, int i, int j) {
+    return face == 1 ? glm::vec4(0.1f + 0.02f * static_cast<float>(i % 7), 0.5f, 0.02f * static_cast<float>(j), 1.0f)
+                     : glm::vec4(NAN);
+  });
+  const PackedScene packed = pack_scene(scene, TexelFormat::Rgba32f);
+  ASSERT_TRUE(std::isnan(packed.texels32.front()));
+  TextureLookups device(runtime(), packed);
+  std::mt19937 rng(21);
+  std::vector<Lookup> lookups = random_lookups(rng, 1, 3000);
+  for (Lookup& l : lookups) l.face = 1;
+  device.set_lookups(lookups);
+  for (Method method : {Method::Clamp, Method::Black, Method::Discard}) {
+    for (Filter filter : {Filter::Bilinear, Filter::Trilinear, Filter::Aniso, Filter::Ewa}) {
+      const std::vector<glm::vec4> colors = device.sample(sampler_params(method, filter, 16, ZeroCoverage::Clamp));
+      for (size_t i = 0; i < colors.size(); ++i) {
+        for (int c = 0; c < 4; ++c) {
+          ASSERT_TRUE(std::isfinite(colors[i][c])) << to_string(method) << " " << to_string(filter) << " lookup " << i;
+        }
+      }
+    }
+  }
+}
+
+TEST(ZeroCoverage, NanOnlyWhereEveryTapFallsOutside) {
+  const Scene scene = random_texture_scene(6);
+  const PackedScene packed = pack_scene(scene, TexelFormat::Rgba8);
+  TextureLookups device(runtime(), packed);
+  std::mt19937 rng(33);
+  const std::vector<Lookup> lookups = random_lookups(rng, static_cast<uint32_t>(scene.faces.size()), 4000);
+  device.set_lookups(lookups);
+  for (Filter filter : {Filter::Bilinear, Filter::Trilinear, Filter::Aniso, Filter::Ewa}) {
+    const std::vector<FilterSum> sums = device.filter(sampler_params(Method::Discard, filter, 16, ZeroCoverage::Nan));
+    const std::vector<glm::vec4> raw = device.sample(sampler_params(Method::Discard, filter, 16, ZeroCoverage::Nan));
+    const std::vector<glm::vec4> fixed = device.sample(sampler_params(Method::Discard, filter, 16, ZeroCoverage::Clamp));
+    size_t nan_count = 0;
+    for (size_t i = 0; i < lookups.size(); ++i) {
+      const bool no_tap_inside = sums[i].weight == 0.0f;
+      EXPECT_EQ(std::isnan(raw[i].r), no_tap_inside) << to_string(filter) << " lookup " << i;
+      nan_count += std::isnan(raw[i].r);
+      for (int c = 0; c < 4; ++c) ASSERT_TRUE(std::isfinite(fixed[i][c])) << to_string(filter) << " lookup " << i;
+    }
+    EXPECT_GT(nan_count, 0u) << "far-outside lookups must provoke the failure";
+  }
+}
