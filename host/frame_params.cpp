@@ -29,9 +29,8 @@ FrameParams make_frame_params(const Scene& scene, const Camera& camera, const Re
   p.input_triangles = static_cast<cl_int>(scene.triangle_count());
   p.bin_capacity = bin_capacity;
   p.near_w = kNearPlane;
-  // |ndc| <= g maps to screen [(0.5 - g/2) W, (0.5 + g/2) W]; keep that inside +-kMaxScreenCoordinate.
-  p.guard_x = static_cast<float>(2.0 * kMaxScreenCoordinate / options.width - 1.0);
-  p.guard_y = static_cast<float>(2.0 * kMaxScreenCoordinate / options.height - 1.0);
+  p.guard_x = kGuardBand;
+  p.guard_y = kGuardBand;
   const glm::vec3 l = glm::normalize(scene.light.to_light);
   for (int i = 0; i < 3; ++i) {
     p.light_dir[i] = l[i];

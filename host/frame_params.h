@@ -10,9 +10,11 @@
 namespace seamcl {
 
 inline constexpr float kNearPlane = 0.01f;
-// Snapped screen coordinates stay within +-2^20 pixels: with 8 sub-pixel bits the edge-function
-// products then stay below 2^58, inside a 64-bit integer.
-inline constexpr double kMaxScreenCoordinate = 1 << 20;
+// Clip planes at |x|, |y| <= kGuardBand * w in NDC: one image width (height) beyond each edge.
+// It bounds screen coordinates to [-W, 2W] (with sides <= 16384 the edge-function products stay
+// far inside 64 bits) and so bounds how far the float attribute planes are extrapolated from
+// their reference vertex (a near-plane vertex would otherwise sit millions of pixels away).
+inline constexpr float kGuardBand = 3.0f;
 
 glm::mat4 view_projection(const Camera& camera, int width, int height);
 
