@@ -75,7 +75,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
   ClRuntime runtime(device);
   Renderer renderer(runtime);
   renderer.load_scene(scene, options.texels);
-  renderer.warm_up();
+  renderer.warm_up(options);
   std::vector<RenderResult> runs;
   for (int i = 0; i < args.repeat; ++i) runs.push_back(renderer.render(camera, options));
   const RenderResult& result = runs.back();

@@ -1,6 +1,7 @@
 #include "renderer.h"
 
 #include <algorithm>
+#include <map>
 #include <cassert>
 #include <stdexcept>
 
@@ -27,6 +28,11 @@ size_t round_up(size_t value, size_t multiple) { return (value + multiple - 1) /
 
 struct Renderer::Impl {
   ClRuntime& runtime;
+  // The kernels of one program variant (texel format and sampler configuration).
+  struct KernelSet {
+    cl::Kernel setup, bin_count, bin_scan, bin_fill, raster, shade;
+  };
+  std::map<std::string, KernelSet> kernel_sets;
   cl::Kernel setup_kernel, bin_count_kernel, bin_scan_kernel, bin_fill_kernel, raster_kernel, shade_kernel;
 
   std::unique_ptr<Scene> scene;
@@ -41,7 +47,6 @@ struct Renderer::Impl {
   FrameParams last_params{};
 
   explicit Impl(ClRuntime& rt) : runtime(rt) {
-    create_kernels(TexelFormat::Rgba8);
     const auto& table = srgb_to_linear_table();
     srgb_table = cl::Buffer(runtime.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(float) * table.size(),
                             const_cast<float*>(table.data()));
@@ -49,15 +54,23 @@ struct Renderer::Impl {
     stats = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, sizeof(FrameStats));
   }
 
-  // The program variant for a texel format (the texel buffer's type differs).
-  void create_kernels(TexelFormat format) {
-    const cl::Program& program = runtime.program(program_options(format));
-    setup_kernel = cl::Kernel(program, "triangle_setup");
-    bin_count_kernel = cl::Kernel(program, "bin_count");
-    bin_scan_kernel = cl::Kernel(program, "bin_scan");
-    bin_fill_kernel = cl::Kernel(program, "bin_fill");
-    raster_kernel = cl::Kernel(program, "raster");
-    shade_kernel = cl::Kernel(program, "shade_resolve");
+  // Makes the kernels of the program variant for this texel format and sampler current.
+  void use_kernels(TexelFormat format, const SamplerParams& sampler) {
+    const std::string options = program_options(format, sampler);
+    auto it = kernel_sets.find(options);
+    if (it == kernel_sets.end()) {
+      const cl::Program& program = runtime.program(options);
+      KernelSet set{cl::Kernel(program, "triangle_setup"), cl::Kernel(program, "bin_count"),
+                    cl::Kernel(program, "bin_scan"),       cl::Kernel(program, "bin_fill"),
+                    cl::Kernel(program, "raster"),         cl::Kernel(program, "shade_resolve")};
+      it = kernel_sets.emplace(options, std::move(set)).first;
+    }
+    setup_kernel = it->second.setup;
+    bin_count_kernel = it->second.bin_count;
+    bin_scan_kernel = it->second.bin_scan;
+    bin_fill_kernel = it->second.bin_fill;
+    raster_kernel = it->second.raster;
+    shade_kernel = it->second.shade;
   }
 
   // Packs and uploads the loaded scene in `format`, with the kernels that read it.
@@ -67,7 +80,6 @@ struct Renderer::Impl {
     faces = upload(packed.faces);
     level_offsets = upload(packed.level_offsets);
     texels = format == TexelFormat::Rgba8 ? upload(packed.texels8) : upload(packed.texels32);
-    create_kernels(format);
   }
 
   template <typename T>
@@ -205,6 +217,7 @@ const PackedScene& Renderer::packed_scene() const { return impl_->packed; }
 RenderResult Renderer::render(const Camera& camera, const RenderOptions& options) {
   if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
   if (options.texels != impl_->packed.format) impl_->pack_and_upload(options.texels);
+  impl_->use_kernels(options.texels, sampler_params(options));
   RenderResult result;
   result.width = options.width;
   result.height = options.height;
@@ -238,13 +251,16 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   }
 }
 
-std::string program_options(TexelFormat format) {
-  return format == TexelFormat::Rgba32f ? "-DSEAMCL_TEXELS_F32=1" : "";
+std::string program_options(TexelFormat format, const SamplerParams& sampler) {
+  return std::string(format == TexelFormat::Rgba32f ? "-DSEAMCL_TEXELS_F32=1" : "-DSEAMCL_TEXELS_F32=0") +
+         " -DSEAMCL_SAMPLER_FILTER=" + std::to_string(sampler.filter) +
+         " -DSEAMCL_SAMPLER_ADDRESS=" + std::to_string(sampler.address) +
+         " -DSEAMCL_SAMPLER_RENORMALIZE=" + std::to_string(sampler.renormalize) +
+         " -DSEAMCL_SAMPLER_ZERO_COVERAGE=" + std::to_string(sampler.zero_coverage);
 }
 
-void Renderer::warm_up() {
-  RenderOptions tiny;
-  tiny.texels = impl_->packed.format;
+void Renderer::warm_up(const RenderOptions& options) {
+  RenderOptions tiny = options;
   tiny.width = SEAMCL_TILE_SIZE;
   tiny.height = SEAMCL_TILE_SIZE;
   render(scene().camera, tiny);

@@ -36,8 +36,10 @@ struct RenderResult {
   int attempts = 1;               // > 1 when the tile lists had to grow
 };
 
-// The build options of the program variant that reads `format` texels.
-std::string program_options(TexelFormat format);
+// The build options of the program variant that reads `format` texels with `sampler`'s filter,
+// address mode, renormalisation and zero-coverage rule fixed at build time (max_aniso stays a
+// run-time parameter). See the specialisation note in kernels/texture_sample.cl.
+std::string program_options(TexelFormat format, const SamplerParams& sampler);
 
 class Renderer {
  public:
@@ -54,9 +56,10 @@ class Renderer {
 
   RenderResult render(const Camera& camera, const RenderOptions& options);
 
-  // Renders one tiny frame of the loaded scene so that PoCL compiles every kernel for its local
-  // size now (20-250 ms each, cold) rather than inside the first timed frame.
-  void warm_up();
+  // Renders one tiny frame of the loaded scene with these options (method, filter, texels) so
+  // that the program variant is built and PoCL compiles every kernel for its local size now
+  // (20-250 ms each, cold) rather than inside the first timed frame.
+  void warm_up(const RenderOptions& options);
 
   // The intermediate buffers of the last frame, for the kernel tests.
   FrameParams last_frame_params() const;

@@ -17,10 +17,8 @@ cl::Buffer read_only_buffer(const cl::Context& context, const std::vector<T>& da
 
 }  // namespace
 
-TextureLookups::TextureLookups(ClRuntime& runtime, const PackedScene& textures) : runtime_(runtime) {
-  const cl::Program& program = runtime.program(program_options(textures.format));
-  sample_kernel_ = cl::Kernel(program, "texture_lookup_batch");
-  filter_kernel_ = cl::Kernel(program, "texture_filter_batch");
+TextureLookups::TextureLookups(ClRuntime& runtime, const PackedScene& textures)
+    : runtime_(runtime), format_(textures.format) {
   const cl::Context& context = runtime.context();
   faces_ = read_only_buffer(context, textures.faces);
   level_offsets_ = read_only_buffer(context, textures.level_offsets);
@@ -28,6 +26,17 @@ TextureLookups::TextureLookups(ClRuntime& runtime, const PackedScene& textures) 
                                                   : read_only_buffer(context, textures.texels32);
   const auto& table = srgb_to_linear_table();
   srgb_table_ = read_only_buffer(context, std::vector<float>(table.begin(), table.end()));
+}
+
+TextureLookups::Kernels& TextureLookups::kernels_for(const SamplerParams& sampler) {
+  const std::string options = program_options(format_, sampler);
+  auto it = kernels_.find(options);
+  if (it == kernels_.end()) {
+    const cl::Program& program = runtime_.program(options);
+    it = kernels_.emplace(options, Kernels{cl::Kernel(program, "texture_lookup_batch"),
+                                           cl::Kernel(program, "texture_filter_batch")}).first;
+  }
+  return it->second;
 }
 
 void TextureLookups::set_lookups(const std::vector<Lookup>& lookups) {
@@ -45,7 +54,7 @@ void TextureLookups::set_lookups(const std::vector<Lookup>& lookups) {
 std::vector<glm::vec4> TextureLookups::sample(const SamplerParams& sampler, double* kernel_ms) {
   std::vector<glm::vec4> out(count_);
   if (count_ == 0) return out;
-  cl::Kernel& k = sample_kernel_;
+  cl::Kernel& k = kernels_for(sampler).sample;
   k.setArg(0, faces_);
   k.setArg(1, level_offsets_);
   k.setArg(2, texels_);
@@ -66,7 +75,7 @@ std::vector<glm::vec4> TextureLookups::sample(const SamplerParams& sampler, doub
 std::vector<FilterSum> TextureLookups::filter(const SamplerParams& sampler) {
   std::vector<FilterSum> out(count_);
   if (count_ == 0) return out;
-  cl::Kernel& k = filter_kernel_;
+  cl::Kernel& k = kernels_for(sampler).filter;
   k.setArg(0, faces_);
   k.setArg(1, level_offsets_);
   k.setArg(2, texels_);

@@ -2,6 +2,8 @@
 // texture_filter_batch): the sampler on its own, for its tests and its benchmark.
 #pragma once
 #include <cstdint>
+#include <map>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -30,8 +32,15 @@ class TextureLookups {
   std::vector<FilterSum> filter(const SamplerParams& sampler);
 
  private:
+  // The kernels of the program variant for a sampler configuration (built on first use).
+  struct Kernels {
+    cl::Kernel sample, filter;
+  };
+  Kernels& kernels_for(const SamplerParams& sampler);
+
   ClRuntime& runtime_;
-  cl::Kernel sample_kernel_, filter_kernel_;
+  TexelFormat format_;
+  std::map<std::string, Kernels> kernels_;
   cl::Buffer faces_, level_offsets_, texels_, srgb_table_, lookups_, colors_, weights_;
   size_t count_ = 0;
 };

@@ -16,6 +16,22 @@
 #ifndef SEAMCL_TEXELS_F32
 #define SEAMCL_TEXELS_F32 0
 #endif
+
+/* Build-time specialisation: the host builds one program variant per sampler configuration, so
+ * a kernel holds only the code its filter and method run. PoCL will not vectorise a kernel that
+ * merely contains a varying-length loop (aniso, ewa), even where that loop is never taken.
+ * Without the defines the kernels read the configuration from SamplerParams at run time. */
+#ifdef SEAMCL_SAMPLER_FILTER
+#define SAMPLER_FILTER(s) SEAMCL_SAMPLER_FILTER
+#define SAMPLER_ADDRESS(s) SEAMCL_SAMPLER_ADDRESS
+#define SAMPLER_RENORMALIZE(s) SEAMCL_SAMPLER_RENORMALIZE
+#define SAMPLER_ZERO_COVERAGE(s) SEAMCL_SAMPLER_ZERO_COVERAGE
+#else
+#define SAMPLER_FILTER(s) ((s).filter)
+#define SAMPLER_ADDRESS(s) ((s).address)
+#define SAMPLER_RENORMALIZE(s) ((s).renormalize)
+#define SAMPLER_ZERO_COVERAGE(s) ((s).zero_coverage)
+#endif
 #if SEAMCL_TEXELS_F32
 #define TEXEL_BUFFER __global const float*
 #else
@@ -264,19 +280,19 @@ inline void accumulate_ewa(FilterSum* sum, const FaceGpu* face, __global const u
 
 /* The filtered sum of one lookup, before any renormalisation. */
 inline FilterSum filter_texture(const FaceGpu* face, __global const uint* level_offsets, TEXEL_BUFFER texels,
-                                __global const float* srgb_to_linear, SamplerParams sampler, int address,
+                                __global const float* srgb_to_linear, int filter, int address, int max_aniso,
                                 float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   FilterSum sum = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
   const Footprint f = footprint(face, dudx, dvdx, dudy, dvdy);
-  if (sampler.filter == SEAMCL_FILTER_BILINEAR) {
+  if (filter == SEAMCL_FILTER_BILINEAR) {
     accumulate_bilinear(&sum, texels, srgb_to_linear, face_level(face, level_offsets, 0), u, v, 1.0f, address);
-  } else if (sampler.filter == SEAMCL_FILTER_TRILINEAR) {
+  } else if (filter == SEAMCL_FILTER_TRILINEAR) {
     const float lod = f.finite ? lod_of(fmax(f.len2_x, f.len2_y)) : (float)(face->level_count - 1);
     accumulate_trilinear(&sum, face, level_offsets, texels, srgb_to_linear, u, v, lod, 1.0f, address);
-  } else if (sampler.filter == SEAMCL_FILTER_ANISO) {
-    accumulate_aniso(&sum, face, level_offsets, texels, srgb_to_linear, u, v, f, sampler.max_aniso, address);
+  } else if (filter == SEAMCL_FILTER_ANISO) {
+    accumulate_aniso(&sum, face, level_offsets, texels, srgb_to_linear, u, v, f, max_aniso, address);
   } else {
-    accumulate_ewa(&sum, face, level_offsets, texels, srgb_to_linear, u, v, f, sampler.max_aniso, address);
+    accumulate_ewa(&sum, face, level_offsets, texels, srgb_to_linear, u, v, f, max_aniso, address);
   }
   return sum;
 }
@@ -288,14 +304,14 @@ inline FilterSum filter_texture(const FaceGpu* face, __global const uint* level_
 inline float4 sample_texture(const FaceGpu* face, __global const uint* level_offsets, TEXEL_BUFFER texels,
                              __global const float* srgb_to_linear, SamplerParams sampler,
                              float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
-  FilterSum sum = filter_texture(face, level_offsets, texels, srgb_to_linear, sampler, sampler.address,
-                                 u, v, dudx, dvdx, dudy, dvdy);
-  if (!sampler.renormalize) return (float4)(sum.r, sum.g, sum.b, sum.a);
-  if (sum.weight == 0.0f && sampler.zero_coverage == SEAMCL_ZERO_COVERAGE_CLAMP) {
-    SamplerParams fallback = sampler;
-    fallback.filter = SEAMCL_FILTER_TRILINEAR;
-    sum = filter_texture(face, level_offsets, texels, srgb_to_linear, fallback, SEAMCL_ADDRESS_CLAMP,
-                         fmin(fmax(u, 0.0f), 1.0f), fmin(fmax(v, 0.0f), 1.0f), dudx, dvdx, dudy, dvdy);
+  FilterSum sum = filter_texture(face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),
+                                 SAMPLER_ADDRESS(sampler), sampler.max_aniso, u, v, dudx, dvdx, dudy, dvdy);
+  if (!SAMPLER_RENORMALIZE(sampler)) return (float4)(sum.r, sum.g, sum.b, sum.a);
+  const int clamp_when_uncovered = SAMPLER_ZERO_COVERAGE(sampler) == SEAMCL_ZERO_COVERAGE_CLAMP;
+  if (clamp_when_uncovered && sum.weight == 0.0f) {
+    sum = filter_texture(face, level_offsets, texels, srgb_to_linear, SEAMCL_FILTER_TRILINEAR, SEAMCL_ADDRESS_CLAMP,
+                         sampler.max_aniso, fmin(fmax(u, 0.0f), 1.0f), fmin(fmax(v, 0.0f), 1.0f), dudx, dvdx, dudy,
+                         dvdy);
   }
   const float inv_weight = 1.0f / sum.weight;
   return (float4)(sum.r * inv_weight, sum.g * inv_weight, sum.b * inv_weight, sum.a * inv_weight);
@@ -322,8 +338,8 @@ __kernel void texture_filter_batch(__global const FaceGpu* faces, __global const
   if (i >= count) return;
   __global const float* q = lookups + 7 * i;
   const FaceGpu face = faces[(uint)q[0]];
-  const FilterSum sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, sampler, sampler.address, q[1], q[2],
-                                       q[3], q[4], q[5], q[6]);
+  const FilterSum sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),
+                                       SAMPLER_ADDRESS(sampler), sampler.max_aniso, q[1], q[2], q[3], q[4], q[5], q[6]);
   out[i] = (float4)(sum.r, sum.g, sum.b, sum.a);
   weights[i] = sum.weight;
 }
