@@ -51,10 +51,11 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
       auto sample_x = [&](int s) { return static_cast<float>(sample_fixed_x(x, pattern[s])) * to_pixels; };
       auto sample_y = [&](int s) { return static_cast<float>(sample_fixed_y(y, pattern[s])) * to_pixels; };
       glm::vec3 sum(0.0f);
+      int uncovered = 0;
       for (int s = 0; s < samples; ++s) {
         const uint32_t slot = ids[s];
         if (slot == SEAMCL_NO_TRIANGLE) {
-          sum += background;
+          ++uncovered;
           continue;
         }
         const TriangleSetup& t = setups.at(slot);
@@ -84,6 +85,7 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
         sum += shade_fragment_reference(scene, f, t, shade_x, shade_y) * static_cast<float>(covered);
         ++out.fragments;
       }
+      sum += background * static_cast<float>(uncovered);  // once: an empty pixel is exactly the background
       out.pixels[static_cast<size_t>(y) * f.width + x] = glm::vec4(sum / static_cast<float>(samples), 1.0f);
     }
   }

@@ -69,10 +69,11 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
     __global const uint* ids = sample_triangle + ((size_t)y * (size_t)frame->width + (size_t)x) * (size_t)samples;
     const float3 background = (float3)(frame->background[0], frame->background[1], frame->background[2]);
     float3 sum = (float3)(0.0f);
+    int uncovered = 0;
     for (int s = 0; s < samples; ++s) {
       const uint slot = ids[s];
       if (slot == SEAMCL_NO_TRIANGLE) {
-        sum += background;
+        ++uncovered;
         continue;
       }
       const float sample_x = (float)sample_fixed_x(x, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
@@ -106,6 +107,9 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
              (float)covered;
       ++fragments;
     }
+    /* Added once, so that an empty pixel is exactly the background (n*b/n is exact for n a power
+     * of two; b+b+b... rounds). */
+    sum += background * (float)uncovered;
     const float3 color = sum / (float)samples;
     image[(size_t)y * (size_t)frame->width + (size_t)x] = (float4)(color, 1.0f);
   }
