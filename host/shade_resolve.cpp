@@ -36,6 +36,31 @@ glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& 
   return glm::vec3(albedo.x * f.light_color[0], albedo.y * f.light_color[1], albedo.z * f.light_color[2]) * lighting;
 }
 
+PixelFragment pixel_fragment(const FrameParams& f, const TriangleSetup& t, const uint32_t* ids, uint32_t slot, int x,
+                             int y) {
+  const std::vector<SampleOffset>& pattern = sample_pattern(f.sample_count);
+  constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
+  PixelFragment out;
+  float centroid_x = 0.0f, centroid_y = 0.0f;
+  const int first = static_cast<int>(std::find(ids, ids + f.sample_count, slot) - ids);
+  for (int r = first; r < f.sample_count; ++r) {
+    if (ids[r] != slot) continue;
+    ++out.covered;
+    centroid_x += static_cast<float>(sample_fixed_x(x, pattern[r])) * to_pixels;
+    centroid_y += static_cast<float>(sample_fixed_y(y, pattern[r])) * to_pixels;
+  }
+  centroid_x /= static_cast<float>(out.covered);
+  centroid_y /= static_cast<float>(out.covered);
+  out.x = static_cast<float>(x) + 0.5f;
+  out.y = static_cast<float>(y) + 0.5f;
+  // The centroid also stands in for a centre beyond the plane's horizon (1/w <= 0).
+  if (f.shading_mode == SEAMCL_SHADE_CENTROID || !(plane_inv_w(t, out.x, out.y) > 0.0f)) {
+    out.x = centroid_x;
+    out.y = centroid_y;
+  }
+  return out;
+}
+
 ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& f,
                                          const std::vector<TriangleSetup>& setups,
                                          const std::vector<uint32_t>& sample_triangle) {
@@ -65,24 +90,8 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
           continue;
         }
         if (std::find(ids, ids + s, slot) != ids + s) continue;  // shaded at its first sample
-        int covered = 0;
-        float centroid_x = 0.0f, centroid_y = 0.0f;
-        for (int r = s; r < samples; ++r) {
-          if (ids[r] != slot) continue;
-          ++covered;
-          centroid_x += sample_x(r);
-          centroid_y += sample_y(r);
-        }
-        centroid_x /= static_cast<float>(covered);
-        centroid_y /= static_cast<float>(covered);
-        float shade_x = static_cast<float>(x) + 0.5f;
-        float shade_y = static_cast<float>(y) + 0.5f;
-        // The centroid also stands in for a centre beyond the plane's horizon (1/w <= 0).
-        if (f.shading_mode == SEAMCL_SHADE_CENTROID || !(plane_inv_w(t, shade_x, shade_y) > 0.0f)) {
-          shade_x = centroid_x;
-          shade_y = centroid_y;
-        }
-        sum += shade_fragment_reference(scene, f, t, shade_x, shade_y) * static_cast<float>(covered);
+        const PixelFragment fragment = pixel_fragment(f, t, ids, slot, x, y);
+        sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y) * static_cast<float>(fragment.covered);
         ++out.fragments;
       }
       sum += background * static_cast<float>(uncovered);  // once: an empty pixel is exactly the background

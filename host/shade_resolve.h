@@ -20,6 +20,15 @@ SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y);
 // Colour of one fragment: texture lookup times the face's Lambert lighting.
 glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& frame, const TriangleSetup& t, float x, float y);
 
+// A triangle's fragment in one pixel (pixel or centroid shading): the samples it covers and
+// where it is shaded. `ids` are the pixel's sample winners; `slot` must be among them.
+struct PixelFragment {
+  int covered = 0;
+  float x = 0, y = 0;  // pixel-space shading point
+};
+PixelFragment pixel_fragment(const FrameParams& frame, const TriangleSetup& t, const uint32_t* ids, uint32_t slot,
+                             int x, int y);
+
 struct ResolveReference {
   std::vector<glm::vec4> pixels;  // linear RGBA
   uint32_t fragments = 0;
