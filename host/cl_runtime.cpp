@@ -205,7 +205,9 @@ const cl::Program& ClRuntime::program(const std::string& options) {
   if (!slot) {
     const auto start = std::chrono::steady_clock::now();
     auto program = std::make_unique<cl::Program>(context_, program_source());
-    program->build(std::vector<cl::Device>{device_}, ("-cl-std=CL1.2 " + options).c_str());
+    std::string all_options = "-cl-std=CL1.2 " + options;
+    if (const char* extra = std::getenv("SEAMCL_EXTRA_BUILD_OPTIONS")) all_options += std::string(" ") + extra;
+    program->build(std::vector<cl::Device>{device_}, all_options.c_str());
     build_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     slot = std::move(program);
   }

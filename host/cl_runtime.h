@@ -42,7 +42,8 @@ class ClRuntime {
   std::string device_description() const;  // "<device> (<platform>, <version>)"
 
   // Builds program_source() with `options` (e.g. "-DSEAMCL_TEXELS_F32=1") once per distinct
-  // options; later calls return the same program. Thread-safe. The milliseconds the builds took
+  // options (plus $SEAMCL_EXTRA_BUILD_OPTIONS, for experiments); later calls return the same
+  // program. Thread-safe. The milliseconds the builds took
   // are kept for --json and the first-start figure.
   const cl::Program& program(const std::string& options = "");
   double program_build_ms() const;

@@ -166,7 +166,8 @@ void accumulate_aniso(FilterSum& sum, const TextureView& tex, const FaceGpu& fac
   const float major2 = x_major ? f.len2_x : f.len2_y;
   const float minor2 = x_major ? f.len2_y : f.len2_x;
   // N = min(ceil(major / minor), max_aniso) trilinear probes at log2(major / N).
-  const float ratio = minor2 > 0.0f ? std::sqrt(major2 / minor2) : static_cast<float>(max_aniso);
+  // A line footprint takes the most probes; a point footprint one.
+  const float ratio = minor2 > 0.0f ? std::sqrt(major2 / minor2) : major2 > 0.0f ? static_cast<float>(max_aniso) : 1.0f;
   const int probes = f.finite ? std::clamp(static_cast<int>(std::ceil(std::fmin(ratio, 16.0f))), 1, max_aniso) : 1;
   const float inv_probes = 1.0f / static_cast<float>(probes);
   const float lod = f.finite ? lod_of(major2) - approx_log2(static_cast<float>(probes))

@@ -10,7 +10,7 @@
  * rest and the host, seeing stats.bin_entries > capacity, grows the buffer and renders again.
  * Host guarantees: tile_counts zeroed before bin_count. Twin: host/binning.cpp. */
 
-inline int tile_may_be_covered(__global const TriangleSetup* s, int tile_x, int tile_y) {
+SEAMCL_INLINE int tile_may_be_covered(__global const TriangleSetup* s, int tile_x, int tile_y) {
   /* Fixed-point extent of every sample position inside the tile. */
   const long x_lo = (long)tile_x * SEAMCL_TILE_SIZE * SEAMCL_SUBPIXEL_ONE;
   const long y_lo = (long)tile_y * SEAMCL_TILE_SIZE * SEAMCL_SUBPIXEL_ONE;

@@ -20,15 +20,15 @@ __constant char sample_offsets[5][SEAMCL_MAX_SAMPLES][2] = {
     {{1, 1}, {-1, -3}, {-3, 2}, {4, -1}, {-5, -2}, {2, 5}, {5, 3}, {3, -5},
      {-2, 6}, {0, -7}, {-4, -6}, {-6, 4}, {-8, 0}, {7, -4}, {6, 7}, {-7, -8}}};
 
-inline int sample_pattern_row(int sample_count) {
+SEAMCL_INLINE int sample_pattern_row(int sample_count) {
   return sample_count == 1 ? 0 : sample_count == 2 ? 1 : sample_count == 4 ? 2 : sample_count == 8 ? 3 : 4;
 }
 
 /* Fixed-point position of sample s of pixel (x, y). */
-inline long sample_fixed_x(int x, int row, int s) {
+SEAMCL_INLINE long sample_fixed_x(int x, int row, int s) {
   return (long)x * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2 + sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16);
 }
-inline long sample_fixed_y(int y, int row, int s) {
+SEAMCL_INLINE long sample_fixed_y(int y, int row, int s) {
   return (long)y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2 + sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
 }
 

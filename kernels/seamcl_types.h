@@ -8,6 +8,9 @@
 /* No fused multiply-add contraction: the scalar C++ twins (built with -ffp-contract=off) then
  * round exactly as the kernels do. */
 #pragma OPENCL FP_CONTRACT OFF
+/* Every helper inlined: a helper left as a call (LLVM's inliner gives up on the larger sampler
+ * functions) stops PoCL from vectorising the work-group loop around it. */
+#define SEAMCL_INLINE inline __attribute__((always_inline))
 typedef uint cl_uint;
 typedef int cl_int;
 typedef long cl_long;

@@ -14,7 +14,7 @@ typedef struct {
   float u, v, dudx, dvdx, dudy, dvdy;
 } SurfaceUv;
 
-inline SurfaceUv interpolate_uv(__global const TriangleSetup* t, float x, float y) {
+SEAMCL_INLINE SurfaceUv interpolate_uv(__global const TriangleSetup* t, float x, float y) {
   const float dx = x - t->ref_x;
   const float dy = y - t->ref_y;
   const float inv_w = t->inv_w[0] + t->inv_w[1] * dx + t->inv_w[2] * dy;
@@ -32,11 +32,11 @@ inline SurfaceUv interpolate_uv(__global const TriangleSetup* t, float x, float 
   return r;
 }
 
-inline float plane_inv_w(__global const TriangleSetup* t, float x, float y) {
+SEAMCL_INLINE float plane_inv_w(__global const TriangleSetup* t, float x, float y) {
   return t->inv_w[0] + t->inv_w[1] * (x - t->ref_x) + t->inv_w[2] * (y - t->ref_y);
 }
 
-inline float3 shade_fragment(__constant FrameParams* frame, __global const TriangleSetup* t,
+SEAMCL_INLINE float3 shade_fragment(__constant FrameParams* frame, __global const TriangleSetup* t,
                              __global const FaceGpu* faces, __global const uint* level_offsets,
                              TEXEL_BUFFER texels, __global const float* srgb_to_linear,
                              float x, float y) {

@@ -48,7 +48,7 @@ typedef struct {
   int width, height;
 } Level;
 
-inline Level face_level(const FaceGpu* face, __global const uint* level_offsets, int level) {
+SEAMCL_INLINE Level face_level(const FaceGpu* face, __global const uint* level_offsets, int level) {
   Level l;
   l.offset = level_offsets[face->level_table + (uint)level];
   l.width = max(face->width >> level, 1);
@@ -57,7 +57,7 @@ inline Level face_level(const FaceGpu* face, __global const uint* level_offsets,
 }
 
 /* log2 for x > 0, within 5e-6: a polynomial on the mantissa (the builtin does not vectorise). */
-inline float approx_log2(float x) {
+SEAMCL_INLINE float approx_log2(float x) {
   const int bits = as_int(x);
   const float exponent = (float)(((bits >> 23) & 255) - 127);
   const float m = as_float((bits & 0x007fffff) | 0x3f800000) - 1.0f;
@@ -66,7 +66,7 @@ inline float approx_log2(float x) {
   return exponent + p;
 }
 
-inline void add_texel(FilterSum* sum, TEXEL_BUFFER texels, __global const float* srgb_to_linear, uint index,
+SEAMCL_INLINE void add_texel(FilterSum* sum, TEXEL_BUFFER texels, __global const float* srgb_to_linear, uint index,
                       float weight) {
 #if SEAMCL_TEXELS_F32
   sum->r += weight * texels[4 * index];
@@ -84,21 +84,21 @@ inline void add_texel(FilterSum* sum, TEXEL_BUFFER texels, __global const float*
 }
 
 /* Texel index along one axis of size n for address mode `address`; *inside is 0 for a border tap. */
-inline int address_texel(int i, int n, int address, float* inside) {
+SEAMCL_INLINE int address_texel(int i, int n, int address, float* inside) {
   const int clamped = clamp(i, 0, n - 1);
   *inside = (address != SEAMCL_ADDRESS_BORDER || i == clamped) ? 1.0f : 0.0f;
   return address == SEAMCL_ADDRESS_WRAP ? (i & (n - 1)) : clamped;
 }
 
 /* Texel-space coordinate of u on an axis of n texels, finite whatever u is. */
-inline float texel_coordinate(float u, int n, int address) {
+SEAMCL_INLINE float texel_coordinate(float u, int n, int address) {
   if (address == SEAMCL_ADDRESS_WRAP) u = u - __builtin_floorf(u);
   /* Two texels beyond either edge is as far as any address mode can tell apart. */
   return fmin(fmax(u * (float)n - 0.5f, -2.0f), (float)n + 1.0f);
 }
 
 /* weight * bilinear(level, u, v) into sum. */
-inline void accumulate_bilinear(FilterSum* sum, TEXEL_BUFFER texels, __global const float* srgb_to_linear,
+SEAMCL_INLINE void accumulate_bilinear(FilterSum* sum, TEXEL_BUFFER texels, __global const float* srgb_to_linear,
                                 Level level, float u, float v, float weight, int address) {
   const float x = texel_coordinate(u, level.width, address);
   const float y = texel_coordinate(v, level.height, address);
@@ -120,7 +120,7 @@ inline void accumulate_bilinear(FilterSum* sum, TEXEL_BUFFER texels, __global co
 }
 
 /* weight * trilinear at `lod` (clamped to the chain) into sum. */
-inline void accumulate_trilinear(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
+SEAMCL_INLINE void accumulate_trilinear(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
                                  TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
                                  float lod, float weight, int address) {
   lod = fmin(fmax(lod, 0.0f), (float)(face->level_count - 1));
@@ -139,7 +139,7 @@ typedef struct {
   int finite;
 } Footprint;
 
-inline Footprint footprint(const FaceGpu* face, float dudx, float dvdx, float dudy, float dvdy) {
+SEAMCL_INLINE Footprint footprint(const FaceGpu* face, float dudx, float dvdx, float dudy, float dvdy) {
   Footprint f;
   const float w = (float)face->width, h = (float)face->height;
   f.ax_u = dudx;
@@ -153,18 +153,19 @@ inline Footprint footprint(const FaceGpu* face, float dudx, float dvdx, float du
 }
 
 /* lod of a footprint whose longer axis has squared length len2 texels (level 0). */
-inline float lod_of(float len2) {
+SEAMCL_INLINE float lod_of(float len2) {
   return 0.5f * approx_log2(fmax(len2, 1e-30f));
 }
 
-inline void accumulate_aniso(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
+SEAMCL_INLINE void accumulate_aniso(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
                              TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
                              Footprint f, int max_aniso, int address) {
   const int x_major = f.len2_x >= f.len2_y;
   const float major2 = x_major ? f.len2_x : f.len2_y;
   const float minor2 = x_major ? f.len2_y : f.len2_x;
   /* N = min(ceil(major / minor), max_aniso) probes; ratio computed on squares, then sqrt. */
-  const float ratio = minor2 > 0.0f ? sqrt(major2 / minor2) : (float)max_aniso;
+  /* A line footprint takes the most probes; a point footprint one. */
+  const float ratio = minor2 > 0.0f ? sqrt(major2 / minor2) : major2 > 0.0f ? (float)max_aniso : 1.0f;
   const int probes = f.finite ? clamp((int)__builtin_ceilf(fmin(ratio, 16.0f)), 1, max_aniso) : 1;
   const float inv_probes = 1.0f / (float)probes;
   /* Each probe is trilinear at log2(major / N). */
@@ -187,7 +188,7 @@ inline void accumulate_aniso(FilterSum* sum, const FaceGpu* face, __global const
 
 /* EWA over one level (pbrt-v4's MIPMap::EWA, Gaussian alpha = 2): the weights are divided by
  * their total over the whole ellipse, so sum.weight is the fraction of it inside the face. */
-inline void accumulate_ewa_level(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
+SEAMCL_INLINE void accumulate_ewa_level(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
                                  TEXEL_BUFFER texels, __global const float* srgb_to_linear, int level_index,
                                  float u, float v, float a_u, float a_v, float b_u, float b_v, float weight,
                                  int address) {
@@ -243,7 +244,7 @@ inline void accumulate_ewa_level(FilterSum* sum, const FaceGpu* face, __global c
   sum->weight += level_sum.weight * scale;
 }
 
-inline void accumulate_ewa(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
+SEAMCL_INLINE void accumulate_ewa(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
                            TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
                            Footprint f, int max_aniso, int address) {
   if (!f.finite) {
@@ -279,7 +280,7 @@ inline void accumulate_ewa(FilterSum* sum, const FaceGpu* face, __global const u
 }
 
 /* The filtered sum of one lookup, before any renormalisation. */
-inline FilterSum filter_texture(const FaceGpu* face, __global const uint* level_offsets, TEXEL_BUFFER texels,
+SEAMCL_INLINE FilterSum filter_texture(const FaceGpu* face, __global const uint* level_offsets, TEXEL_BUFFER texels,
                                 __global const float* srgb_to_linear, int filter, int address, int max_aniso,
                                 float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   FilterSum sum = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
@@ -301,7 +302,7 @@ inline FilterSum filter_texture(const FaceGpu* face, __global const uint* level_
  * colour. Without renormalisation the sum is the colour (border taps added black). With it
  * (discard), colour = sum / weight over the taps inside; when no tap is inside, zero_coverage
  * decides: a clamped trilinear lookup at the centre clamped to the face, or the raw 0/0. */
-inline float4 sample_texture(const FaceGpu* face, __global const uint* level_offsets, TEXEL_BUFFER texels,
+SEAMCL_INLINE float4 sample_texture(const FaceGpu* face, __global const uint* level_offsets, TEXEL_BUFFER texels,
                              __global const float* srgb_to_linear, SamplerParams sampler,
                              float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   FilterSum sum = filter_texture(face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),

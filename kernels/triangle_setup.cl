@@ -16,7 +16,7 @@ typedef struct {
   float u, v;
 } ClipVertex;
 
-inline float clip_distance(ClipVertex p, int plane, __constant FrameParams* frame) {
+SEAMCL_INLINE float clip_distance(ClipVertex p, int plane, __constant FrameParams* frame) {
   switch (plane) {
     case 0: return p.w - frame->near_w;
     case 1: return frame->guard_x * p.w - p.x;
@@ -26,7 +26,7 @@ inline float clip_distance(ClipVertex p, int plane, __constant FrameParams* fram
   }
 }
 
-inline ClipVertex clip_lerp(ClipVertex inside, ClipVertex outside, float d_inside, float d_outside) {
+SEAMCL_INLINE ClipVertex clip_lerp(ClipVertex inside, ClipVertex outside, float d_inside, float d_outside) {
   const float t = d_inside / (d_inside - d_outside);
   ClipVertex r;
   r.x = inside.x + t * (outside.x - inside.x);
@@ -37,12 +37,12 @@ inline ClipVertex clip_lerp(ClipVertex inside, ClipVertex outside, float d_insid
   return r;
 }
 
-inline long floor_div_subpixel(long value) {
+SEAMCL_INLINE long floor_div_subpixel(long value) {
   /* floor(value / SEAMCL_SUBPIXEL_ONE) for negative values too */
   return value >= 0 ? value / SEAMCL_SUBPIXEL_ONE : -((-value + SEAMCL_SUBPIXEL_ONE - 1) / SEAMCL_SUBPIXEL_ONE);
 }
 
-inline TriangleSetup empty_setup(uint face) {
+SEAMCL_INLINE TriangleSetup empty_setup(uint face) {
   TriangleSetup s;
   for (int i = 0; i < 3; ++i) {
     s.edge_a[i] = 0;
@@ -63,7 +63,7 @@ inline TriangleSetup empty_setup(uint face) {
 }
 
 /* Setup of one screen triangle from three clip-space vertices; empty if culled. */
-inline TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, ClipVertex c2, uint face,
+SEAMCL_INLINE TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, ClipVertex c2, uint face,
                                            __constant FrameParams* frame) {
   ClipVertex c[3] = {c0, c1, c2};
   long X[3], Y[3];
