@@ -126,10 +126,16 @@ void accumulate_bilinear(FilterSum& sum, const TextureView& tex, Level level, fl
   const int y1 = address_texel(static_cast<int>(y_floor) + 1, level.height, address, in_y1);
   const uint32_t row0 = level.offset + static_cast<uint32_t>(y0 * level.width);
   const uint32_t row1 = level.offset + static_cast<uint32_t>(y1 * level.width);
-  add_texel(sum, tex, row0 + static_cast<uint32_t>(x0), weight * (1.0f - fx) * (1.0f - fy) * in_x0 * in_y0);
-  add_texel(sum, tex, row0 + static_cast<uint32_t>(x1), weight * fx * (1.0f - fy) * in_x1 * in_y0);
-  add_texel(sum, tex, row1 + static_cast<uint32_t>(x0), weight * (1.0f - fx) * fy * in_x0 * in_y1);
-  add_texel(sum, tex, row1 + static_cast<uint32_t>(x1), weight * fx * fy * in_x1 * in_y1);
+  // The kernel derives each weight from the one before (to keep LLVM's SLP pass from pairing
+  // them); the twin rounds the same way: w10 = (1-fy) - w00 rather than fx (1-fy).
+  const float w00 = (1.0f - fx) * (1.0f - fy);
+  const float w10 = (1.0f - fy) - w00;
+  const float w01 = (1.0f - fx) - w00;
+  const float w11 = fy - w01;
+  add_texel(sum, tex, row0 + static_cast<uint32_t>(x0), weight * w00 * in_x0 * in_y0);
+  add_texel(sum, tex, row0 + static_cast<uint32_t>(x1), weight * w10 * in_x1 * in_y0);
+  add_texel(sum, tex, row1 + static_cast<uint32_t>(x0), weight * w01 * in_x0 * in_y1);
+  add_texel(sum, tex, row1 + static_cast<uint32_t>(x1), weight * w11 * in_x1 * in_y1);
 }
 
 void accumulate_trilinear(FilterSum& sum, const TextureView& tex, const FaceGpu& face, float u, float v, float lod,

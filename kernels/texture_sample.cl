@@ -66,20 +66,32 @@ SEAMCL_INLINE float approx_log2(float x) {
   return exponent + p;
 }
 
+/* weight * texel into sum. Each channel is tied to the one before by a select that always
+ * picks its own value (x == x is false only for NaN, which a texel read here never is): without
+ * the tie LLVM's SLP pass packs the channels into short vectors and PoCL then cannot vectorise
+ * the work-group loop. */
 SEAMCL_INLINE void add_texel(FilterSum* sum, TEXEL_BUFFER texels, __global const float* srgb_to_linear, uint index,
-                      float weight) {
+                             float weight) {
 #if SEAMCL_TEXELS_F32
-  sum->r += weight * texels[4 * index];
-  sum->g += weight * texels[4 * index + 1];
-  sum->b += weight * texels[4 * index + 2];
-  sum->a += weight * texels[4 * index + 3];
+  const float r = texels[4 * index];
+  const float g = texels[4 * index + 1];
+  const float b = texels[4 * index + 2];
+  const float a = texels[4 * index + 3];
 #else
   const uint packed = texels[index];
-  sum->r += weight * srgb_to_linear[packed & 0xffu];
-  sum->g += weight * srgb_to_linear[(packed >> 8) & 0xffu];
-  sum->b += weight * srgb_to_linear[(packed >> 16) & 0xffu];
-  sum->a += weight * ((float)(packed >> 24) * (1.0f / 255.0f));
+  const float r = srgb_to_linear[packed & 0xffu];
+  const float g = srgb_to_linear[(packed >> 8) & 0xffu];
+  const float b = srgb_to_linear[(packed >> 16) & 0xffu];
+  const float a = (float)(packed >> 24) * (1.0f / 255.0f);
 #endif
+  const float wr = weight * r;
+  const float wg = weight * (wr == wr ? g : wr);
+  const float wb = weight * (wg == wg ? b : wg);
+  const float wa = weight * (wb == wb ? a : wb);
+  sum->r += wr;
+  sum->g += sum->r == sum->r ? wg : sum->r;
+  sum->b += sum->g == sum->g ? wb : sum->g;
+  sum->a += sum->b == sum->b ? wa : sum->b;
   sum->weight += weight;
 }
 
@@ -90,6 +102,13 @@ SEAMCL_INLINE int address_texel(int i, int n, int address, float* inside) {
   return address == SEAMCL_ADDRESS_WRAP ? (i & (n - 1)) : clamped;
 }
 
+/* The texel after `first` (the addressed texel of raw index i), derived from it rather than
+ * addressed afresh (see accumulate_bilinear). */
+SEAMCL_INLINE int next_texel(int first, int i, int n, int address, float* inside) {
+  *inside = (address != SEAMCL_ADDRESS_BORDER || (i >= -1 && i < n - 1)) ? 1.0f : 0.0f;
+  return address == SEAMCL_ADDRESS_WRAP ? ((first + 1) & (n - 1)) : min(first + (i >= 0 ? 1 : 0), n - 1);
+}
+
 /* Texel-space coordinate of u on an axis of n texels, finite whatever u is. */
 SEAMCL_INLINE float texel_coordinate(float u, int n, int address) {
   if (address == SEAMCL_ADDRESS_WRAP) u = u - __builtin_floorf(u);
@@ -97,26 +116,37 @@ SEAMCL_INLINE float texel_coordinate(float u, int n, int address) {
   return fmin(fmax(u * (float)n - 0.5f, -2.0f), (float)n + 1.0f);
 }
 
-/* weight * bilinear(level, u, v) into sum. */
+/* weight * bilinear(level, u, v) into sum.
+ * Written so that no two computations have the same shape (the y side derives from the x side,
+ * the second tap from the first): LLVM's SLP pass would otherwise pack such pairs into short
+ * vectors, and PoCL cannot vectorise a work-group loop that holds vector instructions. */
 SEAMCL_INLINE void accumulate_bilinear(FilterSum* sum, TEXEL_BUFFER texels, __global const float* srgb_to_linear,
-                                Level level, float u, float v, float weight, int address) {
+                                       Level level, float u, float v, float weight, int address) {
   const float x = texel_coordinate(u, level.width, address);
-  const float y = texel_coordinate(v, level.height, address);
   const float x_floor = __builtin_floorf(x);
-  const float y_floor = __builtin_floorf(y);
   const float fx = x - x_floor;
+  /* (fx - fx) is 0 (fx is finite) but ties y to x. */
+  const float y = texel_coordinate(v + (fx - fx), level.height, address);
+  const float y_floor = __builtin_floorf(y);
   const float fy = y - y_floor;
   float in_x0, in_x1, in_y0, in_y1;
-  const int x0 = address_texel((int)x_floor, level.width, address, &in_x0);
-  const int x1 = address_texel((int)x_floor + 1, level.width, address, &in_x1);
-  const int y0 = address_texel((int)y_floor, level.height, address, &in_y0);
-  const int y1 = address_texel((int)y_floor + 1, level.height, address, &in_y1);
+  const int ix = (int)x_floor;
+  const int iy = (int)y_floor;
+  const int x0 = address_texel(ix, level.width, address, &in_x0);
+  const int x1 = next_texel(x0, ix, level.width, address, &in_x1);
+  const int y0 = address_texel(iy, level.height, address, &in_y0);
+  const int y1 = next_texel(y0, iy, level.height, address, &in_y1);
   const uint row0 = level.offset + (uint)(y0 * level.width);
-  const uint row1 = level.offset + (uint)(y1 * level.width);
-  add_texel(sum, texels, srgb_to_linear, row0 + (uint)x0, weight * (1.0f - fx) * (1.0f - fy) * in_x0 * in_y0);
-  add_texel(sum, texels, srgb_to_linear, row0 + (uint)x1, weight * fx * (1.0f - fy) * in_x1 * in_y0);
-  add_texel(sum, texels, srgb_to_linear, row1 + (uint)x0, weight * (1.0f - fx) * fy * in_x0 * in_y1);
-  add_texel(sum, texels, srgb_to_linear, row1 + (uint)x1, weight * fx * fy * in_x1 * in_y1);
+  const uint row1 = row0 + (uint)((y1 - y0) * level.width);
+  /* Bilinear weights, each derived from the one before. */
+  const float w00 = (1.0f - fx) * (1.0f - fy);
+  const float w10 = (1.0f - fy) - w00;
+  const float w01 = (1.0f - fx) - w00;
+  const float w11 = fy - w01;
+  add_texel(sum, texels, srgb_to_linear, row0 + (uint)x0, weight * w00 * in_x0 * in_y0);
+  add_texel(sum, texels, srgb_to_linear, row0 + (uint)x1, weight * w10 * in_x1 * in_y0);
+  add_texel(sum, texels, srgb_to_linear, row1 + (uint)x0, weight * w01 * in_x0 * in_y1);
+  add_texel(sum, texels, srgb_to_linear, row1 + (uint)x1, weight * w11 * in_x1 * in_y1);
 }
 
 /* weight * trilinear at `lod` (clamped to the chain) into sum. */
@@ -128,7 +158,9 @@ SEAMCL_INLINE void accumulate_trilinear(FilterSum* sum, const FaceGpu* face, __g
   const int level1 = min(level0 + 1, face->level_count - 1);
   const float t = lod - (float)level0;
   accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level0), u, v, weight * (1.0f - t), address);
-  accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level1), u, v, weight * t, address);
+  /* The second level tied to the first (see accumulate_bilinear): the summed weight is finite. */
+  const float tie = sum->weight - sum->weight;
+  accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level1), u + tie, v, weight * t, address);
 }
 
 /* Screen axes of the footprint in level-0 texels, squared lengths. A non-finite footprint
@@ -146,8 +178,14 @@ SEAMCL_INLINE Footprint footprint(const FaceGpu* face, float dudx, float dvdx, f
   f.ax_v = dvdx;
   f.ay_u = dudy;
   f.ay_v = dvdy;
-  f.len2_x = (dudx * w) * (dudx * w) + (dvdx * h) * (dvdx * h);
-  f.len2_y = (dudy * w) * (dudy * w) + (dvdy * h) * (dvdy * h);
+  /* Each term tied to the one before (see accumulate_bilinear); a tie is 0 when its operand is
+   * finite and NaN otherwise, and a NaN length reads as non-finite just as an infinite one. */
+  const float xu = dudx * w;
+  const float xv = dvdx * h + (xu - xu);
+  f.len2_x = xu * xu + xv * xv;
+  const float yu = dudy * w + (f.len2_x - f.len2_x);
+  const float yv = dvdy * h + (yu - yu);
+  f.len2_y = yu * yu + yv * yv;
   f.finite = f.len2_x < INFINITY && f.len2_y < INFINITY;
   return f;
 }
@@ -327,7 +365,12 @@ __kernel void texture_lookup_batch(__global const FaceGpu* faces, __global const
   if (i >= count) return;
   __global const float* q = lookups + 7 * i;
   const FaceGpu face = faces[(uint)q[0]];
-  out[i] = sample_texture(&face, level_offsets, texels, srgb_to_linear, sampler, q[1], q[2], q[3], q[4], q[5], q[6]);
+  const float4 c = sample_texture(&face, level_offsets, texels, srgb_to_linear, sampler, q[1], q[2], q[3], q[4], q[5], q[6]);
+  __global float* o = (__global float*)out + 4 * i;
+  o[0] = c.x;
+  o[1] = c.y;
+  o[2] = c.z;
+  o[3] = c.w;
 }
 
 /* The same lookups' FilterSum before renormalisation: (r, g, b, a) and the weight inside. */
