@@ -32,6 +32,21 @@
 #define SAMPLER_RENORMALIZE(s) ((s).renormalize)
 #define SAMPLER_ZERO_COVERAGE(s) ((s).zero_coverage)
 #endif
+
+/* Ties against LLVM's SLP pass. PoCL vectorises a kernel by running its work-group loop 8 lanes
+ * wide, and gives up if the loop body already holds short vectors, which the SLP pass makes out
+ * of any two computations of the same shape (u and v, two taps, four channels). TIE(x) is 0 for
+ * finite x but makes whatever it is added to depend on x, so the pair is no longer independent.
+ * Kernels with a varying-length loop (aniso, ewa) stay scalar anyway; there a tie only costs, so
+ * it is compiled out. */
+#if defined(SEAMCL_SAMPLER_FILTER) && SEAMCL_SAMPLER_FILTER >= SEAMCL_FILTER_ANISO
+#define TIE(x) 0.0f
+#define TIED(value, x) (value)
+#else
+#define TIE(x) ((x) - (x))
+/* value, unless x is NaN (then x): a select that orders value after x */
+#define TIED(value, x) ((x) == (x) ? (value) : (x))
+#endif
 #if SEAMCL_TEXELS_F32
 #define TEXEL_BUFFER __global const float*
 #else
@@ -66,10 +81,7 @@ SEAMCL_INLINE float approx_log2(float x) {
   return exponent + p;
 }
 
-/* weight * texel into sum. Each channel is tied to the one before by a select that always
- * picks its own value (x == x is false only for NaN, which a texel read here never is): without
- * the tie LLVM's SLP pass packs the channels into short vectors and PoCL then cannot vectorise
- * the work-group loop. */
+/* weight * texel into sum, each channel TIED to the one before (see TIE). */
 SEAMCL_INLINE void add_texel(FilterSum* sum, TEXEL_BUFFER texels, __global const float* srgb_to_linear, uint index,
                              float weight) {
 #if SEAMCL_TEXELS_F32
@@ -85,13 +97,13 @@ SEAMCL_INLINE void add_texel(FilterSum* sum, TEXEL_BUFFER texels, __global const
   const float a = (float)(packed >> 24) * (1.0f / 255.0f);
 #endif
   const float wr = weight * r;
-  const float wg = weight * (wr == wr ? g : wr);
-  const float wb = weight * (wg == wg ? b : wg);
-  const float wa = weight * (wb == wb ? a : wb);
+  const float wg = weight * TIED(g, wr);
+  const float wb = weight * TIED(b, wg);
+  const float wa = weight * TIED(a, wb);
   sum->r += wr;
-  sum->g += sum->r == sum->r ? wg : sum->r;
-  sum->b += sum->g == sum->g ? wb : sum->g;
-  sum->a += sum->b == sum->b ? wa : sum->b;
+  sum->g += TIED(wg, sum->r);
+  sum->b += TIED(wb, sum->g);
+  sum->a += TIED(wa, sum->b);
   sum->weight += weight;
 }
 
@@ -117,16 +129,14 @@ SEAMCL_INLINE float texel_coordinate(float u, int n, int address) {
 }
 
 /* weight * bilinear(level, u, v) into sum.
- * Written so that no two computations have the same shape (the y side derives from the x side,
- * the second tap from the first): LLVM's SLP pass would otherwise pack such pairs into short
- * vectors, and PoCL cannot vectorise a work-group loop that holds vector instructions. */
+ * The y side is tied to the x side, the second tap derived from the first and each weight from
+ * the one before, so that no two computations have the same shape (see TIE). */
 SEAMCL_INLINE void accumulate_bilinear(FilterSum* sum, TEXEL_BUFFER texels, __global const float* srgb_to_linear,
                                        Level level, float u, float v, float weight, int address) {
   const float x = texel_coordinate(u, level.width, address);
   const float x_floor = __builtin_floorf(x);
   const float fx = x - x_floor;
-  /* (fx - fx) is 0 (fx is finite) but ties y to x. */
-  const float y = texel_coordinate(v + (fx - fx), level.height, address);
+  const float y = texel_coordinate(v + TIE(fx), level.height, address);
   const float y_floor = __builtin_floorf(y);
   const float fy = y - y_floor;
   float in_x0, in_x1, in_y0, in_y1;
@@ -158,9 +168,9 @@ SEAMCL_INLINE void accumulate_trilinear(FilterSum* sum, const FaceGpu* face, __g
   const int level1 = min(level0 + 1, face->level_count - 1);
   const float t = lod - (float)level0;
   accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level0), u, v, weight * (1.0f - t), address);
-  /* The second level tied to the first (see accumulate_bilinear): the summed weight is finite. */
-  const float tie = sum->weight - sum->weight;
-  accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level1), u + tie, v, weight * t, address);
+  /* The second level tied to the first; the summed weight is finite. */
+  accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level1), u + TIE(sum->weight), v,
+                      weight * t, address);
 }
 
 /* Screen axes of the footprint in level-0 texels, squared lengths. A non-finite footprint
@@ -178,13 +188,13 @@ SEAMCL_INLINE Footprint footprint(const FaceGpu* face, float dudx, float dvdx, f
   f.ax_v = dvdx;
   f.ay_u = dudy;
   f.ay_v = dvdy;
-  /* Each term tied to the one before (see accumulate_bilinear); a tie is 0 when its operand is
-   * finite and NaN otherwise, and a NaN length reads as non-finite just as an infinite one. */
+  /* Each term tied to the one before; a tie of a non-finite term is NaN, and a NaN length reads
+   * as non-finite just as an infinite one does. */
   const float xu = dudx * w;
-  const float xv = dvdx * h + (xu - xu);
+  const float xv = dvdx * h + TIE(xu);
   f.len2_x = xu * xu + xv * xv;
-  const float yu = dudy * w + (f.len2_x - f.len2_x);
-  const float yv = dvdy * h + (yu - yu);
+  const float yu = dudy * w + TIE(f.len2_x);
+  const float yv = dvdy * h + TIE(yu);
   f.len2_y = yu * yu + yv * yv;
   f.finite = f.len2_x < INFINITY && f.len2_y < INFINITY;
   return f;
