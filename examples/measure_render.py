@@ -28,15 +28,19 @@ def main():
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--sizes", default="480x540,1920x1080")
     parser.add_argument("--msaa", default="1,2,4,8")
+    parser.add_argument("--method", default="discard")
+    parser.add_argument("--filter", default="aniso")
     args = parser.parse_args()
+    common = ["--scene", args.scene, "--method", args.method, "--filter", args.filter]
 
     first = None
-    print(f"Scene `{args.scene}`, method clamp, median of {args.repeat} renders per row (ms, OpenCL profiling).\n")
+    print(f"Scene `{args.scene}`, method {args.method}, filter {args.filter} (max anisotropy 16), "
+          f"median of {args.repeat} renders per row (ms, OpenCL profiling).\n")
     print("| size | MSAA | total | setup | binning | raster | shade | readback | fragments |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for size in args.sizes.split(","):
         for msaa in args.msaa.split(","):
-            r = render(args.seamcl, ["--scene", args.scene, "--size", size, "--msaa", msaa, "--repeat", str(args.repeat)])
+            r = render(args.seamcl, [*common, "--size", size, "--msaa", msaa, "--repeat", str(args.repeat)])
             first = first or r
             ms = r["ms"]
             print(f"| {size} | {msaa} | {ms['total']:.2f} | {ms['setup']:.2f} | {ms['binning']:.2f} | "
@@ -50,7 +54,7 @@ def main():
     try:
         for label in ("first start (cold PoCL cache)", "second start (warm cache)"):
             begin = time.perf_counter()
-            r = render(args.seamcl, ["--scene", args.scene, "--size", "480x540", "--msaa", "4"], env=env)
+            r = render(args.seamcl, [*common, "--size", "480x540", "--msaa", "4"], env=env)
             wall = (time.perf_counter() - begin) * 1000
             rows.append((label, r["kernel_build_ms"], wall))
     finally:
