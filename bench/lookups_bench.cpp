@@ -46,6 +46,7 @@
 #include "packed_scene.h"
 #include "render_options.h"
 #include "scene.h"
+#include "texture_file.h"
 #include "texture_lookups.h"
 #include "texture_sample.h"
 
@@ -120,28 +121,6 @@ Scene texture_scene() {
   face.texture = build_mip_chain(std::move(level));
   scene.faces.push_back(std::move(face));
   return scene;
-}
-
-// The packed float levels of face 0 as a tiled (64x64), MIP-mapped float OpenEXR texture.
-void write_mip_exr(const PackedScene& packed, const std::string& path) {
-  if (packed.format != TexelFormat::Rgba32f) throw std::logic_error("write_mip_exr wants Rgba32f texels");
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw std::runtime_error("no EXR writer: " + OIIO::geterror());
-  const FaceGpu& face = packed.faces.at(0);
-  for (int l = 0; l < face.level_count; ++l) {
-    const int w = std::max(face.width >> l, 1), h = std::max(face.height >> l, 1);
-    OIIO::ImageSpec spec(w, h, 4, OIIO::TypeDesc::FLOAT);
-    spec.tile_width = 64;
-    spec.tile_height = 64;
-    spec.attribute("textureformat", "Plain Texture");
-    spec.attribute("compression", "zip");
-    const float* texels = packed.texels32.data() + 4 * static_cast<size_t>(packed.level_offsets.at(face.level_table + l));
-    if (!out->open(path, spec, l == 0 ? OIIO::ImageOutput::Create : OIIO::ImageOutput::AppendMIPLevel) ||
-        !out->write_image(OIIO::TypeDesc::FLOAT, texels)) {
-      throw std::runtime_error("writing " + path + ": " + out->geterror());
-    }
-  }
-  if (!out->close()) throw std::runtime_error("closing " + path + ": " + out->geterror());
 }
 
 // Everything both sides share, built once in main.
@@ -269,7 +248,7 @@ int main(int argc, char** argv) {
     setup.dir = fs::temp_directory_path() / ("seamcl-bench-" + std::to_string(::getpid()));
     fs::create_directories(setup.dir);
     setup.exr_path = (setup.dir / "texture.exr").string();
-    write_mip_exr(f32, setup.exr_path);
+    write_face_mip_exr(f32, 0, setup.exr_path);
     for (const PackedScene* packed : {&f32, &u8}) {
       auto lookups = std::make_unique<TextureLookups>(setup.runtime, *packed);
       lookups->set_lookups(workload().lookups);

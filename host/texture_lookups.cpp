@@ -51,22 +51,28 @@ void TextureLookups::set_lookups(const std::vector<Lookup>& lookups) {
   weights_ = cl::Buffer(runtime_.context(), CL_MEM_WRITE_ONLY, std::max<size_t>(count_, 1) * sizeof(cl_float));
 }
 
+cl::Event TextureLookups::run(cl::Kernel& kernel, const SamplerParams& sampler, bool with_weights) {
+  // Both batch kernels take the same arguments; texture_filter_batch adds the weights.
+  kernel.setArg(0, faces_);
+  kernel.setArg(1, level_offsets_);
+  kernel.setArg(2, texels_);
+  kernel.setArg(3, srgb_table_);
+  kernel.setArg(4, sampler);
+  kernel.setArg(5, lookups_);
+  kernel.setArg(6, static_cast<cl_uint>(count_));
+  kernel.setArg(7, colors_);
+  if (with_weights) kernel.setArg(8, weights_);
+  cl::Event event;
+  const size_t group = 64;
+  runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange((count_ + group - 1) / group * group),
+                                        cl::NDRange(group), nullptr, &event);
+  return event;
+}
+
 std::vector<glm::vec4> TextureLookups::sample(const SamplerParams& sampler, double* kernel_ms) {
   std::vector<glm::vec4> out(count_);
   if (count_ == 0) return out;
-  cl::Kernel& k = kernels_for(sampler).sample;
-  k.setArg(0, faces_);
-  k.setArg(1, level_offsets_);
-  k.setArg(2, texels_);
-  k.setArg(3, srgb_table_);
-  k.setArg(4, sampler);
-  k.setArg(5, lookups_);
-  k.setArg(6, static_cast<cl_uint>(count_));
-  k.setArg(7, colors_);
-  cl::Event event;
-  const size_t group = 64;
-  runtime_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange((count_ + group - 1) / group * group),
-                                        cl::NDRange(group), nullptr, &event);
+  const cl::Event event = run(kernels_for(sampler).sample, sampler, false);
   runtime_.queue().enqueueReadBuffer(colors_, CL_TRUE, 0, count_ * sizeof(cl_float4), out.data());
   if (kernel_ms != nullptr) *kernel_ms = event_milliseconds(event);
   return out;
@@ -75,19 +81,7 @@ std::vector<glm::vec4> TextureLookups::sample(const SamplerParams& sampler, doub
 std::vector<FilterSum> TextureLookups::filter(const SamplerParams& sampler) {
   std::vector<FilterSum> out(count_);
   if (count_ == 0) return out;
-  cl::Kernel& k = kernels_for(sampler).filter;
-  k.setArg(0, faces_);
-  k.setArg(1, level_offsets_);
-  k.setArg(2, texels_);
-  k.setArg(3, srgb_table_);
-  k.setArg(4, sampler);
-  k.setArg(5, lookups_);
-  k.setArg(6, static_cast<cl_uint>(count_));
-  k.setArg(7, colors_);
-  k.setArg(8, weights_);
-  const size_t group = 64;
-  runtime_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange((count_ + group - 1) / group * group),
-                                        cl::NDRange(group));
+  run(kernels_for(sampler).filter, sampler, true);
   std::vector<glm::vec4> colors(count_);
   std::vector<float> weights(count_);
   runtime_.queue().enqueueReadBuffer(colors_, CL_TRUE, 0, count_ * sizeof(cl_float4), colors.data());

@@ -37,6 +37,7 @@ class TextureLookups {
     cl::Kernel sample, filter;
   };
   Kernels& kernels_for(const SamplerParams& sampler);
+  cl::Event run(cl::Kernel& kernel, const SamplerParams& sampler, bool with_weights);
 
   ClRuntime& runtime_;
   TexelFormat format_;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <random>
 
+#include "test_support.h"
 #include "binning.h"
 #include "cl_runtime.h"
 #include "frame_params.h"
@@ -21,22 +22,15 @@
 #include "triangle_setup.h"
 
 using namespace seamcl;
+using seamcl_tests::shared_runtime;
+using seamcl_tests::uniform;
 
 namespace {
-
-ClRuntime& runtime() {
-  static ClRuntime rt;
-  return rt;
-}
-
-float random_float(std::mt19937& rng, float lo, float hi) {
-  return lo + (hi - lo) * static_cast<float>(rng() % 1000001u) / 1000000.0f;
-}
 
 TextureLevel random_level(std::mt19937& rng, int width, int height) {
   TextureLevel level{width, height, {}};
   for (int i = 0; i < width * height; ++i) {
-    level.texels.emplace_back(random_float(rng, 0, 1), random_float(rng, 0, 1), random_float(rng, 0, 1), 1.0f);
+    level.texels.emplace_back(uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1), 1.0f);
   }
   return level;
 }
@@ -48,11 +42,11 @@ Scene random_scene(uint32_t seed, int quads) {
   Scene scene;
   scene.name = "random";
   for (int q = 0; q < quads; ++q) {
-    const glm::vec3 center(random_float(rng, -6, 6), random_float(rng, -6, 6), random_float(rng, -6, 6));
-    const glm::vec3 a = glm::normalize(glm::vec3(random_float(rng, -1, 1), random_float(rng, -1, 1), random_float(rng, -1, 1)) + 1e-3f);
-    glm::vec3 b = glm::cross(a, glm::normalize(glm::vec3(random_float(rng, -1, 1), random_float(rng, -1, 1), 1.0f)));
+    const glm::vec3 center(uniform(rng, -6, 6), uniform(rng, -6, 6), uniform(rng, -6, 6));
+    const glm::vec3 a = glm::normalize(glm::vec3(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1)) + 1e-3f);
+    glm::vec3 b = glm::cross(a, glm::normalize(glm::vec3(uniform(rng, -1, 1), uniform(rng, -1, 1), 1.0f)));
     b = glm::normalize(b);
-    const float su = random_float(rng, 0.05f, 4.0f), sv = random_float(rng, 0.002f, 4.0f);  // slivers too
+    const float su = uniform(rng, 0.05f, 4.0f), sv = uniform(rng, 0.002f, 4.0f);  // slivers too
     const uint32_t base = static_cast<uint32_t>(scene.positions.size());
     scene.positions.push_back(center - a * su - b * sv);
     scene.positions.push_back(center + a * su - b * sv);
@@ -63,9 +57,9 @@ Scene random_scene(uint32_t seed, int quads) {
     face.texture = build_mip_chain(random_level(rng, 1 << (rng() % 6), 1 << (rng() % 6)));
     scene.faces.push_back(std::move(face));
   }
-  scene.camera.eye = glm::vec3(random_float(rng, -4, 4), random_float(rng, -4, 4), random_float(rng, 3, 8));
+  scene.camera.eye = glm::vec3(uniform(rng, -4, 4), uniform(rng, -4, 4), uniform(rng, 3, 8));
   scene.camera.target = glm::vec3(0.0f);
-  scene.camera.fov_y_degrees = random_float(rng, 30, 90);
+  scene.camera.fov_y_degrees = uniform(rng, 30, 90);
   return scene;
 }
 
@@ -108,7 +102,7 @@ std::vector<Case> cases() {
 }  // namespace
 
 TEST(KernelVsTwin, EveryStageOnBuiltInAndRandomScenes) {
-  Renderer renderer(runtime());
+  Renderer renderer(shared_runtime());
   for (const Case& c : cases()) {
     SCOPED_TRACE(c.name);
     renderer.load_scene(c.scene);
@@ -199,17 +193,17 @@ TEST(SamplePattern, HostAndKernelTablesAreTheD3D11StandardPatterns) {
       {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, 7}, {7, -7}},
       {{1, 1}, {-1, -3}, {-3, 2}, {4, -1}, {-5, -2}, {2, 5}, {5, 3}, {3, -5},
        {-2, 6}, {0, -7}, {-4, -6}, {-6, 4}, {-8, 0}, {7, -4}, {6, 7}, {-7, -8}}};
-  cl::Kernel kernel(runtime().program(), "sample_pattern");
-  cl::Buffer out(runtime().context(), CL_MEM_WRITE_ONLY, sizeof(cl_int) * 2 * SEAMCL_MAX_SAMPLES);
+  cl::Kernel kernel(shared_runtime().program(), "sample_pattern");
+  cl::Buffer out(shared_runtime().context(), CL_MEM_WRITE_ONLY, sizeof(cl_int) * 2 * SEAMCL_MAX_SAMPLES);
   for (size_t row = 0; row < standard.size(); ++row) {
     const int count = 1 << row;
     const auto& host = sample_pattern(count);
     ASSERT_EQ(host.size(), standard[row].size());
     kernel.setArg(0, static_cast<cl_int>(count));
     kernel.setArg(1, out);
-    runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(1));
+    shared_runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(1));
     std::vector<cl_int> device(2 * static_cast<size_t>(count));
-    runtime().queue().enqueueReadBuffer(out, CL_TRUE, 0, sizeof(cl_int) * device.size(), device.data());
+    shared_runtime().queue().enqueueReadBuffer(out, CL_TRUE, 0, sizeof(cl_int) * device.size(), device.data());
     for (int s = 0; s < count; ++s) {
       EXPECT_EQ(host[s].x, standard[row][s].first) << count << "x sample " << s;
       EXPECT_EQ(host[s].y, standard[row][s].second) << count << "x sample " << s;

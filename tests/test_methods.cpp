@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "test_support.h"
 #include "cl_runtime.h"
 #include "raster.h"
 #include "render_options.h"
@@ -15,13 +16,10 @@
 #include "texture_sample.h"
 
 using namespace seamcl;
+using seamcl_tests::shared_runtime;
+using seamcl_tests::uniform;
 
 namespace {
-
-ClRuntime& runtime() {
-  static ClRuntime rt;
-  return rt;
-}
 
 struct SeamCheck {
   size_t checked = 0;  // pixels with at least one covered sample
@@ -75,7 +73,7 @@ TEST(Methods, DiscardShowsNoSeamOnConstantScenesBlackDoes) {
     GeneratorOptions generator;
     generator.constant_color = color;
     const Scene scene = generate_scene(name, generator);
-    Renderer renderer(runtime());
+    Renderer renderer(shared_runtime());
     renderer.load_scene(scene);
     for (int msaa : {1, 2, 4, 8, 16}) {
       for (int aniso : {1, 4, 16}) {
@@ -104,7 +102,7 @@ TEST(Methods, ZeroCoverageNanOnlyOnFragmentsWithNoTapInsideAndNeverByDefault) {
   size_t nan_pixels_seen = 0;
   for (const GeneratorInfo& info : scene_generators()) {
     const Scene scene = generate_scene(info.name, {});
-    Renderer renderer(runtime());
+    Renderer renderer(shared_runtime());
     renderer.load_scene(scene);
     for (int msaa : {1, 4, 16}) {
       for (Filter filter : {Filter::Trilinear, Filter::Aniso}) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "test_support.h"
 #include "cl_runtime.h"
 #include "packed_scene.h"
 #include "render_options.h"
@@ -13,17 +14,10 @@
 #include "texture_sample.h"
 
 using namespace seamcl;
+using seamcl_tests::shared_runtime;
+using seamcl_tests::uniform;
 
 namespace {
-
-ClRuntime& runtime() {
-  static ClRuntime rt;
-  return rt;
-}
-
-float uniform(std::mt19937& rng, float lo, float hi) {
-  return lo + (hi - lo) * static_cast<float>(rng() % 1000001u) / 1000000.0f;
-}
 
 // Faces side by side, each with its own texture; `fill` gives level 0's texel (face, i, j).
 template <typename Fill>
@@ -99,7 +93,7 @@ TEST(KernelVsTwin, SamplerEveryFilterAddressModeStorageAndMethod) {
   const std::vector<Lookup> lookups = random_lookups(rng, static_cast<uint32_t>(scene.faces.size()), 3000);
   for (TexelFormat format : {TexelFormat::Rgba8, TexelFormat::Rgba32f}) {
     const PackedScene packed = pack_scene(scene, format);
-    TextureLookups device(runtime(), packed);
+    TextureLookups device(shared_runtime(), packed);
     device.set_lookups(lookups);
     for (int filter : {SEAMCL_FILTER_BILINEAR, SEAMCL_FILTER_TRILINEAR, SEAMCL_FILTER_ANISO, SEAMCL_FILTER_EWA}) {
       for (int address : {SEAMCL_ADDRESS_CLAMP, SEAMCL_ADDRESS_WRAP, SEAMCL_ADDRESS_BORDER}) {
@@ -166,7 +160,7 @@ TEST(Discard, ConstantTextureIsReturnedExactlyEverywhere) {
     const PackedScene packed = pack_scene(scene, format);
     // RGBA8 stores the constant after an sRGB round trip; that is the constant it must return.
     const glm::vec4 stored = format == TexelFormat::Rgba8 ? decode_srgb8(encode_srgb8(constant)) : constant;
-    TextureLookups device(runtime(), packed);
+    TextureLookups device(shared_runtime(), packed);
     device.set_lookups(lookups);
     for (int filter : {SEAMCL_FILTER_BILINEAR, SEAMCL_FILTER_TRILINEAR, SEAMCL_FILTER_ANISO, SEAMCL_FILTER_EWA}) {
       SCOPED_TRACE(testing::Message() << to_string(format) << " filter " << filter);
@@ -191,7 +185,7 @@ TEST(Discard, ConstantTextureIsReturnedExactlyEverywhere) {
 TEST(Discard, WeightsSumToOneInsideAndWithClampOrWrap) {
   const Scene scene = random_texture_scene(4);
   const PackedScene packed = pack_scene(scene, TexelFormat::Rgba32f);
-  TextureLookups device(runtime(), packed);
+  TextureLookups device(shared_runtime(), packed);
   std::mt19937 rng(12);
   std::vector<Lookup> lookups = random_lookups(rng, static_cast<uint32_t>(scene.faces.size()), 3000);
   device.set_lookups(lookups);
@@ -221,7 +215,7 @@ TEST(Discard, NaNInNeighbouringMemoryNeverLeaks) {
   });
   const PackedScene packed = pack_scene(scene, TexelFormat::Rgba32f);
   ASSERT_TRUE(std::isnan(packed.texels32.front()));
-  TextureLookups device(runtime(), packed);
+  TextureLookups device(shared_runtime(), packed);
   std::mt19937 rng(21);
   std::vector<Lookup> lookups = random_lookups(rng, 1, 3000);
   for (Lookup& l : lookups) l.face = 1;
@@ -241,7 +235,7 @@ TEST(Discard, NaNInNeighbouringMemoryNeverLeaks) {
 TEST(ZeroCoverage, NanOnlyWhereEveryTapFallsOutside) {
   const Scene scene = random_texture_scene(6);
   const PackedScene packed = pack_scene(scene, TexelFormat::Rgba8);
-  TextureLookups device(runtime(), packed);
+  TextureLookups device(shared_runtime(), packed);
   std::mt19937 rng(33);
   const std::vector<Lookup> lookups = random_lookups(rng, static_cast<uint32_t>(scene.faces.size()), 4000);
   device.set_lookups(lookups);

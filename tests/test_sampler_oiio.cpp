@@ -56,28 +56,24 @@
 
 #include <unistd.h>
 
+#include "test_support.h"
 #include "cl_runtime.h"
 #include "packed_scene.h"
 #include "render_options.h"
 #include "scene.h"
+#include "texture_file.h"
 #include "texture_lookups.h"
 #include "texture_sample.h"
 
 using namespace seamcl;
+using seamcl_tests::shared_runtime;
+using seamcl_tests::uniform;
 namespace fs = std::filesystem;
 
 namespace {
 
 constexpr float kTolerance = 2e-5f;
 
-ClRuntime& runtime() {
-  static ClRuntime rt;
-  return rt;
-}
-
-float uniform(std::mt19937& rng, float lo, float hi) {
-  return std::uniform_real_distribution<float>(lo, hi)(rng);
-}
 
 TextureLevel random_level(uint32_t seed, int width, int height) {
   std::mt19937 rng(seed);
@@ -114,48 +110,6 @@ Scene one_face_scene(TextureLevel level0) {
   face.texture = build_mip_chain(std::move(level0));
   scene.faces.push_back(std::move(face));
   return scene;
-}
-
-// Level `level` of face `face` as the kernels read it, in linear float RGBA.
-std::vector<float> packed_level(const PackedScene& packed, uint32_t face, int level, int& width, int& height) {
-  const FaceGpu& f = packed.faces.at(face);
-  width = std::max(f.width >> level, 1);
-  height = std::max(f.height >> level, 1);
-  const uint32_t offset = packed.level_offsets.at(f.level_table + static_cast<uint32_t>(level));
-  const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
-  std::vector<float> out(count * 4);
-  for (size_t i = 0; i < count; ++i) {
-    glm::vec4 t;
-    if (packed.format == TexelFormat::Rgba8) {
-      t = decode_srgb8(packed.texels8.at(offset + i));
-    } else {
-      const float* p = &packed.texels32.at(4 * (offset + i));
-      t = glm::vec4(p[0], p[1], p[2], p[3]);
-    }
-    for (int c = 0; c < 4; ++c) out[4 * i + static_cast<size_t>(c)] = t[c];
-  }
-  return out;
-}
-
-// Face `face`'s whole chain, as packed, into a tiled MIP-mapped float EXR.
-void write_mip_exr(const PackedScene& packed, uint32_t face, const std::string& path) {
-  auto out = OIIO::ImageOutput::create(path);
-  ASSERT_TRUE(out) << OIIO::geterror();
-  ASSERT_TRUE(out->supports("mipmap") && out->supports("tiles"));
-  const int levels = packed.faces.at(face).level_count;
-  for (int l = 0; l < levels; ++l) {
-    int w = 0, h = 0;
-    const std::vector<float> pixels = packed_level(packed, face, l, w, h);
-    OIIO::ImageSpec spec(w, h, 4, OIIO::TypeDesc::FLOAT);
-    spec.tile_width = 64;
-    spec.tile_height = 64;
-    spec.attribute("textureformat", "Plain Texture");
-    spec.attribute("compression", "zip");
-    const auto mode = l == 0 ? OIIO::ImageOutput::Create : OIIO::ImageOutput::AppendMIPLevel;
-    ASSERT_TRUE(out->open(path, spec, mode)) << out->geterror();
-    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data())) << out->geterror();
-  }
-  ASSERT_TRUE(out->close()) << out->geterror();
 }
 
 // The EXR files live in one temporary directory per process, removed after the last test.
@@ -227,8 +181,8 @@ Textured make_textured(const Scene& scene, TexelFormat format, const std::string
   Textured t;
   t.packed = pack_scene(scene, format);
   t.path = temp_exr_path(stem + (format == TexelFormat::Rgba8 ? "-u8" : "-f32"));
-  write_mip_exr(t.packed, 0, t.path);
-  t.lookups = std::make_unique<TextureLookups>(runtime(), t.packed);
+  write_face_mip_exr(t.packed, 0, t.path);  // throws (failing the test) on error
+  t.lookups = std::make_unique<TextureLookups>(shared_runtime(), t.packed);
   t.width = t.packed.faces[0].width;
   t.height = t.packed.faces[0].height;
   t.levels = t.packed.faces[0].level_count;
@@ -372,7 +326,7 @@ TEST(OiioOracle, ExrHoldsOurLevels) {
   int levels = 0;
   while (in->seek_subimage(0, levels)) {
     int w = 0, h = 0;
-    const std::vector<float> ours = packed_level(tex.packed, 0, levels, w, h);
+    const std::vector<float> ours = packed_level_linear(tex.packed, 0, levels, w, h);
     const OIIO::ImageSpec spec = in->spec();
     ASSERT_EQ(spec.width, w) << "level " << levels;
     ASSERT_EQ(spec.height, h) << "level " << levels;

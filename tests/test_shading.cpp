@@ -16,20 +16,12 @@
 
 #include <glm/glm.hpp>
 
+#include "test_support.h"
 #include "cl_runtime.h"
 #include "renderer.h"
 #include "scene.h"
 #include "scene_generators.h"
 #include "texture_sample.h"
-
-namespace seamcl_tests {
-// One ClRuntime (and so one program build) for the whole test binary: this inline definition is
-// identical in every test file that uses it, so the linker keeps one.
-inline seamcl::ClRuntime& shared_runtime() {
-  static seamcl::ClRuntime runtime;
-  return runtime;
-}
-}  // namespace seamcl_tests
 
 using namespace seamcl;
 
@@ -37,10 +29,6 @@ namespace {
 
 constexpr uint32_t kSlotsPerFace = 2 * SEAMCL_CLIP_SLOTS;
 constexpr float kTolerance = 1e-5f;
-
-const char* shading_name(ShadingMode mode) {
-  return mode == ShadingMode::Pixel ? "pixel" : mode == ShadingMode::Centroid ? "centroid" : "sample";
-}
 
 struct Counts {
   size_t uniform = 0;     // every sample covered, all by faces of one normal
@@ -164,7 +152,7 @@ void check_generator(const SceneCase& c) {
   renderer.load_scene(scene);
   for (const int msaa : {1, 4, 16})
     for (const ShadingMode shading : {ShadingMode::Pixel, ShadingMode::Centroid, ShadingMode::Sample}) {
-      SCOPED_TRACE(c.name + ", msaa " + std::to_string(msaa) + ", shading " + shading_name(shading));
+      SCOPED_TRACE(c.name + ", msaa " + std::to_string(msaa) + ", shading " + to_string(shading));
       const Counts counts = check_constant_scene(renderer, scene, color, c.width, c.height, msaa, shading);
       EXPECT_GT(counts.uniform, static_cast<size_t>(c.width) * c.height / 10);
       if (c.has_background) {

@@ -23,19 +23,11 @@
 
 #include <glm/glm.hpp>
 
+#include "test_support.h"
 #include "cl_runtime.h"
 #include "frame_params.h"
 #include "renderer.h"
 #include "scene.h"
-
-namespace seamcl_tests {
-// One ClRuntime (and so one program build) for the whole test binary: this inline definition is
-// identical in every test file that uses it, so the linker keeps one.
-inline seamcl::ClRuntime& shared_runtime() {
-  static seamcl::ClRuntime runtime;
-  return runtime;
-}
-}  // namespace seamcl_tests
 
 using namespace seamcl;
 
