@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cl_runtime.h"
+#include "commands.h"
 #include "errors.h"
 #include "image_io.h"
 #include "render_options.h"
@@ -183,6 +184,9 @@ int main(int argc, char** argv) {
   scenes->add_flag("--json", scenes_json, "Print a JSON array");
   CLI::App* devices = app.add_subcommand("devices", "List OpenCL devices (* marks the one seamcl would use)");
 
+  // Subcommands defined in their own files (cli/commands.h), one line each.
+  std::vector<seamcl::cli::Command> extra_commands;
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -203,6 +207,9 @@ int main(int argc, char** argv) {
     if (render->parsed()) return run_render(render_args, device);
     if (scenes->parsed()) return run_scenes(scenes_json);
     if (devices->parsed()) return run_devices(device);
+    for (const seamcl::cli::Command& command : extra_commands) {
+      if (command.subcommand->parsed()) return command.run(seamcl::cli::GlobalOptions{device});
+    }
     std::fputs(app.help().c_str(), stdout);
     return 2;
   } catch (const InputError& e) {

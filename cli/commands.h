@@ -1,0 +1,25 @@
+// Subcommands that live in their own file register here: each adds its CLI11 subcommand to the
+// app and returns it with the function main() runs when that subcommand was given. Errors follow main's rules:
+// throw InputError for bad input (exit 2), anything else for other failures (exit 1).
+#pragma once
+#include <functional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace seamcl::cli {
+
+struct GlobalOptions {
+  std::string device;  // --device, before the subcommand
+};
+
+struct Command {
+  CLI::App* subcommand = nullptr;
+  std::function<int(const GlobalOptions&)> run;
+};
+
+// One line per command file: `Command add_<name>_command(CLI::App& app);`, and one call in main.
+Command add_serve_command(CLI::App& app);    // cli/serve_command.cpp
+Command add_compare_command(CLI::App& app);  // cli/compare_command.cpp
+
+}  // namespace seamcl::cli
