@@ -21,3 +21,6 @@ static_assert(offsetof(TriangleSetup, face) == 64);
 static_assert(offsetof(TriangleSetup, inv_w) == 76);
 static_assert(offsetof(TriangleSetup, v_over_w) == 100);
 static_assert(sizeof(FrameStats) == 16, "FrameStats layout");
+static_assert(sizeof(FaceNeighbors) == 112, "FaceNeighbors layout");
+static_assert(offsetof(FaceNeighbors, transform) == 16);
+static_assert(offsetof(SamplerParams, traverse) == 20);

@@ -1,5 +1,7 @@
 #include "packed_scene.h"
 
+#include "adjacency.h"
+
 #include <limits>
 #include <stdexcept>
 
@@ -45,6 +47,7 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format) {
     }
     out.faces.push_back(gpu);
   }
+  out.neighbors = build_adjacency(scene);
   return out;
 }
 

@@ -13,15 +13,17 @@ namespace seamcl {
 struct PackedScene {
   std::vector<cl_float4> positions;     // xyz, w = 1
   std::vector<FaceGpu> faces;
+  std::vector<FaceNeighbors> neighbors;  // edge adjacency, for traverse
   std::vector<uint32_t> level_offsets;  // per face, per level: first texel in `texels`
   TexelFormat format = TexelFormat::Rgba8;
   std::vector<uint32_t> texels8;        // RGBA8, sRGB-encoded RGB (format Rgba8)
   std::vector<float> texels32;          // linear RGBA32F, 4 floats a texel (format Rgba32f)
 
   int input_triangles() const { return static_cast<int>(faces.size() * 2); }
-  TextureView textures() const { return {&faces, &level_offsets, format, &texels8, &texels32}; }
+  TextureView textures() const { return {&faces, &neighbors, &level_offsets, format, &texels8, &texels32}; }
   size_t texel_count() const { return format == TexelFormat::Rgba8 ? texels8.size() : texels32.size() / 4; }
   size_t texture_bytes() const { return texels8.size() * sizeof(uint32_t) + texels32.size() * sizeof(float); }
+  size_t adjacency_bytes() const { return neighbors.size() * sizeof(FaceNeighbors); }
 };
 
 PackedScene pack_scene(const Scene& scene, TexelFormat format = TexelFormat::Rgba8);

@@ -32,8 +32,8 @@ std::vector<std::string> enum_names(const std::array<std::pair<Enum, const char*
   return out;
 }
 
-constexpr std::array<std::pair<Method, const char*>, 3> kMethods{
-    {{Method::Clamp, "clamp"}, {Method::Black, "black"}, {Method::Discard, "discard"}}};
+constexpr std::array<std::pair<Method, const char*>, 4> kMethods{
+    {{Method::Clamp, "clamp"}, {Method::Black, "black"}, {Method::Discard, "discard"}, {Method::Traverse, "traverse"}}};
 constexpr std::array<std::pair<Filter, const char*>, 4> kFilters{
     {{Filter::Bilinear, "bilinear"}, {Filter::Trilinear, "trilinear"}, {Filter::Aniso, "aniso"}, {Filter::Ewa, "ewa"}}};
 constexpr std::array<std::pair<ZeroCoverage, const char*>, 2> kZeroCoverage{
@@ -114,7 +114,8 @@ SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCo
              : filter == Filter::Aniso     ? SEAMCL_FILTER_ANISO
                                            : SEAMCL_FILTER_EWA;
   p.address = method == Method::Clamp ? SEAMCL_ADDRESS_CLAMP : SEAMCL_ADDRESS_BORDER;
-  p.renormalize = method == Method::Discard ? 1 : 0;
+  p.renormalize = method == Method::Discard || method == Method::Traverse ? 1 : 0;
+  p.traverse = method == Method::Traverse ? 1 : 0;
   p.max_aniso = max_aniso;
   p.zero_coverage = zero_coverage == ZeroCoverage::Clamp ? SEAMCL_ZERO_COVERAGE_CLAMP : SEAMCL_ZERO_COVERAGE_NAN;
   return p;

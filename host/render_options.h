@@ -16,8 +16,10 @@ namespace seamcl {
 // How a lookup treats taps outside the face (the seam method):
 //   clamp   - taps read the nearest edge texel (seams show);
 //   black   - taps outside weigh zero, no renormalisation (Ptex's black border: edges darken);
-//   discard - taps outside weigh zero and the rest are renormalised (Toth 2013).
-enum class Method { Clamp, Black, Discard };
+//   discard - taps outside weigh zero and the rest are renormalised (Toth 2013);
+//   traverse - discard, plus the same lookup on the four edge neighbours through their uv
+//              transforms, all summed and then renormalised (McDonald 2013).
+enum class Method { Clamp, Black, Discard, Traverse };
 // The filter of one lookup: bilinear (level 0), trilinear, aniso (hardware-style probes), ewa.
 enum class Filter { Bilinear, Trilinear, Aniso, Ewa };
 // Discard with every tap outside: a clamped lookup (the paper's fix) or the raw 0/0 (NaN).

@@ -37,7 +37,7 @@ struct Renderer::Impl {
 
   std::unique_ptr<Scene> scene;
   PackedScene packed;
-  cl::Buffer positions, faces, level_offsets, texels, srgb_table;
+  cl::Buffer positions, faces, neighbors, level_offsets, texels, srgb_table;
 
   // Frame buffers, grown on demand.
   cl::Buffer frame_params, stats, setups, tile_counts, tile_offsets, tile_cursors, tile_lists, sample_triangle, image;
@@ -78,6 +78,7 @@ struct Renderer::Impl {
     packed = pack_scene(*scene, format);
     positions = upload(packed.positions);
     faces = upload(packed.faces);
+    neighbors = upload(packed.neighbors);
     level_offsets = upload(packed.level_offsets);
     texels = format == TexelFormat::Rgba8 ? upload(packed.texels8) : upload(packed.texels32);
   }
@@ -179,12 +180,13 @@ struct Renderer::Impl {
     shade_kernel.setArg(0, frame_params);
     shade_kernel.setArg(1, setups);
     shade_kernel.setArg(2, faces);
-    shade_kernel.setArg(3, level_offsets);
-    shade_kernel.setArg(4, texels);
-    shade_kernel.setArg(5, srgb_table);
-    shade_kernel.setArg(6, sample_triangle);
-    shade_kernel.setArg(7, image);
-    shade_kernel.setArg(8, stats);
+    shade_kernel.setArg(3, neighbors);
+    shade_kernel.setArg(4, level_offsets);
+    shade_kernel.setArg(5, texels);
+    shade_kernel.setArg(6, srgb_table);
+    shade_kernel.setArg(7, sample_triangle);
+    shade_kernel.setArg(8, image);
+    shade_kernel.setArg(9, stats);
     queue.enqueueNDRangeKernel(shade_kernel, cl::NullRange, tile_grid, tile_group, nullptr, next(ev.shade));
 
     pixels.resize(static_cast<size_t>(p.width) * p.height);
@@ -256,7 +258,8 @@ std::string program_options(TexelFormat format, const SamplerParams& sampler) {
          " -DSEAMCL_SAMPLER_FILTER=" + std::to_string(sampler.filter) +
          " -DSEAMCL_SAMPLER_ADDRESS=" + std::to_string(sampler.address) +
          " -DSEAMCL_SAMPLER_RENORMALIZE=" + std::to_string(sampler.renormalize) +
-         " -DSEAMCL_SAMPLER_ZERO_COVERAGE=" + std::to_string(sampler.zero_coverage);
+         " -DSEAMCL_SAMPLER_ZERO_COVERAGE=" + std::to_string(sampler.zero_coverage) +
+         " -DSEAMCL_SAMPLER_TRAVERSE=" + std::to_string(sampler.traverse);
 }
 
 void Renderer::warm_up(const RenderOptions& options) {

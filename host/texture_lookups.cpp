@@ -21,6 +21,7 @@ TextureLookups::TextureLookups(ClRuntime& runtime, const PackedScene& textures)
     : runtime_(runtime), format_(textures.format) {
   const cl::Context& context = runtime.context();
   faces_ = read_only_buffer(context, textures.faces);
+  neighbors_ = read_only_buffer(context, textures.neighbors);
   level_offsets_ = read_only_buffer(context, textures.level_offsets);
   texels_ = textures.format == TexelFormat::Rgba8 ? read_only_buffer(context, textures.texels8)
                                                   : read_only_buffer(context, textures.texels32);
@@ -54,14 +55,15 @@ void TextureLookups::set_lookups(const std::vector<Lookup>& lookups) {
 cl::Event TextureLookups::run(cl::Kernel& kernel, const SamplerParams& sampler, bool with_weights) {
   // Both batch kernels take the same arguments; texture_filter_batch adds the weights.
   kernel.setArg(0, faces_);
-  kernel.setArg(1, level_offsets_);
-  kernel.setArg(2, texels_);
-  kernel.setArg(3, srgb_table_);
-  kernel.setArg(4, sampler);
-  kernel.setArg(5, lookups_);
-  kernel.setArg(6, static_cast<cl_uint>(count_));
-  kernel.setArg(7, colors_);
-  if (with_weights) kernel.setArg(8, weights_);
+  kernel.setArg(1, neighbors_);
+  kernel.setArg(2, level_offsets_);
+  kernel.setArg(3, texels_);
+  kernel.setArg(4, srgb_table_);
+  kernel.setArg(5, sampler);
+  kernel.setArg(6, lookups_);
+  kernel.setArg(7, static_cast<cl_uint>(count_));
+  kernel.setArg(8, colors_);
+  if (with_weights) kernel.setArg(9, weights_);
   cl::Event event;
   const size_t group = 64;
   runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange((count_ + group - 1) / group * group),

@@ -42,7 +42,7 @@ class TextureLookups {
   ClRuntime& runtime_;
   TexelFormat format_;
   std::map<std::string, Kernels> kernels_;
-  cl::Buffer faces_, level_offsets_, texels_, srgb_table_, lookups_, colors_, weights_;
+  cl::Buffer faces_, neighbors_, level_offsets_, texels_, srgb_table_, lookups_, colors_, weights_;
   size_t count_ = 0;
 };
 

@@ -310,9 +310,29 @@ FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, 
   return sum;
 }
 
+FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const SamplerParams& sampler, float u, float v,
+                               float dudx, float dvdx, float dudy, float dvdy) {
+  FilterSum sum = filter_texture_reference(tex, face, sampler, sampler.address, u, v, dudx, dvdx, dudy, dvdy);
+  if (!sampler.traverse) return sum;
+  // Traverse: each edge neighbour at this point and footprint carried into its uv, border-
+  // addressed. Diagonal faces are not edge neighbours: taps past a corner are not read.
+  const FaceNeighbors& n = tex.neighbors->at(face);
+  for (int k = 0; k < 4; ++k) {
+    if (n.neighbor[k] < 0) continue;
+    const float* t = n.transform[k];
+    const FilterSum s = filter_texture_reference(tex, static_cast<uint32_t>(n.neighbor[k]), sampler, SEAMCL_ADDRESS_BORDER,
+                                                 t[0] * u + t[1] * v + t[2], t[3] * u + t[4] * v + t[5],
+                                                 t[0] * dudx + t[1] * dvdx, t[3] * dudx + t[4] * dvdx,
+                                                 t[0] * dudy + t[1] * dvdy, t[3] * dudy + t[4] * dvdy);
+    sum.color += s.color;
+    sum.weight += s.weight;
+  }
+  return sum;
+}
+
 glm::vec4 sample_texture_reference(const TextureView& tex, uint32_t face, const SamplerParams& sampler, float u, float v,
                                    float dudx, float dvdx, float dudy, float dvdy) {
-  FilterSum sum = filter_texture_reference(tex, face, sampler, sampler.address, u, v, dudx, dvdx, dudy, dvdy);
+  FilterSum sum = method_sum_reference(tex, face, sampler, u, v, dudx, dvdx, dudy, dvdy);
   if (!sampler.renormalize) return sum.color;
   if (sum.weight == 0.0f && sampler.zero_coverage == SEAMCL_ZERO_COVERAGE_CLAMP) {
     // Every tap fell outside: a clamped trilinear lookup at the centre clamped to the face.

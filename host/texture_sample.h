@@ -23,6 +23,7 @@ enum class TexelFormat { Rgba8, Rgba32f };
 // texel arrays is used, as `format` says.
 struct TextureView {
   const std::vector<FaceGpu>* faces;
+  const std::vector<FaceNeighbors>* neighbors;  // read by traverse only
   const std::vector<uint32_t>* level_offsets;
   TexelFormat format;
   const std::vector<uint32_t>* texels8;   // RGBA8 sRGB
@@ -40,6 +41,11 @@ float approx_log2(float x);
 
 FilterSum filter_texture_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler,
                                    int address, float u, float v, float dudx, float dvdx, float dudy, float dvdy);
+// What a method sums before renormalising: filter_texture_reference on the face with the
+// sampler's address mode and, for traverse, on each edge neighbour (border) through its uv
+// transform.
+FilterSum method_sum_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler, float u, float v,
+                               float dudx, float dvdx, float dudy, float dvdy);
 // The lookup as a seam method asks for it (renormalisation and zero-coverage rule included).
 glm::vec4 sample_texture_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler, float u,
                                    float v, float dudx, float dvdx, float dudy, float dvdy);

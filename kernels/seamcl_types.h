@@ -45,15 +45,28 @@ typedef float cl_float;
 #define SEAMCL_ZERO_COVERAGE_NAN 1   /* the raw division 0/0 (the paper's failure case) */
 
 /* How one texture lookup filters. The seam methods are settings of it: clamp = address clamp;
- * black = address border; discard = address border + renormalize. */
+ * black = address border; discard = address border + renormalize; traverse = discard + the same
+ * lookup on each edge neighbour through its uv transform, all summed before renormalising. */
 typedef struct {
   cl_int filter;         /* SEAMCL_FILTER_* */
   cl_int address;        /* SEAMCL_ADDRESS_* */
   cl_int renormalize;    /* 1: divide by the summed weight of the taps inside */
   cl_int max_aniso;      /* 1..16, for aniso and ewa */
   cl_int zero_coverage;  /* SEAMCL_ZERO_COVERAGE_*, when renormalize and no tap is inside */
-  cl_int pad0, pad1, pad2;
+  cl_int traverse;       /* 1: also filter the edge neighbours (FaceNeighbors) */
+  cl_int pad0, pad1;
 } SamplerParams;
+
+/* A face's edge neighbours, for traverse. Edge k runs from corner k to corner k+1 (uv (0,0),
+ * (1,0), (1,1), (0,1)): edge 0 is v = 0, 1 is u = 1, 2 is v = 1, 3 is u = 0. neighbor[k] is the
+ * face across it (-1 at a boundary or a non-manifold edge); transform[k] maps this face's uv to
+ * the neighbour's: (u', v') = (t0 u + t1 v + t2, t3 u + t4 v + t5), derivatives by the linear part.
+ * Both uv spaces are unit squares, so the map is a rotation by a multiple of 90 degrees (or, for
+ * a neighbour of opposite orientation, a reflection) and a translation. */
+typedef struct {
+  cl_int neighbor[4];
+  cl_float transform[4][6];
+} FaceNeighbors;
 
 /* Per frame, read-only in every kernel. Screen space: pixels, origin at the top-left corner of
  * the image, y down; pixel (x, y) spans [x, x+1) x [y, y+1), its centre at (x+0.5, y+0.5). */

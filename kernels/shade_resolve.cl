@@ -37,24 +37,24 @@ SEAMCL_INLINE float plane_inv_w(__global const TriangleSetup* t, float x, float 
 }
 
 SEAMCL_INLINE float3 shade_fragment(__constant FrameParams* frame, __global const TriangleSetup* t,
-                             __global const FaceGpu* faces, __global const uint* level_offsets,
-                             TEXEL_BUFFER texels, __global const float* srgb_to_linear,
-                             float x, float y) {
+                             __global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
+                             __global const uint* level_offsets, TEXEL_BUFFER texels,
+                             __global const float* srgb_to_linear, float x, float y) {
   const SurfaceUv s = interpolate_uv(t, x, y);
-  const FaceGpu face = faces[t->face];
-  const float4 albedo = sample_texture(&face, level_offsets, texels, srgb_to_linear, frame->sampler, s.u, s.v,
-                                       s.dudx, s.dvdx, s.dudy, s.dvdy);
-  const float n_dot_l = face.normal[0] * frame->light_dir[0] + face.normal[1] * frame->light_dir[1] +
-                        face.normal[2] * frame->light_dir[2];
+  const float4 albedo = sample_texture(faces, neighbors, t->face, level_offsets, texels, srgb_to_linear, frame->sampler,
+                                       s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
+  __global const FaceGpu* face = faces + t->face;
+  const float n_dot_l = face->normal[0] * frame->light_dir[0] + face->normal[1] * frame->light_dir[1] +
+                        face->normal[2] * frame->light_dir[2];
   const float lighting = frame->ambient + (1.0f - frame->ambient) * fmax(n_dot_l, 0.0f);
   return (float3)(albedo.x * frame->light_color[0], albedo.y * frame->light_color[1],
                   albedo.z * frame->light_color[2]) * lighting;
 }
 
 __kernel void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* setups,
-                            __global const FaceGpu* faces, __global const uint* level_offsets,
-                            TEXEL_BUFFER texels, __global const float* srgb_to_linear,
-                            __global const uint* sample_triangle, __global float4* image,
+                            __global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
+                            __global const uint* level_offsets, TEXEL_BUFFER texels,
+                            __global const float* srgb_to_linear, __global const uint* sample_triangle, __global float4* image,
                             __global FrameStats* stats) {
   __local uint group_fragments;
   if (get_local_id(0) == 0 && get_local_id(1) == 0) group_fragments = 0;
@@ -79,7 +79,7 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
       const float sample_x = (float)sample_fixed_x(x, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
       const float sample_y = (float)sample_fixed_y(y, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
       if (frame->shading_mode == SEAMCL_SHADE_SAMPLE) {
-        sum += shade_fragment(frame, setups + slot, faces, level_offsets, texels, srgb_to_linear, sample_x, sample_y);
+        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, sample_x, sample_y);
         ++fragments;
         continue;
       }
@@ -103,7 +103,7 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
         shade_x = centroid_x;
         shade_y = centroid_y;
       }
-      sum += shade_fragment(frame, setups + slot, faces, level_offsets, texels, srgb_to_linear, shade_x, shade_y) *
+      sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, shade_x, shade_y) *
              (float)covered;
       ++fragments;
     }

@@ -26,11 +26,13 @@
 #define SAMPLER_ADDRESS(s) SEAMCL_SAMPLER_ADDRESS
 #define SAMPLER_RENORMALIZE(s) SEAMCL_SAMPLER_RENORMALIZE
 #define SAMPLER_ZERO_COVERAGE(s) SEAMCL_SAMPLER_ZERO_COVERAGE
+#define SAMPLER_TRAVERSE(s) SEAMCL_SAMPLER_TRAVERSE
 #else
 #define SAMPLER_FILTER(s) ((s).filter)
 #define SAMPLER_ADDRESS(s) ((s).address)
 #define SAMPLER_RENORMALIZE(s) ((s).renormalize)
 #define SAMPLER_ZERO_COVERAGE(s) ((s).zero_coverage)
+#define SAMPLER_TRAVERSE(s) ((s).traverse)
 #endif
 
 /* Ties against LLVM's SLP pass. PoCL vectorises a kernel by running its work-group loop 8 lanes
@@ -346,19 +348,53 @@ SEAMCL_INLINE FilterSum filter_texture(const FaceGpu* face, __global const uint*
   return sum;
 }
 
+/* Traverse (McDonald 2013, the paper's Listing 1): the same filter, border-addressed, on each
+ * edge neighbour at this lookup's point and footprint carried into the neighbour's uv, summed
+ * into `sum`. Corners: the diagonal faces are not edge neighbours, so taps that fall past a
+ * corner (outside this face and its edge neighbours) are not read and weigh zero; the final
+ * renormalisation spreads their weight over the rest, as Discard does everywhere. */
+SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* faces,
+                                        __global const FaceNeighbors* neighbors, uint face_index,
+                                        __global const uint* level_offsets, TEXEL_BUFFER texels,
+                                        __global const float* srgb_to_linear, int filter, int max_aniso, float u,
+                                        float v, float dudx, float dvdx, float dudy, float dvdy) {
+  __global const FaceNeighbors* n = neighbors + face_index;
+  for (int k = 0; k < 4; ++k) {
+    const int other = n->neighbor[k];
+    if (other < 0) continue;
+    __global const float* t = n->transform[k];
+    const FaceGpu g = faces[other];
+    const FilterSum s = filter_texture(&g, level_offsets, texels, srgb_to_linear, filter, SEAMCL_ADDRESS_BORDER,
+                                       max_aniso, t[0] * u + t[1] * v + t[2], t[3] * u + t[4] * v + t[5],
+                                       t[0] * dudx + t[1] * dvdx, t[3] * dudx + t[4] * dvdx,
+                                       t[0] * dudy + t[1] * dvdy, t[3] * dudy + t[4] * dvdy);
+    sum->r += s.r;
+    sum->g += s.g;
+    sum->b += s.b;
+    sum->a += s.a;
+    sum->weight += s.weight;
+  }
+}
+
 /* One texture lookup as a seam method asks for it: the one place where a FilterSum becomes a
  * colour. Without renormalisation the sum is the colour (border taps added black). With it
- * (discard), colour = sum / weight over the taps inside; when no tap is inside, zero_coverage
+ * (discard, traverse), colour = sum / weight over the taps read; when none was, zero_coverage
  * decides: a clamped trilinear lookup at the centre clamped to the face, or the raw 0/0. */
-SEAMCL_INLINE float4 sample_texture(const FaceGpu* face, __global const uint* level_offsets, TEXEL_BUFFER texels,
-                             __global const float* srgb_to_linear, SamplerParams sampler,
-                             float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
-  FilterSum sum = filter_texture(face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),
+SEAMCL_INLINE float4 sample_texture(__global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
+                                    uint face_index, __global const uint* level_offsets, TEXEL_BUFFER texels,
+                                    __global const float* srgb_to_linear, SamplerParams sampler,
+                                    float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
+  const FaceGpu face = faces[face_index];
+  FilterSum sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),
                                  SAMPLER_ADDRESS(sampler), sampler.max_aniso, u, v, dudx, dvdx, dudy, dvdy);
+  if (SAMPLER_TRAVERSE(sampler)) {
+    accumulate_neighbors(&sum, faces, neighbors, face_index, level_offsets, texels, srgb_to_linear,
+                         SAMPLER_FILTER(sampler), sampler.max_aniso, u, v, dudx, dvdx, dudy, dvdy);
+  }
   if (!SAMPLER_RENORMALIZE(sampler)) return (float4)(sum.r, sum.g, sum.b, sum.a);
   const int clamp_when_uncovered = SAMPLER_ZERO_COVERAGE(sampler) == SEAMCL_ZERO_COVERAGE_CLAMP;
   if (clamp_when_uncovered && sum.weight == 0.0f) {
-    sum = filter_texture(face, level_offsets, texels, srgb_to_linear, SEAMCL_FILTER_TRILINEAR, SEAMCL_ADDRESS_CLAMP,
+    sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, SEAMCL_FILTER_TRILINEAR, SEAMCL_ADDRESS_CLAMP,
                          sampler.max_aniso, fmin(fmax(u, 0.0f), 1.0f), fmin(fmax(v, 0.0f), 1.0f), dudx, dvdx, dudy,
                          dvdy);
   }
@@ -368,14 +404,15 @@ SEAMCL_INLINE float4 sample_texture(const FaceGpu* face, __global const uint* le
 
 /* Lookups for tests and benchmarks, one per work-item: lookups[7 i ..] = face (as a float), u, v,
  * dudx, dvdx, dudy, dvdy; out[i] = the lookup's colour. */
-__kernel void texture_lookup_batch(__global const FaceGpu* faces, __global const uint* level_offsets,
-                                   TEXEL_BUFFER texels, __global const float* srgb_to_linear, SamplerParams sampler,
+__kernel void texture_lookup_batch(__global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
+                                   __global const uint* level_offsets, TEXEL_BUFFER texels,
+                                   __global const float* srgb_to_linear, SamplerParams sampler,
                                    __global const float* lookups, uint count, __global float4* out) {
   const uint i = get_global_id(0);
   if (i >= count) return;
   __global const float* q = lookups + 7 * i;
-  const FaceGpu face = faces[(uint)q[0]];
-  const float4 c = sample_texture(&face, level_offsets, texels, srgb_to_linear, sampler, q[1], q[2], q[3], q[4], q[5], q[6]);
+  const float4 c = sample_texture(faces, neighbors, (uint)q[0], level_offsets, texels, srgb_to_linear, sampler, q[1], q[2],
+                                  q[3], q[4], q[5], q[6]);
   __global float* o = (__global float*)out + 4 * i;
   o[0] = c.x;
   o[1] = c.y;
@@ -383,17 +420,24 @@ __kernel void texture_lookup_batch(__global const FaceGpu* faces, __global const
   o[3] = c.w;
 }
 
-/* The same lookups' FilterSum before renormalisation: (r, g, b, a) and the weight inside. */
-__kernel void texture_filter_batch(__global const FaceGpu* faces, __global const uint* level_offsets,
-                                   TEXEL_BUFFER texels, __global const float* srgb_to_linear, SamplerParams sampler,
+/* The same lookups' FilterSum before renormalisation (neighbours included for traverse):
+ * (r, g, b, a) and the weight of the taps read. */
+__kernel void texture_filter_batch(__global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
+                                   __global const uint* level_offsets, TEXEL_BUFFER texels,
+                                   __global const float* srgb_to_linear, SamplerParams sampler,
                                    __global const float* lookups, uint count, __global float4* out,
                                    __global float* weights) {
   const uint i = get_global_id(0);
   if (i >= count) return;
   __global const float* q = lookups + 7 * i;
-  const FaceGpu face = faces[(uint)q[0]];
-  const FilterSum sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),
-                                       SAMPLER_ADDRESS(sampler), sampler.max_aniso, q[1], q[2], q[3], q[4], q[5], q[6]);
+  const uint face_index = (uint)q[0];
+  const FaceGpu face = faces[face_index];
+  FilterSum sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),
+                                 SAMPLER_ADDRESS(sampler), sampler.max_aniso, q[1], q[2], q[3], q[4], q[5], q[6]);
+  if (SAMPLER_TRAVERSE(sampler)) {
+    accumulate_neighbors(&sum, faces, neighbors, face_index, level_offsets, texels, srgb_to_linear,
+                         SAMPLER_FILTER(sampler), sampler.max_aniso, q[1], q[2], q[3], q[4], q[5], q[6]);
+  }
   out[i] = (float4)(sum.r, sum.g, sum.b, sum.a);
   weights[i] = sum.weight;
 }

@@ -1,5 +1,5 @@
 // The seam methods in whole renders: on scenes whose faces all hold one constant colour, Discard
-// shows no seam at any MSAA rate and anisotropy while Black darkens the seams; NaN from
+// and Traverse show no seam at any MSAA rate and anisotropy while Black darkens the seams; NaN from
 // zero_coverage=nan appears only on fragments whose taps all fall outside, and the default
 // produces none on any built-in scene.
 #include <gtest/gtest.h>
@@ -66,7 +66,7 @@ SeamCheck compare_with_lit_constant(Renderer& renderer, const RenderResult& resu
 
 }  // namespace
 
-TEST(Methods, DiscardShowsNoSeamOnConstantScenesBlackDoes) {
+TEST(Methods, DiscardAndTraverseShowNoSeamOnConstantScenesBlackDoes) {
   const glm::vec3 color(0.8f, 0.5f, 0.2f);
   const glm::vec3 stored(decode_srgb8(encode_srgb8(glm::vec4(color, 1.0f))));
   for (const char* name : {"quad2", "paper"}) {
@@ -83,10 +83,12 @@ TEST(Methods, DiscardShowsNoSeamOnConstantScenesBlackDoes) {
         options.height = 96;
         options.msaa = msaa;
         options.aniso = aniso;
-        options.method = Method::Discard;
-        const SeamCheck discard = compare_with_lit_constant(renderer, renderer.render(scene.camera, options), stored);
-        EXPECT_GT(discard.checked, 2000u);
-        EXPECT_EQ(discard.off, 0u) << "worst " << discard.worst;
+        for (Method seamless : {Method::Discard, Method::Traverse}) {
+          options.method = seamless;
+          const SeamCheck check = compare_with_lit_constant(renderer, renderer.render(scene.camera, options), stored);
+          EXPECT_GT(check.checked, 2000u);
+          EXPECT_EQ(check.off, 0u) << to_string(seamless) << " worst " << check.worst;
+        }
 
         options.method = Method::Black;
         const SeamCheck black = compare_with_lit_constant(renderer, renderer.render(scene.camera, options), stored);
@@ -135,8 +137,8 @@ TEST(Methods, ZeroCoverageNanOnlyOnFragmentsWithNoTapInsideAndNeverByDefault) {
               const TriangleSetup& t = setups[ids[s]];
               const PixelFragment fragment = pixel_fragment(frame, t, ids, ids[s], x, y);
               const SurfaceUv uv = interpolate_uv(t, fragment.x, fragment.y);
-              const FilterSum sum = filter_texture_reference(packed.textures(), t.face, frame.sampler, frame.sampler.address,
-                                                             uv.u, uv.v, uv.dudx, uv.dvdx, uv.dudy, uv.dvdy);
+              const FilterSum sum = method_sum_reference(packed.textures(), t.face, frame.sampler, uv.u, uv.v, uv.dudx,
+                                                         uv.dvdx, uv.dudy, uv.dvdy);
               uncovered_fragment |= sum.weight == 0.0f;
             }
             EXPECT_EQ(std::isnan(raw.pixels[pixel].r), uncovered_fragment) << "pixel " << x << "," << y;

@@ -50,7 +50,7 @@ TEST(RenderOptions, EnumNamesRoundTrip) {
   for (const std::string& name : filter_names()) EXPECT_EQ(to_string(*parse_filter(name)), name);
   for (const std::string& name : zero_coverage_names()) EXPECT_EQ(to_string(*parse_zero_coverage(name)), name);
   for (const std::string& name : texel_format_names()) EXPECT_EQ(to_string(*parse_texel_format(name)), name);
-  EXPECT_EQ(method_names(), (std::vector<std::string>{"clamp", "black", "discard"}));
+  EXPECT_EQ(method_names(), (std::vector<std::string>{"clamp", "black", "discard", "traverse"}));
   EXPECT_EQ(filter_names(), (std::vector<std::string>{"bilinear", "trilinear", "aniso", "ewa"}));
   EXPECT_FALSE(parse_method("Clamp").has_value());
   EXPECT_FALSE(parse_shading_mode("").has_value());
@@ -76,6 +76,11 @@ TEST(RenderOptions, MethodsAreSamplerSettings) {
   EXPECT_EQ(discard.filter, SEAMCL_FILTER_EWA);
   EXPECT_EQ(discard.max_aniso, 8);
   EXPECT_EQ(discard.zero_coverage, SEAMCL_ZERO_COVERAGE_NAN);
+  EXPECT_EQ(discard.traverse, 0);
+  const SamplerParams traverse = sampler_params(Method::Traverse, Filter::Aniso, 16, ZeroCoverage::Clamp);
+  EXPECT_EQ(traverse.address, SEAMCL_ADDRESS_BORDER);
+  EXPECT_EQ(traverse.renormalize, 1);
+  EXPECT_EQ(traverse.traverse, 1);
 }
 
 TEST(RenderOptions, RefusalsNameTheField) {

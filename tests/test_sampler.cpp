@@ -116,8 +116,8 @@ TEST(KernelVsTwin, SamplerEveryFilterAddressModeStorageAndMethod) {
               const Lookup& l = lookups[i];
               const glm::vec4 twin =
                   sample_texture_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
-              const FilterSum twin_sum = filter_texture_reference(packed.textures(), l.face, sampler, sampler.address, l.u,
-                                                                  l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+              const FilterSum twin_sum =
+                  method_sum_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
               // 1e-5: the kernels round as the twin does except in the exp and sqrt builtins (EWA, aniso).
               bool ok = near(gpu_sums[i].weight, twin_sum.weight, 1e-5f);
               for (int c = 0; c < 4; ++c) {
