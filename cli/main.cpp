@@ -27,7 +27,7 @@ using namespace seamcl;
 
 struct RenderArgs {
   std::optional<std::string> scene, method, filter, zero_coverage, texels, size, shading;
-  std::optional<int> msaa, aniso, frame, frames;
+  std::optional<int> msaa, aniso, guard_band, frame, frames;
   bool centroid = false;
   bool tint = false;
   std::string output;
@@ -51,6 +51,7 @@ json render_request(const RenderArgs& a) {
   if (a.texels) request["texels"] = *a.texels;
   if (a.msaa) request["msaa"] = *a.msaa;
   if (a.aniso) request["aniso"] = *a.aniso;
+  if (a.guard_band) request["guard_band"] = *a.guard_band;
   if (a.size) request["size"] = *a.size;
   if (a.shading) request["shading"] = *a.shading;
   if (a.centroid) request["centroid"] = true;
@@ -101,6 +102,8 @@ int run_render(const RenderArgs& args, const std::string& device) {
                 {"visible_triangles", result.stats.visible_triangles},
                 {"fragments", result.stats.fragments},
                 {"texture_bytes", renderer.packed_scene().texture_bytes()},
+                {"padding_bytes", renderer.packed_scene().padding_bytes()},
+                {"adjacency_bytes", options.method == Method::Traverse ? renderer.packed_scene().adjacency_bytes() : 0},
                 {"bin_entries", result.stats.bin_entries}};
     if (!args.output.empty()) out["output"] = args.output;
     std::cout << out.dump(2) << "\n";
@@ -169,6 +172,7 @@ int main(int argc, char** argv) {
   render->add_option("--texels", render_args.texels, "Texel storage: " + listed(texel_format_names()) + " [rgba8]");
   render->add_option("--msaa", render_args.msaa, "Samples per pixel: 1, 2, 4, 8 or 16 [1]");
   render->add_option("--aniso", render_args.aniso, "Maximum anisotropy, 1..16 [16]");
+  render->add_option("--guard-band", render_args.guard_band, "guardband: band texels per side of every level, 1..16 [4]");
   render->add_option("--size", render_args.size, "Image size WIDTHxHEIGHT [480x540]");
   render->add_option("--frame", render_args.frame, "Orbit frame K (0-based) of --frames");
   render->add_option("--frames", render_args.frames, "Frames in the orbit [60]");

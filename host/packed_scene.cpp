@@ -1,15 +1,19 @@
 #include "packed_scene.h"
 
 #include "adjacency.h"
+#include "guard_band.h"
 
 #include <limits>
 #include <stdexcept>
 
 namespace seamcl {
 
-PackedScene pack_scene(const Scene& scene, TexelFormat format) {
+PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
+  if (guard_band < 0 || guard_band > kMaxGuardBand) throw std::invalid_argument("guard band out of range");
   PackedScene out;
   out.format = format;
+  out.guard_band = guard_band;
+  out.neighbors = build_adjacency(scene);
   out.positions.reserve(scene.positions.size());
   for (const glm::vec3& p : scene.positions) out.positions.push_back({{p.x, p.y, p.z, 1.0f}});
   out.faces.reserve(scene.faces.size());
@@ -19,7 +23,8 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format) {
     out.texels32.reserve(scene.texel_count() * 4);
   }
   size_t texels = 0;
-  for (const Face& face : scene.faces) {
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    const Face& face = scene.faces[f];
     FaceGpu gpu{};
     for (int i = 0; i < 4; ++i) gpu.vertex[i] = face.vertices[i];
     gpu.level_table = static_cast<cl_uint>(out.level_offsets.size());
@@ -30,13 +35,18 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format) {
     gpu.normal[0] = n.x;
     gpu.normal[1] = n.y;
     gpu.normal[2] = n.z;
-    for (const TextureLevel& level : face.texture.levels) {
+    for (size_t l = 0; l < face.texture.levels.size(); ++l) {
+      const TextureLevel banded = guard_band > 0 ? guard_banded_level(scene, out.neighbors, static_cast<uint32_t>(f),
+                                                                      static_cast<int>(l), guard_band)
+                                                 : TextureLevel{};
+      const TextureLevel& level = guard_band > 0 ? banded : face.texture.levels[l];
       // Offsets are 32-bit texel indices (and 4x that for float texels).
       if ((texels + level.texels.size()) * 4 > std::numeric_limits<uint32_t>::max()) {
         throw std::length_error("scene textures exceed 2^30 texels");
       }
       out.level_offsets.push_back(static_cast<uint32_t>(texels));
       texels += level.texels.size();
+      out.band_texels += level.texels.size() - face.texture.levels[l].texels.size();
       for (const glm::vec4& texel : level.texels) {
         if (format == TexelFormat::Rgba8) {
           out.texels8.push_back(encode_srgb8(texel));
@@ -47,7 +57,6 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format) {
     }
     out.faces.push_back(gpu);
   }
-  out.neighbors = build_adjacency(scene);
   return out;
 }
 

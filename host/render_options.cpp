@@ -32,8 +32,11 @@ std::vector<std::string> enum_names(const std::array<std::pair<Enum, const char*
   return out;
 }
 
-constexpr std::array<std::pair<Method, const char*>, 4> kMethods{
-    {{Method::Clamp, "clamp"}, {Method::Black, "black"}, {Method::Discard, "discard"}, {Method::Traverse, "traverse"}}};
+constexpr std::array<std::pair<Method, const char*>, 5> kMethods{{{Method::Clamp, "clamp"},
+                                                                  {Method::Black, "black"},
+                                                                  {Method::Discard, "discard"},
+                                                                  {Method::Traverse, "traverse"},
+                                                                  {Method::Guardband, "guardband"}}};
 constexpr std::array<std::pair<Filter, const char*>, 4> kFilters{
     {{Filter::Bilinear, "bilinear"}, {Filter::Trilinear, "trilinear"}, {Filter::Aniso, "aniso"}, {Filter::Ewa, "ewa"}}};
 constexpr std::array<std::pair<ZeroCoverage, const char*>, 2> kZeroCoverage{
@@ -107,13 +110,14 @@ std::optional<TexelFormat> parse_texel_format(std::string_view name) { return pa
 std::string to_string(TexelFormat format) { return enum_name(format, kTexelFormats); }
 std::vector<std::string> texel_format_names() { return enum_names(kTexelFormats); }
 
-SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCoverage zero_coverage) {
+SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCoverage zero_coverage, int guard_band) {
   SamplerParams p{};
   p.filter = filter == Filter::Bilinear    ? SEAMCL_FILTER_BILINEAR
              : filter == Filter::Trilinear ? SEAMCL_FILTER_TRILINEAR
              : filter == Filter::Aniso     ? SEAMCL_FILTER_ANISO
                                            : SEAMCL_FILTER_EWA;
-  p.address = method == Method::Clamp ? SEAMCL_ADDRESS_CLAMP : SEAMCL_ADDRESS_BORDER;
+  p.address = method == Method::Clamp || method == Method::Guardband ? SEAMCL_ADDRESS_CLAMP : SEAMCL_ADDRESS_BORDER;
+  p.guard_band = method == Method::Guardband ? guard_band : 0;
   p.renormalize = method == Method::Discard || method == Method::Traverse ? 1 : 0;
   p.traverse = method == Method::Traverse ? 1 : 0;
   p.max_aniso = max_aniso;
@@ -160,6 +164,8 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
       }
     } else if (key == "aniso") {
       options.aniso = int_field(value, key, 1, 16);
+    } else if (key == "guard_band") {
+      options.guard_band = int_field(value, key, 1, 16);
     } else if (key == "size") {
       std::tie(options.width, options.height) = parse_size(string_field(value, key), key);
     } else if (key == "shading") {
@@ -198,6 +204,7 @@ nlohmann::json to_json(const RenderOptions& options) {
                         {"texels", to_string(options.texels)},
                         {"msaa", options.msaa},
                         {"aniso", options.aniso},
+                        {"guard_band", options.guard_band},
                         {"size", std::to_string(options.width) + "x" + std::to_string(options.height)},
                         {"shading", to_string(options.shading)},
                         {"tint", options.tint}};

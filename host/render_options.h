@@ -18,8 +18,10 @@ namespace seamcl {
 //   black   - taps outside weigh zero, no renormalisation (Ptex's black border: edges darken);
 //   discard - taps outside weigh zero and the rest are renormalised (Toth 2013);
 //   traverse - discard, plus the same lookup on the four edge neighbours through their uv
-//              transforms, all summed and then renormalised (McDonald 2013).
-enum class Method { Clamp, Black, Discard, Traverse };
+//              transforms, all summed and then renormalised (McDonald 2013);
+//   guardband - clamp, on textures whose every level carries a band of guard_band texels
+//               filled from the neighbours at build time (McDonald and Burley 2011).
+enum class Method { Clamp, Black, Discard, Traverse, Guardband };
 // The filter of one lookup: bilinear (level 0), trilinear, aniso (hardware-style probes), ewa.
 enum class Filter { Bilinear, Trilinear, Aniso, Ewa };
 // Discard with every tap outside: a clamped lookup (the paper's fix) or the raw 0/0 (NaN).
@@ -58,6 +60,7 @@ struct RenderOptions {
   TexelFormat texels = TexelFormat::Rgba8;
   int msaa = 1;                 // 1, 2, 4, 8 or 16 samples per pixel
   int aniso = 16;               // maximum anisotropy, 1..16 (aniso and ewa filters)
+  int guard_band = 4;           // guardband: band texels per side, 1..kMaxGuardBand (16)
   int width = 480;
   int height = 540;
   ShadingMode shading = ShadingMode::Pixel;
@@ -69,14 +72,16 @@ struct RenderOptions {
 // Reads the keys present in `request` over the defaults. Throws InputError naming the key on a
 // wrong type, an out-of-range value or an unknown key. Keys: scene, method, filter, msaa, aniso,
 // size ("WxH"), shading, centroid (bool, same as shading=centroid), zero_coverage, texels,
-// frame, frames, tint.
+// guard_band, frame, frames, tint.
 RenderOptions parse_render_options(const nlohmann::json& request);
 nlohmann::json to_json(const RenderOptions& options);
 
 // The sampler settings a method stands for (see SamplerParams in kernels/seamcl_types.h).
-SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCoverage zero_coverage);
+// guard_band is used by Method::Guardband only (0 otherwise).
+SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCoverage zero_coverage,
+                             int guard_band = 4);
 inline SamplerParams sampler_params(const RenderOptions& o) {
-  return sampler_params(o.method, o.filter, o.aniso, o.zero_coverage);
+  return sampler_params(o.method, o.filter, o.aniso, o.zero_coverage, o.guard_band);
 }
 
 // "480x540" -> {480, 540}; throws InputError(field) unless both are integers in 1..kMaxImageSide.

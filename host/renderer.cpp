@@ -73,9 +73,9 @@ struct Renderer::Impl {
     shade_kernel = it->second.shade;
   }
 
-  // Packs and uploads the loaded scene in `format`, with the kernels that read it.
-  void pack_and_upload(TexelFormat format) {
-    packed = pack_scene(*scene, format);
+  // Packs and uploads the loaded scene in `format` with `guard_band` texels of band per level.
+  void pack_and_upload(TexelFormat format, int guard_band) {
+    packed = pack_scene(*scene, format, guard_band);
     positions = upload(packed.positions);
     faces = upload(packed.faces);
     neighbors = upload(packed.neighbors);
@@ -202,7 +202,7 @@ Renderer::~Renderer() = default;
 void Renderer::load_scene(const Scene& scene, TexelFormat format) {
   validate_scene(scene);
   impl_->scene = std::make_unique<Scene>(scene);
-  impl_->pack_and_upload(format);
+  impl_->pack_and_upload(format, 0);
   // Start the tile lists at a few entries per triangle slot; render() grows them when needed.
   impl_->bin_capacity = std::max<uint32_t>(impl_->bin_capacity, static_cast<uint32_t>(std::min<size_t>(
                                                                       scene.triangle_count() * 8 + 65536, 1u << 30)));
@@ -218,8 +218,11 @@ const PackedScene& Renderer::packed_scene() const { return impl_->packed; }
 
 RenderResult Renderer::render(const Camera& camera, const RenderOptions& options) {
   if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
-  if (options.texels != impl_->packed.format) impl_->pack_and_upload(options.texels);
-  impl_->use_kernels(options.texels, sampler_params(options));
+  const SamplerParams sampler = sampler_params(options);
+  if (options.texels != impl_->packed.format || sampler.guard_band != impl_->packed.guard_band) {
+    impl_->pack_and_upload(options.texels, sampler.guard_band);
+  }
+  impl_->use_kernels(options.texels, sampler);
   RenderResult result;
   result.width = options.width;
   result.height = options.height;
@@ -259,7 +262,8 @@ std::string program_options(TexelFormat format, const SamplerParams& sampler) {
          " -DSEAMCL_SAMPLER_ADDRESS=" + std::to_string(sampler.address) +
          " -DSEAMCL_SAMPLER_RENORMALIZE=" + std::to_string(sampler.renormalize) +
          " -DSEAMCL_SAMPLER_ZERO_COVERAGE=" + std::to_string(sampler.zero_coverage) +
-         " -DSEAMCL_SAMPLER_TRAVERSE=" + std::to_string(sampler.traverse);
+         " -DSEAMCL_SAMPLER_TRAVERSE=" + std::to_string(sampler.traverse) +
+         " -DSEAMCL_SAMPLER_GUARD_BAND=" + std::to_string(sampler.guard_band);
 }
 
 void Renderer::warm_up(const RenderOptions& options) {

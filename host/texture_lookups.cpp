@@ -1,6 +1,7 @@
 #include "texture_lookups.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "renderer.h"
 
@@ -18,7 +19,7 @@ cl::Buffer read_only_buffer(const cl::Context& context, const std::vector<T>& da
 }  // namespace
 
 TextureLookups::TextureLookups(ClRuntime& runtime, const PackedScene& textures)
-    : runtime_(runtime), format_(textures.format) {
+    : runtime_(runtime), format_(textures.format), guard_band_(textures.guard_band) {
   const cl::Context& context = runtime.context();
   faces_ = read_only_buffer(context, textures.faces);
   neighbors_ = read_only_buffer(context, textures.neighbors);
@@ -30,6 +31,10 @@ TextureLookups::TextureLookups(ClRuntime& runtime, const PackedScene& textures)
 }
 
 TextureLookups::Kernels& TextureLookups::kernels_for(const SamplerParams& sampler) {
+  if (sampler.guard_band != guard_band_) {
+    throw std::logic_error("sampler guard band " + std::to_string(sampler.guard_band) + " on textures packed with " +
+                           std::to_string(guard_band_));
+  }
   const std::string options = program_options(format_, sampler);
   auto it = kernels_.find(options);
   if (it == kernels_.end()) {

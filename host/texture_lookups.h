@@ -26,7 +26,8 @@ class TextureLookups {
 
   // Uploads the lookups; later calls run them.
   void set_lookups(const std::vector<Lookup>& lookups);
-  // The colours sample_texture returns for each lookup; `kernel_ms` gets the kernel's time.
+  // The colours sample_texture returns for each lookup; `kernel_ms` gets the kernel's time. The
+  // sampler's guard_band must be the one the textures were packed with.
   std::vector<glm::vec4> sample(const SamplerParams& sampler, double* kernel_ms = nullptr);
   // The FilterSums before renormalisation (colour sums and the weight inside the face).
   std::vector<FilterSum> filter(const SamplerParams& sampler);
@@ -41,6 +42,7 @@ class TextureLookups {
 
   ClRuntime& runtime_;
   TexelFormat format_;
+  int guard_band_;
   std::map<std::string, Kernels> kernels_;
   cl::Buffer faces_, neighbors_, level_offsets_, texels_, srgb_table_, lookups_, colors_, weights_;
   size_t count_ = 0;

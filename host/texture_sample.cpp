@@ -81,13 +81,16 @@ glm::vec4 decode_srgb8(uint32_t packed) {
 namespace {
 
 struct Level {
-  uint32_t offset;
-  int width, height;
+  uint32_t offset;    // first stored texel (the band's corner with a guard band)
+  int width, height;  // the face's texels
+  int pad;            // guard band texels on each side
+  int stride;         // stored texels per row
 };
 
 Level face_level(const TextureView& tex, const FaceGpu& face, int level) {
-  return {tex.level_offsets->at(face.level_table + static_cast<uint32_t>(level)), std::max(face.width >> level, 1),
-          std::max(face.height >> level, 1)};
+  const int width = std::max(face.width >> level, 1);
+  return {tex.level_offsets->at(face.level_table + static_cast<uint32_t>(level)), width,
+          std::max(face.height >> level, 1), tex.guard_band, width + 2 * tex.guard_band};
 }
 
 void add_texel(FilterSum& sum, const TextureView& tex, uint32_t index, float weight) {
@@ -102,30 +105,32 @@ void add_texel(FilterSum& sum, const TextureView& tex, uint32_t index, float wei
   sum.weight += weight;
 }
 
-// Texel index on an axis of n texels; inside = 0 for a tap the border address mode discards.
-int address_texel(int i, int n, int address, float& inside) {
-  const int clamped = std::clamp(i, 0, n - 1);
+// Stored index on an axis of n texels with `pad` band texels each side; inside = 0 for a tap
+// the border address mode discards. Clamp reaches into the band, to its outer edge.
+int address_texel(int i, int n, int pad, int address, float& inside) {
+  const int clamped = std::clamp(i, -pad, n - 1 + pad);
   inside = (address != SEAMCL_ADDRESS_BORDER || i == clamped) ? 1.0f : 0.0f;
-  return address == SEAMCL_ADDRESS_WRAP ? (i & (n - 1)) : clamped;
+  return address == SEAMCL_ADDRESS_WRAP ? (i & (n - 1)) : clamped + pad;
 }
 
-float texel_coordinate(float u, int n, int address) {
+float texel_coordinate(float u, int n, int pad, int address) {
   if (address == SEAMCL_ADDRESS_WRAP) u = u - std::floor(u);
-  return std::fmin(std::fmax(u * static_cast<float>(n) - 0.5f, -2.0f), static_cast<float>(n) + 1.0f);
+  return std::fmin(std::fmax(u * static_cast<float>(n) - 0.5f, -2.0f - static_cast<float>(pad)),
+                   static_cast<float>(n + 1 + pad));
 }
 
 void accumulate_bilinear(FilterSum& sum, const TextureView& tex, Level level, float u, float v, float weight, int address) {
-  const float x = texel_coordinate(u, level.width, address);
-  const float y = texel_coordinate(v, level.height, address);
+  const float x = texel_coordinate(u, level.width, level.pad, address);
+  const float y = texel_coordinate(v, level.height, level.pad, address);
   const float x_floor = std::floor(x), y_floor = std::floor(y);
   const float fx = x - x_floor, fy = y - y_floor;
   float in_x0, in_x1, in_y0, in_y1;
-  const int x0 = address_texel(static_cast<int>(x_floor), level.width, address, in_x0);
-  const int x1 = address_texel(static_cast<int>(x_floor) + 1, level.width, address, in_x1);
-  const int y0 = address_texel(static_cast<int>(y_floor), level.height, address, in_y0);
-  const int y1 = address_texel(static_cast<int>(y_floor) + 1, level.height, address, in_y1);
-  const uint32_t row0 = level.offset + static_cast<uint32_t>(y0 * level.width);
-  const uint32_t row1 = level.offset + static_cast<uint32_t>(y1 * level.width);
+  const int x0 = address_texel(static_cast<int>(x_floor), level.width, level.pad, address, in_x0);
+  const int x1 = address_texel(static_cast<int>(x_floor) + 1, level.width, level.pad, address, in_x1);
+  const int y0 = address_texel(static_cast<int>(y_floor), level.height, level.pad, address, in_y0);
+  const int y1 = address_texel(static_cast<int>(y_floor) + 1, level.height, level.pad, address, in_y1);
+  const uint32_t row0 = level.offset + static_cast<uint32_t>(y0 * level.stride);
+  const uint32_t row1 = level.offset + static_cast<uint32_t>(y1 * level.stride);
   // The kernel derives each weight from the one before (to keep LLVM's SLP pass from pairing
   // them); the twin rounds the same way: w10 = (1-fy) - w00 rather than fx (1-fy).
   const float w00 = (1.0f - fx) * (1.0f - fy);
@@ -226,16 +231,16 @@ void accumulate_ewa_level(FilterSum& sum, const TextureView& tex, const FaceGpu&
   for (int it = t0; it <= t1; ++it) {
     const float tt = static_cast<float>(it) - ct;
     float in_y;
-    const int iy = address_texel(it, level.height, address, in_y);
+    const int iy = address_texel(it, level.height, level.pad, address, in_y);
     for (int is = s0; is <= s1; ++is) {
       const float ss = static_cast<float>(is) - cs;
       const float r2 = A * ss * ss + B * ss * tt + C * tt * tt;
       if (r2 >= 1.0f) continue;
       const float gauss = std::exp(-2.0f * r2) - std::exp(-2.0f);
       float in_x;
-      const int ix = address_texel(is, level.width, address, in_x);
+      const int ix = address_texel(is, level.width, level.pad, address, in_x);
       total += gauss;
-      add_texel(level_sum, tex, level.offset + static_cast<uint32_t>(iy * level.width + ix), gauss * in_x * in_y);
+      add_texel(level_sum, tex, level.offset + static_cast<uint32_t>(iy * level.stride + ix), gauss * in_x * in_y);
     }
   }
   const float scale = total > 0.0f ? weight / total : 0.0f;

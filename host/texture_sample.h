@@ -28,6 +28,7 @@ struct TextureView {
   TexelFormat format;
   const std::vector<uint32_t>* texels8;   // RGBA8 sRGB
   const std::vector<float>* texels32;     // linear RGBA32F, 4 floats a texel
+  int guard_band = 0;                     // texels of band stored around every level (guardband)
 };
 
 // Filtered colour and the summed weight of the taps inside the face (1 unless border).

@@ -46,7 +46,8 @@ typedef float cl_float;
 
 /* How one texture lookup filters. The seam methods are settings of it: clamp = address clamp;
  * black = address border; discard = address border + renormalize; traverse = discard + the same
- * lookup on each edge neighbour through its uv transform, all summed before renormalising. */
+ * lookup on each edge neighbour through its uv transform, all summed before renormalising;
+ * guardband = address clamp on textures stored with a band filled from the neighbours. */
 typedef struct {
   cl_int filter;         /* SEAMCL_FILTER_* */
   cl_int address;        /* SEAMCL_ADDRESS_* */
@@ -54,7 +55,9 @@ typedef struct {
   cl_int max_aniso;      /* 1..16, for aniso and ewa */
   cl_int zero_coverage;  /* SEAMCL_ZERO_COVERAGE_*, when renormalize and no tap is inside */
   cl_int traverse;       /* 1: also filter the edge neighbours (FaceNeighbors) */
-  cl_int pad0, pad1;
+  cl_int guard_band;     /* band texels stored around every level (guardband); the kernels take it
+                            from the build option SEAMCL_SAMPLER_GUARD_BAND, this is the host's copy */
+  cl_int pad0;
 } SamplerParams;
 
 /* A face's edge neighbours, for traverse. Edge k runs from corner k to corner k+1 (uv (0,0),

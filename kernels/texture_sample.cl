@@ -35,6 +35,16 @@
 #define SAMPLER_TRAVERSE(s) ((s).traverse)
 #endif
 
+/* Guard bands (McDonald and Burley 2011): with -DSEAMCL_SAMPLER_GUARD_BAND=g every level is
+ * stored with a band of g texels on each side, filled from the neighbours at build time; the
+ * clamp address mode then clamps to the outside of the band instead of the face's edge texels.
+ * A build-time constant of the program variant; 0 (no band) otherwise. */
+#ifdef SEAMCL_SAMPLER_GUARD_BAND
+#define GUARD SEAMCL_SAMPLER_GUARD_BAND
+#else
+#define GUARD 0
+#endif
+
 /* Ties against LLVM's SLP pass. PoCL vectorises a kernel by running its work-group loop 8 lanes
  * wide, and gives up if the loop body already holds short vectors, which the SLP pass makes out
  * of any two computations of the same shape (u and v, two taps, four channels). TIE(x) is 0 for
@@ -61,8 +71,9 @@ typedef struct {
 } FilterSum;
 
 typedef struct {
-  uint offset;       /* first texel */
-  int width, height;
+  uint offset;       /* first stored texel (the band's corner when there is a guard band) */
+  int width, height; /* the face's texels, without the band */
+  int stride;        /* stored texels per row: width + 2 GUARD */
 } Level;
 
 SEAMCL_INLINE Level face_level(const FaceGpu* face, __global const uint* level_offsets, int level) {
@@ -70,6 +81,7 @@ SEAMCL_INLINE Level face_level(const FaceGpu* face, __global const uint* level_o
   l.offset = level_offsets[face->level_table + (uint)level];
   l.width = max(face->width >> level, 1);
   l.height = max(face->height >> level, 1);
+  l.stride = l.width + 2 * GUARD;
   return l;
 }
 
@@ -109,25 +121,26 @@ SEAMCL_INLINE void add_texel(FilterSum* sum, TEXEL_BUFFER texels, __global const
   sum->weight += weight;
 }
 
-/* Texel index along one axis of size n for address mode `address`; *inside is 0 for a border tap. */
+/* Stored index along one axis of n texels (plus the guard band) of texel i for address mode
+ * `address`; *inside is 0 for a border tap. */
 SEAMCL_INLINE int address_texel(int i, int n, int address, float* inside) {
-  const int clamped = clamp(i, 0, n - 1);
+  const int clamped = clamp(i, -GUARD, n - 1 + GUARD);
   *inside = (address != SEAMCL_ADDRESS_BORDER || i == clamped) ? 1.0f : 0.0f;
-  return address == SEAMCL_ADDRESS_WRAP ? (i & (n - 1)) : clamped;
+  return address == SEAMCL_ADDRESS_WRAP ? (i & (n - 1)) : clamped + GUARD;
 }
 
 /* The texel after `first` (the addressed texel of raw index i), derived from it rather than
  * addressed afresh (see accumulate_bilinear). */
 SEAMCL_INLINE int next_texel(int first, int i, int n, int address, float* inside) {
   *inside = (address != SEAMCL_ADDRESS_BORDER || (i >= -1 && i < n - 1)) ? 1.0f : 0.0f;
-  return address == SEAMCL_ADDRESS_WRAP ? ((first + 1) & (n - 1)) : min(first + (i >= 0 ? 1 : 0), n - 1);
+  return address == SEAMCL_ADDRESS_WRAP ? ((first + 1) & (n - 1)) : min(first + (i >= -GUARD ? 1 : 0), n - 1 + 2 * GUARD);
 }
 
 /* Texel-space coordinate of u on an axis of n texels, finite whatever u is. */
 SEAMCL_INLINE float texel_coordinate(float u, int n, int address) {
   if (address == SEAMCL_ADDRESS_WRAP) u = u - __builtin_floorf(u);
-  /* Two texels beyond either edge is as far as any address mode can tell apart. */
-  return fmin(fmax(u * (float)n - 0.5f, -2.0f), (float)n + 1.0f);
+  /* Two texels beyond the edge (or the band) is as far as any address mode can tell apart. */
+  return fmin(fmax(u * (float)n - 0.5f, -2.0f - (float)GUARD), (float)(n + 1 + GUARD));
 }
 
 /* weight * bilinear(level, u, v) into sum.
@@ -148,8 +161,8 @@ SEAMCL_INLINE void accumulate_bilinear(FilterSum* sum, TEXEL_BUFFER texels, __gl
   const int x1 = next_texel(x0, ix, level.width, address, &in_x1);
   const int y0 = address_texel(iy, level.height, address, &in_y0);
   const int y1 = next_texel(y0, iy, level.height, address, &in_y1);
-  const uint row0 = level.offset + (uint)(y0 * level.width);
-  const uint row1 = row0 + (uint)((y1 - y0) * level.width);
+  const uint row0 = level.offset + (uint)(y0 * level.stride);
+  const uint row1 = row0 + (uint)((y1 - y0) * level.stride);
   /* Bilinear weights, each derived from the one before. */
   const float w00 = (1.0f - fx) * (1.0f - fy);
   const float w10 = (1.0f - fy) - w00;
@@ -283,7 +296,7 @@ SEAMCL_INLINE void accumulate_ewa_level(FilterSum* sum, const FaceGpu* face, __g
       float in_x;
       const int ix = address_texel(is, level.width, address, &in_x);
       total += gauss;
-      add_texel(&level_sum, texels, srgb_to_linear, level.offset + (uint)(iy * level.width + ix), gauss * in_x * in_y);
+      add_texel(&level_sum, texels, srgb_to_linear, level.offset + (uint)(iy * level.stride + ix), gauss * in_x * in_y);
     }
   }
   const float scale = total > 0.0f ? weight / total : 0.0f;
