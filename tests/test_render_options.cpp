@@ -50,7 +50,7 @@ TEST(RenderOptions, EnumNamesRoundTrip) {
   for (const std::string& name : filter_names()) EXPECT_EQ(to_string(*parse_filter(name)), name);
   for (const std::string& name : zero_coverage_names()) EXPECT_EQ(to_string(*parse_zero_coverage(name)), name);
   for (const std::string& name : texel_format_names()) EXPECT_EQ(to_string(*parse_texel_format(name)), name);
-  EXPECT_EQ(method_names(), (std::vector<std::string>{"clamp", "black", "discard", "traverse"}));
+  EXPECT_EQ(method_names(), (std::vector<std::string>{"clamp", "black", "discard", "traverse", "guardband"}));
   EXPECT_EQ(filter_names(), (std::vector<std::string>{"bilinear", "trilinear", "aniso", "ewa"}));
   EXPECT_FALSE(parse_method("Clamp").has_value());
   EXPECT_FALSE(parse_shading_mode("").has_value());
@@ -81,6 +81,12 @@ TEST(RenderOptions, MethodsAreSamplerSettings) {
   EXPECT_EQ(traverse.address, SEAMCL_ADDRESS_BORDER);
   EXPECT_EQ(traverse.renormalize, 1);
   EXPECT_EQ(traverse.traverse, 1);
+  EXPECT_EQ(traverse.guard_band, 0);
+  const SamplerParams guardband = sampler_params(Method::Guardband, Filter::Aniso, 16, ZeroCoverage::Clamp, 3);
+  EXPECT_EQ(guardband.address, SEAMCL_ADDRESS_CLAMP);
+  EXPECT_EQ(guardband.renormalize, 0);
+  EXPECT_EQ(guardband.guard_band, 3);
+  EXPECT_EQ(parse_render_options(json{{"method", "guardband"}, {"guard_band", 2}}).guard_band, 2);
 }
 
 TEST(RenderOptions, RefusalsNameTheField) {
@@ -111,6 +117,8 @@ TEST(RenderOptions, RefusalsNameTheField) {
       {{{"filter", "box"}}, "filter", "unknown filter 'box'"},
       {{{"zero_coverage", "zero"}}, "zero_coverage", "unknown zero_coverage mode"},
       {{{"texels", "rgba16"}}, "texels", "unknown texel format"},
+      {{{"guard_band", 0}}, "guard_band", "1..16"},
+      {{{"guard_band", 17}}, "guard_band", "1..16"},
   };
   for (const BadOption& c : cases) {
     try {
