@@ -1,0 +1,304 @@
+// seamcl compare: renders one frame with every method x MSAA rate, measures each against the
+// paper's reference (host/reference.h) and prints the errors (host/metrics.h) with the timings.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cl_runtime.h"
+#include "commands.h"
+#include "errors.h"
+#include "image_io.h"
+#include "metrics.h"
+#include "reference.h"
+#include "render_options.h"
+#include "renderer.h"
+#include "scene_generators.h"
+#include "scene_json.h"
+
+namespace seamcl::cli {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+struct CompareArgs {
+  std::optional<std::string> scene, filter, zero_coverage, texels, size, shading;
+  std::optional<int> aniso, frame, frames;
+  std::string methods = "discard,clamp";
+  std::string msaa = "1,2,4,8";
+  bool tint = false;
+  std::string constant_color;  // "r,g,b" linear: paint every face this colour
+  std::string reference_method;
+  int reference_msaa = 0;
+  std::string cache_dir;
+  bool no_cache = false;
+  std::string images_dir;
+  int repeat = 3;
+  bool json_out = false;
+};
+
+std::vector<std::string> split_list(const std::string& text, const std::string& field) {
+  std::vector<std::string> items;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const size_t a = item.find_first_not_of(" \t"), b = item.find_last_not_of(" \t");
+    if (a == std::string::npos) throw InputError(field, "empty item in list '" + text + "'");
+    items.push_back(item.substr(a, b - a + 1));
+  }
+  if (items.empty() || text.back() == ',') throw InputError(field, "must be a comma list, got '" + text + "'");
+  return items;
+}
+
+int parse_int_item(const std::string& item, const std::string& field) {
+  size_t used = 0;
+  int value = 0;
+  try {
+    value = std::stoi(item, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != item.size()) throw InputError(field, "not an integer: '" + item + "'");
+  return value;
+}
+
+glm::vec3 parse_color(const std::string& text) {
+  const std::vector<std::string> parts = split_list(text, "constant_color");
+  if (parts.size() != 3) throw InputError("constant_color", "must be r,g,b, got '" + text + "'");
+  glm::vec3 c;
+  for (int i = 0; i < 3; ++i) {
+    size_t used = 0;
+    float v = -1.0f;
+    try {
+      v = std::stof(parts[static_cast<size_t>(i)], &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != parts[static_cast<size_t>(i)].size() || !(v >= 0.0f && v <= 1.0f)) {
+      throw InputError("constant_color", "each component must be a number in [0, 1], got '" + text + "'");
+    }
+    c[i] = v;
+  }
+  return c;
+}
+
+json base_request(const CompareArgs& a) {
+  json request = json::object();
+  if (a.scene) request["scene"] = *a.scene;
+  if (a.filter) request["filter"] = *a.filter;
+  if (a.zero_coverage) request["zero_coverage"] = *a.zero_coverage;
+  if (a.texels) request["texels"] = *a.texels;
+  if (a.aniso) request["aniso"] = *a.aniso;
+  if (a.size) request["size"] = *a.size;
+  if (a.shading) request["shading"] = *a.shading;
+  if (a.frame) request["frame"] = *a.frame;
+  if (a.frames) request["frames"] = *a.frames;
+  if (a.tint) request["tint"] = true;
+  return request;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// JSON numbers must be finite; a statistic over no pixels is 0 already, but be safe.
+double finite_or_zero(double v) { return std::isfinite(v) ? v : 0.0; }
+
+int run_compare(const CompareArgs& args, const GlobalOptions& global) {
+  // Validate everything before any work.
+  const json base = base_request(args);
+  const RenderOptions frame = parse_render_options(base);
+  struct Entry {
+    std::string method_name;
+    RenderOptions options;
+  };
+  std::vector<Entry> entries;
+  const std::vector<std::string> methods = split_list(args.methods, "methods");
+  std::vector<int> rates;
+  for (const std::string& item : split_list(args.msaa, "msaa")) rates.push_back(parse_int_item(item, "msaa"));
+  for (const std::string& method : methods) {
+    for (int msaa : rates) {
+      json request = base;
+      request["method"] = method;
+      request["msaa"] = msaa;
+      try {
+        entries.push_back({method, parse_render_options(request)});
+      } catch (const InputError& e) {
+        if (e.field() == "method") throw InputError("methods", std::string(e.what()).substr(e.field().size() + 2));
+        throw;
+      }
+    }
+  }
+  if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
+  ReferenceSettings ref_settings;
+  ref_settings.method = args.reference_method;
+  ref_settings.msaa = args.reference_msaa;
+  ref_settings.cache_dir = args.cache_dir;
+  ref_settings.use_cache = !args.no_cache;
+  (void)reference_render_options(frame, ref_settings);  // size and reference settings checked now
+  GeneratorOptions generator_options;
+  generator_options.tint = frame.tint;
+  if (!args.constant_color.empty()) generator_options.constant_color = parse_color(args.constant_color);
+
+  const Scene scene = load_scene(frame.scene, generator_options);
+  const Camera camera = frame.frame ? orbit_camera(scene, *frame.frame, frame.frames) : scene.camera;
+  if (!args.images_dir.empty()) fs::create_directories(args.images_dir);
+
+  ClRuntime runtime(global.device);
+  Renderer renderer(runtime);
+  renderer.load_scene(scene, frame.texels);
+
+  // The seam mask of this frame at its own size, from a 1-sample render.
+  const FaceMap faces = render_face_map(renderer, camera, frame);
+  const std::vector<uint8_t> mask = seam_mask(faces);
+  const size_t seam_pixels = static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{1}));
+
+  const ReferenceImage reference = reference_image(renderer, camera, frame, ref_settings);
+  if (!args.images_dir.empty()) {
+    write_image((fs::path(args.images_dir) / "reference.png").string(), reference.width, reference.height,
+                reference.pixels);
+  }
+
+  const std::vector<double> xs = error_curve_thresholds();
+  json results = json::array();
+  for (const Entry& entry : entries) {
+    const RenderOptions& options = entry.options;
+    renderer.load_scene(scene, options.texels);
+    renderer.warm_up(options);
+    std::vector<double> ms;
+    RenderResult result;
+    for (int i = 0; i < args.repeat; ++i) {
+      result = renderer.render(camera, options);
+      ms.push_back(result.ms.total);
+    }
+    const ImageErrors errors = compare_images(result.pixels, reference.pixels, &mask);
+    json curve = json::array();
+    for (size_t i = 0; i < xs.size(); ++i) curve.push_back({xs[i], errors.all.curve[i]});
+    json seam_curve = json::array();
+    for (size_t i = 0; i < xs.size(); ++i) seam_curve.push_back({xs[i], errors.seam.curve[i]});
+    json item = {{"method", entry.method_name},
+                 {"msaa", options.msaa},
+                 {"aniso", options.aniso},
+                 {"filter", to_string(options.filter)},
+                 {"ms", {{"median", median(ms)}, {"min", *std::min_element(ms.begin(), ms.end())},
+                         {"max", *std::max_element(ms.begin(), ms.end())}, {"runs", args.repeat}}},
+                 {"error",
+                  {{"mean", finite_or_zero(errors.all.mean)},
+                   {"p99", finite_or_zero(errors.all.p99)},
+                   {"max", finite_or_zero(errors.all.max)},
+                   {"seam_mean", finite_or_zero(errors.seam.mean)},
+                   {"seam_p99", finite_or_zero(errors.seam.p99)},
+                   {"seam_max", finite_or_zero(errors.seam.max)},
+                   {"nan_pixels", errors.nan_pixels},
+                   {"seam_nan_pixels", errors.seam_nan_pixels},
+                   {"pixels", errors.all.pixels},
+                   {"seam_pixels", errors.seam.pixels}}},
+                 {"texture_bytes", renderer.packed_scene().texture_bytes()},
+                 {"curve", curve},
+                 {"seam_curve", seam_curve}};
+    if (!args.images_dir.empty()) {
+      const std::string stem = entry.method_name + "_msaa" + std::to_string(options.msaa);
+      const fs::path image = fs::path(args.images_dir) / (stem + ".png");
+      const fs::path heat = fs::path(args.images_dir) / (stem + "_error.png");
+      write_image(image.string(), result.width, result.height, result.pixels);
+      write_image(heat.string(), result.width, result.height, error_heatmap(errors.distance));
+      item["images"] = {{"image", image.string()}, {"error", heat.string()}};
+    }
+    results.push_back(item);
+  }
+
+  if (!args.images_dir.empty()) {
+    std::vector<glm::vec4> mask_image(mask.size());
+    for (size_t i = 0; i < mask.size(); ++i) mask_image[i] = mask[i] ? glm::vec4(1) : glm::vec4(0, 0, 0, 1);
+    write_image((fs::path(args.images_dir) / "seam_mask.png").string(), frame.width, frame.height, mask_image);
+  }
+
+  const std::string size = std::to_string(frame.width) + "x" + std::to_string(frame.height);
+  if (args.json_out) {
+    json out = {{"scene", scene.name},
+                {"size", size},
+                {"device", runtime.device_description()},
+                {"reference_method", reference.method},
+                {"reference",
+                 {{"method", reference.method},
+                  {"msaa", reference.msaa},
+                  {"scale", kReferenceScale},
+                  {"filter", "mitchell"},
+                  {"filter_width", kMitchellWidth},
+                  {"B", kMitchellB},
+                  {"C", kMitchellC},
+                  {"from_cache", reference.from_cache},
+                  {"cache_path", reference.cache_path},
+                  {"ms", reference.render_ms}}},
+                {"seam_pixels", seam_pixels},
+                {"seam_radius", kSeamRadius},
+                {"options", to_json(frame)},
+                {"results", results}};
+    if (frame.frame) {
+      out["frame"] = *frame.frame;
+      out["frames"] = frame.frames;
+    }
+    if (!args.images_dir.empty()) out["images"] = args.images_dir;
+    std::cout << out.dump(2) << "\n";
+  } else {
+    std::printf("%s %s, reference: %s at %dx, %d spp, Mitchell B=C=1/3 (%s); %zu seam pixels\n", scene.name.c_str(),
+                size.c_str(), reference.method.c_str(), kReferenceScale, reference.msaa,
+                reference.from_cache ? "cached" : "rendered", seam_pixels);
+    std::printf("%-10s %4s %9s %10s %10s %10s %10s %10s %6s\n", "method", "msaa", "ms", "mean", "p99", "max",
+                "seam_mean", "seam_p99", "nan");
+    for (const json& r : results) {
+      const json& e = r["error"];
+      std::printf("%-10s %4d %9.2f %10.3e %10.3e %10.3e %10.3e %10.3e %6zu\n", r["method"].get<std::string>().c_str(),
+                  r["msaa"].get<int>(), r["ms"]["median"].get<double>(), e["mean"].get<double>(),
+                  e["p99"].get<double>(), e["max"].get<double>(), e["seam_mean"].get<double>(),
+                  e["seam_p99"].get<double>(), e["nan_pixels"].get<size_t>());
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_compare_command(CLI::App& app) {
+  auto args = std::make_shared<CompareArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "compare", "Render one frame with each method x MSAA rate and measure the error against the paper's reference");
+  cmd->add_option("--scene", args->scene, "Built-in scene name or a scene JSON file [paper]");
+  cmd->add_option("--methods", args->methods, "Comma list of seam methods [discard,clamp]");
+  cmd->add_option("--msaa", args->msaa, "Comma list of MSAA rates (1, 2, 4, 8, 16) [1,2,4,8]");
+  cmd->add_option("--aniso", args->aniso, "Maximum anisotropy, 1..16 [16]");
+  cmd->add_option("--filter", args->filter, "Texture filter [aniso]");
+  cmd->add_option("--zero-coverage", args->zero_coverage, "discard with every tap outside: clamp or nan [clamp]");
+  cmd->add_option("--texels", args->texels, "Texel storage: rgba8 or rgba32f [rgba8]");
+  cmd->add_option("--size", args->size, "Image size WIDTHxHEIGHT [480x540]");
+  cmd->add_option("--frame", args->frame, "Orbit frame K (0-based) of --frames");
+  cmd->add_option("--frames", args->frames, "Frames in the orbit [60]");
+  cmd->add_option("--shading", args->shading, "Where to shade: pixel, centroid or sample [pixel]");
+  cmd->add_flag("--tint", args->tint, "Built-in scenes: tint each face a different base colour");
+  cmd->add_option("--constant-color", args->constant_color,
+                  "Paint every face one linear colour r,g,b (each 0..1): seams then carry no texture error");
+  cmd->add_option("--reference-method", args->reference_method,
+                  "Method of the 8x reference render [traverse if available, else discard]");
+  cmd->add_option("--reference-msaa", args->reference_msaa,
+                  "Samples per pixel of the 8x reference render [1 for traverse, 16 for discard]");
+  cmd->add_option("--cache", args->cache_dir, "Reference cache directory [$SEAMCL_CACHE_DIR or ~/.cache/seamcl]");
+  cmd->add_flag("--no-cache", args->no_cache, "Always render the reference; do not read or write the cache");
+  cmd->add_option("--images", args->images_dir,
+                  "Write each image, an error heat map (log scale 1e-4..1), the reference and the seam mask (PNG) here");
+  cmd->add_option("--repeat", args->repeat, "Timed renders per method and rate; ms reports median, min, max [3]");
+  cmd->add_flag("--json", args->json_out, "Print one JSON object");
+  return Command{cmd, [args](const GlobalOptions& global) { return run_compare(*args, global); }};
+}
+
+}  // namespace seamcl::cli
