@@ -190,6 +190,7 @@ int main(int argc, char** argv) {
 
   // Subcommands defined in their own files (cli/commands.h), one line each.
   std::vector<seamcl::cli::Command> extra_commands;
+  extra_commands.push_back(seamcl::cli::add_serve_command(app));
   extra_commands.push_back(seamcl::cli::add_compare_command(app));
 
   try {

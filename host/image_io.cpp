@@ -71,7 +71,9 @@ std::string encode_image(ImageFormat format, int width, int height, const std::v
   if (!output) throw std::runtime_error("no " + to_string(format) + " writer: " + OIIO::geterror());
   OIIO::ImageSpec spec = buffer.spec();
   spec.set_format(format == ImageFormat::Png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::HALF);
-  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &memory);
+  // The attribute holds a pointer: OIIO reads the address of our pointer to the proxy.
+  void* proxy = &memory;
+  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
   if (!output->open("memory." + to_string(format), spec) || !buffer.write(output.get()) || !output->close()) {
     throw std::runtime_error("encoding " + to_string(format) + " failed: " + output->geterror());
   }

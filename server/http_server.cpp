@@ -1,0 +1,499 @@
+#include "http_server.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include <unistd.h>
+#include <utility>
+
+#include <httplib.h>
+
+#include "errors.h"
+#include "image_io.h"
+#include "packed_scene.h"
+#include "renderer.h"
+#include "scene.h"
+#include "scene_generators.h"
+#include "scene_json.h"
+
+namespace seamcl::server {
+namespace {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::string scene_key(const std::string& name, bool tint) { return tint ? name + "+tint" : name; }
+
+// The paths the server answers and the methods each allows (others: 405).
+const std::map<std::string, std::vector<std::string>>& known_paths() {
+  static const std::map<std::string, std::vector<std::string>> paths = {
+      {"/", {"GET"}},           {"/health", {"GET"}},          {"/v1/scenes", {"GET"}},
+      {"/v1/methods", {"GET"}}, {"/v1/render", {"GET", "POST"}}, {"/v1/compare", {"POST"}},
+      {"/openapi.json", {"GET"}}};
+  return paths;
+}
+
+std::string method_description(const std::string& name) {
+  if (name == "clamp") return "taps outside the face read the nearest edge texel (seams show)";
+  if (name == "black") return "taps outside the face weigh zero, no renormalisation (edges darken)";
+  if (name == "discard") return "taps outside the face weigh zero, the rest are renormalised (Toth 2013)";
+  if (name == "traverse") return "taps outside the face are fetched from the edge-adjacent faces (McDonald 2013)";
+  if (name == "guardband") return "each mip level carries a band of texels from its neighbours (McDonald and Burley 2011)";
+  return "";
+}
+
+// A query string as the JSON object the shared parser reads: integers and true/false become
+// JSON numbers and booleans, everything else stays a string (the parser then names the field
+// whose type is wrong).
+json query_to_json(const httplib::Params& params) {
+  json out = json::object();
+  for (const auto& [key, value] : params) {
+    if (out.contains(key)) throw InputError(key, "given more than once");
+    long long number = 0;
+    const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), number);
+    if (!value.empty() && error == std::errc() && end == value.data() + value.size()) {
+      out[key] = number;
+    } else if (value == "true" || value == "false") {
+      out[key] = value == "true";
+    } else {
+      out[key] = value;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+// A refusal: status, the field at fault and a message, answered as {"error", "field"}.
+struct HttpServer::HttpError {
+  int status;
+  std::string field;
+  std::string message;
+  int retry_after_s = 0;  // > 0: a Retry-After header (503)
+};
+
+// One render slot: the Renderers one worker uses, one per built-in scene (and tint) and a scratch
+// one for inline scenes, which reloads its scene on every request.
+struct HttpServer::Slot {
+  std::map<std::string, std::unique_ptr<Renderer>> renderers;
+  std::unique_ptr<Renderer> scratch;
+};
+
+struct HttpServer::SlotLease {
+  HttpServer* server;
+  Slot* slot;
+  SlotLease(HttpServer* s, Slot* sl) : server(s), slot(sl) {}
+  ~SlotLease() { server->release_slot(slot); }
+  SlotLease(const SlotLease&) = delete;
+  SlotLease& operator=(const SlotLease&) = delete;
+};
+
+HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
+    : runtime_(runtime), options_(std::move(options)), http_(std::make_unique<httplib::Server>()) {
+  if (options_.threads < 1) throw InputError("threads", "must be at least 1");
+  if (options_.queue < 0) throw InputError("queue", "must be at least 0");
+
+  // 1. The built-in scenes, plain and tinted.
+  for (const GeneratorInfo& g : scene_generators()) {
+    for (bool tint : {false, true}) {
+      GeneratorOptions generator_options;
+      generator_options.tint = tint;
+      scenes_[scene_key(g.name, tint)] = std::make_shared<const Scene>(generate_scene(g.name, generator_options));
+    }
+  }
+
+  // 2. One slot per thread, each with a Renderer for the default scene, warmed up (this builds
+  // the default program variant and compiles its kernels before anything listens).
+  const RenderOptions defaults;
+  for (int i = 0; i < options_.threads; ++i) {
+    auto slot = std::make_unique<Slot>();
+    auto renderer = std::make_unique<Renderer>(runtime_);
+    renderer->load_scene(*scenes_.at(scene_key(defaults.scene, false)), defaults.texels);
+    renderer->warm_up(defaults);
+    if (i == 0 && options_.warm_all_methods) {
+      for (const std::string& method : method_names()) {
+        for (const std::string& filter : filter_names()) {
+          renderer->warm_up(parse_render_options({{"method", method}, {"filter", filter}}));
+        }
+      }
+    }
+    slot->renderers[scene_key(defaults.scene, false)] = std::move(renderer);
+    free_slots_.push_back(slot.get());
+    slots_.push_back(std::move(slot));
+  }
+
+  // 3. The /v1/methods answer: texture memory of each method on the default scene, as packed for
+  // the device (rgba8; rgba32f stores the same texels at 16 bytes each).
+  const json default_json = to_json(defaults);
+  const Scene& default_scene = *scenes_.at(scene_key(defaults.scene, false));
+  json methods = json::array();
+  for (const std::string& name : method_names()) {
+    const Method method = *parse_method(name);
+    const PackedScene packed = pack_scene(default_scene, TexelFormat::Rgba8, method == Method::Guardband ? defaults.guard_band : 0);
+    const size_t float_texel_bytes = 4 * sizeof(float);
+    methods.push_back({{"name", name},
+                       {"description", method_description(name)},
+                       {"texture_bytes", {{"rgba8", packed.texture_bytes()}, {"rgba32f", packed.texel_count() * float_texel_bytes}}},
+                       {"padding_bytes", {{"rgba8", packed.padding_bytes()}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
+                       {"adjacency_bytes", method == Method::Traverse ? packed.adjacency_bytes() : 0}});
+  }
+  json scene_names = json::array();
+  for (const GeneratorInfo& g : scene_generators()) scene_names.push_back(g.name);
+  auto enum_option = [&](const std::vector<std::string>& names, const std::string& key) {
+    return json{{"type", "string"}, {"enum", names}, {"default", default_json.at(key)}};
+  };
+  methods_cache_ = {
+      {"scene", defaults.scene},
+      {"methods", methods},
+      {"options",
+       {{"scene", {{"type", "string"}, {"enum", scene_names}, {"default", defaults.scene},
+                   {"description", "a built-in scene name, or (POST only) an inline scene object as in docs/scene-format.md"}}},
+        {"method", enum_option(method_names(), "method")},
+        {"filter", enum_option(filter_names(), "filter")},
+        {"zero_coverage", enum_option(zero_coverage_names(), "zero_coverage")},
+        {"texels", enum_option(texel_format_names(), "texels")},
+        {"shading", enum_option(shading_mode_names(), "shading")},
+        {"msaa", {{"type", "integer"}, {"enum", {1, 2, 4, 8, 16}}, {"default", defaults.msaa}}},
+        {"aniso", {{"type", "integer"}, {"minimum", 1}, {"maximum", 16}, {"default", defaults.aniso}}},
+        {"guard_band", {{"type", "integer"}, {"minimum", 1}, {"maximum", kMaxGuardBand}, {"default", defaults.guard_band},
+                        {"description", "guardband: band texels per side of every level"}}},
+        {"size", {{"type", "string"}, {"pattern", "^[0-9]+x[0-9]+$"}, {"minimum", 1}, {"maximum", kMaxImageSide},
+                  {"default", default_json.at("size")},
+                  {"description", "WIDTHxHEIGHT, each side in 1.." + std::to_string(kMaxImageSide) +
+                                      ", width*height*msaa at most " + std::to_string(options_.max_samples)}}},
+        {"frame", {{"type", "integer"}, {"minimum", 0}, {"maximum", 999999},
+                   {"description", "orbit frame, less than frames (default: the scene's camera)"}}},
+        {"frames", {{"type", "integer"}, {"minimum", 1}, {"maximum", 1000000}, {"default", defaults.frames}}},
+        {"centroid", {{"type", "boolean"}, {"default", false}, {"description", "same as shading=centroid"}}},
+        {"tint", {{"type", "boolean"}, {"default", defaults.tint}}},
+        {"format", {{"type", "string"}, {"enum", {"png", "exr"}}, {"default", "png"}}}}},
+      {"limits",
+       {{"max_body_bytes", options_.max_body_bytes},
+        {"max_samples", options_.max_samples},
+        {"max_inline_faces", options_.max_inline_faces},
+        {"max_inline_texels", options_.max_inline_texels}}}};
+
+  install_routes();
+}
+
+HttpServer::~HttpServer() { stop(); }
+
+int HttpServer::bind() {
+  if (options_.port == 0) {
+    port_ = http_->bind_to_any_port(options_.host);
+  } else {
+    port_ = http_->bind_to_port(options_.host, options_.port) ? options_.port : -1;
+  }
+  return port_;
+}
+
+bool HttpServer::listen_after_bind() {
+  started_ = Clock::now();
+  return http_->listen_after_bind();
+}
+
+void HttpServer::stop() {
+  if (http_) http_->stop();
+}
+
+bool HttpServer::is_running() const { return http_ && http_->is_running(); }
+
+void HttpServer::log_line(const std::string& line) const {
+  if (options_.log) {
+    options_.log(line);
+  } else {
+    std::fprintf(stderr, "%s\n", line.c_str());
+  }
+}
+
+std::unique_ptr<HttpServer::SlotLease> HttpServer::acquire_slot() {
+  const int capacity = options_.threads + options_.queue;
+  if (admitted_.fetch_add(1) >= capacity) {
+    admitted_.fetch_sub(1);
+    throw HttpError{503, "queue",
+                    "busy: " + std::to_string(options_.threads) + " renders running and " +
+                        std::to_string(options_.queue) + " waiting; retry later",
+                    1};
+  }
+  std::unique_lock lock(slots_mutex_);
+  slot_freed_.wait(lock, [&] { return !free_slots_.empty(); });
+  Slot* slot = free_slots_.back();
+  free_slots_.pop_back();
+  return std::make_unique<SlotLease>(this, slot);
+}
+
+void HttpServer::release_slot(Slot* slot) {
+  {
+    std::lock_guard lock(slots_mutex_);
+    free_slots_.push_back(slot);
+  }
+  admitted_.fetch_sub(1);
+  slot_freed_.notify_one();
+}
+
+json HttpServer::health_json() const {
+  return {{"status", "ok"},
+          {"device", runtime_.device_description()},
+          {"uptime_s", std::chrono::duration<double>(Clock::now() - started_).count()},
+          {"requests_served", served_.load()},
+          {"renders_admitted", admitted_.load()},
+          {"threads", options_.threads},
+          {"queue", options_.queue}};
+}
+
+json HttpServer::scenes_json() const {
+  json list = json::array();
+  const std::string default_scene = RenderOptions{}.scene;
+  for (const GeneratorInfo& g : scene_generators()) {
+    const Scene& scene = *scenes_.at(scene_key(g.name, false));
+    list.push_back({{"name", g.name},
+                    {"description", g.description},
+                    {"faces", scene.faces.size()},
+                    {"triangles", scene.triangle_count()},
+                    {"texels", scene.texel_count()},
+                    {"orbit", scene.orbit.has_value()},
+                    {"default", g.name == default_scene}});
+  }
+  return {{"scenes", list}};
+}
+
+json HttpServer::methods_json() const { return methods_cache_; }
+
+void HttpServer::handle_render(const json& request, httplib::Response& res) {
+  const Clock::time_point start = Clock::now();
+  if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
+
+  // The server's own keys (format, an inline scene); the rest goes to the shared parser.
+  json rest = request;
+  ImageFormat format = ImageFormat::Png;
+  if (rest.contains("format")) {
+    const json& value = rest.at("format");
+    const auto parsed = value.is_string() ? parse_image_format(value.get<std::string>()) : std::nullopt;
+    if (!parsed) throw HttpError{400, "format", "must be \"png\" or \"exr\", got " + value.dump()};
+    format = *parsed;
+    rest.erase("format");
+  }
+  json inline_scene;
+  if (rest.contains("scene") && rest.at("scene").is_object()) {
+    inline_scene = rest.at("scene");
+    rest.erase("scene");
+  }
+  RenderOptions options = parse_render_options(rest);
+  if (static_cast<long long>(options.width) * options.height * options.msaa > options_.max_samples) {
+    throw HttpError{413, "size",
+                    "width x height x msaa = " + std::to_string(static_cast<long long>(options.width) * options.height * options.msaa) +
+                        " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
+  }
+
+  // The scene: a built-in one (never a file path: clients name no server files) or inline.
+  std::shared_ptr<const Scene> scene;
+  std::string key;
+  if (inline_scene.is_null()) {
+    const auto found = scenes_.find(scene_key(options.scene, options.tint));
+    if (found == scenes_.end() || options.scene.find('+') != std::string::npos) {
+      std::string known;
+      for (const GeneratorInfo& g : scene_generators()) known += (known.empty() ? "" : ", ") + g.name;
+      throw HttpError{400, "scene", "unknown scene '" + options.scene + "' (built-in: " + known + "; or an inline scene object)"};
+    }
+    scene = found->second;
+    key = found->first;
+  } else {
+    // Limits first, from the JSON, before any texture is made.
+    if (inline_scene.contains("faces") && inline_scene.at("faces").is_array()) {
+      const json& faces = inline_scene.at("faces");
+      if (faces.size() > options_.max_inline_faces) {
+        throw HttpError{413, "scene.faces", std::to_string(faces.size()) + " faces exceed this server's limit of " +
+                                                std::to_string(options_.max_inline_faces)};
+      }
+      long long texels = 0;
+      for (size_t i = 0; i < faces.size(); ++i) {
+        const json* texture = faces[i].is_object() && faces[i].contains("texture") ? &faces[i].at("texture") : nullptr;
+        if (!texture || !texture->is_object()) continue;
+        auto side = [&](const char* name) -> long long {
+          if (!texture->contains(name) || !texture->at(name).is_number_integer()) return 1;
+          return std::clamp<long long>(texture->at(name).get<long long>(), 1, 1 << 20);
+        };
+        texels += side("width") * side("height");
+        if (texels > options_.max_inline_texels) {
+          throw HttpError{413, "scene.faces[" + std::to_string(i) + "].texture",
+                          "the scene's textures exceed this server's limit of " +
+                              std::to_string(options_.max_inline_texels) + " texels at level 0"};
+        }
+      }
+    }
+    try {
+      Scene parsed = parse_scene_json(inline_scene);
+      if (options.tint) {
+        GeneratorOptions generator_options;
+        generator_options.tint = true;
+        apply_generator_options(parsed, generator_options);
+      }
+      validate_scene(parsed);
+      scene = std::make_shared<const Scene>(std::move(parsed));
+    } catch (const InputError& e) {
+      throw InputError("scene." + e.field(), std::string(e.what()).substr(e.field().size() + 2));
+    }
+    options.scene = scene->name;
+  }
+  const Camera camera = options.frame ? orbit_camera(*scene, *options.frame, options.frames) : scene->camera;
+
+  // Wait for a render slot (or 503), render, and give the slot back before encoding.
+  const Clock::time_point queued = Clock::now();
+  RenderResult result;
+  double queue_ms = 0;
+  {
+    const std::unique_ptr<SlotLease> lease = acquire_slot();
+    queue_ms = ms_since(queued);
+    Slot& slot = *lease->slot;
+    std::unique_ptr<Renderer>& renderer = key.empty() ? slot.scratch : slot.renderers[key];
+    try {
+      if (!renderer) {
+        renderer = std::make_unique<Renderer>(runtime_);
+        if (!key.empty()) renderer->load_scene(*scene, options.texels);
+      }
+      if (key.empty()) renderer->load_scene(*scene, options.texels);
+      result = renderer->render(camera, options);
+    } catch (...) {
+      renderer.reset();  // a failed Renderer is not reused: the next request gets a fresh one
+      throw;
+    }
+  }
+  const Clock::time_point encode_start = Clock::now();
+  std::string image = encode_image(format, result.width, result.height, result.pixels);
+  const double encode_ms = ms_since(encode_start);
+
+  const json stage_ms = {{"setup", result.ms.setup},   {"binning", result.ms.binning},   {"raster", result.ms.raster},
+                         {"shade", result.ms.shade},   {"readback", result.ms.readback}, {"total", result.ms.total}};
+  res.set_header("X-Seamcl-Render-Ms", std::to_string(result.ms.total));
+  res.set_header("X-Seamcl-Stage-Ms", stage_ms.dump());
+  res.set_header("X-Seamcl-Queue-Ms", std::to_string(queue_ms));
+  res.set_header("X-Seamcl-Encode-Ms", std::to_string(encode_ms));
+  res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
+  res.set_header("X-Seamcl-Options", to_json(options).dump());
+  res.set_header("X-Seamcl-Fragments", std::to_string(result.stats.fragments));
+  res.set_content(std::move(image), format == ImageFormat::Png ? "image/png" : "image/x-exr");
+}
+
+void HttpServer::install_routes() {
+  httplib::Server& http = *http_;
+  // Enough pool threads for every admitted render plus a few for /health and refusals.
+  const size_t pool = static_cast<size_t>(options_.threads + options_.queue + 4);
+  http.new_task_queue = [pool] { return new httplib::ThreadPool(pool); };
+  http.set_payload_max_length(options_.max_body_bytes);
+  http.set_keep_alive_timeout(2);  // idle keep-alive connections hold a pool thread
+  http.set_read_timeout(10, 0);
+  http.set_write_timeout(10, 0);
+
+  auto send_error = [](httplib::Response& res, int status, const std::string& field, const std::string& message) {
+    res.status = status;
+    res.set_content(json{{"error", message}, {"field", field}}.dump(), "application/json");
+  };
+  // Every handler runs inside this: refusals become {"error", "field"} with their status.
+  auto guarded = [this, send_error](auto handler) {
+    return [this, send_error, handler](const httplib::Request& req, httplib::Response& res) {
+      try {
+        handler(req, res);
+      } catch (const HttpError& e) {
+        if (e.retry_after_s > 0) res.set_header("Retry-After", std::to_string(e.retry_after_s));
+        send_error(res, e.status, e.field, e.field + ": " + e.message);
+      } catch (const InputError& e) {
+        send_error(res, 400, e.field(), e.what());
+      } catch (const std::exception& e) {
+        log_line(std::string("error: ") + describe_cl_exception(e));
+        send_error(res, 500, "server", "render failed: " + describe_cl_exception(e));
+      }
+    };
+  };
+
+  // Per-request start time, for the log line (the logger runs on the same thread, after).
+  static thread_local Clock::time_point request_start{};
+  http.set_pre_routing_handler([send_error](const httplib::Request& req, httplib::Response& res) {
+    request_start = Clock::now();
+    const auto found = known_paths().find(req.path);
+    if (found != known_paths().end() &&
+        std::find(found->second.begin(), found->second.end(), req.method) == found->second.end()) {
+      std::string allow;
+      for (const std::string& m : found->second) allow += (allow.empty() ? "" : ", ") + m;
+      res.set_header("Allow", allow);
+      send_error(res, 405, "method", req.method + " is not allowed on " + req.path + " (allowed: " + allow + ")");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+  http.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
+    const double ms = request_start == Clock::time_point{} ? 0.0 : ms_since(request_start);
+    request_start = Clock::time_point{};
+    served_.fetch_add(1);
+    char line[512];
+    std::snprintf(line, sizeof line, "%s %s %d %zu B %.1f ms", req.method.c_str(), req.path.substr(0, 200).c_str(),
+                  res.status, res.body.size(), ms);
+    log_line(line);
+  });
+  // Statuses httplib sets itself (404, 413, 400 for a malformed request line) get the JSON body too.
+  http.set_error_handler(httplib::Server::HandlerWithResponse([send_error](const httplib::Request& req, httplib::Response& res) {
+    if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+    if (res.status == 404) {
+      send_error(res, 404, "path", "no such endpoint: " + req.method + " " + req.path.substr(0, 200));
+    } else if (res.status == 413) {
+      send_error(res, 413, "body", "the request body exceeds this server's limit");
+    } else {
+      send_error(res, res.status, "request", "the request could not be handled (HTTP " + std::to_string(res.status) + ")");
+    }
+    return httplib::Server::HandlerResponse::Handled;
+  }));
+  http.set_exception_handler([send_error](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
+    send_error(res, 500, "server", "internal error");
+  });
+
+  http.Get("/", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content(std::string(viewer_html()), "text/html; charset=utf-8");
+  });
+  http.Get("/openapi.json", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content(std::string(openapi_json()), "application/json");
+  });
+  http.Get("/health", guarded([this](const httplib::Request&, httplib::Response& res) {
+             res.set_content(health_json().dump(), "application/json");
+           }));
+  http.Get("/v1/scenes", guarded([this](const httplib::Request&, httplib::Response& res) {
+             res.set_content(scenes_json().dump(), "application/json");
+           }));
+  http.Get("/v1/methods", guarded([this](const httplib::Request&, httplib::Response& res) {
+             res.set_content(methods_json().dump(), "application/json");
+           }));
+  http.Get("/v1/render", guarded([this](const httplib::Request& req, httplib::Response& res) {
+             handle_render(query_to_json(req.params), res);
+           }));
+  http.Post("/v1/render", guarded([this](const httplib::Request& req, httplib::Response& res) {
+              const std::string type = req.get_header_value("Content-Type");
+              if (type.substr(0, type.find(';')) != "application/json") {
+                throw HttpError{415, "Content-Type", "must be application/json, got '" + type.substr(0, 100) + "'"};
+              }
+              // Parse with a depth limit: the library's error messages print values, recursively.
+              bool too_deep = false;
+              const int max_depth = options_.max_json_depth;
+              json body;
+              try {
+                body = json::parse(req.body, [&](int depth, json::parse_event_t, json&) {
+                  if (depth > max_depth) too_deep = true;
+                  return !too_deep;
+                });
+              } catch (const json::exception& e) {
+                throw HttpError{400, "body", std::string("not valid JSON: ") + e.what()};
+              }
+              if (too_deep) throw HttpError{400, "body", "nested deeper than " + std::to_string(max_depth) + " levels"};
+              handle_render(body, res);
+            }));
+  http.Post("/v1/compare", guarded([](const httplib::Request&, httplib::Response&) {
+              throw HttpError{501, "path", "compare is not implemented yet: image metrics land in a later release"};
+            }));
+}
+
+}  // namespace seamcl::server

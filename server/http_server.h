@@ -1,0 +1,115 @@
+// The HTTP service: a translation layer between HTTP requests and the library (the shared option
+// parser, the scene loaders, Renderer, encode_image). It computes nothing itself.
+//
+// Device sharing: the server owns no OpenCL state of its own beyond one ClRuntime (context,
+// queue, compiled programs), which every render shares; contexts, queues and programs are
+// thread-safe. Kernel arguments are not (clSetKernelArg on one kernel object from two threads
+// races), so each render slot owns its own Renderer objects (kernel objects and buffers) and a
+// slot serves one request at a time. There are --threads slots.
+//
+// Admission: cpp-httplib's thread pool queues connections without bound, so the server counts
+// admitted renders itself: at most `threads` render at once and at most `queue` wait for a slot;
+// any render beyond that is answered 503 with Retry-After at once. The pool has enough threads
+// for every admitted render plus a few more, so /health and refusals are answered while busy.
+#pragma once
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cl_runtime.h"
+#include "render_options.h"
+
+namespace httplib {
+class Server;
+struct Request;
+struct Response;
+}  // namespace httplib
+
+namespace seamcl {
+class Renderer;
+struct Scene;
+}  // namespace seamcl
+
+namespace seamcl::server {
+
+struct ServerOptions {
+  std::string host = "127.0.0.1";  // loopback unless asked otherwise
+  int port = 8080;                 // 0: any free port (see HttpServer::port)
+  int threads = 2;                 // render slots (one Renderer set each)
+  int queue = 8;                   // renders allowed to wait for a slot; more get 503
+  size_t max_body_bytes = size_t{1} << 20;              // larger bodies: 413
+  long long max_samples = 2048LL * 2048 * 4;            // width * height * msaa per request: 413 "size"
+  size_t max_inline_faces = 1024;                       // inline scene faces: 413 "scene.faces"
+  long long max_inline_texels = 1LL << 21;              // inline scene texels at level 0: 413
+  int max_json_depth = 32;                              // deeper request JSON: 400 "body"
+  bool warm_all_methods = true;    // at start, build every method x filter (rgba8), not just the default
+  std::function<void(const std::string&)> log;          // one line per request; empty: stderr
+};
+
+// The built-in assets, embedded at build time (server/embed_assets.cmake).
+std::string_view viewer_html();
+std::string_view openapi_json();
+
+class HttpServer {
+ public:
+  // Builds and warms the kernels and generates the built-in scenes (blocking, before anything
+  // listens). Throws on OpenCL failures.
+  HttpServer(ClRuntime& runtime, ServerOptions options);
+  ~HttpServer();
+  HttpServer(const HttpServer&) = delete;
+  HttpServer& operator=(const HttpServer&) = delete;
+
+  // Binds host:port (port 0: an ephemeral port); returns the port, or -1 on failure.
+  int bind();
+  int port() const { return port_; }
+  // Serves until stop(); returns after every in-flight request has been answered.
+  bool listen_after_bind();
+  // Safe from any thread (e.g. a signal-waiting thread).
+  void stop();
+  bool is_running() const;
+
+  long long requests_served() const { return served_.load(); }
+
+ private:
+  struct Slot;
+  struct SlotLease;
+  struct HttpError;
+
+  void install_routes();
+  void handle_render(const nlohmann::json& request, httplib::Response& res);
+  nlohmann::json scenes_json() const;
+  nlohmann::json methods_json() const;
+  nlohmann::json health_json() const;
+  std::unique_ptr<SlotLease> acquire_slot();
+  void release_slot(Slot* slot);
+  void log_line(const std::string& line) const;
+
+  ClRuntime& runtime_;
+  ServerOptions options_;
+  std::unique_ptr<httplib::Server> http_;
+  int port_ = -1;
+  std::chrono::steady_clock::time_point started_;
+
+  // Built-in scenes, generated once: key "<name>" and "<name>+tint".
+  std::map<std::string, std::shared_ptr<const Scene>> scenes_;
+  nlohmann::json methods_cache_;
+
+  std::vector<std::unique_ptr<Slot>> slots_;
+  std::vector<Slot*> free_slots_;
+  std::mutex slots_mutex_;
+  std::condition_variable slot_freed_;
+  std::atomic<int> admitted_{0};  // rendering + waiting
+  std::atomic<long long> served_{0};
+};
+
+}  // namespace seamcl::server

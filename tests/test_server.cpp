@@ -1,0 +1,719 @@
+// The HTTP service, end to end: a real server on an ephemeral loopback port, in this process on a
+// thread, talked to with the real httplib::Client. Every answer with a JSON body is validated
+// against the server's own OpenAPI document, so the document stays true. Images are decoded and
+// compared pixel for pixel with Renderer::render on the same options and the same encoding.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include "errors.h"
+#include "http_server.h"
+#include "image_io.h"
+#include "packed_scene.h"
+#include "render_options.h"
+#include "renderer.h"
+#include "scene_generators.h"
+#include "scene_json.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace seamcl;
+
+namespace {
+
+// ---- A validator for the JSON-Schema subset the OpenAPI document uses: $ref (local), type,
+// properties, required, additionalProperties: false, enum, items, minimum, maximum.
+void validate(const json& value, const json& schema, const json& root, const std::string& path,
+              std::vector<std::string>& errors) {
+  if (schema.contains("$ref")) {
+    const std::string ref = schema.at("$ref");
+    if (!ref.starts_with("#/")) {
+      errors.push_back(path + ": unsupported $ref " + ref);
+      return;
+    }
+    validate(value, root.at(json::json_pointer(ref.substr(1))), root, path, errors);
+    return;
+  }
+  if (schema.contains("type")) {
+    const std::string type = schema.at("type");
+    const bool ok = type == "object"    ? value.is_object()
+                    : type == "array"   ? value.is_array()
+                    : type == "string"  ? value.is_string()
+                    : type == "integer" ? value.is_number_integer()
+                    : type == "number"  ? value.is_number()
+                    : type == "boolean" ? value.is_boolean()
+                                        : false;
+    if (!ok) {
+      errors.push_back(path + ": expected " + type + ", got " + value.dump());
+      return;
+    }
+  }
+  if (schema.contains("enum")) {
+    const json& allowed = schema.at("enum");
+    if (std::find(allowed.begin(), allowed.end(), value) == allowed.end())
+      errors.push_back(path + ": " + value.dump() + " not in " + allowed.dump());
+  }
+  if (value.is_number()) {
+    if (schema.contains("minimum") && value.get<double>() < schema.at("minimum").get<double>())
+      errors.push_back(path + ": " + value.dump() + " below minimum");
+    if (schema.contains("maximum") && value.get<double>() > schema.at("maximum").get<double>())
+      errors.push_back(path + ": " + value.dump() + " above maximum");
+  }
+  if (value.is_object()) {
+    const json properties = schema.value("properties", json::object());
+    for (const auto& name : schema.value("required", json::array())) {
+      if (!value.contains(name.get<std::string>())) errors.push_back(path + ": missing required " + name.dump());
+    }
+    for (const auto& [key, item] : value.items()) {
+      if (properties.contains(key)) {
+        validate(item, properties.at(key), root, path + "." + key, errors);
+      } else if (schema.contains("additionalProperties") && schema.at("additionalProperties") == false) {
+        errors.push_back(path + ": unexpected property " + key);
+      }
+    }
+  }
+  if (value.is_array() && schema.contains("items")) {
+    for (size_t i = 0; i < value.size(); ++i)
+      validate(value[i], schema.at("items"), root, path + "[" + std::to_string(i) + "]", errors);
+  }
+}
+
+std::string schema_errors(const json& value, const json& schema, const json& root) {
+  std::vector<std::string> errors;
+  validate(value, schema, root, "$", errors);
+  std::string out;
+  for (const std::string& e : errors) out += e + "\n";
+  return out;
+}
+
+const json& openapi() {
+  static const json doc = json::parse(server::openapi_json());
+  return doc;
+}
+
+json resolve(const json& node) {
+  if (node.contains("$ref")) return resolve(openapi().at(json::json_pointer(node.at("$ref").get<std::string>().substr(1))));
+  return node;
+}
+
+// The documented JSON schema of `status` for `method path`; fails the test when undocumented.
+json response_schema(const std::string& method, const std::string& path, int status) {
+  const json& paths = openapi().at("paths");
+  EXPECT_TRUE(paths.contains(path)) << path;
+  if (!paths.contains(path) || !paths.at(path).contains(method)) {
+    ADD_FAILURE() << method << " " << path << " undocumented";
+    return json::object();
+  }
+  const json& responses = paths.at(path).at(method).at("responses");
+  const std::string code = std::to_string(status);
+  if (!responses.contains(code)) {
+    ADD_FAILURE() << method << " " << path << " status " << code << " undocumented";
+    return json::object();
+  }
+  const json response = resolve(responses.at(code));
+  if (!response.contains("content") || !response.at("content").contains("application/json")) return json::object();
+  return response.at("content").at("application/json").at("schema");
+}
+
+void expect_documented(const std::string& method, const std::string& path, const httplib::Result& res) {
+  ASSERT_TRUE(res) << "no answer to " << method << " " << path;
+  const json body = json::parse(res->body);
+  EXPECT_EQ(schema_errors(body, response_schema(method, path, res->status), openapi()), "") << method << " " << path;
+}
+
+// ---- Images.
+std::vector<glm::vec4> decode(const std::string& bytes, const std::string& extension, int& width, int& height) {
+  static std::atomic<int> counter{0};
+  const fs::path path = fs::temp_directory_path() /
+                        ("seamcl-test-server-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + extension);
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << bytes;
+  }
+  std::vector<glm::vec4> pixels = read_image(path.string(), width, height);
+  fs::remove(path);
+  return pixels;
+}
+
+// What the library makes of a request: Renderer::render, then the same encoding (PNG via OIIO),
+// decoded again.
+std::vector<glm::vec4> library_image(const json& request, const Scene* inline_scene = nullptr) {
+  const RenderOptions options = parse_render_options(request);
+  GeneratorOptions generator_options;
+  generator_options.tint = options.tint;
+  const Scene scene = inline_scene ? *inline_scene : generate_scene(options.scene, generator_options);
+  Renderer renderer(seamcl_tests::shared_runtime());
+  renderer.load_scene(scene, options.texels);
+  const Camera camera = options.frame ? orbit_camera(scene, *options.frame, options.frames) : scene.camera;
+  const RenderResult result = renderer.render(camera, options);
+  // A new name each time: OIIO's image cache would hand back an earlier file's pixels.
+  static std::atomic<int> counter{0};
+  const fs::path path = fs::temp_directory_path() / ("seamcl-test-server-expected-" + std::to_string(::getpid()) + "-" +
+                                                     std::to_string(counter++) + ".png");
+  write_image(path.string(), result.width, result.height, result.pixels);
+  int w = 0, h = 0;
+  std::vector<glm::vec4> pixels = read_image(path.string(), w, h);
+  fs::remove(path);
+  return pixels;
+}
+
+bool all_zero(const std::vector<glm::vec4>& pixels) {
+  return std::all_of(pixels.begin(), pixels.end(), [](glm::vec4 p) { return p.r == 0 && p.g == 0 && p.b == 0; });
+}
+
+// ---- A server on a thread.
+struct RunningServer {
+  std::unique_ptr<server::HttpServer> http;
+  std::thread thread;
+  std::mutex log_mutex;
+  std::vector<std::string> log;
+
+  explicit RunningServer(server::ServerOptions options) {
+    options.host = "127.0.0.1";
+    options.port = 0;
+    options.warm_all_methods = false;
+    options.log = [this](const std::string& line) {
+      std::lock_guard lock(log_mutex);
+      log.push_back(line);
+    };
+    http = std::make_unique<server::HttpServer>(seamcl_tests::shared_runtime(), options);
+    if (http->bind() <= 0) throw std::runtime_error("cannot bind");
+    thread = std::thread([this] { http->listen_after_bind(); });
+    for (int i = 0; i < 500 && !http->is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ~RunningServer() {
+    http->stop();
+    if (thread.joinable()) thread.join();
+  }
+  httplib::Client client() const {
+    httplib::Client c("127.0.0.1", http->port());
+    c.set_connection_timeout(5, 0);
+    c.set_read_timeout(30, 0);
+    c.set_write_timeout(10, 0);
+    return c;
+  }
+  std::vector<std::string> log_lines() {
+    std::lock_guard lock(log_mutex);
+    return log;
+  }
+};
+
+class Server : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    std::signal(SIGPIPE, SIG_IGN);
+    server::ServerOptions options;
+    options.threads = 2;
+    options.queue = 8;
+    server_ = new RunningServer(options);
+  }
+  static void TearDownTestSuite() {
+    delete server_;
+    server_ = nullptr;
+  }
+  static httplib::Client client() { return server_->client(); }
+  static RunningServer* server_;
+};
+RunningServer* Server::server_ = nullptr;
+
+httplib::Result post_json(httplib::Client& c, const std::string& body, const std::string& type = "application/json") {
+  return c.Post("/v1/render", body, type.c_str());
+}
+
+// ---- The validator itself: it must catch what it claims to.
+TEST(ServerSchema, ValidatorCatchesViolations) {
+  const json root = openapi();
+  const json error_schema = {{"$ref", "#/components/schemas/Error"}};
+  EXPECT_EQ(schema_errors({{"error", "x"}, {"field", "y"}}, error_schema, root), "");
+  EXPECT_NE(schema_errors({{"error", "x"}}, error_schema, root), "");                              // required
+  EXPECT_NE(schema_errors({{"error", "x"}, {"field", "y"}, {"z", 1}}, error_schema, root), "");    // extra
+  EXPECT_NE(schema_errors({{"error", 1}, {"field", "y"}}, error_schema, root), "");                // type
+  EXPECT_NE(schema_errors(json(17), {{"type", "integer"}, {"maximum", 16}}, root), "");            // maximum
+  EXPECT_NE(schema_errors(json(0), {{"type", "integer"}, {"minimum", 1}}, root), "");              // minimum
+  EXPECT_NE(schema_errors(json("x"), {{"enum", {"a", "b"}}}, root), "");                           // enum
+  EXPECT_NE(schema_errors(json::array({1, "a"}), {{"type", "array"}, {"items", {{"type", "integer"}}}}, root), "");
+  EXPECT_NE(schema_errors(json(1.5), {{"type", "integer"}}, root), "");
+}
+
+TEST(ServerSchema, OpenApiDocumentsEveryEndpoint) {
+  const json& doc = openapi();
+  EXPECT_TRUE(doc.at("openapi").get<std::string>().starts_with("3."));
+  for (const auto& [path, method] : std::vector<std::pair<std::string, std::string>>{
+           {"/", "get"}, {"/health", "get"}, {"/v1/scenes", "get"}, {"/v1/methods", "get"}, {"/v1/render", "get"},
+           {"/v1/render", "post"}, {"/v1/compare", "post"}, {"/openapi.json", "get"}}) {
+    EXPECT_TRUE(doc.at("paths").contains(path) && doc.at("paths").at(path).contains(method)) << method << " " << path;
+  }
+  // Every $ref resolves.
+  std::function<void(const json&)> walk = [&](const json& node) {
+    if (node.is_object()) {
+      if (node.contains("$ref")) EXPECT_NO_THROW(resolve(node)) << node.dump();
+      for (const auto& [k, v] : node.items()) walk(v);
+    } else if (node.is_array()) {
+      for (const auto& v : node) walk(v);
+    }
+  };
+  walk(doc);
+  // The request schema names exactly the options the shared parser knows, plus format.
+  const json properties = doc.at("components").at("schemas").at("RenderRequest").at("properties");
+  for (const auto& [key, value] : properties.items()) {
+    if (key == "format" || key == "scene") continue;
+    json probe = json::object();
+    probe[key] = value.contains("type") && value.at("type") == "integer" ? json(1)
+                 : value.contains("type") && value.at("type") == "boolean" ? json(false)
+                                                                           : json("?");
+    try {
+      parse_render_options(probe);
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).find("unknown option"), std::string::npos) << key << " is not a render option";
+    }
+  }
+}
+
+TEST_F(Server, HealthReportsDeviceUptimeAndRequests) {
+  httplib::Client c = client();
+  auto res = c.Get("/health");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  expect_documented("get", "/health", res);
+  const json body = json::parse(res->body);
+  EXPECT_EQ(body.at("device"), seamcl_tests::shared_runtime().device_description());
+  EXPECT_GE(body.at("uptime_s").get<double>(), 0.0);
+  const long long before = body.at("requests_served");
+  auto again = c.Get("/health");
+  ASSERT_TRUE(again);
+  EXPECT_GT(json::parse(again->body).at("requests_served").get<long long>(), before);
+}
+
+TEST_F(Server, ScenesListsTheBuiltInScenes) {
+  httplib::Client c = client();
+  auto res = c.Get("/v1/scenes");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  expect_documented("get", "/v1/scenes", res);
+  const json scenes = json::parse(res->body).at("scenes");
+  ASSERT_EQ(scenes.size(), scene_generators().size());
+  for (size_t i = 0; i < scenes.size(); ++i) EXPECT_EQ(scenes[i].at("name"), scene_generators()[i].name);
+  EXPECT_EQ(generate_scene("quad2", {}).faces.size(), scenes[1].at("faces").get<size_t>());
+}
+
+TEST_F(Server, MethodsListsOptionsRangesAndTextureMemory) {
+  httplib::Client c = client();
+  auto res = c.Get("/v1/methods");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  expect_documented("get", "/v1/methods", res);
+  const json body = json::parse(res->body);
+  std::vector<std::string> names;
+  for (const json& m : body.at("methods")) names.push_back(m.at("name"));
+  EXPECT_EQ(names, method_names());
+  EXPECT_EQ(body.at("options").at("method").at("enum").get<std::vector<std::string>>(), method_names());
+  EXPECT_EQ(body.at("options").at("filter").at("enum").get<std::vector<std::string>>(), filter_names());
+  EXPECT_EQ(body.at("options").at("size").at("default"), to_json(RenderOptions{}).at("size"));
+  const Scene paper = generate_scene(RenderOptions{}.scene, {});
+  EXPECT_EQ(body.at("methods")[0].at("texture_bytes").at("rgba8").get<size_t>(), pack_scene(paper).texture_bytes());
+  // The ranges are the parser's: the bounds pass, one past them fails.
+  const json& aniso = body.at("options").at("aniso");
+  EXPECT_NO_THROW(parse_render_options({{"aniso", aniso.at("maximum")}}));
+  EXPECT_THROW(parse_render_options({{"aniso", aniso.at("maximum").get<int>() + 1}}), InputError);
+  EXPECT_THROW(parse_render_options({{"aniso", aniso.at("minimum").get<int>() - 1}}), InputError);
+  for (const json& msaa : body.at("options").at("msaa").at("enum")) EXPECT_NO_THROW(parse_render_options({{"msaa", msaa}}));
+}
+
+TEST_F(Server, OpenApiAndViewerAreServed) {
+  httplib::Client c = client();
+  auto doc = c.Get("/openapi.json");
+  ASSERT_TRUE(doc);
+  EXPECT_EQ(doc->status, 200);
+  EXPECT_EQ(json::parse(doc->body), openapi());
+  auto page = c.Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_TRUE(page->get_header_value("Content-Type").starts_with("text/html"));
+  EXPECT_NE(page->body.find("<html"), std::string::npos);
+  EXPECT_NE(page->body.find("/v1/render"), std::string::npos);
+  EXPECT_EQ(page->body, std::string(server::viewer_html()));
+}
+
+TEST_F(Server, PostRenderMatchesTheLibrary) {
+  httplib::Client c = client();
+  const json request = {{"scene", "quad2"}, {"method", "black"}, {"msaa", 4}, {"size", "64x48"}, {"aniso", 8}};
+  auto res = post_json(c, request.dump());
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  EXPECT_EQ(res->get_header_value("Content-Type"), "image/png");
+  EXPECT_GE(std::stod(res->get_header_value("X-Seamcl-Render-Ms")), 0.0);
+  const json stages = json::parse(res->get_header_value("X-Seamcl-Stage-Ms"));
+  for (const char* stage : {"setup", "binning", "raster", "shade", "readback", "total"}) EXPECT_TRUE(stages.contains(stage)) << stage;
+  EXPECT_EQ(json::parse(res->get_header_value("X-Seamcl-Options")), to_json(parse_render_options(request)));
+  int w = 0, h = 0;
+  const std::vector<glm::vec4> pixels = decode(res->body, ".png", w, h);
+  EXPECT_EQ(w, 64);
+  EXPECT_EQ(h, 48);
+  EXPECT_FALSE(all_zero(pixels));
+  EXPECT_TRUE(pixels == library_image(request));
+}
+
+TEST_F(Server, GetRenderMatchesPostAndTheLibrary) {
+  httplib::Client c = client();
+  auto get = c.Get("/v1/render?scene=paper&msaa=4&size=96x80&frame=3&frames=60&tint=true&filter=ewa");
+  ASSERT_TRUE(get);
+  ASSERT_EQ(get->status, 200) << get->body;
+  const json request = {{"scene", "paper"}, {"msaa", 4}, {"size", "96x80"}, {"frame", 3}, {"frames", 60}, {"tint", true}, {"filter", "ewa"}};
+  auto post = post_json(c, request.dump());
+  ASSERT_TRUE(post);
+  ASSERT_EQ(post->status, 200);
+  EXPECT_EQ(get->body, post->body);
+  int w = 0, h = 0;
+  const std::vector<glm::vec4> pixels = decode(get->body, ".png", w, h);
+  EXPECT_EQ(w, 96);
+  EXPECT_EQ(h, 80);
+  EXPECT_FALSE(all_zero(pixels));
+  EXPECT_TRUE(pixels == library_image(request));
+}
+
+TEST_F(Server, RenderExr) {
+  httplib::Client c = client();
+  auto res = post_json(c, json{{"scene", "cube"}, {"size", "40x30"}, {"format", "exr"}, {"texels", "rgba32f"}}.dump());
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  EXPECT_EQ(res->get_header_value("Content-Type"), "image/x-exr");
+  int w = 0, h = 0;
+  const std::vector<glm::vec4> pixels = decode(res->body, ".exr", w, h);
+  EXPECT_EQ(w, 40);
+  EXPECT_EQ(h, 30);
+  EXPECT_FALSE(all_zero(pixels));
+}
+
+TEST_F(Server, InlineSceneMatchesTheSceneFile) {
+  std::ifstream in(std::string(SEAMCL_EXAMPLES_DIR) + "/scenes/two_quads_constant.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  const json scene_doc = json::parse(text.str());
+  httplib::Client c = client();
+  auto res = post_json(c, json{{"scene", scene_doc}, {"size", "64x32"}, {"msaa", 2}}.dump());
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  int w = 0, h = 0;
+  const std::vector<glm::vec4> pixels = decode(res->body, ".png", w, h);
+  const Scene scene = parse_scene_json(scene_doc);
+  EXPECT_TRUE(pixels == library_image({{"size", "64x32"}, {"msaa", 2}}, &scene));
+  // The next request of a built-in scene is unaffected.
+  auto after = post_json(c, json{{"scene", "quad2"}, {"size", "32x32"}}.dump());
+  ASSERT_TRUE(after);
+  ASSERT_EQ(after->status, 200);
+  EXPECT_TRUE(decode(after->body, ".png", w, h) == library_image({{"scene", "quad2"}, {"size", "32x32"}}));
+}
+
+TEST_F(Server, CompareIsNotImplementedYet) {
+  httplib::Client c = client();
+  auto res = c.Post("/v1/compare", "{}", "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 501);
+  expect_documented("post", "/v1/compare", res);
+}
+
+// One malformed request and what it must get.
+struct Malformed {
+  std::string method;
+  std::string path;
+  std::string content_type;  // empty: no Content-Type header
+  std::string body;
+  int status;
+  std::string field;  // the field the answer names (a prefix for inline-scene JSON paths)
+};
+
+std::string inline_scene_with_faces(size_t faces, int side) {
+  json scene = {{"positions", {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}},
+                {"camera", {{"eye", {0, 0, 3}}, {"target", {0, 0, 0}}}}};
+  json list = json::array();
+  for (size_t i = 0; i < faces; ++i) list.push_back({{"vertices", {0, 1, 2, 3}}, {"texture", {{"width", side}, {"height", side}}}});
+  scene["faces"] = list;
+  return json{{"scene", scene}, {"size", "16x16"}}.dump();
+}
+
+std::vector<Malformed> malformed_requests() {
+  const std::string json_type = "application/json";
+  auto post = [&](std::string body, int status, std::string field) {
+    return Malformed{"POST", "/v1/render", json_type, std::move(body), status, std::move(field)};
+  };
+  auto get = [](std::string query, int status, std::string field) {
+    return Malformed{"GET", "/v1/render?" + std::move(query), "", "", status, std::move(field)};
+  };
+  std::string deep = R"({"msaa": )" + std::string(200, '[') + std::string(200, ']') + "}";
+  return {
+      post("{", 400, "body"),
+      post("", 400, "body"),
+      post("[1, 2]", 400, "body"),
+      post("\"paper\"", 400, "body"),
+      post("null", 400, "body"),
+      post("{\"msaa\": 4,}", 400, "body"),
+      post(deep, 400, "body"),
+      post(R"({"msaa": "4"})", 400, "msaa"),
+      post(R"({"msaa": 3})", 400, "msaa"),
+      post(R"({"msaa": 4.5})", 400, "msaa"),
+      post(R"({"msaa": 99999999999999999999})", 400, "msaa"),
+      post(R"({"msaa": -4})", 400, "msaa"),
+      post(R"({"msaa": null})", 400, "msaa"),
+      post(R"({"msaa": true})", 400, "msaa"),
+      post(R"({"aniso": 0})", 400, "aniso"),
+      post(R"({"aniso": 17})", 400, "aniso"),
+      post(R"({"aniso": "NaN"})", 400, "aniso"),
+      post(R"({"size": "0x10"})", 400, "size"),
+      post(R"({"size": "-64x64"})", 400, "size"),
+      post(R"({"size": "64"})", 400, "size"),
+      post(R"({"size": 64})", 400, "size"),
+      post(R"({"size": "64x64x64"})", 400, "size"),
+      post(R"({"size": "99999x99999"})", 400, "size"),
+      post(R"({"size": "2048x2048", "msaa": 8})", 413, "size"),
+      post(R"({"method": "bogus"})", 400, "method"),
+      post(R"({"method": 1})", 400, "method"),
+      post(R"({"filter": "nearest"})", 400, "filter"),
+      post(R"({"shading": "flat"})", 400, "shading"),
+      post(R"({"zero_coverage": "zero"})", 400, "zero_coverage"),
+      post(R"({"texels": "rgb565"})", 400, "texels"),
+      post(R"({"format": "jpeg"})", 400, "format"),
+      post(R"({"format": 1})", 400, "format"),
+      post(R"({"scene": "nonexistent"})", 400, "scene"),
+      post(R"({"scene": "examples/scenes/quad2.json"})", 400, "scene"),
+      post(R"({"scene": "/etc/passwd"})", 400, "scene"),
+      post(R"({"scene": ""})", 400, "scene"),
+      post(R"({"scene": 5})", 400, "scene"),
+      post(R"({"scene": ["paper"]})", 400, "scene"),
+      post(R"({"colour": "red"})", 400, "colour"),
+      post(R"({"frame": 60, "frames": 60})", 400, "frame"),
+      post(R"({"frame": -1})", 400, "frame"),
+      post(R"({"frames": 0})", 400, "frames"),
+      post(R"({"tint": "yes"})", 400, "tint"),
+      post(R"({"centroid": true, "shading": "sample"})", 400, "centroid"),
+      post(R"({"scene": {"faces": []}})", 400, "scene."),
+      post(R"({"scene": {"generator": "nope"}})", 400, "scene."),
+      post(R"({"scene": {"positions": [[0,0,0]], "faces": [{"vertices": [0,0,0,0], "texture": {"width": 4, "height": 4}}], "camera": {"eye": [0,0,1], "target": [0,0,0]}}})",
+           400, "scene.faces[0]"),
+      post(R"({"scene": {"positions": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]], "faces": [{"vertices": [0,1,2,3], "texture": {"width": 3, "height": 4}}], "camera": {"eye": [0,0,1], "target": [0,0,0]}}})",
+           400, "scene.faces[0].texture.width"),
+      post(inline_scene_with_faces(2000, 1), 413, "scene.faces"),
+      post(inline_scene_with_faces(1, 4096), 413, "scene.faces[0].texture"),
+      post(std::string(size_t{1} << 20, ' ') + "{}", 413, "body"),
+      Malformed{"POST", "/v1/render", "text/plain", R"({"msaa": 4})", 415, "Content-Type"},
+      Malformed{"POST", "/v1/render", "application/x-www-form-urlencoded", "msaa=4", 415, "Content-Type"},
+      Malformed{"POST", "/v1/render", "", R"({"msaa": 4})", 415, "Content-Type"},
+      get("msaa=abc", 400, "msaa"),
+      get("msaa=4.0", 400, "msaa"),
+      get("msaa=", 400, "msaa"),
+      get("msaa=1e400", 400, "msaa"),
+      get("size=-1x5", 400, "size"),
+      get("aniso=99999999999999999999999", 400, "aniso"),
+      get("msaa=4&msaa=8", 400, "msaa"),
+      get("unknown=1", 400, "unknown"),
+      get("tint=maybe", 400, "tint"),
+      get("scene=..%2F..%2Fetc%2Fpasswd", 400, "scene"),
+      get("frame=NaN", 400, "frame"),
+      get("format=gif", 400, "format"),
+      get("size=4096x4096&msaa=16", 413, "size"),
+      Malformed{"GET", "/v1/nothing", "", "", 404, "path"},
+      Malformed{"DELETE", "/v1/render", "", "", 405, "method"},
+      Malformed{"PUT", "/health", "application/json", "{}", 405, "method"},
+      Malformed{"POST", "/v1/scenes", "application/json", "{}", 405, "method"},
+      Malformed{"GET", "/v1/compare", "", "", 405, "method"},
+  };
+}
+
+TEST_F(Server, MalformedRequestsAreRefusedNamingTheField) {
+  const std::vector<Malformed> table = malformed_requests();
+  ASSERT_GE(table.size(), 40u);
+  httplib::Client c = client();
+  for (const Malformed& m : table) {
+    httplib::Request req;
+    req.method = m.method;
+    req.path = m.path;
+    if (!m.content_type.empty()) req.set_header("Content-Type", m.content_type);
+    req.body = m.body;
+    const std::string label = m.method + " " + m.path + " " + m.body.substr(0, 80);
+    auto res = c.send(req);
+    ASSERT_TRUE(res) << label << ": " << httplib::to_string(res.error());
+    EXPECT_EQ(res->status, m.status) << label << " -> " << res->body;
+    json body;
+    ASSERT_NO_THROW(body = json::parse(res->body)) << label << " -> " << res->body;
+    EXPECT_EQ(schema_errors(body, openapi().at("components").at("schemas").at("Error"), openapi()), "") << label;
+    const std::string field = body.value("field", "");
+    EXPECT_TRUE(field.starts_with(m.field)) << label << ": field '" << field << "', expected '" << m.field << "'";
+    const std::string error = body.value("error", "");
+    EXPECT_FALSE(error.empty()) << label;
+    if (m.field != "body" && m.field != "method" && m.field != "path" && m.field != "Content-Type") {
+      EXPECT_NE(error.find(m.field), std::string::npos) << label << ": message does not name the field: " << error;
+    }
+    // The documented statuses of the real endpoints include this one.
+    const std::string path = m.path.substr(0, m.path.find('?'));
+    std::string op = m.method;
+    std::transform(op.begin(), op.end(), op.begin(), ::tolower);
+    if (openapi().at("paths").contains(path) && openapi().at("paths").at(path).contains(op)) {
+      EXPECT_TRUE(openapi().at("paths").at(path).at(op).at("responses").contains(std::to_string(m.status))) << label;
+    }
+  }
+  // Still serving, and serving the right thing.
+  auto health = c.Get("/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->status, 200);
+  auto res = post_json(c, json{{"scene", "quad2"}, {"size", "32x32"}}.dump());
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200);
+  int w = 0, h = 0;
+  EXPECT_TRUE(decode(res->body, ".png", w, h) == library_image({{"scene", "quad2"}, {"size", "32x32"}}));
+}
+
+TEST_F(Server, LogsOneLinePerRequest) {
+  httplib::Client c = client();
+  const size_t before = server_->log_lines().size();
+  ASSERT_TRUE(c.Get("/v1/scenes"));
+  ASSERT_TRUE(c.Get("/v1/nothing-here"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const std::vector<std::string> lines = server_->log_lines();
+  ASSERT_GE(lines.size(), before + 2);
+  EXPECT_TRUE(std::any_of(lines.begin() + static_cast<long>(before), lines.end(),
+                          [](const std::string& l) { return l.starts_with("GET /v1/scenes 200 ") && l.ends_with(" ms"); }));
+  EXPECT_TRUE(std::any_of(lines.begin() + static_cast<long>(before), lines.end(),
+                          [](const std::string& l) { return l.starts_with("GET /v1/nothing-here 404 "); }));
+}
+
+TEST_F(Server, ConcurrentClientsAllGetTheRightImage) {
+  const json request = {{"scene", "quad2"}, {"size", "64x64"}, {"msaa", 2}};
+  int w = 0, h = 0;
+  const std::vector<glm::vec4> expected = library_image(request);
+  std::string reference;
+  {
+    httplib::Client c = client();
+    auto res = c.Get("/v1/render?scene=quad2&size=64x64&msaa=2");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200);
+    reference = res->body;
+    ASSERT_TRUE(decode(reference, ".png", w, h) == expected);
+  }
+  constexpr int kClients = 8, kRequests = 20;
+  std::atomic<int> ok{0}, wrong{0}, failed{0};
+  std::vector<std::thread> clients;
+  for (int i = 0; i < kClients; ++i) {
+    clients.emplace_back([&, i] {
+      httplib::Client c = client();
+      for (int k = 0; k < kRequests; ++k) {
+        // Alternate GET and POST: both must give the same bytes.
+        auto res = (i + k) % 2 ? c.Get("/v1/render?scene=quad2&size=64x64&msaa=2") : post_json(c, request.dump());
+        if (!res || res->status != 200) {
+          failed++;
+        } else if (res->body != reference) {
+          wrong++;
+        } else {
+          ok++;
+        }
+      }
+    });
+  }
+  for (std::thread& t : clients) t.join();
+  EXPECT_EQ(ok.load(), kClients * kRequests);
+  EXPECT_EQ(wrong.load(), 0);
+  EXPECT_EQ(failed.load(), 0);
+}
+
+// Own server: one render thread, a queue of one. Many slow renders at once: two are admitted,
+// the rest are refused at once with 503 and Retry-After; afterwards the server serves normally.
+TEST(ServerOverload, FullQueueGetsFast503sAndRecovers) {
+  std::signal(SIGPIPE, SIG_IGN);
+  server::ServerOptions options;
+  options.threads = 1;
+  options.queue = 1;
+  RunningServer s(options);
+  const std::string slow = "/v1/render?scene=paper&size=1024x1024&msaa=8&filter=ewa";
+  constexpr int kClients = 8;
+  struct Outcome {
+    int status = 0;
+    double ms = 0;
+    std::string retry_after;
+    std::string body;
+  };
+  std::vector<Outcome> outcomes(kClients);
+  std::vector<std::thread> clients;
+  for (int i = 0; i < kClients; ++i) {
+    clients.emplace_back([&, i] {
+      httplib::Client c = s.client();
+      const auto start = std::chrono::steady_clock::now();
+      auto res = c.Get(slow);
+      outcomes[i].ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      if (res) {
+        outcomes[i].status = res->status;
+        outcomes[i].retry_after = res->get_header_value("Retry-After");
+        outcomes[i].body = res->body;
+      }
+    });
+  }
+  for (std::thread& t : clients) t.join();
+  int ok = 0, busy = 0;
+  double slowest_ok = 0, slowest_busy = 0;
+  for (const Outcome& o : outcomes) {
+    if (o.status == 200) {
+      ok++;
+      slowest_ok = std::max(slowest_ok, o.ms);
+    } else {
+      ASSERT_EQ(o.status, 503) << o.body;
+      busy++;
+      slowest_busy = std::max(slowest_busy, o.ms);
+      EXPECT_EQ(o.retry_after, "1");
+      const json body = json::parse(o.body);
+      EXPECT_EQ(body.at("field"), "queue");
+      EXPECT_EQ(schema_errors(body, response_schema("get", "/v1/render", 503), openapi()), "");
+    }
+  }
+  EXPECT_GE(ok, 1);
+  EXPECT_LE(ok, kClients - 2);
+  EXPECT_GE(busy, 2);
+  EXPECT_LT(slowest_busy, slowest_ok) << "a 503 should not wait for a render";
+  // Recovered: a small render and /health succeed, and nothing is left admitted.
+  httplib::Client c = s.client();
+  auto res = c.Get("/v1/render?scene=quad2&size=32x32");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  auto health = c.Get("/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(json::parse(health->body).at("renders_admitted"), 0);
+}
+
+// stop() while a render is in flight: the render is still answered, then listen returns.
+TEST(ServerOverload, StopFinishesInFlightRequests) {
+  server::ServerOptions options;
+  options.threads = 1;
+  options.queue = 1;
+  RunningServer s(options);
+  int status = 0;
+  std::thread client([&] {
+    httplib::Client c = s.client();
+    auto res = c.Get("/v1/render?scene=paper&size=512x512&msaa=4");
+    status = res ? res->status : -1;
+  });
+  // Wait until the render is admitted, then stop.
+  for (int i = 0; i < 500; ++i) {
+    httplib::Client probe = s.client();
+    auto h = probe.Get("/health");
+    if (h && json::parse(h->body).at("renders_admitted").get<int>() > 0) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  s.http->stop();
+  client.join();
+  EXPECT_EQ(status, 200);
+  s.thread.join();
+  EXPECT_FALSE(s.http->is_running());
+}
+
+}  // namespace
