@@ -16,8 +16,8 @@ namespace seamcl {
 namespace {
 
 // The pixels as a format stores them: sRGB 8-bit for PNG (encoded with encode_srgb8, the one
-// sRGB encoding of the project, a table rather than OIIO's per-pixel colour conversion, which
-// took 4x as long), linear float for EXR (stored as half).
+// sRGB encoding of the project: a table, where OIIO's per-pixel colour conversion took several
+// times as long), linear float for EXR (stored as half).
 struct Encoded {
   OIIO::ImageSpec spec;
   std::vector<uint8_t> srgb8;  // PNG
@@ -36,8 +36,9 @@ Encoded encode_pixels(ImageFormat format, int width, int height, const std::vect
     return out;
   }
   out.spec = OIIO::ImageSpec(width, height, 4, OIIO::TypeDesc::UINT8);
-  // zlib level 3: as small as the default (6) on renders, in about two thirds of the time.
-  out.spec.attribute("png:compressionLevel", 3);
+  // zlib level 1: on a 256x256 render 3.8 ms and 110 KB, against 5.3 ms and 107 KB at level 3
+  // and more at OIIO's default (6); what the HTTP service pays on every image.
+  out.spec.attribute("png:compressionLevel", 1);
   out.srgb8.resize(pixels.size() * 4);
   for (size_t i = 0; i < pixels.size(); ++i) {
     const uint32_t packed = encode_srgb8(pixels[i]);
