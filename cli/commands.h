@@ -21,5 +21,6 @@ struct Command {
 // One line per command file: `Command add_<name>_command(CLI::App& app);`, and one call in main.
 Command add_serve_command(CLI::App& app);    // cli/serve_command.cpp
 Command add_compare_command(CLI::App& app);  // cli/compare_command.cpp
+Command add_bench_command(CLI::App& app);    // cli/bench_command.cpp
 
 }  // namespace seamcl::cli

@@ -15,6 +15,7 @@
 
 #include "cl_runtime.h"
 #include "commands.h"
+#include "comparison.h"
 #include "errors.h"
 #include "image_io.h"
 #include "metrics.h"
@@ -45,31 +46,6 @@ struct CompareArgs {
   int repeat = 3;
   bool json_out = false;
 };
-
-std::vector<std::string> split_list(const std::string& text, const std::string& field) {
-  std::vector<std::string> items;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    const size_t a = item.find_first_not_of(" \t"), b = item.find_last_not_of(" \t");
-    if (a == std::string::npos) throw InputError(field, "empty item in list '" + text + "'");
-    items.push_back(item.substr(a, b - a + 1));
-  }
-  if (items.empty() || text.back() == ',') throw InputError(field, "must be a comma list, got '" + text + "'");
-  return items;
-}
-
-int parse_int_item(const std::string& item, const std::string& field) {
-  size_t used = 0;
-  int value = 0;
-  try {
-    value = std::stoi(item, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != item.size()) throw InputError(field, "not an integer: '" + item + "'");
-  return value;
-}
 
 glm::vec3 parse_color(const std::string& text) {
   const std::vector<std::string> parts = split_list(text, "constant_color");
@@ -106,40 +82,13 @@ json base_request(const CompareArgs& a) {
   return request;
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-// JSON numbers must be finite; a statistic over no pixels is 0 already, but be safe.
-double finite_or_zero(double v) { return std::isfinite(v) ? v : 0.0; }
-
 int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   // Validate everything before any work.
   const json base = base_request(args);
   const RenderOptions frame = parse_render_options(base);
-  struct Entry {
-    std::string method_name;
-    RenderOptions options;
-  };
-  std::vector<Entry> entries;
   const std::vector<std::string> methods = split_list(args.methods, "methods");
-  std::vector<int> rates;
-  for (const std::string& item : split_list(args.msaa, "msaa")) rates.push_back(parse_int_item(item, "msaa"));
-  for (const std::string& method : methods) {
-    for (int msaa : rates) {
-      json request = base;
-      request["method"] = method;
-      request["msaa"] = msaa;
-      try {
-        entries.push_back({method, parse_render_options(request)});
-      } catch (const InputError& e) {
-        if (e.field() == "method") throw InputError("methods", std::string(e.what()).substr(e.field().size() + 2));
-        throw;
-      }
-    }
-  }
+  const std::vector<int> rates = parse_int_list(args.msaa, "msaa");
+  const std::vector<MethodEntry> entries = method_entries(base, methods, rates);
   if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
   ReferenceSettings ref_settings;
   ref_settings.method = args.reference_method;
@@ -170,49 +119,17 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
                 reference.pixels);
   }
 
-  const std::vector<double> xs = error_curve_thresholds();
   json results = json::array();
-  for (const Entry& entry : entries) {
-    const RenderOptions& options = entry.options;
-    renderer.load_scene(scene, options.texels);
-    renderer.warm_up(options);
-    std::vector<double> ms;
-    RenderResult result;
-    for (int i = 0; i < args.repeat; ++i) {
-      result = renderer.render(camera, options);
-      ms.push_back(result.ms.total);
-    }
-    const ImageErrors errors = compare_images(result.pixels, reference.pixels, &mask);
-    json curve = json::array();
-    for (size_t i = 0; i < xs.size(); ++i) curve.push_back({xs[i], errors.all.curve[i]});
-    json seam_curve = json::array();
-    for (size_t i = 0; i < xs.size(); ++i) seam_curve.push_back({xs[i], errors.seam.curve[i]});
-    json item = {{"method", entry.method_name},
-                 {"msaa", options.msaa},
-                 {"aniso", options.aniso},
-                 {"filter", to_string(options.filter)},
-                 {"ms", {{"median", median(ms)}, {"min", *std::min_element(ms.begin(), ms.end())},
-                         {"max", *std::max_element(ms.begin(), ms.end())}, {"runs", args.repeat}}},
-                 {"error",
-                  {{"mean", finite_or_zero(errors.all.mean)},
-                   {"p99", finite_or_zero(errors.all.p99)},
-                   {"max", finite_or_zero(errors.all.max)},
-                   {"seam_mean", finite_or_zero(errors.seam.mean)},
-                   {"seam_p99", finite_or_zero(errors.seam.p99)},
-                   {"seam_max", finite_or_zero(errors.seam.max)},
-                   {"nan_pixels", errors.nan_pixels},
-                   {"seam_nan_pixels", errors.seam_nan_pixels},
-                   {"pixels", errors.all.pixels},
-                   {"seam_pixels", errors.seam.pixels}}},
-                 {"texture_bytes", renderer.packed_scene().texture_bytes()},
-                 {"curve", curve},
-                 {"seam_curve", seam_curve}};
+  for (const EntryResult& measured :
+       compare_methods(renderer, scene, camera, entries, &reference.pixels, &mask, args.repeat)) {
+    json item = compare_result_json(measured);
     if (!args.images_dir.empty()) {
-      const std::string stem = entry.method_name + "_msaa" + std::to_string(options.msaa);
+      const RenderResult& result = measured.last;
+      const std::string stem = measured.entry.method_name + "_msaa" + std::to_string(measured.entry.options.msaa);
       const fs::path image = fs::path(args.images_dir) / (stem + ".png");
       const fs::path heat = fs::path(args.images_dir) / (stem + "_error.png");
       write_image(image.string(), result.width, result.height, result.pixels);
-      write_image(heat.string(), result.width, result.height, error_heatmap(errors.distance));
+      write_image(heat.string(), result.width, result.height, error_heatmap(measured.errors->distance));
       item["images"] = {{"image", image.string()}, {"error", heat.string()}};
     }
     results.push_back(item);

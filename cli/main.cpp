@@ -192,6 +192,7 @@ int main(int argc, char** argv) {
   std::vector<seamcl::cli::Command> extra_commands;
   extra_commands.push_back(seamcl::cli::add_serve_command(app));
   extra_commands.push_back(seamcl::cli::add_compare_command(app));
+  extra_commands.push_back(seamcl::cli::add_bench_command(app));
 
   try {
     app.parse(argc, argv);

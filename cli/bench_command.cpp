@@ -1,0 +1,439 @@
+// seamcl bench: an orbit of N frames, every method x MSAA rate rendered on each frame (frame-major,
+// so machine noise falls on all methods alike), timed from OpenCL profiling events and measured
+// against each frame's reference (host/reference.h, cached) on every K-th frame. Also NaN/Inf
+// pixels per frame, temporal stability near seams, memory per method, and the discard-traverse
+// difference curves of the paper's Figure 5 (left).
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cl_runtime.h"
+#include "commands.h"
+#include "comparison.h"
+#include "errors.h"
+#include "metrics.h"
+#include "reference.h"
+#include "render_options.h"
+#include "renderer.h"
+#include "scene_generators.h"
+#include "scene_json.h"
+
+namespace seamcl::cli {
+namespace {
+
+using nlohmann::json;
+
+struct BenchArgs {
+  std::optional<std::string> scene, filter, zero_coverage, texels, size, shading;
+  std::optional<int> aniso;
+  std::string methods = "discard,traverse";
+  std::string msaa = "1,2,4,8";
+  int frames = 60;
+  int reference_frames = 1;
+  bool no_errors = false;
+  bool tint = false;
+  std::string reference_method;
+  int reference_msaa = 0;
+  std::string cache_dir;
+  bool no_cache = false;
+  bool json_out = false;
+};
+
+json base_request(const BenchArgs& a) {
+  json request = json::object();
+  if (a.scene) request["scene"] = *a.scene;
+  if (a.filter) request["filter"] = *a.filter;
+  if (a.zero_coverage) request["zero_coverage"] = *a.zero_coverage;
+  if (a.texels) request["texels"] = *a.texels;
+  if (a.aniso) request["aniso"] = *a.aniso;
+  if (a.size) request["size"] = *a.size;
+  if (a.shading) request["shading"] = *a.shading;
+  if (a.tint) request["tint"] = true;
+  request["frame"] = 0;
+  request["frames"] = a.frames;  // parse_render_options checks the range and names "frames"
+  return request;
+}
+
+size_t count_nonfinite(const std::vector<glm::vec4>& pixels) {
+  size_t n = 0;
+  for (const glm::vec4& p : pixels) {
+    if (!std::isfinite(p.r) || !std::isfinite(p.g) || !std::isfinite(p.b)) ++n;
+  }
+  return n;
+}
+
+// Pixels of several frames pooled, so the statistics over them are exact (not means of means).
+struct Pool {
+  std::vector<float> distance;
+  std::vector<uint8_t> mask;
+  size_t nan_pixels = 0, seam_nan_pixels = 0;
+  int frames = 0;
+  void add(const ImageErrors& e, const std::vector<uint8_t>& m) {
+    distance.insert(distance.end(), e.distance.begin(), e.distance.end());
+    mask.insert(mask.end(), m.begin(), m.end());
+    nan_pixels += e.nan_pixels;
+    seam_nan_pixels += e.seam_nan_pixels;
+    ++frames;
+  }
+  ImageErrors stats() const {
+    ImageErrors e;
+    e.all = error_stats(distance);
+    e.seam = error_stats(distance, &mask);
+    e.nan_pixels = nan_pixels;
+    e.seam_nan_pixels = seam_nan_pixels;
+    return e;
+  }
+};
+
+struct Accum {
+  MethodEntry entry;
+  Renderer* renderer = nullptr;
+  std::vector<StageTimes> ms;            // per frame
+  std::vector<size_t> nan_per_frame;     // non-finite pixels of each frame's image
+  Pool errors;
+  json error_per_frame = json::array();
+  std::vector<glm::vec4> previous;       // last frame's image, for temporal stability
+  std::vector<double> temporal_seam, temporal_all;
+  RenderResult current;
+  size_t texture_bytes = 0, padding_bytes = 0, adjacency_bytes = 0;
+};
+
+struct DifferenceAccum {
+  size_t a = 0, b = 0;  // indices into the entries
+  int msaa = 0;
+  Pool pool;
+};
+
+json stats_json(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const double med = median_of(v);
+  auto quantile = [&](double q) {
+    const double pos = q * static_cast<double>(v.size() - 1);
+    const size_t i = static_cast<size_t>(pos);
+    const double f = pos - static_cast<double>(i);
+    return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
+  };
+  double mean = 0;
+  for (double x : v) mean += x;
+  mean /= static_cast<double>(v.size());
+  return {{"median", med},
+          {"min", v.front()},
+          {"max", v.back()},
+          {"mean", mean},
+          {"p10", quantile(0.1)},
+          {"p90", quantile(0.9)},
+          {"spread", med > 0 ? (v.back() - v.front()) / med : 0.0},
+          {"frames", v.size()}};
+}
+
+double mean_of(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+}
+
+class Progress {
+ public:
+  Progress(size_t total, bool quiet) : total_(total), tty_(!quiet && isatty(STDERR_FILENO) == 1), quiet_(quiet) {}
+  void step(int frame, int frames, const std::string& what) {
+    ++done_;
+    if (!tty_) return;
+    const int width = 30;
+    const int filled = static_cast<int>(static_cast<double>(width) * static_cast<double>(done_) /
+                                        static_cast<double>(std::max<size_t>(total_, 1)));
+    std::fprintf(stderr, "\r[%s%s] %3d%% frame %d/%d %-24s", std::string(static_cast<size_t>(filled), '#').c_str(),
+                 std::string(static_cast<size_t>(width - filled), '.').c_str(),
+                 static_cast<int>(100.0 * static_cast<double>(done_) / static_cast<double>(std::max<size_t>(total_, 1))),
+                 frame + 1, frames, what.c_str());
+    std::fflush(stderr);
+  }
+  // One plain line (not on a terminal): a frame's entries and their times.
+  void line(const std::string& text) {
+    if (quiet_ || tty_) return;
+    std::fprintf(stderr, "%s\n", text.c_str());
+  }
+  void finish() {
+    if (tty_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  size_t total_, done_ = 0;
+  bool tty_, quiet_;
+};
+
+int run_bench(const BenchArgs& args, const GlobalOptions& global) {
+  // Validate everything before any work.
+  const json base = base_request(args);
+  const RenderOptions frame = parse_render_options(base);
+  const std::vector<std::string> methods = split_list(args.methods, "methods");
+  const std::vector<int> rates = parse_int_list(args.msaa, "msaa");
+  std::vector<MethodEntry> entries = method_entries(base, methods, rates);
+  if (args.reference_frames < 1) throw InputError("reference_frames", "must be at least 1");
+  const bool with_errors = !args.no_errors;
+  ReferenceSettings ref_settings;
+  ref_settings.method = args.reference_method;
+  ref_settings.msaa = args.reference_msaa;
+  ref_settings.cache_dir = args.cache_dir;
+  ref_settings.use_cache = !args.no_cache;
+  if (with_errors) (void)reference_render_options(frame, ref_settings);  // size and settings checked now
+
+  GeneratorOptions generator_options;
+  generator_options.tint = frame.tint;
+  const Scene scene = load_scene(frame.scene, generator_options);
+  const auto wall_start = std::chrono::steady_clock::now();
+
+  ClRuntime runtime(global.device);
+  // One renderer for the face maps and references, one per method (a method's packing, e.g. the
+  // guard bands, then stays uploaded instead of being rebuilt on every switch).
+  Renderer base_renderer(runtime);
+  base_renderer.load_scene(scene, frame.texels);
+  std::map<std::string, std::unique_ptr<Renderer>> renderers;
+  std::vector<Accum> acc(entries.size());
+  for (size_t i = 0; i < entries.size(); ++i) {
+    std::unique_ptr<Renderer>& r = renderers[entries[i].method_name];
+    if (!r) {
+      r = std::make_unique<Renderer>(runtime);
+      r->load_scene(scene, frame.texels);
+    }
+    acc[i].entry = entries[i];
+    acc[i].renderer = r.get();
+    r->warm_up(entries[i].options);
+  }
+  // Figure 5 (left): discard against traverse at each rate both have.
+  std::vector<DifferenceAccum> diffs;
+  for (size_t i = 0; i < entries.size(); ++i) {
+    if (entries[i].options.method != Method::Discard) continue;
+    for (size_t j = 0; j < entries.size(); ++j) {
+      if (entries[j].options.method == Method::Traverse && entries[j].options.msaa == entries[i].options.msaa) {
+        diffs.push_back({i, j, entries[i].options.msaa, {}});
+        break;
+      }
+    }
+  }
+
+  const int frames = frame.frames;
+  const int error_frames = with_errors ? (frames + args.reference_frames - 1) / args.reference_frames : 0;
+  Progress progress(static_cast<size_t>(frames) * entries.size() + static_cast<size_t>(error_frames), false);
+  std::string reference_method;
+  int reference_msaa = 0, references_cached = 0, references_rendered = 0;
+  double reference_ms = 0;
+  std::vector<int> error_frame_list;
+  std::vector<size_t> seam_pixels_per_frame;
+
+  for (int k = 0; k < frames; ++k) {
+    RenderOptions frame_options = frame;
+    frame_options.frame = k;
+    const Camera camera = orbit_camera(scene, k, frames);
+    const std::vector<uint8_t> mask = seam_mask(render_face_map(base_renderer, camera, frame_options));
+    seam_pixels_per_frame.push_back(static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{1})));
+    std::optional<ReferenceImage> reference;
+    if (with_errors && k % args.reference_frames == 0) {
+      reference = reference_image(base_renderer, camera, frame_options, ref_settings);
+      reference_method = reference->method;
+      reference_msaa = reference->msaa;
+      reference->from_cache ? ++references_cached : ++references_rendered;
+      reference_ms += reference->render_ms;
+      error_frame_list.push_back(k);
+      progress.step(k, frames, reference->from_cache ? "reference (cached)" : "reference");
+    }
+    std::string line = "bench: frame " + std::to_string(k + 1) + "/" + std::to_string(frames) +
+                       (reference ? (reference->from_cache ? " [reference cached]" : " [reference rendered]") : "") +
+                       " ms:";
+    // Interleaved: every entry once per frame, starting one further along each frame so that no
+    // entry always runs first (or right after a reference render).
+    for (size_t n = 0; n < entries.size(); ++n) {
+      const size_t i = (n + static_cast<size_t>(k)) % entries.size();
+      Accum& a = acc[i];
+      MethodEntry entry = a.entry;
+      entry.options.frame = k;
+      EntryResult r = measure_entry(*a.renderer, camera, entry, 1, reference ? &reference->pixels : nullptr, &mask);
+      a.ms.push_back(r.last.ms);
+      a.nan_per_frame.push_back(count_nonfinite(r.last.pixels));
+      a.texture_bytes = r.texture_bytes;
+      a.padding_bytes = r.padding_bytes;
+      a.adjacency_bytes = r.adjacency_bytes;
+      if (r.errors) {
+        a.error_per_frame.push_back({{"frame", k},
+                                     {"mean", finite_or_zero(r.errors->all.mean)},
+                                     {"p99", finite_or_zero(r.errors->all.p99)},
+                                     {"seam_mean", finite_or_zero(r.errors->seam.mean)},
+                                     {"nan_pixels", r.errors->nan_pixels}});
+        a.errors.add(*r.errors, mask);
+      }
+      a.current = std::move(r.last);
+      progress.step(k, frames, entry.method_name + " x" + std::to_string(entry.options.msaa));
+    }
+    for (size_t i = 0; i < entries.size(); ++i) {
+      Accum& a = acc[i];
+      line += " " + a.entry.method_name + "/" + std::to_string(a.entry.options.msaa) + "=" +
+              std::to_string(a.current.ms.total).substr(0, 6);
+      if (!a.previous.empty()) {
+        const std::vector<float> change = pixel_distances(a.current.pixels, a.previous);
+        const ErrorStats seam = error_stats(change, &mask);
+        if (seam.pixels > 0) a.temporal_seam.push_back(seam.mean);  // frames with no seam in view: skipped
+        a.temporal_all.push_back(error_stats(change).mean);
+      }
+    }
+    for (DifferenceAccum& d : diffs) {
+      d.pool.add(compare_images(acc[d.a].current.pixels, acc[d.b].current.pixels, &mask), mask);
+    }
+    for (Accum& a : acc) a.previous = std::move(a.current.pixels);
+    progress.line(line);
+  }
+  progress.finish();
+
+  json results = json::array();
+  for (const Accum& a : acc) {
+    const RenderOptions& o = a.entry.options;
+    std::vector<double> total, setup, binning, raster, shade, readback;
+    for (const StageTimes& t : a.ms) {
+      total.push_back(t.total);
+      setup.push_back(t.setup);
+      binning.push_back(t.binning);
+      raster.push_back(t.raster);
+      shade.push_back(t.shade);
+      readback.push_back(t.readback);
+    }
+    json ms = stats_json(total);
+    ms["stages"] = {{"setup", median_of(setup)},     {"binning", median_of(binning)}, {"raster", median_of(raster)},
+                    {"shade", median_of(shade)},     {"readback", median_of(readback)}};
+    size_t nan_total = 0;
+    for (size_t n : a.nan_per_frame) nan_total += n;
+    json item = {{"method", a.entry.method_name},
+                 {"msaa", o.msaa},
+                 {"aniso", o.aniso},
+                 {"filter", to_string(o.filter)},
+                 {"ms", ms},
+                 {"ms_per_frame", total},
+                 {"nan_pixels", nan_total},
+                 {"nan_pixels_per_frame", a.nan_per_frame},
+                 {"temporal",
+                  {{"seam_mean", finite_or_zero(mean_of(a.temporal_seam))},
+                   {"mean", finite_or_zero(mean_of(a.temporal_all))},
+                   {"pairs", a.temporal_all.size()},
+                   {"seam_pairs", a.temporal_seam.size()}}},
+                 {"texture_bytes", a.texture_bytes},
+                 {"padding_bytes", a.padding_bytes},
+                 {"adjacency_bytes", a.adjacency_bytes}};
+    if (with_errors) {
+      const ImageErrors e = a.errors.stats();
+      item["error"] = errors_json(e);
+      item["error"]["frames"] = a.errors.frames;
+      item["curve"] = curve_json(e.all);
+      item["seam_curve"] = curve_json(e.seam);
+      item["error_per_frame"] = a.error_per_frame;
+    }
+    results.push_back(item);
+  }
+  json differences = json::array();
+  for (const DifferenceAccum& d : diffs) {
+    const ImageErrors e = d.pool.stats();
+    json item = errors_json(e);
+    item["a"] = acc[d.a].entry.method_name;
+    item["b"] = acc[d.b].entry.method_name;
+    item["msaa"] = d.msaa;
+    item["frames"] = d.pool.frames;
+    item["curve"] = curve_json(e.all);
+    item["seam_curve"] = curve_json(e.seam);
+    differences.push_back(item);
+  }
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+
+  const std::string size = std::to_string(frame.width) + "x" + std::to_string(frame.height);
+  if (args.json_out) {
+    json out = {{"scene", scene.name},
+                {"size", size},
+                {"device", runtime.device_description()},
+                {"frames", frames},
+                {"reference_frames", args.reference_frames},
+                {"errors", with_errors},
+                {"error_frames", error_frame_list},
+                {"order", "frame-major: every entry once per frame, start rotated by one each frame"},
+                {"seam_radius", kSeamRadius},
+                {"seam_pixels_per_frame", seam_pixels_per_frame},
+                {"options", to_json(frame)},
+                {"wall_s", wall_s},
+                {"results", results},
+                {"differences", differences}};
+    if (with_errors) {
+      out["reference"] = {{"method", reference_method},
+                          {"msaa", reference_msaa},
+                          {"scale", kReferenceScale},
+                          {"filter", "mitchell"},
+                          {"filter_width", kMitchellWidth},
+                          {"B", kMitchellB},
+                          {"C", kMitchellC},
+                          {"cached", references_cached},
+                          {"rendered", references_rendered},
+                          {"ms", reference_ms}};
+    }
+    std::cout << out.dump(2) << "\n";
+  } else {
+    std::printf("%s %s, %d frames (orbit), errors %s; %.1f s\n", scene.name.c_str(), size.c_str(), frames,
+                with_errors ? ("on every " + std::to_string(args.reference_frames) + ". frame vs " + reference_method +
+                               " 8x reference").c_str()
+                            : "off",
+                wall_s);
+    std::printf("%-10s %4s %9s %9s %9s %7s %5s %10s %10s %10s %12s\n", "method", "msaa", "ms_med", "ms_min", "ms_max",
+                "spread", "nan", "mean", "seam_mean", "temporal", "tex_bytes");
+    for (const json& r : results) {
+      const bool e = r.contains("error");
+      std::printf("%-10s %4d %9.3f %9.3f %9.3f %7.3f %5zu %10.3e %10.3e %10.3e %12zu\n",
+                  r["method"].get<std::string>().c_str(), r["msaa"].get<int>(), r["ms"]["median"].get<double>(),
+                  r["ms"]["min"].get<double>(), r["ms"]["max"].get<double>(), r["ms"]["spread"].get<double>(),
+                  r["nan_pixels"].get<size_t>(), e ? r["error"]["mean"].get<double>() : 0.0,
+                  e ? r["error"]["seam_mean"].get<double>() : 0.0, r["temporal"]["seam_mean"].get<double>(),
+                  r["texture_bytes"].get<size_t>());
+    }
+    for (const json& d : differences) {
+      std::printf("||%s - %s|| at %dx: mean %.3e, seam_mean %.3e, p99 %.3e\n", d["a"].get<std::string>().c_str(),
+                  d["b"].get<std::string>().c_str(), d["msaa"].get<int>(), d["mean"].get<double>(),
+                  d["seam_mean"].get<double>(), d["p99"].get<double>());
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_bench_command(CLI::App& app) {
+  auto args = std::make_shared<BenchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Time every method x MSAA rate side by side over an orbit of frames, with errors against the reference");
+  cmd->add_option("--scene", args->scene, "Built-in scene name or a scene JSON file [paper]");
+  cmd->add_option("--methods", args->methods, "Comma list of seam methods [discard,traverse]");
+  cmd->add_option("--msaa", args->msaa, "Comma list of MSAA rates (1, 2, 4, 8, 16) [1,2,4,8]");
+  cmd->add_option("--aniso", args->aniso, "Maximum anisotropy, 1..16 [16]");
+  cmd->add_option("--filter", args->filter, "Texture filter [aniso]");
+  cmd->add_option("--zero-coverage", args->zero_coverage, "discard with every tap outside: clamp or nan [clamp]");
+  cmd->add_option("--texels", args->texels, "Texel storage: rgba8 or rgba32f [rgba8]");
+  cmd->add_option("--size", args->size, "Image size WIDTHxHEIGHT [480x540]");
+  cmd->add_option("--frames", args->frames, "Frames of the camera orbit; frame k uses orbit frame k of N [60]");
+  cmd->add_option("--shading", args->shading, "Where to shade: pixel, centroid or sample [pixel]");
+  cmd->add_flag("--tint", args->tint, "Built-in scenes: tint each face a different base colour");
+  cmd->add_flag("--no-errors", args->no_errors, "Skip the references and errors (times, NaN counts, temporal only)");
+  cmd->add_option("--reference-frames", args->reference_frames,
+                  "Measure errors on every K-th frame only (frames 0, K, 2K, ...): each needs an 8x reference [1]");
+  cmd->add_option("--reference-method", args->reference_method,
+                  "Method of the 8x reference render [traverse if available, else discard]");
+  cmd->add_option("--reference-msaa", args->reference_msaa,
+                  "Samples per pixel of the 8x reference render [1 for traverse, 16 for discard]");
+  cmd->add_option("--cache", args->cache_dir, "Reference cache directory [$SEAMCL_CACHE_DIR or ~/.cache/seamcl]");
+  cmd->add_flag("--no-cache", args->no_cache, "Always render the references; do not read or write the cache");
+  cmd->add_flag("--json", args->json_out, "Print one JSON object");
+  return Command{cmd, [args](const GlobalOptions& global) { return run_bench(*args, global); }};
+}
+
+}  // namespace seamcl::cli

@@ -1,0 +1,192 @@
+#!/usr/bin/python3
+"""Charts and the paper's Table 1 from `seamcl bench --json` output.
+
+    build/seamcl bench --scene paper --methods discard,traverse,clamp,guardband --msaa 1,2,4,8 \
+        --frames 60 --reference-frames 5 --json > bench.json
+    /usr/bin/python3 examples/charts.py bench.json --out docs/results
+
+writes into --out:
+  pareto.png    time per frame (median over the orbit) against seam error (mean over the seam
+                mask of the reference frames), one point per method and MSAA rate, the Pareto
+                front (no other point both faster and more accurate) marked;
+  figure5.png   the paper's Figure 5: left, the fraction of pixels where ||discard - traverse||
+                >= x per MSAA rate (bench's "differences"); right, the fraction of pixels that
+                deviate from the reference by >= x, discard and traverse per MSAA rate; log x;
+  table.md      the paper's Table 1 (median ms per method and MSAA rate) with the discard /
+                traverse time ratio per rate, plus errors, NaN pixels and memory.
+
+Needs matplotlib (Debian: python3-matplotlib); it is not needed to build or test seamcl.
+"""
+import argparse
+import json
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+COLOURS = {"discard": "tab:blue", "traverse": "tab:orange", "clamp": "tab:green", "guardband": "tab:red",
+           "black": "tab:gray"}
+MARKERS = {1: "o", 2: "s", 4: "^", 8: "D", 16: "P"}
+
+
+def load(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def results_by(bench):
+    return {(r["method"], r["msaa"]): r for r in bench["results"]}
+
+
+def pareto_front(points):
+    """Indices of the points (x, y) that no other point beats on both (lower is better)."""
+    front = []
+    for i, (x, y) in enumerate(points):
+        dominated = any((x2 <= x and y2 <= y and (x2 < x or y2 < y)) for j, (x2, y2) in enumerate(points) if j != i)
+        if not dominated:
+            front.append(i)
+    return sorted(front, key=lambda i: points[i][0])
+
+
+def chart_pareto(bench, out, error_key="seam_mean"):
+    rs = [r for r in bench["results"] if "error" in r]
+    if not rs:
+        print("charts: no errors in the bench JSON (--no-errors); skipping pareto.png", file=sys.stderr)
+        return None
+    pts = [(r["ms"]["median"], r["error"][error_key]) for r in rs]
+    front = pareto_front(pts)
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for r, (x, y) in zip(rs, pts):
+        ax.scatter(x, y, color=COLOURS.get(r["method"], "k"), marker=MARKERS.get(r["msaa"], "x"), s=50, zorder=3)
+        ax.annotate(f'{r["method"]} {r["msaa"]}x', (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
+        # min..max over the orbit's frames
+        ax.plot([r["ms"]["min"], r["ms"]["max"]], [y, y], color=COLOURS.get(r["method"], "k"), alpha=0.25, lw=1)
+    fx = [pts[i][0] for i in front]
+    fy = [pts[i][1] for i in front]
+    ax.step(fx, fy, where="post", color="k", lw=1, ls="--", label="Pareto front")
+    ax.scatter(fx, fy, facecolors="none", edgecolors="k", s=140, lw=1.2, zorder=4)
+    for m, c in COLOURS.items():
+        if any(r["method"] == m for r in rs):
+            ax.scatter([], [], color=c, label=m)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time per frame, ms (median over the orbit; bar: min..max)")
+    ax.set_ylabel(f"error vs reference: {error_key} (2-norm, linear RGB)")
+    ax.set_title(f'{bench["scene"]} {bench["size"]}, {bench["frames"]} frames, '
+                 f'errors on {len(bench.get("error_frames", []))}')
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    path = os.path.join(out, "pareto.png")
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def chart_figure5(bench, out, curve_key="curve"):
+    by = results_by(bench)
+    diffs = sorted(bench.get("differences", []), key=lambda d: d["msaa"])
+    rates = sorted({r["msaa"] for r in bench["results"]})
+    cmap = plt.get_cmap("viridis")
+    colour = {m: cmap(i / max(1, len(rates) - 1)) for i, m in enumerate(rates)}
+    fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.8))
+    for d in diffs:
+        xs, ys = zip(*d[curve_key])
+        left.plot(xs, ys, color=colour.get(d["msaa"], "k"), label=f'{d["msaa"]}x')
+    left.set_title("Difference between Traverse and Discard")
+    for m in rates:
+        for method, ls in (("traverse", "--"), ("discard", "-")):
+            r = by.get((method, m))
+            if r is None or curve_key not in r:
+                continue
+            xs, ys = zip(*r[curve_key])
+            right.plot(xs, ys, color=colour[m], ls=ls, label=f"{method.capitalize()} {m}x")
+    right.set_title("Deviation from the reference (solid: Discard, dashed: Traverse)")
+    for ax in (left, right):
+        ax.set_xscale("log")
+        ax.set_xlim(1e-4, 1)
+        ax.set_xlabel("x: 2-norm distance in linear RGB")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    where = "pixels near seams" if curve_key == "seam_curve" else "all pixels"
+    for ax in (left, right):
+        ax.set_ylabel(f"fraction of {where} with distance >= x")
+    fig.suptitle(f'{bench["scene"]} {bench["size"]}: {bench["frames"]}-frame orbit '
+                 f'(differences on every frame, reference errors on {len(bench.get("error_frames", []))})',
+                 fontsize=10)
+    fig.tight_layout()
+    name = "figure5_seams.png" if curve_key == "seam_curve" else "figure5.png"
+    path = os.path.join(out, name)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def table_md(bench):
+    by = results_by(bench)
+    rates = sorted({r["msaa"] for r in bench["results"]})
+    methods = list(dict.fromkeys(r["method"] for r in bench["results"]))
+    head = "| method | " + " | ".join(f"{m}x" for m in rates) + " |"
+    sep = "| --- |" + " ---: |" * len(rates)
+    lines = [f'Median time per frame in ms (OpenCL profiling, {bench["frames"]}-frame orbit of '
+             f'`{bench["scene"]}` at {bench["size"]}, aniso {bench["results"][0]["aniso"]}; '
+             f'device: {bench.get("device", "?")})', "", head, sep]
+    for method in methods:
+        cells = [f'{by[(method, m)]["ms"]["median"]:.2f}' if (method, m) in by else "" for m in rates]
+        lines.append(f"| {method.capitalize()} | " + " | ".join(cells) + " |")
+    if any(("discard", m) in by and ("traverse", m) in by for m in rates):
+        cells = []
+        for m in rates:
+            if ("discard", m) in by and ("traverse", m) in by:
+                cells.append(f'**{by[("discard", m)]["ms"]["median"] / by[("traverse", m)]["ms"]["median"]:.2f}**')
+            else:
+                cells.append("")
+        lines.append("| Discard / Traverse | " + " | ".join(cells) + " |")
+        lines += ["", "The paper's Table 1 ratios, for comparison: GTX680 0.49 / 0.59 / 0.62 / 0.73, "
+                  "Iris Pro 5200 0.35 / 0.46 / 0.46 / 0.60 (1x / 2x / 4x / 8x)."]
+    lines += ["", "Per entry: time spread over the frames, errors against the reference (mean over the reference "
+              "frames' pixels; seam = within 2 px of a seam), NaN/Inf pixels over every frame, temporal change near "
+              "seams (mean per-pixel ||frame k - frame k-1||), memory.", "",
+              "| method | msaa | ms median | ms min | ms max | spread | error mean | seam mean | seam p99 | "
+              "NaN/Inf px | temporal (seam) | texture bytes | padding | adjacency |",
+              "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    for r in bench["results"]:
+        e = r.get("error")
+        err = (f'{e["mean"]:.3e} | {e["seam_mean"]:.3e} | {e["seam_p99"]:.3e}' if e else "- | - | -")
+        lines.append(f'| {r["method"]} | {r["msaa"]} | {r["ms"]["median"]:.2f} | {r["ms"]["min"]:.2f} | '
+                     f'{r["ms"]["max"]:.2f} | {r["ms"]["spread"]:.2f} | {err} | {r["nan_pixels"]} | '
+                     f'{r["temporal"]["seam_mean"]:.3e} | {r["texture_bytes"]} | {r["padding_bytes"]} | '
+                     f'{r["adjacency_bytes"]} |')
+    if bench.get("differences"):
+        lines += ["", "Difference Discard vs Traverse (2-norm per pixel, linear RGB) per MSAA rate, over every frame:", "",
+                  "| msaa | mean | seam mean | p99 | seam p99 |", "| ---: | ---: | ---: | ---: | ---: |"]
+        for d in sorted(bench["differences"], key=lambda d: d["msaa"]):
+            lines.append(f'| {d["msaa"]} | {d["mean"]:.3e} | {d["seam_mean"]:.3e} | {d["p99"]:.3e} | '
+                         f'{d["seam_p99"]:.3e} |')
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("bench_json", help="output of seamcl bench --json ('-' for stdin)")
+    ap.add_argument("--out", default=".", help="directory for the PNGs and table.md [.]")
+    args = ap.parse_args(argv)
+    bench = json.load(sys.stdin) if args.bench_json == "-" else load(args.bench_json)
+    os.makedirs(args.out, exist_ok=True)
+    written = [chart_pareto(bench, args.out), chart_figure5(bench, args.out),
+               chart_figure5(bench, args.out, "seam_curve")]
+    path = os.path.join(args.out, "table.md")
+    with open(path, "w") as f:
+        f.write(table_md(bench))
+    written.append(path)
+    for p in written:
+        if p:
+            print(p)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
