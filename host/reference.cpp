@@ -1,5 +1,8 @@
 #include "reference.h"
 
+#include <functional>
+#include <thread>
+
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -102,7 +105,9 @@ bool write_cached(const std::string& path, const std::string& key, int width, in
                   const std::vector<glm::vec4>& pixels) {
   std::error_code ec;
   fs::create_directories(fs::path(path).parent_path(), ec);
-  const std::string temp = path + ".tmp" + std::to_string(::getpid()) + ".exr";
+  // Unique per process and thread, so concurrent writers of one entry never share a temp file.
+  const std::string temp = path + ".tmp" + std::to_string(::getpid()) + "-" +
+                           std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id())) + ".exr";
   {
     auto output = OIIO::ImageOutput::create(temp);
     if (!output) return false;

@@ -2,19 +2,25 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <optional>
 
 #include <unistd.h>
 #include <utility>
 
 #include <httplib.h>
 
+#include "comparison.h"
 #include "errors.h"
 #include "image_io.h"
+#include "metrics.h"
 #include "packed_scene.h"
+#include "reference.h"
 #include "renderer.h"
 #include "scene.h"
 #include "scene_generators.h"
@@ -70,6 +76,33 @@ json query_to_json(const httplib::Params& params) {
   return out;
 }
 
+// A compare list ("methods", "msaa") as the comma text `seamcl compare` takes, from either form:
+// a comma string, or an array of strings (methods) or integers (msaa; a single integer too). The
+// text then goes through the CLI's helpers, so both forms are refused with the same messages.
+std::string compare_list_text(const json& value, const std::string& field, bool integers) {
+  const char* expected = integers ? "a comma list string (\"1,4\"), an integer or an array of integers"
+                                  : "a comma list string (\"discard,traverse\") or an array of strings";
+  if (value.is_string()) return value.get<std::string>();
+  if (integers && value.is_number_integer()) return value.dump();
+  if (!value.is_array() || value.empty()) throw InputError(field, std::string("must be ") + expected + ", got " + value.dump().substr(0, 100));
+  std::string text;
+  for (const json& item : value) {
+    if (integers ? !item.is_number_integer() : !item.is_string()) {
+      throw InputError(field, std::string("must be ") + expected + ", got the item " + item.dump().substr(0, 100));
+    }
+    if (!text.empty()) text += ',';
+    text += integers ? item.dump() : item.get<std::string>();
+  }
+  return text;
+}
+
+// The reference cache of POST /v1/compare: the server's own directory, not a user's ~/.cache.
+std::string server_cache_dir(const std::string& configured) {
+  if (!configured.empty()) return configured;
+  if (const char* dir = std::getenv("SEAMCL_CACHE_DIR"); dir && *dir) return dir;
+  return (std::filesystem::temp_directory_path() / "seamcl-serve-cache").string();
+}
+
 }  // namespace
 
 // A refusal: status, the field at fault and a message, answered as {"error", "field"}.
@@ -100,6 +133,7 @@ HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
     : runtime_(runtime), options_(std::move(options)), http_(std::make_unique<httplib::Server>()) {
   if (options_.threads < 1) throw InputError("threads", "must be at least 1");
   if (options_.queue < 0) throw InputError("queue", "must be at least 0");
+  options_.cache_dir = server_cache_dir(options_.cache_dir);
 
   // 1. The built-in scenes, plain and tinted.
   for (const GeneratorInfo& g : scene_generators()) {
@@ -179,7 +213,11 @@ HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
        {{"max_body_bytes", options_.max_body_bytes},
         {"max_samples", options_.max_samples},
         {"max_inline_faces", options_.max_inline_faces},
-        {"max_inline_texels", options_.max_inline_texels}}}};
+        {"max_inline_texels", options_.max_inline_texels},
+        {"max_compare_pixels", options_.max_compare_pixels},
+        {"max_compare_entries", options_.max_compare_entries},
+        {"max_compare_repeat", options_.max_compare_repeat},
+        {"max_reference_samples", options_.max_reference_samples}}}};
 
   install_routes();
 }
@@ -267,35 +305,11 @@ json HttpServer::scenes_json() const {
 
 json HttpServer::methods_json() const { return methods_cache_; }
 
-void HttpServer::handle_render(const json& request, httplib::Response& res) {
-  const Clock::time_point start = Clock::now();
-  if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
-
-  // The server's own keys (format, an inline scene); the rest goes to the shared parser.
-  json rest = request;
-  ImageFormat format = ImageFormat::Png;
-  if (rest.contains("format")) {
-    const json& value = rest.at("format");
-    const auto parsed = value.is_string() ? parse_image_format(value.get<std::string>()) : std::nullopt;
-    if (!parsed) throw HttpError{400, "format", "must be \"png\" or \"exr\", got " + value.dump()};
-    format = *parsed;
-    rest.erase("format");
-  }
-  json inline_scene;
-  if (rest.contains("scene") && rest.at("scene").is_object()) {
-    inline_scene = rest.at("scene");
-    rest.erase("scene");
-  }
-  RenderOptions options = parse_render_options(rest);
-  if (static_cast<long long>(options.width) * options.height * options.msaa > options_.max_samples) {
-    throw HttpError{413, "size",
-                    "width x height x msaa = " + std::to_string(static_cast<long long>(options.width) * options.height * options.msaa) +
-                        " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
-  }
-
-  // The scene: a built-in one (never a file path: clients name no server files) or inline.
+// The scene: a built-in one (never a file path: clients name no server files) or inline.
+std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene, RenderOptions& options,
+                                                       std::string& key) const {
   std::shared_ptr<const Scene> scene;
-  std::string key;
+  key.clear();
   if (inline_scene.is_null()) {
     const auto found = scenes_.find(scene_key(options.scene, options.tint));
     if (found == scenes_.end() || options.scene.find('+') != std::string::npos) {
@@ -343,6 +357,37 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
     }
     options.scene = scene->name;
   }
+  return scene;
+}
+
+void HttpServer::handle_render(const json& request, httplib::Response& res) {
+  const Clock::time_point start = Clock::now();
+  if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
+
+  // The server's own keys (format, an inline scene); the rest goes to the shared parser.
+  json rest = request;
+  ImageFormat format = ImageFormat::Png;
+  if (rest.contains("format")) {
+    const json& value = rest.at("format");
+    const auto parsed = value.is_string() ? parse_image_format(value.get<std::string>()) : std::nullopt;
+    if (!parsed) throw HttpError{400, "format", "must be \"png\" or \"exr\", got " + value.dump()};
+    format = *parsed;
+    rest.erase("format");
+  }
+  json inline_scene;
+  if (rest.contains("scene") && rest.at("scene").is_object()) {
+    inline_scene = rest.at("scene");
+    rest.erase("scene");
+  }
+  RenderOptions options = parse_render_options(rest);
+  if (static_cast<long long>(options.width) * options.height * options.msaa > options_.max_samples) {
+    throw HttpError{413, "size",
+                    "width x height x msaa = " + std::to_string(static_cast<long long>(options.width) * options.height * options.msaa) +
+                        " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
+  }
+
+  std::string key;
+  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, options, key);
   const Camera camera = options.frame ? orbit_camera(*scene, *options.frame, options.frames) : scene->camera;
 
   // Wait for a render slot (or 503), render, and give the slot back before encoding.
@@ -380,6 +425,173 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   res.set_header("X-Seamcl-Options", to_json(options).dump());
   res.set_header("X-Seamcl-Fragments", std::to_string(result.stats.fragments));
   res.set_content(std::move(image), format == ImageFormat::Png ? "image/png" : "image/x-exr");
+}
+
+json HttpServer::parse_body(const httplib::Request& req) const {
+  const std::string type = req.get_header_value("Content-Type");
+  if (type.substr(0, type.find(';')) != "application/json") {
+    throw HttpError{415, "Content-Type", "must be application/json, got '" + type.substr(0, 100) + "'"};
+  }
+  // Parse with a depth limit: the library's error messages print values, recursively.
+  bool too_deep = false;
+  const int max_depth = options_.max_json_depth;
+  json body;
+  try {
+    body = json::parse(req.body, [&](int depth, json::parse_event_t, json&) {
+      if (depth > max_depth) too_deep = true;
+      return !too_deep;
+    });
+  } catch (const json::exception& e) {
+    throw HttpError{400, "body", std::string("not valid JSON: ") + e.what()};
+  }
+  if (too_deep) throw HttpError{400, "body", "nested deeper than " + std::to_string(max_depth) + " levels"};
+  return body;
+}
+
+// POST /v1/compare: seamcl compare's loop (host/comparison.h) on one frame, answered as the JSON
+// of `seamcl compare --json` (without server paths: no cache_path, no images).
+void HttpServer::handle_compare(const json& request, httplib::Response& res) {
+  const Clock::time_point start = Clock::now();
+  if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
+
+  // compare's own keys; the rest is the frame's render options, for the shared parser.
+  json rest = request;
+  if (rest.contains("method")) {
+    throw HttpError{400, "method", "compare takes \"methods\", a list (\"discard,traverse\" or [\"discard\", \"traverse\"])"};
+  }
+  if (rest.contains("format")) throw HttpError{400, "format", "compare answers JSON; format is for /v1/render"};
+  std::string methods_text = "discard,clamp";  // seamcl compare's defaults
+  std::string msaa_text = "1,2,4,8";
+  if (rest.contains("methods")) {
+    methods_text = compare_list_text(rest.at("methods"), "methods", false);
+    rest.erase("methods");
+  }
+  if (rest.contains("msaa")) {
+    msaa_text = compare_list_text(rest.at("msaa"), "msaa", true);
+    rest.erase("msaa");
+  }
+  int repeat = 3;
+  if (rest.contains("repeat")) {
+    const json& value = rest.at("repeat");
+    if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > options_.max_compare_repeat) {
+      throw InputError("repeat", "must be an integer in 1.." + std::to_string(options_.max_compare_repeat) + ", got " +
+                                     value.dump().substr(0, 100));
+    }
+    repeat = value.get<int>();
+    rest.erase("repeat");
+  }
+  ReferenceSettings reference_settings;
+  reference_settings.cache_dir = options_.cache_dir;
+  if (rest.contains("reference_method")) {
+    const json& value = rest.at("reference_method");
+    if (!value.is_string()) throw InputError("reference_method", "must be a method name, got " + value.dump().substr(0, 100));
+    reference_settings.method = value.get<std::string>();
+    rest.erase("reference_method");
+  }
+  bool explicit_reference_msaa = false;
+  if (rest.contains("reference_msaa")) {
+    const json& value = rest.at("reference_msaa");
+    if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 16) {
+      throw InputError("reference_msaa", "must be 1, 2, 4, 8 or 16, got " + value.dump().substr(0, 100));
+    }
+    reference_settings.msaa = value.get<int>();
+    explicit_reference_msaa = true;
+    rest.erase("reference_msaa");
+  }
+  json inline_scene;
+  if (rest.contains("scene") && rest.at("scene").is_object()) {
+    inline_scene = rest.at("scene");
+    rest.erase("scene");
+  }
+
+  // Validate everything before any work, in seamcl compare's order.
+  RenderOptions frame = parse_render_options(rest);
+  const long long pixels = static_cast<long long>(frame.width) * frame.height;
+  if (pixels > options_.max_compare_pixels) {
+    throw HttpError{413, "size",
+                    std::to_string(frame.width) + "x" + std::to_string(frame.height) + " = " + std::to_string(pixels) +
+                        " pixels exceeds this server's compare limit of " + std::to_string(options_.max_compare_pixels) +
+                        " (the reference renders at " + std::to_string(kReferenceScale) + "x width and height)"};
+  }
+  const std::vector<std::string> methods = split_list(methods_text, "methods");
+  const std::vector<int> rates = parse_int_list(msaa_text, "msaa");
+  if (methods.size() * rates.size() > static_cast<size_t>(options_.max_compare_entries)) {
+    throw HttpError{400, "methods",
+                    std::to_string(methods.size()) + " methods x " + std::to_string(rates.size()) +
+                        " msaa rates = " + std::to_string(methods.size() * rates.size()) +
+                        " renders exceeds this server's limit of " + std::to_string(options_.max_compare_entries)};
+  }
+  const std::vector<MethodEntry> entries = method_entries(rest, methods, rates);
+  for (const MethodEntry& entry : entries) {
+    if (pixels * entry.options.msaa > options_.max_samples) {
+      throw HttpError{413, "size",
+                      "width x height x msaa = " + std::to_string(pixels * entry.options.msaa) +
+                          " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
+    }
+  }
+  const RenderOptions high = reference_render_options(frame, reference_settings);
+  const long long reference_samples = static_cast<long long>(high.width) * high.height * high.msaa;
+  if (reference_samples > options_.max_reference_samples) {
+    const std::string field = explicit_reference_msaa ? "reference_msaa" : "size";
+    throw HttpError{413, field,
+                    "the reference renders " + std::to_string(high.width) + "x" + std::to_string(high.height) + " x " +
+                        std::to_string(high.msaa) + " samples = " + std::to_string(reference_samples) +
+                        ", over this server's limit of " + std::to_string(options_.max_reference_samples)};
+  }
+  std::string key;
+  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key);
+  const Camera camera = frame.frame ? orbit_camera(*scene, *frame.frame, frame.frames) : scene->camera;
+
+  // One admitted request for the whole compare. A Renderer of its own: the 8x reference's
+  // buffers are freed with it, and the slot's warm Renderers keep their scenes.
+  const Clock::time_point queued = Clock::now();
+  double queue_ms = 0;
+  size_t seam_pixels = 0;
+  ReferenceImage reference;
+  std::vector<EntryResult> measured;
+  {
+    const std::unique_ptr<SlotLease> lease = acquire_slot();
+    queue_ms = ms_since(queued);
+    Renderer renderer(runtime_);
+    renderer.load_scene(*scene, frame.texels);
+    const std::vector<uint8_t> mask = seam_mask(render_face_map(renderer, camera, frame));
+    seam_pixels = static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{1}));
+    {
+      const std::string cache_key = reference_cache_key(*scene, camera, frame, reference_settings);
+      std::lock_guard lock(reference_locks_[std::hash<std::string>{}(cache_key) % reference_locks_.size()]);
+      reference = reference_image(renderer, camera, frame, reference_settings);
+    }
+    measured = compare_methods(renderer, *scene, camera, entries, &reference.pixels, &mask, repeat);
+  }
+
+  json results = json::array();
+  for (const EntryResult& m : measured) results.push_back(compare_result_json(m));
+  json out = {{"scene", scene->name},
+              {"size", std::to_string(frame.width) + "x" + std::to_string(frame.height)},
+              {"device", runtime_.device_description()},
+              {"reference_method", reference.method},
+              {"reference",
+               {{"method", reference.method},
+                {"msaa", reference.msaa},
+                {"scale", kReferenceScale},
+                {"filter", "mitchell"},
+                {"filter_width", kMitchellWidth},
+                {"B", kMitchellB},
+                {"C", kMitchellC},
+                {"from_cache", reference.from_cache},
+                {"ms", reference.render_ms}}},
+              {"seam_pixels", seam_pixels},
+              {"seam_radius", kSeamRadius},
+              {"repeat", repeat},
+              {"options", to_json(frame)},
+              {"results", results}};
+  if (frame.frame) {
+    out["frame"] = *frame.frame;
+    out["frames"] = frame.frames;
+  }
+  out["queue_ms"] = queue_ms;
+  out["server_ms"] = ms_since(start);
+  res.set_content(out.dump(), "application/json");
 }
 
 void HttpServer::install_routes() {
@@ -472,27 +684,10 @@ void HttpServer::install_routes() {
              handle_render(query_to_json(req.params), res);
            }));
   http.Post("/v1/render", guarded([this](const httplib::Request& req, httplib::Response& res) {
-              const std::string type = req.get_header_value("Content-Type");
-              if (type.substr(0, type.find(';')) != "application/json") {
-                throw HttpError{415, "Content-Type", "must be application/json, got '" + type.substr(0, 100) + "'"};
-              }
-              // Parse with a depth limit: the library's error messages print values, recursively.
-              bool too_deep = false;
-              const int max_depth = options_.max_json_depth;
-              json body;
-              try {
-                body = json::parse(req.body, [&](int depth, json::parse_event_t, json&) {
-                  if (depth > max_depth) too_deep = true;
-                  return !too_deep;
-                });
-              } catch (const json::exception& e) {
-                throw HttpError{400, "body", std::string("not valid JSON: ") + e.what()};
-              }
-              if (too_deep) throw HttpError{400, "body", "nested deeper than " + std::to_string(max_depth) + " levels"};
-              handle_render(body, res);
+              handle_render(parse_body(req), res);
             }));
-  http.Post("/v1/compare", guarded([](const httplib::Request&, httplib::Response&) {
-              throw HttpError{501, "path", "compare is not implemented yet: image metrics land in a later release"};
+  http.Post("/v1/compare", guarded([this](const httplib::Request& req, httplib::Response& res) {
+              handle_compare(parse_body(req), res);
             }));
 }
 

@@ -11,7 +11,10 @@
 // admitted renders itself: at most `threads` render at once and at most `queue` wait for a slot;
 // any render beyond that is answered 503 with Retry-After at once. The pool has enough threads
 // for every admitted render plus a few more, so /health and refusals are answered while busy.
+// A compare (POST /v1/compare) is one admitted request like a render: it holds one slot for its
+// whole run (seam mask, 8x reference or cache hit, every method x rate).
 #pragma once
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -52,6 +55,13 @@ struct ServerOptions {
   size_t max_inline_faces = 1024;                       // inline scene faces: 413 "scene.faces"
   long long max_inline_texels = 1LL << 21;              // inline scene texels at level 0: 413
   int max_json_depth = 32;                              // deeper request JSON: 400 "body"
+  // POST /v1/compare renders an 8x reference (64x the pixels), so its frames are much smaller.
+  long long max_compare_pixels = 256LL * 256;           // width * height per compare: 413 "size"
+  int max_compare_entries = 16;                         // methods x msaa rates: 400 "methods"
+  int max_compare_repeat = 10;                          // timed renders per entry: 400 "repeat"
+  long long max_reference_samples = 2048LL * 2048 * 4;  // 8W * 8H * reference_msaa: 413
+  // Reference cache of POST /v1/compare. Empty: $SEAMCL_CACHE_DIR, else <temp>/seamcl-serve-cache.
+  std::string cache_dir;
   bool warm_all_methods = true;    // at start, build every method x filter (rgba8), not just the default
   std::function<void(const std::string&)> log;          // one line per request; empty: stderr
 };
@@ -87,6 +97,13 @@ class HttpServer {
 
   void install_routes();
   void handle_render(const nlohmann::json& request, httplib::Response& res);
+  void handle_compare(const nlohmann::json& request, httplib::Response& res);
+  nlohmann::json parse_body(const httplib::Request& req) const;
+  // A built-in scene by options.scene (and tint), or `inline_scene` when it is not null (limits
+  // checked, parsed, validated; options.scene becomes its name). `key` is the slot Renderer's key,
+  // empty for an inline scene.
+  std::shared_ptr<const Scene> resolve_scene(const nlohmann::json& inline_scene, RenderOptions& options,
+                                             std::string& key) const;
   nlohmann::json scenes_json() const;
   nlohmann::json methods_json() const;
   nlohmann::json health_json() const;
@@ -110,6 +127,9 @@ class HttpServer {
   std::condition_variable slot_freed_;
   std::atomic<int> admitted_{0};  // rendering + waiting
   std::atomic<long long> served_{0};
+  // Two compares of the same reference at once would both render it and write the same cache
+  // file: one lock per hash stripe of the cache key, held while the reference is read or made.
+  std::array<std::mutex, 16> reference_locks_;
 };
 
 }  // namespace seamcl::server

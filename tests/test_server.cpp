@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -20,10 +21,13 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
+#include "comparison.h"
 #include "errors.h"
 #include "http_server.h"
 #include "image_io.h"
+#include "metrics.h"
 #include "packed_scene.h"
+#include "reference.h"
 #include "render_options.h"
 #include "renderer.h"
 #include "scene_generators.h"
@@ -220,11 +224,18 @@ class Server : public ::testing::Test {
     server::ServerOptions options;
     options.threads = 2;
     options.queue = 8;
+    options.cache_dir = cache_dir();
     server_ = new RunningServer(options);
   }
   static void TearDownTestSuite() {
     delete server_;
     server_ = nullptr;
+    std::error_code ec;
+    fs::remove_all(cache_dir(), ec);
+  }
+  // The compare reference cache of this process's server: starts empty, removed at the end.
+  static std::string cache_dir() {
+    return (fs::temp_directory_path() / ("seamcl-test-server-cache-" + std::to_string(::getpid()))).string();
   }
   static httplib::Client client() { return server_->client(); }
   static RunningServer* server_;
@@ -233,6 +244,10 @@ RunningServer* Server::server_ = nullptr;
 
 httplib::Result post_json(httplib::Client& c, const std::string& body, const std::string& type = "application/json") {
   return c.Post("/v1/render", body, type.c_str());
+}
+
+httplib::Result post_compare(httplib::Client& c, const json& body) {
+  return c.Post("/v1/compare", body.dump(), "application/json");
 }
 
 // ---- The validator itself: it must catch what it claims to.
@@ -282,6 +297,13 @@ TEST(ServerSchema, OpenApiDocumentsEveryEndpoint) {
       EXPECT_EQ(std::string(e.what()).find("unknown option"), std::string::npos) << key << " is not a render option";
     }
   }
+  // The compare request: the render options of the frame (no method, no format) and compare's own keys.
+  const json compare = doc.at("components").at("schemas").at("CompareRequest").at("properties");
+  for (const auto& [key, value] : compare.items()) {
+    EXPECT_TRUE(properties.contains(key) || key == "methods" || key == "repeat" || key.starts_with("reference_")) << key;
+  }
+  EXPECT_FALSE(compare.contains("method"));
+  EXPECT_FALSE(compare.contains("format"));
 }
 
 TEST_F(Server, HealthReportsDeviceUptimeAndRequests) {
@@ -346,6 +368,7 @@ TEST_F(Server, OpenApiAndViewerAreServed) {
   EXPECT_TRUE(page->get_header_value("Content-Type").starts_with("text/html"));
   EXPECT_NE(page->body.find("<html"), std::string::npos);
   EXPECT_NE(page->body.find("/v1/render"), std::string::npos);
+  EXPECT_NE(page->body.find("/v1/compare"), std::string::npos);
   EXPECT_EQ(page->body, std::string(server::viewer_html()));
 }
 
@@ -419,12 +442,93 @@ TEST_F(Server, InlineSceneMatchesTheSceneFile) {
   EXPECT_TRUE(decode(after->body, ".png", w, h) == library_image({{"scene", "quad2"}, {"size", "32x32"}}));
 }
 
-TEST_F(Server, CompareIsNotImplementedYet) {
+// What the library makes of a compare: seamcl compare's steps on the same inputs, with a
+// reference rendered afresh (no cache), one timed render per entry.
+json library_compare(const json& base, const std::string& methods, const std::string& msaa, size_t& seam_pixels) {
+  const RenderOptions frame = parse_render_options(base);
+  const std::vector<MethodEntry> entries =
+      method_entries(base, split_list(methods, "methods"), parse_int_list(msaa, "msaa"));
+  const Scene scene = generate_scene(frame.scene, {});
+  const Camera camera = frame.frame ? orbit_camera(scene, *frame.frame, frame.frames) : scene.camera;
+  Renderer renderer(seamcl_tests::shared_runtime());
+  renderer.load_scene(scene, frame.texels);
+  const std::vector<uint8_t> mask = seam_mask(render_face_map(renderer, camera, frame));
+  seam_pixels = static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{1}));
+  ReferenceSettings settings;
+  settings.use_cache = false;
+  const ReferenceImage reference = reference_image(renderer, camera, frame, settings);
+  json results = json::array();
+  for (const EntryResult& r : compare_methods(renderer, scene, camera, entries, &reference.pixels, &mask, 1))
+    results.push_back(compare_result_json(r));
+  return results;
+}
+
+// Numbers within 1e-6 (relative to 1 or the value), everything else equal; "ms" is skipped.
+void expect_close(const json& got, const json& want, const std::string& path) {
+  if (got.is_number() && want.is_number()) {
+    const double a = got.get<double>(), b = want.get<double>();
+    EXPECT_LE(std::fabs(a - b), 1e-6 * std::max(1.0, std::fabs(b))) << path << ": " << a << " vs " << b;
+  } else if (got.is_object() && want.is_object()) {
+    EXPECT_EQ(got.size(), want.size()) << path;
+    for (const auto& [key, value] : want.items()) {
+      if (key == "ms") continue;
+      if (!got.contains(key)) {
+        ADD_FAILURE() << path << "." << key << " missing";
+        continue;
+      }
+      expect_close(got.at(key), value, path + "." + key);
+    }
+  } else if (got.is_array() && want.is_array()) {
+    ASSERT_EQ(got.size(), want.size()) << path;
+    for (size_t i = 0; i < got.size(); ++i) expect_close(got[i], want[i], path + "[" + std::to_string(i) + "]");
+  } else {
+    EXPECT_EQ(got, want) << path;
+  }
+}
+
+TEST_F(Server, CompareMatchesTheLibrary) {
   httplib::Client c = client();
-  auto res = c.Post("/v1/compare", "{}", "application/json");
+  const json request = {{"scene", "quad2"}, {"size", "64x64"}, {"methods", "discard,clamp"}, {"msaa", "1,4"}, {"repeat", 1}};
+  auto res = post_compare(c, request);
   ASSERT_TRUE(res);
-  EXPECT_EQ(res->status, 501);
+  ASSERT_EQ(res->status, 200) << res->body;
+  EXPECT_EQ(res->get_header_value("Content-Type"), "application/json");
   expect_documented("post", "/v1/compare", res);
+  const json body = json::parse(res->body);
+  EXPECT_EQ(body.at("scene"), "quad2");
+  EXPECT_EQ(body.at("size"), "64x64");
+  EXPECT_EQ(body.at("reference").at("scale"), kReferenceScale);
+  EXPECT_FALSE(body.at("reference").at("from_cache").get<bool>());
+  const json& results = body.at("results");
+  ASSERT_EQ(results.size(), 4u);
+  const std::vector<std::pair<std::string, int>> order = {{"discard", 1}, {"discard", 4}, {"clamp", 1}, {"clamp", 4}};
+  for (size_t i = 0; i < results.size(); ++i) {
+    EXPECT_EQ(results[i].at("method"), order[i].first);
+    EXPECT_EQ(results[i].at("msaa"), order[i].second);
+    EXPECT_EQ(results[i].at("ms").at("runs"), 1);
+    EXPECT_GT(results[i].at("texture_bytes").get<size_t>(), 0u);
+    for (const char* key : {"mean", "p99", "max", "seam_mean", "seam_p99", "nan_pixels"}) {
+      const double v = results[i].at("error").at(key).get<double>();
+      EXPECT_TRUE(std::isfinite(v) && v >= 0) << key << " = " << v;
+    }
+    EXPECT_GT(results[i].at("error").at("seam_pixels").get<size_t>(), 0u) << "quad2 has a seam in view";
+  }
+  // The same numbers as the library's loop on the same inputs.
+  size_t seam_pixels = 0;
+  const json expected = library_compare({{"scene", "quad2"}, {"size", "64x64"}}, "discard,clamp", "1,4", seam_pixels);
+  expect_close(results, expected, "results");
+  EXPECT_EQ(body.at("seam_pixels").get<size_t>(), seam_pixels);
+
+  // The array forms give the same answer, and the reference now comes from the server's cache.
+  auto again = post_compare(c, {{"scene", "quad2"}, {"size", "64x64"}, {"methods", {"discard", "clamp"}}, {"msaa", {1, 4}}, {"repeat", 1}});
+  ASSERT_TRUE(again);
+  ASSERT_EQ(again->status, 200) << again->body;
+  expect_documented("post", "/v1/compare", again);
+  const json cached = json::parse(again->body);
+  EXPECT_TRUE(cached.at("reference").at("from_cache").get<bool>());
+  EXPECT_EQ(cached.at("reference").at("ms"), 0.0);
+  expect_close(cached.at("results"), expected, "cached results");
+  EXPECT_FALSE(fs::is_empty(cache_dir()));
 }
 
 // One malformed request and what it must get.
@@ -454,8 +558,52 @@ std::vector<Malformed> malformed_requests() {
   auto get = [](std::string query, int status, std::string field) {
     return Malformed{"GET", "/v1/render?" + std::move(query), "", "", status, std::move(field)};
   };
+  auto compare = [&](std::string body, int status, std::string field) {
+    return Malformed{"POST", "/v1/compare", json_type, std::move(body), status, std::move(field)};
+  };
   std::string deep = R"({"msaa": )" + std::string(200, '[') + std::string(200, ']') + "}";
   return {
+      compare(R"({"scene": "quad2", "size": "64x64", "methods": "discard,bogus", "msaa": 1})", 400, "methods"),
+      compare(R"({"scene": "quad2", "size": "64x64", "methods": ["discard", "nope"]})", 400, "methods"),
+      compare(R"({"scene": "quad2", "size": "64x64", "methods": 5})", 400, "methods"),
+      compare(R"({"scene": "quad2", "size": "64x64", "methods": [1]})", 400, "methods"),
+      compare(R"({"scene": "quad2", "size": "64x64", "methods": ""})", 400, "methods"),
+      compare(R"({"scene": "quad2", "size": "64x64", "methods": "discard,"})", 400, "methods"),
+      compare(R"({"scene": "quad2", "size": "64x64", "methods": []})", 400, "methods"),
+      compare(R"({"scene": "quad2", "size": "64x64", "methods": "clamp,black,discard,traverse,guardband", "msaa": "1,2,4,8"})",
+              400, "methods"),
+      compare(R"({"scene": "quad2", "size": "64x64", "methods": "discard", "msaa": "1,2,4,8,16,1,2,4,8,16,1,2,4,8,16,1,2"})",
+              400, "methods"),
+      compare(R"({"scene": "quad2", "size": "64x64", "msaa": 3})", 400, "msaa"),
+      compare(R"({"scene": "quad2", "size": "64x64", "msaa": "1,3"})", 400, "msaa"),
+      compare(R"({"scene": "quad2", "size": "64x64", "msaa": "1,x"})", 400, "msaa"),
+      compare(R"({"scene": "quad2", "size": "64x64", "msaa": [1, "4"]})", 400, "msaa"),
+      compare(R"({"scene": "quad2", "size": "64x64", "msaa": [1, 4.5]})", 400, "msaa"),
+      compare(R"({"scene": "quad2", "size": "64x64", "msaa": 4.5})", 400, "msaa"),
+      compare(R"({"scene": "quad2", "size": "64x64", "msaa": true})", 400, "msaa"),
+      compare(R"({"scene": "quad2", "size": "64x64", "msaa": [99999999999]})", 400, "msaa"),
+      compare(R"({"scene": "quad2", "size": "512x512"})", 413, "size"),
+      compare(R"({"scene": "quad2", "size": "257x256", "methods": "discard", "msaa": 1})", 413, "size"),
+      compare(R"({"scene": "quad2"})", 413, "size"),
+      compare(R"({"scene": "quad2", "size": "99999x99999"})", 400, "size"),
+      compare(R"({"scene": "quad2", "size": 64})", 400, "size"),
+      compare(R"({"scene": "quad2", "size": "64x64", "method": "discard"})", 400, "method"),
+      compare(R"({"scene": "quad2", "size": "64x64", "format": "png"})", 400, "format"),
+      compare(R"({"scene": "quad2", "size": "64x64", "aniso": 0})", 400, "aniso"),
+      compare(R"({"scene": "quad2", "size": "64x64", "repeat": 0})", 400, "repeat"),
+      compare(R"({"scene": "quad2", "size": "64x64", "repeat": 11})", 400, "repeat"),
+      compare(R"({"scene": "quad2", "size": "64x64", "repeat": "3"})", 400, "repeat"),
+      compare(R"({"scene": "quad2", "size": "64x64", "reference_method": "bogus"})", 400, "reference_method"),
+      compare(R"({"scene": "quad2", "size": "64x64", "reference_method": 1})", 400, "reference_method"),
+      compare(R"({"scene": "quad2", "size": "64x64", "reference_msaa": 3})", 400, "reference_msaa"),
+      compare(R"({"scene": "quad2", "size": "256x256", "reference_msaa": 16})", 413, "reference_msaa"),
+      compare(R"({"scene": "nonexistent", "size": "64x64"})", 400, "scene"),
+      compare(R"({"scene": "/etc/passwd", "size": "64x64"})", 400, "scene"),
+      compare(R"({"scene": "quad2", "size": "64x64", "images": "/tmp/x"})", 400, "images"),
+      compare(R"({"scene": "quad2", "size": "64x64", "cache": "/tmp/x"})", 400, "cache"),
+      compare("[1, 2]", 400, "body"),
+      compare("{", 400, "body"),
+      Malformed{"POST", "/v1/compare", "text/plain", R"({"msaa": 4})", 415, "Content-Type"},
       post("{", 400, "body"),
       post("", 400, "body"),
       post("[1, 2]", 400, "body"),
@@ -688,6 +836,49 @@ TEST(ServerOverload, FullQueueGetsFast503sAndRecovers) {
   auto health = c.Get("/health");
   ASSERT_TRUE(health);
   EXPECT_EQ(json::parse(health->body).at("renders_admitted"), 0);
+}
+
+// A compare is admitted like a render: with the only slot busy and no queue it is refused at once
+// with 503; once the slot is free it runs, and nothing stays admitted.
+TEST(ServerOverload, CompareCountsAgainstTheAdmissionQueue) {
+  std::signal(SIGPIPE, SIG_IGN);
+  server::ServerOptions options;
+  options.threads = 1;
+  options.queue = 0;
+  options.cache_dir = (fs::temp_directory_path() / ("seamcl-test-server-cache-busy-" + std::to_string(::getpid()))).string();
+  RunningServer s(options);
+  int status = 0;
+  std::thread slow([&] {
+    httplib::Client c = s.client();
+    auto res = c.Get("/v1/render?scene=paper&size=512x512&msaa=4");
+    status = res ? res->status : -1;
+  });
+  bool admitted = false;
+  for (int i = 0; i < 500 && !admitted; ++i) {
+    httplib::Client probe = s.client();
+    auto h = probe.Get("/health");
+    admitted = h && json::parse(h->body).at("renders_admitted").get<int>() > 0;
+    if (!admitted) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  httplib::Client c = s.client();
+  const json request = {{"scene", "quad2"}, {"size", "32x32"}, {"methods", "clamp"}, {"msaa", 1}, {"repeat", 1}};
+  auto busy = post_compare(c, request);
+  slow.join();
+  ASSERT_TRUE(admitted);
+  EXPECT_EQ(status, 200);
+  ASSERT_TRUE(busy);
+  ASSERT_EQ(busy->status, 503) << busy->body;
+  EXPECT_EQ(busy->get_header_value("Retry-After"), "1");
+  EXPECT_EQ(json::parse(busy->body).at("field"), "queue");
+  expect_documented("post", "/v1/compare", busy);
+  auto res = post_compare(c, request);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200) << res->body;
+  auto health = c.Get("/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(json::parse(health->body).at("renders_admitted"), 0);
+  std::error_code ec;
+  fs::remove_all(options.cache_dir, ec);
 }
 
 // stop() while a render is in flight: the render is still answered, then listen returns.
