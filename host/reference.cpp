@@ -256,4 +256,13 @@ ReferenceImage reference_image(Renderer& renderer, const Camera& camera, const R
                          [&](const RenderOptions& high) { return renderer.render(camera, high); });
 }
 
+nlohmann::json reference_json(const ReferenceImage& reference, bool with_cache_path) {
+  nlohmann::json out = {{"method", reference.method},     {"msaa", reference.msaa},      {"scale", kReferenceScale},
+                        {"filter", "mitchell"},           {"filter_width", kMitchellWidth}, {"B", kMitchellB},
+                        {"C", kMitchellC},                {"from_cache", reference.from_cache},
+                        {"ms", reference.render_ms}};
+  if (with_cache_path) out["cache_path"] = reference.cache_path;
+  return out;
+}
+
 }  // namespace seamcl

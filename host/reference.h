@@ -18,6 +18,7 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include "render_options.h"
 #include "renderer.h"
@@ -89,5 +90,10 @@ ReferenceImage reference_image(const Scene& scene, const Camera& camera, const R
 // The usual HighResRender: `renderer` (with `scene` loaded) renders `camera`.
 ReferenceImage reference_image(Renderer& renderer, const Camera& camera, const RenderOptions& frame,
                                const ReferenceSettings& settings);
+
+// How a reference was made, as compare, bench and the HTTP service report it: method, msaa,
+// scale, filter and its width, B, C, whether it came from the cache, ms; with_cache_path adds
+// the file (the HTTP service leaves it out: clients never see server paths).
+nlohmann::json reference_json(const ReferenceImage& reference, bool with_cache_path);
 
 }  // namespace seamcl
