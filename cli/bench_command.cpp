@@ -20,6 +20,7 @@
 
 #include "cl_runtime.h"
 #include "commands.h"
+#include "measure_args.h"
 #include "comparison.h"
 #include "errors.h"
 #include "metrics.h"
@@ -34,32 +35,14 @@ namespace {
 
 using nlohmann::json;
 
-struct BenchArgs {
-  std::optional<std::string> scene, filter, zero_coverage, texels, size, shading;
-  std::optional<int> aniso;
-  std::string methods = "discard,traverse";
-  std::string msaa = "1,2,4,8";
+struct BenchArgs : MeasureArgs {
   int frames = 60;
   int reference_frames = 1;
   bool no_errors = false;
-  bool tint = false;
-  std::string reference_method;
-  int reference_msaa = 0;
-  std::string cache_dir;
-  bool no_cache = false;
-  bool json_out = false;
 };
 
 json base_request(const BenchArgs& a) {
-  json request = json::object();
-  if (a.scene) request["scene"] = *a.scene;
-  if (a.filter) request["filter"] = *a.filter;
-  if (a.zero_coverage) request["zero_coverage"] = *a.zero_coverage;
-  if (a.texels) request["texels"] = *a.texels;
-  if (a.aniso) request["aniso"] = *a.aniso;
-  if (a.size) request["size"] = *a.size;
-  if (a.shading) request["shading"] = *a.shading;
-  if (a.tint) request["tint"] = true;
+  json request = measure_request(a);
   request["frame"] = 0;
   request["frames"] = a.frames;  // parse_render_options checks the range and names "frames"
   return request;
@@ -181,11 +164,7 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
   std::vector<MethodEntry> entries = method_entries(base, methods, rates);
   if (args.reference_frames < 1) throw InputError("reference_frames", "must be at least 1");
   const bool with_errors = !args.no_errors;
-  ReferenceSettings ref_settings;
-  ref_settings.method = args.reference_method;
-  ref_settings.msaa = args.reference_msaa;
-  ref_settings.cache_dir = args.cache_dir;
-  ref_settings.use_cache = !args.no_cache;
+  const ReferenceSettings ref_settings = reference_settings(args);
   if (with_errors) (void)reference_render_options(frame, ref_settings);  // size and settings checked now
 
   GeneratorOptions generator_options;
@@ -412,27 +391,11 @@ Command add_bench_command(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
   CLI::App* cmd = app.add_subcommand(
       "bench", "Time every method x MSAA rate side by side over an orbit of frames, with errors against the reference");
-  cmd->add_option("--scene", args->scene, "Built-in scene name or a scene JSON file [paper]");
-  cmd->add_option("--methods", args->methods, "Comma list of seam methods [discard,traverse]");
-  cmd->add_option("--msaa", args->msaa, "Comma list of MSAA rates (1, 2, 4, 8, 16) [1,2,4,8]");
-  cmd->add_option("--aniso", args->aniso, "Maximum anisotropy, 1..16 [16]");
-  cmd->add_option("--filter", args->filter, "Texture filter [aniso]");
-  cmd->add_option("--zero-coverage", args->zero_coverage, "discard with every tap outside: clamp or nan [clamp]");
-  cmd->add_option("--texels", args->texels, "Texel storage: rgba8 or rgba32f [rgba8]");
-  cmd->add_option("--size", args->size, "Image size WIDTHxHEIGHT [480x540]");
+  add_measure_options(cmd, *args, "discard,traverse");
   cmd->add_option("--frames", args->frames, "Frames of the camera orbit; frame k uses orbit frame k of N [60]");
-  cmd->add_option("--shading", args->shading, "Where to shade: pixel, centroid or sample [pixel]");
-  cmd->add_flag("--tint", args->tint, "Built-in scenes: tint each face a different base colour");
   cmd->add_flag("--no-errors", args->no_errors, "Skip the references and errors (times, NaN counts, temporal only)");
   cmd->add_option("--reference-frames", args->reference_frames,
                   "Measure errors on every K-th frame only (frames 0, K, 2K, ...): each needs an 8x reference [1]");
-  cmd->add_option("--reference-method", args->reference_method,
-                  "Method of the 8x reference render [traverse if available, else discard]");
-  cmd->add_option("--reference-msaa", args->reference_msaa,
-                  "Samples per pixel of the 8x reference render [1 for traverse, 16 for discard]");
-  cmd->add_option("--cache", args->cache_dir, "Reference cache directory [$SEAMCL_CACHE_DIR or ~/.cache/seamcl]");
-  cmd->add_flag("--no-cache", args->no_cache, "Always render the references; do not read or write the cache");
-  cmd->add_flag("--json", args->json_out, "Print one JSON object");
   return Command{cmd, [args](const GlobalOptions& global) { return run_bench(*args, global); }};
 }
 

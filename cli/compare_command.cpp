@@ -15,6 +15,7 @@
 
 #include "cl_runtime.h"
 #include "commands.h"
+#include "measure_args.h"
 #include "comparison.h"
 #include "errors.h"
 #include "image_io.h"
@@ -31,20 +32,11 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-struct CompareArgs {
-  std::optional<std::string> scene, filter, zero_coverage, texels, size, shading;
-  std::optional<int> aniso, frame, frames;
-  std::string methods = "discard,clamp";
-  std::string msaa = "1,2,4,8";
-  bool tint = false;
+struct CompareArgs : MeasureArgs {
+  std::optional<int> frame, frames;
   std::string constant_color;  // "r,g,b" linear: paint every face this colour
-  std::string reference_method;
-  int reference_msaa = 0;
-  std::string cache_dir;
-  bool no_cache = false;
   std::string images_dir;
   int repeat = 3;
-  bool json_out = false;
 };
 
 glm::vec3 parse_color(const std::string& text) {
@@ -68,17 +60,9 @@ glm::vec3 parse_color(const std::string& text) {
 }
 
 json base_request(const CompareArgs& a) {
-  json request = json::object();
-  if (a.scene) request["scene"] = *a.scene;
-  if (a.filter) request["filter"] = *a.filter;
-  if (a.zero_coverage) request["zero_coverage"] = *a.zero_coverage;
-  if (a.texels) request["texels"] = *a.texels;
-  if (a.aniso) request["aniso"] = *a.aniso;
-  if (a.size) request["size"] = *a.size;
-  if (a.shading) request["shading"] = *a.shading;
+  json request = measure_request(a);
   if (a.frame) request["frame"] = *a.frame;
   if (a.frames) request["frames"] = *a.frames;
-  if (a.tint) request["tint"] = true;
   return request;
 }
 
@@ -90,11 +74,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   const std::vector<int> rates = parse_int_list(args.msaa, "msaa");
   const std::vector<MethodEntry> entries = method_entries(base, methods, rates);
   if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
-  ReferenceSettings ref_settings;
-  ref_settings.method = args.reference_method;
-  ref_settings.msaa = args.reference_msaa;
-  ref_settings.cache_dir = args.cache_dir;
-  ref_settings.use_cache = !args.no_cache;
+  const ReferenceSettings ref_settings = reference_settings(args);
   (void)reference_render_options(frame, ref_settings);  // size and reference settings checked now
   GeneratorOptions generator_options;
   generator_options.tint = frame.tint;
@@ -181,30 +161,14 @@ Command add_compare_command(CLI::App& app) {
   auto args = std::make_shared<CompareArgs>();
   CLI::App* cmd = app.add_subcommand(
       "compare", "Render one frame with each method x MSAA rate and measure the error against the paper's reference");
-  cmd->add_option("--scene", args->scene, "Built-in scene name or a scene JSON file [paper]");
-  cmd->add_option("--methods", args->methods, "Comma list of seam methods [discard,clamp]");
-  cmd->add_option("--msaa", args->msaa, "Comma list of MSAA rates (1, 2, 4, 8, 16) [1,2,4,8]");
-  cmd->add_option("--aniso", args->aniso, "Maximum anisotropy, 1..16 [16]");
-  cmd->add_option("--filter", args->filter, "Texture filter [aniso]");
-  cmd->add_option("--zero-coverage", args->zero_coverage, "discard with every tap outside: clamp or nan [clamp]");
-  cmd->add_option("--texels", args->texels, "Texel storage: rgba8 or rgba32f [rgba8]");
-  cmd->add_option("--size", args->size, "Image size WIDTHxHEIGHT [480x540]");
+  add_measure_options(cmd, *args, "discard,clamp");
   cmd->add_option("--frame", args->frame, "Orbit frame K (0-based) of --frames");
   cmd->add_option("--frames", args->frames, "Frames in the orbit [60]");
-  cmd->add_option("--shading", args->shading, "Where to shade: pixel, centroid or sample [pixel]");
-  cmd->add_flag("--tint", args->tint, "Built-in scenes: tint each face a different base colour");
   cmd->add_option("--constant-color", args->constant_color,
                   "Paint every face one linear colour r,g,b (each 0..1): seams then carry no texture error");
-  cmd->add_option("--reference-method", args->reference_method,
-                  "Method of the 8x reference render [traverse if available, else discard]");
-  cmd->add_option("--reference-msaa", args->reference_msaa,
-                  "Samples per pixel of the 8x reference render [1 for traverse, 16 for discard]");
-  cmd->add_option("--cache", args->cache_dir, "Reference cache directory [$SEAMCL_CACHE_DIR or ~/.cache/seamcl]");
-  cmd->add_flag("--no-cache", args->no_cache, "Always render the reference; do not read or write the cache");
   cmd->add_option("--images", args->images_dir,
                   "Write each image, an error heat map (log scale 1e-4..1), the reference and the seam mask (PNG) here");
   cmd->add_option("--repeat", args->repeat, "Timed renders per method and rate; ms reports median, min, max [3]");
-  cmd->add_flag("--json", args->json_out, "Print one JSON object");
   return Command{cmd, [args](const GlobalOptions& global) { return run_compare(*args, global); }};
 }
 

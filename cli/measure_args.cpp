@@ -1,0 +1,48 @@
+#include "measure_args.h"
+
+namespace seamcl::cli {
+
+void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& default_methods) {
+  a.methods = default_methods;
+  command->add_option("--scene", a.scene, "Built-in scene name or a scene JSON file [paper]");
+  command->add_option("--methods", a.methods, "Comma list of seam methods [" + default_methods + "]");
+  command->add_option("--msaa", a.msaa, "Comma list of MSAA rates (1, 2, 4, 8, 16) [1,2,4,8]");
+  command->add_option("--aniso", a.aniso, "Maximum anisotropy, 1..16 [16]");
+  command->add_option("--filter", a.filter, "Texture filter [aniso]");
+  command->add_option("--zero-coverage", a.zero_coverage, "discard with every tap outside: clamp or nan [clamp]");
+  command->add_option("--texels", a.texels, "Texel storage: rgba8 or rgba32f [rgba8]");
+  command->add_option("--size", a.size, "Image size WIDTHxHEIGHT [480x540]");
+  command->add_option("--shading", a.shading, "Where to shade: pixel, centroid or sample [pixel]");
+  command->add_flag("--tint", a.tint, "Built-in scenes: tint each face a different base colour");
+  command->add_option("--reference-method", a.reference_method,
+                      "Method of the 8x reference render [traverse if available, else discard]");
+  command->add_option("--reference-msaa", a.reference_msaa,
+                      "Samples per pixel of the 8x reference render [1 for traverse, 16 for discard]");
+  command->add_option("--cache", a.cache_dir, "Reference cache directory [$SEAMCL_CACHE_DIR or ~/.cache/seamcl]");
+  command->add_flag("--no-cache", a.no_cache, "Always render references; do not read or write the cache");
+  command->add_flag("--json", a.json_out, "Print one JSON object");
+}
+
+nlohmann::json measure_request(const MeasureArgs& a) {
+  nlohmann::json request = nlohmann::json::object();
+  if (a.scene) request["scene"] = *a.scene;
+  if (a.filter) request["filter"] = *a.filter;
+  if (a.zero_coverage) request["zero_coverage"] = *a.zero_coverage;
+  if (a.texels) request["texels"] = *a.texels;
+  if (a.aniso) request["aniso"] = *a.aniso;
+  if (a.size) request["size"] = *a.size;
+  if (a.shading) request["shading"] = *a.shading;
+  if (a.tint) request["tint"] = true;
+  return request;
+}
+
+ReferenceSettings reference_settings(const MeasureArgs& a) {
+  ReferenceSettings settings;
+  settings.method = a.reference_method;
+  settings.msaa = a.reference_msaa;
+  settings.cache_dir = a.cache_dir;
+  settings.use_cache = !a.no_cache;
+  return settings;
+}
+
+}  // namespace seamcl::cli

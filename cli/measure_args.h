@@ -1,0 +1,35 @@
+// What `compare` and `bench` share on the command line: one frame's render options (the names
+// `render` uses), the method and MSAA lists, and where the reference comes from.
+#pragma once
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "reference.h"
+
+namespace seamcl::cli {
+
+struct MeasureArgs {
+  std::optional<std::string> scene, filter, zero_coverage, texels, size, shading;
+  std::optional<int> aniso;
+  std::string methods;
+  std::string msaa = "1,2,4,8";
+  bool tint = false;
+  std::string reference_method;
+  int reference_msaa = 0;
+  std::string cache_dir;
+  bool no_cache = false;
+  bool json_out = false;
+};
+
+// Adds the shared options to `command`; `methods` starts as default_methods.
+void add_measure_options(CLI::App* command, MeasureArgs& args, const std::string& default_methods);
+
+// The frame's render options given on the command line, as parse_render_options reads them.
+nlohmann::json measure_request(const MeasureArgs& args);
+
+ReferenceSettings reference_settings(const MeasureArgs& args);
+
+}  // namespace seamcl::cli
