@@ -61,6 +61,20 @@ PixelFragment pixel_fragment(const FrameParams& f, const TriangleSetup& t, const
   return out;
 }
 
+bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& f,
+                                  const std::vector<TriangleSetup>& setups, const uint32_t* ids, int x, int y) {
+  for (int s = 0; s < f.sample_count; ++s) {
+    if (ids[s] == SEAMCL_NO_TRIANGLE || std::find(ids, ids + s, ids[s]) != ids + s) continue;
+    const TriangleSetup& t = setups.at(ids[s]);
+    const PixelFragment fragment = pixel_fragment(f, t, ids, ids[s], x, y);
+    const SurfaceUv uv = interpolate_uv(t, fragment.x, fragment.y);
+    const FilterSum sum =
+        method_sum_reference(scene.textures(), t.face, f.sampler, uv.u, uv.v, uv.dudx, uv.dvdx, uv.dudy, uv.dvdy);
+    if (sum.weight == 0.0f) return true;
+  }
+  return false;
+}
+
 ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& f,
                                          const std::vector<TriangleSetup>& setups,
                                          const std::vector<uint32_t>& sample_triangle) {

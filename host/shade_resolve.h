@@ -29,6 +29,11 @@ struct PixelFragment {
 PixelFragment pixel_fragment(const FrameParams& frame, const TriangleSetup& t, const uint32_t* ids, uint32_t slot,
                              int x, int y);
 
+// Whether some fragment of pixel (x, y) (pixel or centroid shading) has no filter tap inside its
+// face (nor, for traverse, its neighbours): the fragments zero_coverage=nan turns into NaN.
+bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& frame,
+                                  const std::vector<TriangleSetup>& setups, const uint32_t* ids, int x, int y);
+
 struct ResolveReference {
   std::vector<glm::vec4> pixels;  // linear RGBA
   uint32_t fragments = 0;

@@ -229,16 +229,7 @@ NanCheck check_nan_pixels(Renderer& renderer, const RenderResult& raw) {
     for (int x = 0; x < frame.width; ++x) {
       const size_t pixel = static_cast<size_t>(y) * static_cast<size_t>(frame.width) + static_cast<size_t>(x);
       const uint32_t* ids = &winners[pixel * static_cast<size_t>(msaa)];
-      bool uncovered_fragment = false;
-      for (int s = 0; s < msaa; ++s) {
-        if (ids[s] == SEAMCL_NO_TRIANGLE || std::find(ids, ids + s, ids[s]) != ids + s) continue;
-        const TriangleSetup& t = setups[ids[s]];
-        const PixelFragment fragment = pixel_fragment(frame, t, ids, ids[s], x, y);
-        const SurfaceUv uv = interpolate_uv(t, fragment.x, fragment.y);
-        const FilterSum sum = method_sum_reference(packed.textures(), t.face, frame.sampler, uv.u, uv.v, uv.dudx,
-                                                   uv.dvdx, uv.dudy, uv.dvdy);
-        uncovered_fragment |= sum.weight == 0.0f;
-      }
+      const bool uncovered_fragment = pixel_has_uncovered_fragment(packed, frame, setups, ids, x, y);
       const bool is_nan = std::isnan(raw.pixels[pixel].r);
       check.nan_pixels += is_nan;
       check.uncovered_pixels += uncovered_fragment;
