@@ -1,6 +1,6 @@
 // seamcl bench: an orbit of N frames, every method x MSAA rate rendered on each frame (frame-major,
 // so machine noise falls on all methods alike), timed from OpenCL profiling events and measured
-// against each frame's reference (host/reference.h, cached) on every K-th frame. Also NaN/Inf
+// against each frame's reference (host/eval/reference.h, cached) on every K-th frame. Also NaN/Inf
 // pixels per frame, temporal stability near seams, memory per method, and the discard-traverse
 // difference curves of the paper's Figure 5 (left).
 #include <unistd.h>
@@ -18,17 +18,17 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cl_runtime.h"
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/core/input_error.h>
+#include <seamcl/eval/comparison.h>
+#include <seamcl/eval/metrics.h>
+#include <seamcl/eval/reference.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene_generators.h>
+#include <seamcl/scene/scene_json.h>
 #include "commands.h"
 #include "measure_args.h"
-#include "comparison.h"
-#include "errors.h"
-#include "metrics.h"
-#include "reference.h"
-#include "render_options.h"
-#include "renderer.h"
-#include "scene_generators.h"
-#include "scene_json.h"
 
 namespace seamcl::cli {
 namespace {

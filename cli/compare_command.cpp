@@ -1,5 +1,5 @@
 // seamcl compare: renders one frame with every method x MSAA rate, measures each against the
-// paper's reference (host/reference.h) and prints the errors (host/metrics.h) with the timings.
+// paper's reference (host/eval/reference.h) and prints the errors (host/eval/metrics.h) with the timings.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,18 +13,18 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cl_runtime.h"
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/core/input_error.h>
+#include <seamcl/eval/comparison.h>
+#include <seamcl/eval/metrics.h>
+#include <seamcl/eval/reference.h>
+#include <seamcl/io/image_io.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene_generators.h>
+#include <seamcl/scene/scene_json.h>
 #include "commands.h"
 #include "measure_args.h"
-#include "comparison.h"
-#include "errors.h"
-#include "image_io.h"
-#include "metrics.h"
-#include "reference.h"
-#include "render_options.h"
-#include "renderer.h"
-#include "scene_generators.h"
-#include "scene_json.h"
 
 namespace seamcl::cli {
 namespace {

@@ -11,14 +11,15 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "cl_runtime.h"
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/core/input_error.h>
+#include <seamcl/io/image_io.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene_generators.h>
+#include <seamcl/scene/scene_json.h>
+#include <seamcl/version.h>
 #include "commands.h"
-#include "errors.h"
-#include "image_io.h"
-#include "render_options.h"
-#include "renderer.h"
-#include "scene_generators.h"
-#include "scene_json.h"
 
 namespace {
 

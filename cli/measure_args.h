@@ -7,7 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "reference.h"
+#include <seamcl/eval/reference.h>
 
 namespace seamcl::cli {
 

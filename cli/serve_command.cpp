@@ -10,9 +10,9 @@
 
 #include <pthread.h>
 
-#include "cl_runtime.h"
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/core/input_error.h>
 #include "commands.h"
-#include "errors.h"
 #include "http_server.h"
 
 namespace seamcl::cli {

@@ -15,16 +15,16 @@
 
 #include <httplib.h>
 
-#include "comparison.h"
-#include "errors.h"
-#include "image_io.h"
-#include "metrics.h"
-#include "packed_scene.h"
-#include "reference.h"
-#include "renderer.h"
-#include "scene.h"
-#include "scene_generators.h"
-#include "scene_json.h"
+#include <seamcl/core/input_error.h>
+#include <seamcl/eval/comparison.h>
+#include <seamcl/eval/metrics.h>
+#include <seamcl/eval/reference.h>
+#include <seamcl/io/image_io.h>
+#include <seamcl/pipeline/packed_scene.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene.h>
+#include <seamcl/scene/scene_generators.h>
+#include <seamcl/scene/scene_json.h>
 
 namespace seamcl::server {
 namespace {
@@ -448,7 +448,7 @@ json HttpServer::parse_body(const httplib::Request& req) const {
   return body;
 }
 
-// POST /v1/compare: seamcl compare's loop (host/comparison.h) on one frame, answered as the JSON
+// POST /v1/compare: seamcl compare's loop (host/eval/comparison.h) on one frame, answered as the JSON
 // of `seamcl compare --json` (without server paths: no cache_path, no images).
 void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   const Clock::time_point start = Clock::now();

@@ -29,8 +29,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cl_runtime.h"
-#include "render_options.h"
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/pipeline/render_options.h>
 
 namespace httplib {
 class Server;

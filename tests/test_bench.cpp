@@ -1,6 +1,6 @@
-// seamcl bench (cli/bench_command.cpp) and the shared comparison loop (host/comparison.h): the JSON
+// seamcl bench (cli/bench_command.cpp) and the shared comparison loop (host/eval/comparison.h): the JSON
 // shape and values on a small scene, bad input, and that `seamcl compare` still prints what its
-// loop printed before it moved into host/comparison.cpp.
+// loop printed before it moved into host/eval/comparison.cpp.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -16,14 +16,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include "comparison.h"
-#include "errors.h"
-#include "metrics.h"
-#include "reference.h"
-#include "render_options.h"
-#include "renderer.h"
-#include "scene_generators.h"
-#include "scene_json.h"
+#include <seamcl/core/input_error.h>
+#include <seamcl/eval/comparison.h>
+#include <seamcl/eval/metrics.h>
+#include <seamcl/eval/reference.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene_generators.h>
+#include <seamcl/scene/scene_json.h>
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -204,7 +204,7 @@ TEST_F(Bench, BadInputExits2NamingTheField) {
   }
 }
 
-// compare's loop moved into host/comparison.cpp; this is the loop as it stood in
+// compare's loop moved into host/eval/comparison.cpp; this is the loop as it stood in
 // cli/compare_command.cpp before the move, and compare must still print what it computed.
 TEST_F(Bench, CompareOutputIsThePreRefactorLoopsButTimings) {
   const BenchProcess c = run_cli(*dir_, "compare --scene quad2 --methods discard,clamp,traverse,guardband --msaa 1,4 "

@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "cl_runtime.h"
-#include "kernel_sources.h"
+#include <seamcl/cl/cl_runtime.h>
+#include "cl/kernel_sources.h"
 
 using namespace seamcl;
 

@@ -16,7 +16,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "image_io.h"
+#include <seamcl/io/image_io.h>
+#include <seamcl/version.h>
 
 namespace fs = std::filesystem;
 using nlohmann::json;

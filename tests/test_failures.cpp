@@ -21,17 +21,17 @@
 
 #include <nlohmann/json.hpp>
 
+#include <seamcl/eval/metrics.h>
+#include <seamcl/eval/reference.h>
+#include <seamcl/io/image_io.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene.h>
+#include <seamcl/scene/scene_generators.h>
 #include "test_support.h"
-#include "image_io.h"
-#include "metrics.h"
-#include "raster.h"
-#include "reference.h"
-#include "render_options.h"
-#include "renderer.h"
-#include "scene.h"
-#include "scene_generators.h"
-#include "shade_resolve.h"
-#include "texture_sample.h"
+#include "twins/raster.h"
+#include "twins/shade_resolve.h"
+#include "twins/texture_sample.h"
 
 using namespace seamcl;
 using nlohmann::json;

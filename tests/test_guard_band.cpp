@@ -7,13 +7,13 @@
 #include <cmath>
 #include <random>
 
-#include "guard_band.h"
-#include "adjacency.h"
-#include "packed_scene.h"
-#include "render_options.h"
-#include "scene_generators.h"
-#include "texture_lookups.h"
-#include "texture_sample.h"
+#include <seamcl/pipeline/packed_scene.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/texture_lookups.h>
+#include <seamcl/scene/scene_generators.h>
+#include "pipeline/adjacency.h"
+#include "pipeline/guard_band.h"
+#include "twins/texture_sample.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

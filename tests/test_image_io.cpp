@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "errors.h"
-#include "image_io.h"
+#include <seamcl/core/input_error.h>
+#include <seamcl/io/image_io.h>
 
 using namespace seamcl;
 

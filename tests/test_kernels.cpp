@@ -9,17 +9,17 @@
 #include <cmath>
 #include <random>
 
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene_generators.h>
+#include "pipeline/frame_params.h"
 #include "test_support.h"
-#include "binning.h"
-#include "cl_runtime.h"
-#include "frame_params.h"
-#include "raster.h"
-#include "renderer.h"
-#include "sample_pattern.h"
-#include "scene_generators.h"
-#include "shade_resolve.h"
-#include "texture_sample.h"
-#include "triangle_setup.h"
+#include "twins/binning.h"
+#include "twins/raster.h"
+#include "twins/sample_pattern.h"
+#include "twins/shade_resolve.h"
+#include "twins/texture_sample.h"
+#include "twins/triangle_setup.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;
@@ -185,7 +185,7 @@ TEST(KernelVsTwin, EveryStageOnBuiltInAndRandomScenes) {
 
 TEST(SamplePattern, HostAndKernelTablesAreTheD3D11StandardPatterns) {
   // D3D11_STANDARD_MULTISAMPLE_PATTERN, in 1/16 pixel from the centre (D3D11.3 spec 3.5.6.1),
-  // written out here independently of host/sample_pattern.cpp.
+  // written out here independently of host/twins/sample_pattern.cpp.
   const std::vector<std::vector<std::pair<int, int>>> standard = {
       {{0, 0}},
       {{4, 4}, {-4, -4}},

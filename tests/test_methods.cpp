@@ -6,14 +6,15 @@
 
 #include <cmath>
 
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene_generators.h>
+#include "core/srgb.h"
 #include "test_support.h"
-#include "cl_runtime.h"
-#include "raster.h"
-#include "render_options.h"
-#include "renderer.h"
-#include "scene_generators.h"
-#include "shade_resolve.h"
-#include "texture_sample.h"
+#include "twins/raster.h"
+#include "twins/shade_resolve.h"
+#include "twins/texture_sample.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

@@ -1,5 +1,5 @@
-// Error metrics (host/metrics.h) on synthetic images with known answers, the paper's reference
-// (host/reference.h: the Mitchell downsample held to a direct evaluation of the kernel, the disk
+// Error metrics (host/eval/metrics.h) on synthetic images with known answers, the paper's reference
+// (host/eval/reference.h: the Mitchell downsample held to a direct evaluation of the kernel, the disk
 // cache), and `seamcl compare` end to end through the real binary.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -21,12 +21,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "errors.h"
-#include "gpu_types.h"
-#include "metrics.h"
-#include "reference.h"
-#include "renderer.h"
-#include "scene_generators.h"
+#include <seamcl/core/input_error.h>
+#include <seamcl/eval/metrics.h>
+#include <seamcl/eval/reference.h>
+#include <seamcl/pipeline/gpu_types.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene_generators.h>
 #include "test_support.h"
 
 namespace fs = std::filesystem;

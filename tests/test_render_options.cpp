@@ -2,8 +2,8 @@
 // refusal naming its field.
 #include <gtest/gtest.h>
 
-#include "errors.h"
-#include "render_options.h"
+#include <seamcl/core/input_error.h>
+#include <seamcl/pipeline/render_options.h>
 
 using nlohmann::json;
 using namespace seamcl;

@@ -6,12 +6,13 @@
 #include <cmath>
 #include <random>
 
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/pipeline/packed_scene.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/texture_lookups.h>
+#include "core/srgb.h"
 #include "test_support.h"
-#include "cl_runtime.h"
-#include "packed_scene.h"
-#include "render_options.h"
-#include "texture_lookups.h"
-#include "texture_sample.h"
+#include "twins/texture_sample.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

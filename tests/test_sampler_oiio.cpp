@@ -56,14 +56,15 @@
 
 #include <unistd.h>
 
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/pipeline/packed_scene.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/texture_lookups.h>
+#include <seamcl/scene/scene.h>
+#include "core/srgb.h"
+#include "io/texture_file.h"
 #include "test_support.h"
-#include "cl_runtime.h"
-#include "packed_scene.h"
-#include "render_options.h"
-#include "scene.h"
-#include "texture_file.h"
-#include "texture_lookups.h"
-#include "texture_sample.h"
+#include "twins/texture_sample.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

@@ -12,10 +12,10 @@
 #include <random>
 #include <set>
 
-#include "errors.h"
-#include "scene.h"
-#include "scene_generators.h"
-#include "scene_json.h"
+#include <seamcl/core/input_error.h>
+#include <seamcl/scene/scene.h>
+#include <seamcl/scene/scene_generators.h>
+#include <seamcl/scene/scene_json.h>
 
 namespace seamcl {
 namespace {

@@ -21,17 +21,17 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
-#include "comparison.h"
-#include "errors.h"
+#include <seamcl/core/input_error.h>
+#include <seamcl/eval/comparison.h>
+#include <seamcl/eval/metrics.h>
+#include <seamcl/eval/reference.h>
+#include <seamcl/io/image_io.h>
+#include <seamcl/pipeline/packed_scene.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene_generators.h>
+#include <seamcl/scene/scene_json.h>
 #include "http_server.h"
-#include "image_io.h"
-#include "metrics.h"
-#include "packed_scene.h"
-#include "reference.h"
-#include "render_options.h"
-#include "renderer.h"
-#include "scene_generators.h"
-#include "scene_json.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;

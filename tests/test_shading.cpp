@@ -16,12 +16,13 @@
 
 #include <glm/glm.hpp>
 
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene.h>
+#include <seamcl/scene/scene_generators.h>
+#include "core/srgb.h"
 #include "test_support.h"
-#include "cl_runtime.h"
-#include "renderer.h"
-#include "scene.h"
-#include "scene_generators.h"
-#include "texture_sample.h"
+#include "twins/texture_sample.h"
 
 using namespace seamcl;
 

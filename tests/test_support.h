@@ -3,7 +3,7 @@
 #pragma once
 #include <random>
 
-#include "cl_runtime.h"
+#include <seamcl/cl/cl_runtime.h>
 
 namespace seamcl_tests {
 

@@ -23,11 +23,11 @@
 
 #include <glm/glm.hpp>
 
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene.h>
+#include "pipeline/frame_params.h"
 #include "test_support.h"
-#include "cl_runtime.h"
-#include "frame_params.h"
-#include "renderer.h"
-#include "scene.h"
 
 using namespace seamcl;
 

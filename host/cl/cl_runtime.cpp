@@ -1,0 +1,228 @@
+#include <seamcl/cl/cl_runtime.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+#include "cl/kernel_sources.h"
+
+namespace seamcl {
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+std::string trimmed(std::string s) {
+  while (!s.empty() && (s.back() == '\0' || std::isspace(static_cast<unsigned char>(s.back())))) s.pop_back();
+  return s;
+}
+
+std::string device_type_name(cl_device_type type) {
+  if (type & CL_DEVICE_TYPE_GPU) return "GPU";
+  if (type & CL_DEVICE_TYPE_CPU) return "CPU";
+  if (type & CL_DEVICE_TYPE_ACCELERATOR) return "accelerator";
+  return "other";
+}
+
+struct Candidate {
+  cl::Platform platform;
+  cl::Device device;
+  DeviceInfo info;
+};
+
+std::vector<Candidate> all_devices() {
+  std::vector<cl::Platform> platforms;
+  try {
+    cl::Platform::get(&platforms);
+  } catch (const cl::Error& e) {
+    // The ICD loader reports "no platforms" as an error; that is an empty list to us.
+    if (e.err() == CL_PLATFORM_NOT_FOUND_KHR) return {};
+    throw;
+  }
+  std::vector<Candidate> out;
+  for (const cl::Platform& platform : platforms) {
+    std::vector<cl::Device> devices;
+    try {
+      platform.getDevices(CL_DEVICE_TYPE_ALL, &devices);
+    } catch (const cl::Error& e) {
+      if (e.err() == CL_DEVICE_NOT_FOUND) continue;
+      throw;
+    }
+    for (const cl::Device& device : devices) {
+      DeviceInfo info;
+      info.platform = trimmed(platform.getInfo<CL_PLATFORM_NAME>());
+      info.name = trimmed(device.getInfo<CL_DEVICE_NAME>());
+      info.type = device_type_name(device.getInfo<CL_DEVICE_TYPE>());
+      info.version = trimmed(device.getInfo<CL_DEVICE_VERSION>());
+      info.compute_units = static_cast<int>(device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>());
+      out.push_back({platform, device, info});
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<DeviceInfo> list_devices() {
+  std::vector<DeviceInfo> out;
+  for (const Candidate& c : all_devices()) out.push_back(c.info);
+  return out;
+}
+
+std::string cl_error_name(int code) {
+  switch (code) {
+#define SEAMCL_CASE(name) \
+  case name:              \
+    return #name;
+    SEAMCL_CASE(CL_SUCCESS)
+    SEAMCL_CASE(CL_DEVICE_NOT_FOUND)
+    SEAMCL_CASE(CL_DEVICE_NOT_AVAILABLE)
+    SEAMCL_CASE(CL_COMPILER_NOT_AVAILABLE)
+    SEAMCL_CASE(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+    SEAMCL_CASE(CL_OUT_OF_RESOURCES)
+    SEAMCL_CASE(CL_OUT_OF_HOST_MEMORY)
+    SEAMCL_CASE(CL_PROFILING_INFO_NOT_AVAILABLE)
+    SEAMCL_CASE(CL_MEM_COPY_OVERLAP)
+    SEAMCL_CASE(CL_IMAGE_FORMAT_MISMATCH)
+    SEAMCL_CASE(CL_IMAGE_FORMAT_NOT_SUPPORTED)
+    SEAMCL_CASE(CL_BUILD_PROGRAM_FAILURE)
+    SEAMCL_CASE(CL_MAP_FAILURE)
+    SEAMCL_CASE(CL_MISALIGNED_SUB_BUFFER_OFFSET)
+    SEAMCL_CASE(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+    SEAMCL_CASE(CL_COMPILE_PROGRAM_FAILURE)
+    SEAMCL_CASE(CL_LINKER_NOT_AVAILABLE)
+    SEAMCL_CASE(CL_LINK_PROGRAM_FAILURE)
+    SEAMCL_CASE(CL_DEVICE_PARTITION_FAILED)
+    SEAMCL_CASE(CL_KERNEL_ARG_INFO_NOT_AVAILABLE)
+    SEAMCL_CASE(CL_INVALID_VALUE)
+    SEAMCL_CASE(CL_INVALID_DEVICE_TYPE)
+    SEAMCL_CASE(CL_INVALID_PLATFORM)
+    SEAMCL_CASE(CL_INVALID_DEVICE)
+    SEAMCL_CASE(CL_INVALID_CONTEXT)
+    SEAMCL_CASE(CL_INVALID_QUEUE_PROPERTIES)
+    SEAMCL_CASE(CL_INVALID_COMMAND_QUEUE)
+    SEAMCL_CASE(CL_INVALID_HOST_PTR)
+    SEAMCL_CASE(CL_INVALID_MEM_OBJECT)
+    SEAMCL_CASE(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR)
+    SEAMCL_CASE(CL_INVALID_IMAGE_SIZE)
+    SEAMCL_CASE(CL_INVALID_SAMPLER)
+    SEAMCL_CASE(CL_INVALID_BINARY)
+    SEAMCL_CASE(CL_INVALID_BUILD_OPTIONS)
+    SEAMCL_CASE(CL_INVALID_PROGRAM)
+    SEAMCL_CASE(CL_INVALID_PROGRAM_EXECUTABLE)
+    SEAMCL_CASE(CL_INVALID_KERNEL_NAME)
+    SEAMCL_CASE(CL_INVALID_KERNEL_DEFINITION)
+    SEAMCL_CASE(CL_INVALID_KERNEL)
+    SEAMCL_CASE(CL_INVALID_ARG_INDEX)
+    SEAMCL_CASE(CL_INVALID_ARG_VALUE)
+    SEAMCL_CASE(CL_INVALID_ARG_SIZE)
+    SEAMCL_CASE(CL_INVALID_KERNEL_ARGS)
+    SEAMCL_CASE(CL_INVALID_WORK_DIMENSION)
+    SEAMCL_CASE(CL_INVALID_WORK_GROUP_SIZE)
+    SEAMCL_CASE(CL_INVALID_WORK_ITEM_SIZE)
+    SEAMCL_CASE(CL_INVALID_GLOBAL_OFFSET)
+    SEAMCL_CASE(CL_INVALID_EVENT_WAIT_LIST)
+    SEAMCL_CASE(CL_INVALID_EVENT)
+    SEAMCL_CASE(CL_INVALID_OPERATION)
+    SEAMCL_CASE(CL_INVALID_GL_OBJECT)
+    SEAMCL_CASE(CL_INVALID_BUFFER_SIZE)
+    SEAMCL_CASE(CL_INVALID_MIP_LEVEL)
+    SEAMCL_CASE(CL_INVALID_GLOBAL_WORK_SIZE)
+    SEAMCL_CASE(CL_INVALID_PROPERTY)
+    SEAMCL_CASE(CL_INVALID_IMAGE_DESCRIPTOR)
+    SEAMCL_CASE(CL_INVALID_COMPILER_OPTIONS)
+    SEAMCL_CASE(CL_INVALID_LINKER_OPTIONS)
+    SEAMCL_CASE(CL_INVALID_DEVICE_PARTITION_COUNT)
+    SEAMCL_CASE(CL_PLATFORM_NOT_FOUND_KHR)
+#undef SEAMCL_CASE
+    default:
+      return "CL_ERROR(" + std::to_string(code) + ")";
+  }
+}
+
+std::string describe_cl_exception(const std::exception& error) {
+  if (const auto* build = dynamic_cast<const cl::BuildError*>(&error)) {
+    std::ostringstream out;
+    out << "OpenCL " << build->what() << " failed: " << cl_error_name(build->err());
+    for (const auto& [device, log] : build->getBuildLog()) {
+      out << "\n--- build log for " << trimmed(device.getInfo<CL_DEVICE_NAME>()) << " ---\n" << trimmed(log);
+    }
+    return out.str();
+  }
+  if (const auto* cl_error = dynamic_cast<const cl::Error*>(&error)) {
+    return std::string("OpenCL call ") + cl_error->what() + " failed: " + cl_error_name(cl_error->err());
+  }
+  return error.what();
+}
+
+ClRuntime::ClRuntime(const std::string& device_filter) {
+  std::string filter = device_filter;
+  if (filter.empty()) {
+    if (const char* env = std::getenv("SEAMCL_DEVICE")) filter = env;
+  }
+  const std::vector<Candidate> candidates = all_devices();
+  if (candidates.empty()) {
+    throw std::runtime_error("no OpenCL device found (is an ICD such as pocl-opencl-icd installed?)");
+  }
+  const Candidate* chosen = nullptr;
+  if (!filter.empty()) {
+    for (const Candidate& c : candidates) {
+      if (lower(c.info.platform + " " + c.info.name).find(lower(filter)) != std::string::npos) {
+        chosen = &c;
+        break;
+      }
+    }
+    if (chosen == nullptr) {
+      std::string known;
+      for (const Candidate& c : candidates) known += (known.empty() ? "" : ", ") + c.info.name;
+      throw std::runtime_error("device: no OpenCL device matches '" + filter + "' (devices: " + known + ")");
+    }
+  } else {
+    for (const char* wanted : {"GPU", "CPU"}) {
+      for (const Candidate& c : candidates) {
+        if (chosen == nullptr && c.info.type == wanted) chosen = &c;
+      }
+    }
+    if (chosen == nullptr) chosen = &candidates.front();
+  }
+  device_ = chosen->device;
+  info_ = chosen->info;
+  context_ = cl::Context(device_);
+  queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
+}
+
+std::string ClRuntime::device_description() const {
+  return info_.name + " (" + info_.platform + ", " + info_.version + ")";
+}
+
+const cl::Program& ClRuntime::program(const std::string& options) {
+  std::lock_guard<std::mutex> lock(programs_mutex_);
+  std::unique_ptr<cl::Program>& slot = programs_[options];
+  if (!slot) {
+    const auto start = std::chrono::steady_clock::now();
+    auto program = std::make_unique<cl::Program>(context_, program_source());
+    std::string all_options = "-cl-std=CL1.2 " + options;
+    if (const char* extra = std::getenv("SEAMCL_EXTRA_BUILD_OPTIONS")) all_options += std::string(" ") + extra;
+    program->build(std::vector<cl::Device>{device_}, all_options.c_str());
+    build_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    slot = std::move(program);
+  }
+  return *slot;
+}
+
+double ClRuntime::program_build_ms() const {
+  std::lock_guard<std::mutex> lock(programs_mutex_);
+  return build_ms_;
+}
+
+double event_milliseconds(const cl::Event& event) {
+  const cl_ulong start = event.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+  const cl_ulong end = event.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+  return static_cast<double>(end - start) * 1e-6;
+}
+
+}  // namespace seamcl

@@ -1,0 +1,89 @@
+// Image error metrics: how far a rendered frame is from a reference frame of the same size, as in
+// the paper's Figure 5 (the fraction of pixels whose 2-norm distance in linear RGB is at least x),
+// with summary numbers over the whole frame and over the pixels near texture seams.
+//
+// Definitions (the tests hold these exactly):
+// - distance of a pixel: ||test.rgb - reference.rgb||_2 in linear RGB (alpha ignored);
+// - a pixel is non-finite when any of its six rgb values (test or reference) is NaN or Inf; it is
+//   counted in nan_pixels and left out of every other statistic;
+// - mean: the arithmetic mean over the finite pixels; max: their largest distance;
+// - p99: the nearest-rank 99th percentile, the ceil(0.99 n)-th smallest distance (1-based);
+// - curve: for x_i = 10^(-4 + i/10), i = 0..40 (1e-4 .. 1, 41 steps, 10 per decade), the fraction
+//   of the finite pixels with distance >= x_i;
+// - seam mask: pixels within Chebyshev distance kSeamRadius (2, i.e. a 5x5 square) of a seam
+//   pixel. A seam pixel is a covered pixel with a 4-neighbour covered by a *different face*, or a
+//   pixel whose samples mix faces (FaceMap::mixed). Face-to-background edges (silhouettes) are not
+//   seams: they are geometry, the same for every seam method.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/scene/scene.h>
+
+namespace seamcl {
+
+class Renderer;
+
+inline constexpr int kCurveSteps = 41;
+inline constexpr int kSeamRadius = 2;
+
+// The curve's x values: 10^(-4 + i/10), i = 0..kCurveSteps-1.
+std::vector<double> error_curve_thresholds();
+
+// The face visible at each pixel (-1 for background) of a frame at its own resolution.
+struct FaceMap {
+  int width = 0;
+  int height = 0;
+  std::vector<int32_t> face;    // row-major, row 0 at the top
+  std::vector<uint8_t> mixed;   // 1 where the pixel's samples cover more than one face; empty = none
+};
+
+// From the raster stage's winners (slot per sample, SEAMCL_NO_TRIANGLE for none) and the setups
+// (setups[slot].face). With one sample per pixel the face is the one at the pixel centre; with
+// more, the face of the first covered sample, and `mixed` marks pixels whose samples differ
+// (background counts as a face of its own there).
+FaceMap face_map_from_winners(const std::vector<uint32_t>& winners, const std::vector<uint32_t>& slot_faces, int width,
+                              int height, int samples);
+
+// Renders `options` (scene already loaded) with 1 sample per pixel and reads the winners: the
+// face id map of that frame at its own size.
+FaceMap render_face_map(Renderer& renderer, const Camera& camera, RenderOptions options);
+
+// 1 for the pixels near a seam (see above), 0 elsewhere.
+std::vector<uint8_t> seam_mask(const FaceMap& faces, int radius = kSeamRadius);
+
+struct ErrorStats {
+  size_t pixels = 0;  // finite pixels counted (inside the mask, if any)
+  double mean = 0;
+  double p99 = 0;
+  double max = 0;
+  std::vector<double> curve;  // fraction of `pixels` with distance >= error_curve_thresholds()[i]
+};
+
+struct ImageErrors {
+  ErrorStats all;
+  ErrorStats seam;            // over the seam mask (all zero and pixels = 0 without one)
+  size_t nan_pixels = 0;      // non-finite pixels, whole frame
+  size_t seam_nan_pixels = 0; // non-finite pixels inside the seam mask
+  std::vector<float> distance;  // per pixel; NaN where non-finite
+};
+
+// Per-pixel distances; NaN for non-finite pixels. Sizes must match (std::invalid_argument).
+std::vector<float> pixel_distances(const std::vector<glm::vec4>& test, const std::vector<glm::vec4>& reference);
+
+// Statistics over the finite distances, restricted to mask[i] != 0 when `mask` is given.
+ErrorStats error_stats(const std::vector<float>& distance, const std::vector<uint8_t>* mask = nullptr);
+
+// Everything above in one call; `mask` (optional) is a seam mask of the same size.
+ImageErrors compare_images(const std::vector<glm::vec4>& test, const std::vector<glm::vec4>& reference,
+                           const std::vector<uint8_t>* mask = nullptr);
+
+// A heat map of the distances for viewing: log10 scale from 1e-4 (black) through blue, red and
+// yellow to 1 and above (white); exactly 0 is black, non-finite pixels magenta. Opaque linear RGBA.
+std::vector<glm::vec4> error_heatmap(const std::vector<float>& distance);
+
+}  // namespace seamcl

@@ -1,0 +1,99 @@
+// The paper's reference image (section 5): the same scene and camera rendered with the reference
+// method at 8x the width and 8x the height, 1 sample per pixel, then downsampled by 8 with a
+// Mitchell-Netravali filter, B = C = 1/3. Cached on disk as float EXR.
+//
+// The downsample is OpenImageIO's ImageBufAlgo::resize with filter "mitchell" at width 4 (in
+// pixels of the *output* image). Checked in OIIO's source (src/libutil/filter.cpp,
+// FilterMitchell1D::mitchell1d): B = C = 1/3 exactly, the classic formula evaluated on x rescaled
+// so that the filter's full width maps to Mitchell's [-2, 2]. resize() (imagebufalgo_xform.cpp)
+// takes the width in destination pixels and, when no width is given, uses the filter's default
+// (4 for mitchell) times max(1, dst/src), i.e. 4 when shrinking: support radius 2 output pixels =
+// 16 source pixels at 8x. The 2D filter is separable (product of the 1D ones), the weights are
+// normalised to sum 1 and taps beyond the image edge read the edge pixel (clamp). We pass the
+// width (4) explicitly; tests/test_metrics.cpp holds the result to a direct evaluation of the
+// kernel and checks the installed library's default width.
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene.h>
+
+namespace seamcl {
+
+inline constexpr int kReferenceScale = 8;             // 8x width and 8x height
+inline constexpr float kMitchellWidth = 4.0f;         // full width in output pixels (radius 2)
+inline constexpr double kMitchellB = 1.0 / 3.0;
+inline constexpr double kMitchellC = 1.0 / 3.0;
+inline constexpr long long kMaxReferencePixels = 1LL << 26;  // 8W x 8H; 64 Mpixel = 1 GiB of float RGBA
+
+// The Mitchell-Netravali (1988) cubic, support |x| < 2, integral 1.
+double mitchell_netravali(double x, double b = kMitchellB, double c = kMitchellC);
+
+// Downsamples linear RGBA (width and height multiples of `factor`) by `factor` with OIIO's
+// "mitchell" resize at kMitchellWidth output pixels. Throws std::invalid_argument on bad sizes and
+// std::runtime_error if OIIO fails.
+std::vector<glm::vec4> downsample_mitchell(const std::vector<glm::vec4>& pixels, int width, int height, int factor);
+
+// "traverse" when parse_method accepts it, else "discard".
+std::string default_reference_method();
+// 1 sample per pixel for traverse (the paper's reference); 16 for the discard stand-in.
+int default_reference_msaa(const std::string& method);
+
+struct ReferenceSettings {
+  std::string method;      // empty: default_reference_method()
+  int msaa = 0;            // 0: default_reference_msaa(method)
+  std::string cache_dir;   // empty: default_cache_dir()
+  bool use_cache = true;
+};
+
+// $SEAMCL_CACHE_DIR, else $HOME/.cache/seamcl, else <temp>/seamcl-cache.
+std::string default_cache_dir();
+
+// The options of the high-resolution render for a measured frame: the frame's options with the
+// reference method and msaa, 8x the size, pixel shading. InputError("size", ...) when that is
+// too large, InputError("reference_method"/"reference_msaa", ...) for bad settings.
+RenderOptions reference_render_options(const RenderOptions& frame, const ReferenceSettings& settings);
+
+// Everything the reference depends on, as one canonical JSON string: a hash of the scene's
+// content (geometry, textures, light, background), the camera, the reference render options
+// (scene name, frame, frames, size, method, msaa, filter, aniso, texels, ...), the kernel
+// sources, the scale and the downsample filter.
+std::string reference_cache_key(const Scene& scene, const Camera& camera, const RenderOptions& frame,
+                                const ReferenceSettings& settings);
+
+struct ReferenceImage {
+  int width = 0;
+  int height = 0;
+  std::vector<glm::vec4> pixels;  // linear RGBA at the frame's size
+  std::string method;             // the reference method used
+  int msaa = 1;                   // its samples per pixel at 8x
+  bool from_cache = false;
+  std::string cache_path;         // empty when not cached
+  double render_ms = 0;           // wall time of the 8x render + downsample (0 from cache)
+};
+
+// Renders a high-resolution frame (the options come from reference_render_options).
+using HighResRender = std::function<RenderResult(const RenderOptions&)>;
+
+// The reference for `frame` of `scene` seen from `camera`. With use_cache, a cache entry whose
+// stored key matches is returned without calling `render`; a missing, unreadable or mismatched
+// entry is rendered again and rewritten (atomically: temporary file and rename).
+ReferenceImage reference_image(const Scene& scene, const Camera& camera, const RenderOptions& frame,
+                               const ReferenceSettings& settings, const HighResRender& render);
+
+// The usual HighResRender: `renderer` (with `scene` loaded) renders `camera`.
+ReferenceImage reference_image(Renderer& renderer, const Camera& camera, const RenderOptions& frame,
+                               const ReferenceSettings& settings);
+
+// How a reference was made, as compare, bench and the HTTP service report it: method, msaa,
+// scale, filter and its width, B, C, whether it came from the cache, ms; with_cache_path adds
+// the file (the HTTP service leaves it out: clients never see server paths).
+nlohmann::json reference_json(const ReferenceImage& reference, bool with_cache_path);
+
+}  // namespace seamcl

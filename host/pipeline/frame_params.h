@@ -1,0 +1,24 @@
+// The per-frame constants of the pipeline (FrameParams): camera matrices, clip planes sized so
+// that fixed-point arithmetic cannot overflow, tiles, samples and lighting.
+#pragma once
+#include <cstdint>
+
+#include <seamcl/pipeline/gpu_types.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/scene/scene.h>
+
+namespace seamcl {
+
+inline constexpr float kNearPlane = 0.01f;
+// Clip planes at |x|, |y| <= kGuardBand * w in NDC: one image width (height) beyond each edge.
+// It bounds screen coordinates to [-W, 2W] (with sides <= 16384 the edge-function products stay
+// far inside 64 bits) and so bounds how far the float attribute planes are extrapolated from
+// their reference vertex (a near-plane vertex would otherwise sit millions of pixels away).
+inline constexpr float kGuardBand = 3.0f;
+
+glm::mat4 view_projection(const Camera& camera, int width, int height);
+
+FrameParams make_frame_params(const Scene& scene, const Camera& camera, const RenderOptions& options,
+                              uint32_t bin_capacity);
+
+}  // namespace seamcl

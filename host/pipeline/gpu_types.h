@@ -1,0 +1,26 @@
+// The host view of kernels/seamcl_types.h, with its layout pinned: a change on one side that the
+// other does not make fails to compile here rather than corrupting buffers at run time.
+#pragma once
+#include <cstddef>
+
+#include <seamcl/kernels/seamcl_types.h>
+
+static_assert(sizeof(SamplerParams) == 32, "SamplerParams layout");
+static_assert(sizeof(FrameParams) == 184, "FrameParams layout");
+static_assert(offsetof(FrameParams, sampler) == 152);
+static_assert(offsetof(FrameParams, width) == 64);
+static_assert(offsetof(FrameParams, near_w) == 96);
+static_assert(offsetof(FrameParams, light_dir) == 108);
+static_assert(offsetof(FrameParams, background) == 136);
+static_assert(sizeof(FaceGpu) == 48, "FaceGpu layout");
+static_assert(offsetof(FaceGpu, normal) == 32);
+static_assert(sizeof(TriangleSetup) == 112, "TriangleSetup layout");
+static_assert(offsetof(TriangleSetup, edge_a) == 24);
+static_assert(offsetof(TriangleSetup, bbox_min_x) == 48);
+static_assert(offsetof(TriangleSetup, face) == 64);
+static_assert(offsetof(TriangleSetup, inv_w) == 76);
+static_assert(offsetof(TriangleSetup, v_over_w) == 100);
+static_assert(sizeof(FrameStats) == 16, "FrameStats layout");
+static_assert(sizeof(FaceNeighbors) == 112, "FaceNeighbors layout");
+static_assert(offsetof(FaceNeighbors, transform) == 16);
+static_assert(offsetof(SamplerParams, traverse) == 20);

@@ -1,0 +1,39 @@
+// A scene flattened into the arrays the kernels read (and the twins read too): positions, faces
+// with their texture level tables, and every texel of every level in one RGBA8 sRGB buffer.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <seamcl/pipeline/gpu_types.h>
+#include <seamcl/pipeline/texture_view.h>
+#include <seamcl/scene/scene.h>
+
+namespace seamcl {
+
+struct PackedScene {
+  std::vector<cl_float4> positions;     // xyz, w = 1
+  std::vector<FaceGpu> faces;
+  std::vector<FaceNeighbors> neighbors;  // edge adjacency, for traverse
+  std::vector<uint32_t> level_offsets;  // per face, per level: first texel in `texels`
+  TexelFormat format = TexelFormat::Rgba8;
+  int guard_band = 0;                   // band texels stored around every level (guardband method)
+  size_t band_texels = 0;               // of all stored texels, those in bands
+  std::vector<uint32_t> texels8;        // RGBA8, sRGB-encoded RGB (format Rgba8)
+  std::vector<float> texels32;          // linear RGBA32F, 4 floats a texel (format Rgba32f)
+
+  int input_triangles() const { return static_cast<int>(faces.size() * 2); }
+  TextureView textures() const { return {&faces, &neighbors, &level_offsets, format, &texels8, &texels32, guard_band}; }
+  size_t texel_count() const { return format == TexelFormat::Rgba8 ? texels8.size() : texels32.size() / 4; }
+  size_t texel_bytes() const { return format == TexelFormat::Rgba8 ? sizeof(uint32_t) : 4 * sizeof(float); }
+  // All stored texels, bands included; padding_bytes() is the bands' share.
+  size_t texture_bytes() const { return texels8.size() * sizeof(uint32_t) + texels32.size() * sizeof(float); }
+  size_t padding_bytes() const { return band_texels * texel_bytes(); }
+  size_t adjacency_bytes() const { return neighbors.size() * sizeof(FaceNeighbors); }
+};
+
+inline constexpr int kMaxGuardBand = 16;
+
+// With guard_band > 0 every level is stored with that many band texels each side (guard_band.h).
+PackedScene pack_scene(const Scene& scene, TexelFormat format = TexelFormat::Rgba8, int guard_band = 0);
+
+}  // namespace seamcl

@@ -1,0 +1,90 @@
+// The options of one render, with their defaults, parsed from one JSON object by the same code
+// for the CLI (which gathers its flags into such an object) and the HTTP service, so the two use
+// the same names, value forms and error messages.
+#pragma once
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <seamcl/pipeline/texture_view.h>
+
+namespace seamcl {
+
+// How a lookup treats taps outside the face (the seam method):
+//   clamp   - taps read the nearest edge texel (seams show);
+//   black   - taps outside weigh zero, no renormalisation (Ptex's black border: edges darken);
+//   discard - taps outside weigh zero and the rest are renormalised (Toth 2013);
+//   traverse - discard, plus the same lookup on the four edge neighbours through their uv
+//              transforms, all summed and then renormalised (McDonald 2013);
+//   guardband - clamp, on textures whose every level carries a band of guard_band texels
+//               filled from the neighbours at build time (McDonald and Burley 2011).
+enum class Method { Clamp, Black, Discard, Traverse, Guardband };
+// The filter of one lookup: bilinear (level 0), trilinear, aniso (hardware-style probes), ewa.
+enum class Filter { Bilinear, Trilinear, Aniso, Ewa };
+// Discard with every tap outside: a clamped lookup (the paper's fix) or the raw 0/0 (NaN).
+enum class ZeroCoverage { Clamp, Nan };
+// Where a fragment is shaded: the pixel centre, the centroid of its covered samples, or every
+// sample (supersampling).
+enum class ShadingMode { Pixel, Centroid, Sample };
+enum class ImageFormat { Png, Exr };
+
+std::optional<Method> parse_method(std::string_view name);
+std::string to_string(Method method);
+std::vector<std::string> method_names();
+std::optional<ShadingMode> parse_shading_mode(std::string_view name);
+std::string to_string(ShadingMode mode);
+std::vector<std::string> shading_mode_names();
+std::optional<ImageFormat> parse_image_format(std::string_view name);
+std::string to_string(ImageFormat format);
+std::optional<Filter> parse_filter(std::string_view name);
+std::string to_string(Filter filter);
+std::vector<std::string> filter_names();
+std::optional<ZeroCoverage> parse_zero_coverage(std::string_view name);
+std::string to_string(ZeroCoverage mode);
+std::vector<std::string> zero_coverage_names();
+std::optional<TexelFormat> parse_texel_format(std::string_view name);
+std::string to_string(TexelFormat format);
+std::vector<std::string> texel_format_names();
+
+inline constexpr int kMaxImageSide = 16384;
+inline constexpr long long kMaxSamplesPerImage = 1LL << 28;  // width * height * msaa
+
+struct RenderOptions {
+  std::string scene = "paper";  // built-in name or scene file
+  Method method = Method::Discard;
+  Filter filter = Filter::Aniso;
+  ZeroCoverage zero_coverage = ZeroCoverage::Clamp;
+  TexelFormat texels = TexelFormat::Rgba8;
+  int msaa = 1;                 // 1, 2, 4, 8 or 16 samples per pixel
+  int aniso = 16;               // maximum anisotropy, 1..16 (aniso and ewa filters)
+  int guard_band = 4;           // guardband: band texels per side, 1..kMaxGuardBand (16)
+  int width = 480;
+  int height = 540;
+  ShadingMode shading = ShadingMode::Pixel;
+  std::optional<int> frame;     // orbit frame, with `frames`
+  int frames = 60;
+  bool tint = false;            // built-in scenes: a base colour per face
+};
+
+// Reads the keys present in `request` over the defaults. Throws InputError naming the key on a
+// wrong type, an out-of-range value or an unknown key. Keys: scene, method, filter, msaa, aniso,
+// size ("WxH"), shading, centroid (bool, same as shading=centroid), zero_coverage, texels,
+// guard_band, frame, frames, tint.
+RenderOptions parse_render_options(const nlohmann::json& request);
+nlohmann::json to_json(const RenderOptions& options);
+
+// The sampler settings a method stands for (see SamplerParams in kernels/seamcl_types.h).
+// guard_band is used by Method::Guardband only (0 otherwise).
+SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCoverage zero_coverage,
+                             int guard_band = 4);
+inline SamplerParams sampler_params(const RenderOptions& o) {
+  return sampler_params(o.method, o.filter, o.aniso, o.zero_coverage, o.guard_band);
+}
+
+// "480x540" -> {480, 540}; throws InputError(field) unless both are integers in 1..kMaxImageSide.
+std::pair<int, int> parse_size(const std::string& text, const std::string& field = "size");
+
+}  // namespace seamcl

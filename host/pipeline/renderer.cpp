@@ -1,0 +1,301 @@
+#include <seamcl/pipeline/renderer.h>
+
+#include <algorithm>
+#include <map>
+#include <cassert>
+#include <stdexcept>
+
+#include "core/srgb.h"
+#include "pipeline/frame_params.h"
+
+namespace seamcl {
+namespace {
+
+template <typename T>
+std::vector<T> read_buffer(cl::CommandQueue& queue, const cl::Buffer& buffer, size_t count) {
+  std::vector<T> out(count);
+  if (count > 0) queue.enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(T), out.data());
+  return out;
+}
+
+// Fixed local sizes: PoCL compiles a kernel once per local size, so a size that never changes is
+// compiled once (at warm-up) instead of once per new image or scene size.
+constexpr size_t kLinearGroup = 64;
+
+size_t round_up(size_t value, size_t multiple) { return (value + multiple - 1) / multiple * multiple; }
+
+}  // namespace
+
+struct Renderer::Impl {
+  ClRuntime& runtime;
+  // The kernels of one program variant (texel format and sampler configuration).
+  struct KernelSet {
+    cl::Kernel setup, bin_count, bin_scan, bin_fill, raster, shade;
+  };
+  std::map<std::string, KernelSet> kernel_sets;
+  cl::Kernel setup_kernel, bin_count_kernel, bin_scan_kernel, bin_fill_kernel, raster_kernel, shade_kernel;
+
+  std::unique_ptr<Scene> scene;
+  PackedScene packed;
+  cl::Buffer positions, faces, neighbors, level_offsets, texels, srgb_table;
+
+  // Frame buffers, grown on demand.
+  cl::Buffer frame_params, stats, setups, tile_counts, tile_offsets, tile_cursors, tile_lists, sample_triangle, image;
+  size_t setups_capacity = 0, tiles_capacity = 0, samples_capacity = 0, pixels_capacity = 0;
+  uint32_t bin_capacity = 0;         // tile-list entries the next frame asks for
+  uint32_t tile_lists_capacity = 0;  // entries allocated
+  FrameParams last_params{};
+
+  explicit Impl(ClRuntime& rt) : runtime(rt) {
+    const auto& table = srgb_to_linear_table();
+    srgb_table = cl::Buffer(runtime.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(float) * table.size(),
+                            const_cast<float*>(table.data()));
+    frame_params = cl::Buffer(runtime.context(), CL_MEM_READ_ONLY, sizeof(FrameParams));
+    stats = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, sizeof(FrameStats));
+  }
+
+  // Makes the kernels of the program variant for this texel format and sampler current.
+  void use_kernels(TexelFormat format, const SamplerParams& sampler) {
+    const std::string options = program_options(format, sampler);
+    auto it = kernel_sets.find(options);
+    if (it == kernel_sets.end()) {
+      const cl::Program& program = runtime.program(options);
+      KernelSet set{cl::Kernel(program, "triangle_setup"), cl::Kernel(program, "bin_count"),
+                    cl::Kernel(program, "bin_scan"),       cl::Kernel(program, "bin_fill"),
+                    cl::Kernel(program, "raster"),         cl::Kernel(program, "shade_resolve")};
+      it = kernel_sets.emplace(options, std::move(set)).first;
+    }
+    setup_kernel = it->second.setup;
+    bin_count_kernel = it->second.bin_count;
+    bin_scan_kernel = it->second.bin_scan;
+    bin_fill_kernel = it->second.bin_fill;
+    raster_kernel = it->second.raster;
+    shade_kernel = it->second.shade;
+  }
+
+  // Packs and uploads the loaded scene in `format` with `guard_band` texels of band per level.
+  void pack_and_upload(TexelFormat format, int guard_band) {
+    packed = pack_scene(*scene, format, guard_band);
+    positions = upload(packed.positions);
+    faces = upload(packed.faces);
+    neighbors = upload(packed.neighbors);
+    level_offsets = upload(packed.level_offsets);
+    texels = format == TexelFormat::Rgba8 ? upload(packed.texels8) : upload(packed.texels32);
+  }
+
+  template <typename T>
+  cl::Buffer upload(const std::vector<T>& data) {
+    // OpenCL refuses zero-sized buffers; one element of padding keeps empty arrays legal.
+    const size_t bytes = std::max<size_t>(data.size(), 1) * sizeof(T);
+    cl::Buffer buffer(runtime.context(), CL_MEM_READ_ONLY, bytes);
+    if (!data.empty()) runtime.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, data.size() * sizeof(T), data.data());
+    return buffer;
+  }
+
+  static void grow(cl::Buffer& buffer, size_t& capacity, size_t needed, size_t element_bytes, const cl::Context& context) {
+    if (needed <= capacity && capacity > 0) return;
+    capacity = std::max<size_t>(needed, 1);
+    buffer = cl::Buffer(context, CL_MEM_READ_WRITE, capacity * element_bytes);
+  }
+
+  void ensure_frame_buffers(const FrameParams& p) {
+    const cl::Context& context = runtime.context();
+    grow(setups, setups_capacity, static_cast<size_t>(p.input_triangles) * SEAMCL_CLIP_SLOTS, sizeof(TriangleSetup), context);
+    const size_t tiles = static_cast<size_t>(p.tiles_x) * p.tiles_y;
+    if (tiles > tiles_capacity || tiles_capacity == 0) {
+      tiles_capacity = tiles;
+      tile_counts = cl::Buffer(context, CL_MEM_READ_WRITE, tiles * sizeof(cl_uint));
+      tile_offsets = cl::Buffer(context, CL_MEM_READ_WRITE, tiles * sizeof(cl_uint));
+      tile_cursors = cl::Buffer(context, CL_MEM_READ_WRITE, tiles * sizeof(cl_uint));
+    }
+    grow(sample_triangle, samples_capacity, static_cast<size_t>(p.width) * p.height * p.sample_count, sizeof(cl_uint), context);
+    grow(image, pixels_capacity, static_cast<size_t>(p.width) * p.height, sizeof(cl_float4), context);
+    if (tile_lists() == nullptr || tile_lists_capacity < p.bin_capacity) {
+      tile_lists_capacity = p.bin_capacity;
+      tile_lists = cl::Buffer(context, CL_MEM_READ_WRITE, static_cast<size_t>(p.bin_capacity) * sizeof(cl_uint));
+    }
+  }
+
+  // Queues one frame; returns the events of each stage in order.
+  struct StageEvents {
+    std::vector<cl::Event> setup, binning, raster, shade, readback;
+  };
+
+  StageEvents enqueue_frame(const FrameParams& p, std::vector<glm::vec4>& pixels) {
+    cl::CommandQueue& queue = runtime.queue();
+    StageEvents ev;
+    auto next = [](std::vector<cl::Event>& list) -> cl::Event* {
+      list.emplace_back();
+      return &list.back();
+    };
+    ev.setup.reserve(2);
+    ev.binning.reserve(5);
+    queue.enqueueWriteBuffer(frame_params, CL_FALSE, 0, sizeof(FrameParams), &p, nullptr, next(ev.setup));
+    const FrameStats zero_stats{};
+    queue.enqueueWriteBuffer(stats, CL_FALSE, 0, sizeof(FrameStats), &zero_stats, nullptr, next(ev.setup));
+
+    const size_t slots = static_cast<size_t>(p.input_triangles) * SEAMCL_CLIP_SLOTS;
+    if (p.input_triangles > 0) {
+      setup_kernel.setArg(0, frame_params);
+      setup_kernel.setArg(1, positions);
+      setup_kernel.setArg(2, faces);
+      setup_kernel.setArg(3, setups);
+      setup_kernel.setArg(4, stats);
+      queue.enqueueNDRangeKernel(setup_kernel, cl::NullRange, cl::NDRange(round_up(static_cast<size_t>(p.input_triangles), kLinearGroup)),
+                                 cl::NDRange(kLinearGroup), nullptr, next(ev.setup));
+    }
+    const size_t tiles = static_cast<size_t>(p.tiles_x) * p.tiles_y;
+    queue.enqueueFillBuffer(tile_counts, cl_uint{0}, 0, tiles * sizeof(cl_uint), nullptr, next(ev.binning));
+    if (slots > 0) {
+      bin_count_kernel.setArg(0, frame_params);
+      bin_count_kernel.setArg(1, setups);
+      bin_count_kernel.setArg(2, tile_counts);
+      queue.enqueueNDRangeKernel(bin_count_kernel, cl::NullRange, cl::NDRange(round_up(slots, kLinearGroup)), cl::NDRange(kLinearGroup), nullptr,
+                                 next(ev.binning));
+    }
+    bin_scan_kernel.setArg(0, frame_params);
+    bin_scan_kernel.setArg(1, tile_counts);
+    bin_scan_kernel.setArg(2, tile_offsets);
+    bin_scan_kernel.setArg(3, tile_cursors);
+    bin_scan_kernel.setArg(4, stats);
+    queue.enqueueNDRangeKernel(bin_scan_kernel, cl::NullRange, cl::NDRange(1), cl::NDRange(1), nullptr, next(ev.binning));
+    if (slots > 0) {
+      bin_fill_kernel.setArg(0, frame_params);
+      bin_fill_kernel.setArg(1, setups);
+      bin_fill_kernel.setArg(2, tile_cursors);
+      bin_fill_kernel.setArg(3, tile_lists);
+      queue.enqueueNDRangeKernel(bin_fill_kernel, cl::NullRange, cl::NDRange(round_up(slots, kLinearGroup)), cl::NDRange(kLinearGroup), nullptr,
+                                 next(ev.binning));
+    }
+    const cl::NDRange tile_grid(static_cast<size_t>(p.tiles_x) * SEAMCL_TILE_SIZE, static_cast<size_t>(p.tiles_y) * SEAMCL_TILE_SIZE);
+    const cl::NDRange tile_group(SEAMCL_TILE_SIZE, SEAMCL_TILE_SIZE);
+    raster_kernel.setArg(0, frame_params);
+    raster_kernel.setArg(1, setups);
+    raster_kernel.setArg(2, tile_counts);
+    raster_kernel.setArg(3, tile_offsets);
+    raster_kernel.setArg(4, tile_lists);
+    raster_kernel.setArg(5, sample_triangle);
+    queue.enqueueNDRangeKernel(raster_kernel, cl::NullRange, tile_grid, tile_group, nullptr, next(ev.raster));
+
+    shade_kernel.setArg(0, frame_params);
+    shade_kernel.setArg(1, setups);
+    shade_kernel.setArg(2, faces);
+    shade_kernel.setArg(3, neighbors);
+    shade_kernel.setArg(4, level_offsets);
+    shade_kernel.setArg(5, texels);
+    shade_kernel.setArg(6, srgb_table);
+    shade_kernel.setArg(7, sample_triangle);
+    shade_kernel.setArg(8, image);
+    shade_kernel.setArg(9, stats);
+    queue.enqueueNDRangeKernel(shade_kernel, cl::NullRange, tile_grid, tile_group, nullptr, next(ev.shade));
+
+    pixels.resize(static_cast<size_t>(p.width) * p.height);
+    queue.enqueueReadBuffer(image, CL_FALSE, 0, pixels.size() * sizeof(cl_float4), pixels.data(), nullptr, next(ev.readback));
+    queue.finish();
+    return ev;
+  }
+};
+
+Renderer::Renderer(ClRuntime& runtime) : impl_(std::make_unique<Impl>(runtime)) {}
+Renderer::~Renderer() = default;
+
+void Renderer::load_scene(const Scene& scene, TexelFormat format) {
+  validate_scene(scene);
+  impl_->scene = std::make_unique<Scene>(scene);
+  impl_->pack_and_upload(format, 0);
+  // Start the tile lists at a few entries per triangle slot; render() grows them when needed.
+  impl_->bin_capacity = std::max<uint32_t>(impl_->bin_capacity, static_cast<uint32_t>(std::min<size_t>(
+                                                                      scene.triangle_count() * 8 + 65536, 1u << 30)));
+  impl_->tile_lists = cl::Buffer();
+}
+
+const Scene& Renderer::scene() const {
+  if (!impl_->scene) throw std::logic_error("Renderer::scene before load_scene");
+  return *impl_->scene;
+}
+
+const PackedScene& Renderer::packed_scene() const { return impl_->packed; }
+
+RenderResult Renderer::render(const Camera& camera, const RenderOptions& options) {
+  if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
+  const SamplerParams sampler = sampler_params(options);
+  if (options.texels != impl_->packed.format || sampler.guard_band != impl_->packed.guard_band) {
+    impl_->pack_and_upload(options.texels, sampler.guard_band);
+  }
+  impl_->use_kernels(options.texels, sampler);
+  RenderResult result;
+  result.width = options.width;
+  result.height = options.height;
+  for (result.attempts = 1;; ++result.attempts) {
+    const FrameParams params = make_frame_params(*impl_->scene, camera, options, impl_->bin_capacity);
+    impl_->ensure_frame_buffers(params);
+    impl_->bin_capacity = params.bin_capacity;
+    impl_->last_params = params;
+    const Impl::StageEvents ev = impl_->enqueue_frame(params, result.pixels);
+    impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &result.stats);
+    if (result.stats.bin_entries > params.bin_capacity) {
+      // The lists overflowed (the kernels stayed in bounds): grow with headroom and render again.
+      if (result.attempts >= 3) throw std::runtime_error("tile lists overflowed three times");
+      impl_->bin_capacity = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{result.stats.bin_entries} * 5 / 4 + 1024, 1u << 31));
+      continue;
+    }
+    auto sum = [](const std::vector<cl::Event>& events) {
+      double ms = 0;
+      for (const cl::Event& e : events) ms += event_milliseconds(e);
+      return ms;
+    };
+    result.ms.setup = sum(ev.setup);
+    result.ms.binning = sum(ev.binning);
+    result.ms.raster = sum(ev.raster);
+    result.ms.shade = sum(ev.shade);
+    result.ms.readback = sum(ev.readback);
+    const cl_ulong first = ev.setup.front().getProfilingInfo<CL_PROFILING_COMMAND_START>();
+    const cl_ulong last = ev.readback.back().getProfilingInfo<CL_PROFILING_COMMAND_END>();
+    result.ms.total = static_cast<double>(last - first) * 1e-6;
+    return result;
+  }
+}
+
+std::string program_options(TexelFormat format, const SamplerParams& sampler) {
+  return std::string(format == TexelFormat::Rgba32f ? "-DSEAMCL_TEXELS_F32=1" : "-DSEAMCL_TEXELS_F32=0") +
+         " -DSEAMCL_SAMPLER_FILTER=" + std::to_string(sampler.filter) +
+         " -DSEAMCL_SAMPLER_ADDRESS=" + std::to_string(sampler.address) +
+         " -DSEAMCL_SAMPLER_RENORMALIZE=" + std::to_string(sampler.renormalize) +
+         " -DSEAMCL_SAMPLER_ZERO_COVERAGE=" + std::to_string(sampler.zero_coverage) +
+         " -DSEAMCL_SAMPLER_TRAVERSE=" + std::to_string(sampler.traverse) +
+         " -DSEAMCL_SAMPLER_GUARD_BAND=" + std::to_string(sampler.guard_band);
+}
+
+void Renderer::warm_up(const RenderOptions& options) {
+  RenderOptions tiny = options;
+  tiny.width = SEAMCL_TILE_SIZE;
+  tiny.height = SEAMCL_TILE_SIZE;
+  render(scene().camera, tiny);
+}
+
+FrameParams Renderer::last_frame_params() const { return impl_->last_params; }
+
+std::vector<TriangleSetup> Renderer::read_setups() {
+  return read_buffer<TriangleSetup>(impl_->runtime.queue(), impl_->setups,
+                                    static_cast<size_t>(impl_->last_params.input_triangles) * SEAMCL_CLIP_SLOTS);
+}
+std::vector<uint32_t> Renderer::read_tile_counts() {
+  return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_counts,
+                               static_cast<size_t>(impl_->last_params.tiles_x) * impl_->last_params.tiles_y);
+}
+std::vector<uint32_t> Renderer::read_tile_offsets() {
+  return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_offsets,
+                               static_cast<size_t>(impl_->last_params.tiles_x) * impl_->last_params.tiles_y);
+}
+std::vector<uint32_t> Renderer::read_tile_lists() {
+  FrameStats stats{};
+  impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &stats);
+  return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_lists, std::min(stats.bin_entries, impl_->bin_capacity));
+}
+std::vector<uint32_t> Renderer::read_sample_triangles() {
+  const FrameParams& p = impl_->last_params;
+  return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->sample_triangle,
+                               static_cast<size_t>(p.width) * p.height * p.sample_count);
+}
+
+}  // namespace seamcl

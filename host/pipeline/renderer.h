@@ -1,0 +1,77 @@
+// Runs the pipeline on the device: setup -> binning -> raster -> shade/resolve, queued back to
+// back and waited for once per frame. A Renderer owns its kernel objects and buffers, so one per
+// thread (they may share a ClRuntime: contexts, queues and programs are thread-safe, kernel
+// arguments are not).
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/pipeline/gpu_types.h>
+#include <seamcl/pipeline/packed_scene.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/scene/scene.h>
+
+namespace seamcl {
+
+// Milliseconds from OpenCL profiling events.
+struct StageTimes {
+  double setup = 0;     // triangle setup (transform, clip, edge functions, planes)
+  double binning = 0;   // clear + count + scan + fill
+  double raster = 0;    // coverage and depth per sample
+  double shade = 0;     // shading and resolve
+  double readback = 0;  // image to host
+  double total = 0;     // first command's start to last command's end
+};
+
+struct RenderResult {
+  int width = 0;
+  int height = 0;
+  std::vector<glm::vec4> pixels;  // linear RGBA, row-major, row 0 at the top
+  StageTimes ms;
+  FrameStats stats{};
+  int attempts = 1;               // > 1 when the tile lists had to grow
+};
+
+// The build options of the program variant that reads `format` texels with `sampler`'s filter,
+// address mode, renormalisation and zero-coverage rule fixed at build time (max_aniso stays a
+// run-time parameter). See the specialisation note in kernels/texture_sample.cl.
+std::string program_options(TexelFormat format, const SamplerParams& sampler);
+
+class Renderer {
+ public:
+  explicit Renderer(ClRuntime& runtime);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Packs and uploads the scene (validated first). Later renders use it until the next call; a
+  // render asking for another texel format packs it again.
+  void load_scene(const Scene& scene, TexelFormat format = TexelFormat::Rgba8);
+  const Scene& scene() const;
+  const PackedScene& packed_scene() const;
+
+  RenderResult render(const Camera& camera, const RenderOptions& options);
+
+  // Renders one tiny frame of the loaded scene with these options (method, filter, texels) so
+  // that the program variant is built and PoCL compiles every kernel for its local size now
+  // (20-250 ms each, cold) rather than inside the first timed frame.
+  void warm_up(const RenderOptions& options);
+
+  // The intermediate buffers of the last frame, for the kernel tests.
+  FrameParams last_frame_params() const;
+  std::vector<TriangleSetup> read_setups();
+  std::vector<uint32_t> read_tile_counts();
+  std::vector<uint32_t> read_tile_offsets();
+  std::vector<uint32_t> read_tile_lists();
+  std::vector<uint32_t> read_sample_triangles();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace seamcl

@@ -1,0 +1,295 @@
+#include <seamcl/scene/scene.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <seamcl/core/input_error.h>
+
+namespace seamcl {
+namespace {
+
+constexpr int kMaxTextureSide = 4096;
+
+bool is_power_of_two(int n) { return n > 0 && (n & (n - 1)) == 0; }
+
+bool is_finite(glm::vec3 v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+bool is_finite(glm::vec4 v) { return is_finite(glm::vec3(v)) && std::isfinite(v.w); }
+
+int log2_of_power_of_two(int n) {
+  int log = 0;
+  while ((1 << log) < n) ++log;
+  return log;
+}
+
+std::string size_text(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+TextureLevel box_downsample(const TextureLevel& fine) {
+  TextureLevel coarse;
+  coarse.width = std::max(1, fine.width / 2);
+  coarse.height = std::max(1, fine.height / 2);
+  // A side that is already 1 is not halved, so its footprint along that axis is one texel.
+  const int step_x = fine.width / coarse.width;
+  const int step_y = fine.height / coarse.height;
+  const float weight = 1.0f / static_cast<float>(step_x * step_y);
+  coarse.texels.resize(static_cast<size_t>(coarse.width) * coarse.height);
+  for (int j = 0; j < coarse.height; ++j) {
+    for (int i = 0; i < coarse.width; ++i) {
+      glm::vec4 sum(0.0f);
+      for (int dy = 0; dy < step_y; ++dy)
+        for (int dx = 0; dx < step_x; ++dx) sum += fine.at(i * step_x + dx, j * step_y + dy);
+      coarse.texels[static_cast<size_t>(j) * coarse.width + i] = sum * weight;
+    }
+  }
+  return coarse;
+}
+
+// A sine with a continuous first derivative, within 1e-3 of std::sin and several times cheaper:
+// the pattern below is evaluated for every texel of every generated scene (millions), and only
+// its smoothness, not its exactness, matters for showing seams.
+inline float smooth_sine(float x) {
+  constexpr float kInverseTwoPi = 0.15915494f;
+  // Adding and subtracting 1.5 * 2^23 rounds to the nearest integer (for |t| < 2^22; beyond that
+  // a float has no fraction left anyway) without a libm call, so loops over it vectorise.
+  constexpr float kRoundingShift = 12582912.0f;
+  float t = x * kInverseTwoPi;
+  t -= (t + kRoundingShift) - kRoundingShift;  // one period, t in [-0.5, 0.5]
+  const float parabola = 8.0f * t - 16.0f * t * std::fabs(t);
+  return parabola + 0.225f * (parabola * std::fabs(parabola) - parabola);
+}
+
+void check_vec3(glm::vec3 v, const std::string& field) {
+  if (!is_finite(v)) throw InputError(field, "must be finite");
+}
+
+void check_texture(const MipChain& chain, const std::string& field) {
+  if (chain.levels.empty()) throw InputError(field, "has no mip levels");
+  const int width = chain.width();
+  const int height = chain.height();
+  if (!is_power_of_two(width) || !is_power_of_two(height) || width > kMaxTextureSide ||
+      height > kMaxTextureSide) {
+    throw InputError(field, "size " + size_text(width, height) +
+                                " must be powers of two from 1 to " +
+                                std::to_string(kMaxTextureSide));
+  }
+  const size_t expected_levels =
+      1 + static_cast<size_t>(log2_of_power_of_two(std::max(width, height)));
+  if (chain.levels.size() != expected_levels) {
+    throw InputError(field, "has " + std::to_string(chain.levels.size()) +
+                                " mip levels, expected " + std::to_string(expected_levels) +
+                                " (a full chain down to 1x1)");
+  }
+  for (size_t k = 0; k < chain.levels.size(); ++k) {
+    const TextureLevel& level = chain.levels[k];
+    const int expected_width = std::max(1, width >> k);
+    const int expected_height = std::max(1, height >> k);
+    if (level.width != expected_width || level.height != expected_height ||
+        level.texels.size() != static_cast<size_t>(expected_width) * expected_height) {
+      throw InputError(field, "mip level " + std::to_string(k) + " is " +
+                                  size_text(level.width, level.height) + " with " +
+                                  std::to_string(level.texels.size()) + " texels, expected " +
+                                  size_text(expected_width, expected_height));
+    }
+    for (const glm::vec4& texel : level.texels)
+      if (!is_finite(texel))
+        throw InputError(field, "mip level " + std::to_string(k) + " has a non-finite texel");
+  }
+}
+
+}  // namespace
+
+MipChain build_mip_chain(TextureLevel level0) {
+  if (!is_power_of_two(level0.width) || !is_power_of_two(level0.height))
+    throw InputError("texture", "size " + size_text(level0.width, level0.height) +
+                                    " is not a power of two on each side");
+  const size_t expected = static_cast<size_t>(level0.width) * level0.height;
+  if (level0.texels.size() != expected)
+    throw InputError("texture", "has " + std::to_string(level0.texels.size()) +
+                                    " texels, expected " + std::to_string(expected));
+  MipChain chain;
+  chain.levels.push_back(std::move(level0));
+  while (chain.levels.back().width > 1 || chain.levels.back().height > 1)
+    chain.levels.push_back(box_downsample(chain.levels.back()));
+  return chain;
+}
+
+glm::vec3 face_point(const std::array<glm::vec3, 4>& corners, float u, float v) {
+  const auto& [p0, p1, p2, p3] = corners;
+  // Barycentric weights of (u, v) in triangle (v0, v1, v2) = uv (0,0), (1,0), (1,1) ...
+  if (u >= v) return (1.0f - u) * p0 + (u - v) * p1 + v * p2;
+  // ... and in triangle (v0, v2, v3) = uv (0,0), (1,1), (0,1).
+  return (1.0f - v) * p0 + u * p2 + (v - u) * p3;
+}
+
+TextureLevel bake_face_texture(const std::array<glm::vec3, 4>& corners, int width, int height,
+                               const std::function<glm::vec4(glm::vec3)>& surface_color) {
+  TextureLevel level;
+  level.width = width;
+  level.height = height;
+  level.texels.resize(static_cast<size_t>(width) * height);
+  for (int j = 0; j < height; ++j) {
+    const float v = (static_cast<float>(j) + 0.5f) / static_cast<float>(height);
+    for (int i = 0; i < width; ++i) {
+      const float u = (static_cast<float>(i) + 0.5f) / static_cast<float>(width);
+      level.texels[static_cast<size_t>(j) * width + i] = surface_color(face_point(corners, u, v));
+    }
+  }
+  return level;
+}
+
+glm::vec4 surface_pattern(glm::vec3 p) {
+  // Each channel sums two waves with different directions and wavelengths (0.5 to 0.75 units,
+  // so features of 0.25 to 0.4), and the colour changes along every direction of every surface;
+  // two stripe families (period about 0.9 units, lines about 0.17 wide) add sharp-but-smooth
+  // features in which a shifted or mismatched seam shows at once. Waves 0-2 and 4-6 are the
+  // channels' (r, g, b), 3 and 7 the stripes'.
+  constexpr int kWaves = 8;
+  constexpr float kWaveX[kWaves] = {7.1f, -4.4f, 3.6f, -3.2f, -2.7f, 10.8f, 2.4f, 5.3f};
+  constexpr float kWaveY[kWaves] = {2.3f, 6.2f, -7.7f, 5.8f, 9.4f, -3.1f, 4.9f, 1.9f};
+  constexpr float kWaveZ[kWaves] = {-3.9f, 8.3f, 5.1f, 2.6f, 4.6f, 2.2f, -11.2f, 4.1f};
+  constexpr float kPhase[kWaves] = {0.3f, 2.9f, 4.1f, 1.0f, 1.7f, 0.8f, 5.3f, 0.0f};
+  float sine[kWaves];
+  for (int k = 0; k < kWaves; ++k)
+    sine[k] = smooth_sine(kWaveX[k] * p.x + kWaveY[k] * p.y + kWaveZ[k] * p.z + kPhase[k]);
+
+  glm::vec3 color(0.5f + 0.22f * sine[0] + 0.16f * sine[4],
+                  0.5f + 0.22f * sine[1] + 0.16f * sine[5],
+                  0.5f + 0.22f * sine[2] + 0.16f * sine[6]);
+  auto thin_stripe = [](float wave) {
+    // (0.5 + 0.5 sin)^8: smooth peaks about a fifth of the period wide.
+    const float s = 0.5f + 0.5f * wave;
+    const float s2 = s * s;
+    const float s4 = s2 * s2;
+    return s4 * s4;
+  };
+  color = glm::mix(color, glm::vec3(0.95f, 0.93f, 0.85f), 0.75f * thin_stripe(sine[3]));
+  color = glm::mix(color, glm::vec3(0.05f), 0.85f * thin_stripe(sine[7]));
+  return glm::vec4(glm::clamp(color, glm::vec3(0.05f), glm::vec3(0.95f)), 1.0f);
+}
+
+void set_constant_textures(Scene& scene, glm::vec4 color) {
+  for (Face& face : scene.faces) {
+    const int width = face.texture.width();
+    const int height = face.texture.height();
+    face.texture.levels.clear();
+    // A box filter of a constant is that constant, so each level is filled directly.
+    for (int k = 0; k == 0 || (width >> (k - 1)) > 1 || (height >> (k - 1)) > 1; ++k) {
+      TextureLevel level;
+      level.width = std::max(1, width >> k);
+      level.height = std::max(1, height >> k);
+      level.texels.assign(static_cast<size_t>(level.width) * level.height, color);
+      face.texture.levels.push_back(std::move(level));
+    }
+  }
+}
+
+std::array<glm::vec3, 4> Scene::corners(const Face& f) const {
+  return {positions[f.vertices[0]], positions[f.vertices[1]], positions[f.vertices[2]],
+          positions[f.vertices[3]]};
+}
+
+glm::vec3 Scene::face_normal(const Face& f) const {
+  const auto [p0, p1, p2, p3] = corners(f);
+  return glm::normalize(glm::cross(p2 - p0, p3 - p1));
+}
+
+size_t Scene::texel_count() const {
+  size_t count = 0;
+  for (const Face& face : faces)
+    for (const TextureLevel& level : face.texture.levels) count += level.texels.size();
+  return count;
+}
+
+Camera orbit_camera(const Scene& scene, int frame, int frames) {
+  if (!scene.orbit) throw InputError("frame", "scene '" + scene.name + "' has no orbit");
+  if (frames < 1) throw InputError("frames", "must be at least 1, got " + std::to_string(frames));
+  if (frame < 0 || frame >= frames)
+    throw InputError(
+        "frame", "must be in [0, " + std::to_string(frames) + "), got " + std::to_string(frame));
+  const Orbit& orbit = *scene.orbit;
+  const double degrees =
+      static_cast<double>(orbit.start_degrees) + 360.0 * static_cast<double>(frame) / frames;
+  const double radians = degrees * (3.14159265358979323846 / 180.0);
+  // Angle 0 puts the eye on +z of the centre; angles grow towards +x.
+  Camera camera = scene.camera;
+  camera.eye =
+      orbit.center + glm::vec3(orbit.radius * static_cast<float>(std::sin(radians)), orbit.height,
+                               orbit.radius * static_cast<float>(std::cos(radians)));
+  camera.target = orbit.center;
+  // The orbit circles the vertical axis, so world up can never be parallel to the view direction.
+  camera.up = glm::vec3(0, 1, 0);
+  return camera;
+}
+
+void validate_scene(const Scene& scene) {
+  if (scene.faces.empty()) throw InputError("faces", "the scene has no faces");
+  for (size_t i = 0; i < scene.positions.size(); ++i)
+    check_vec3(scene.positions[i], "positions[" + std::to_string(i) + "]");
+
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    const Face& face = scene.faces[f];
+    const std::string face_field = "faces[" + std::to_string(f) + "]";
+    for (size_t k = 0; k < 4; ++k) {
+      if (face.vertices[k] >= scene.positions.size())
+        throw InputError(face_field + ".vertices[" + std::to_string(k) + "]",
+                         "index " + std::to_string(face.vertices[k]) + " out of range (" +
+                             std::to_string(scene.positions.size()) + " positions)");
+    }
+    // A face without area has no normal to light it with (it would be NaN).
+    const auto [p0, p1, p2, p3] = scene.corners(face);
+    const glm::vec3 diagonal_cross = glm::cross(p2 - p0, p3 - p1);
+    const float area_measure = glm::length(diagonal_cross);
+    if (!(area_measure > 0.0f) || !std::isfinite(area_measure))
+      throw InputError(face_field + ".vertices", "the quad is degenerate (zero area)");
+    check_texture(face.texture, face_field + ".texture");
+  }
+
+  const Camera& camera = scene.camera;
+  check_vec3(camera.eye, "camera.eye");
+  check_vec3(camera.target, "camera.target");
+  check_vec3(camera.up, "camera.up");
+  if (!std::isfinite(camera.fov_y_degrees) || !(camera.fov_y_degrees > 0.0f) ||
+      !(camera.fov_y_degrees < 180.0f))
+    throw InputError("camera.fov_y_degrees",
+                     "must be in (0, 180), got " + std::to_string(camera.fov_y_degrees));
+  const glm::vec3 view = camera.target - camera.eye;
+  const float view_length = glm::length(view);
+  const float scale = glm::length(camera.eye) + glm::length(camera.target);
+  if (!(view_length > 1e-6f * scale) || !std::isfinite(view_length))
+    throw InputError("camera.eye", "must differ from camera.target");
+  const float up_length = glm::length(camera.up);
+  if (!(up_length > 0.0f) || !std::isfinite(up_length))
+    throw InputError("camera.up", "must be non-zero");
+  const float sine_between = glm::length(glm::cross(view / view_length, camera.up / up_length));
+  if (!(sine_between > 1e-4f)) throw InputError("camera.up", "is parallel to the view direction");
+
+  if (scene.orbit) {
+    const Orbit& orbit = *scene.orbit;
+    check_vec3(orbit.center, "orbit.center");
+    if (!std::isfinite(orbit.radius) || !(orbit.radius > 0.0f))
+      throw InputError("orbit.radius", "must be positive and finite");
+    if (!std::isfinite(orbit.height)) throw InputError("orbit.height", "must be finite");
+    if (!std::isfinite(orbit.start_degrees))
+      throw InputError("orbit.start_degrees", "must be finite");
+  }
+
+  const Light& light = scene.light;
+  check_vec3(light.to_light, "light.to_light");
+  if (std::abs(glm::length(light.to_light) - 1.0f) > 1e-3f)
+    throw InputError("light.to_light", "must be a unit vector");
+  check_vec3(light.color, "light.color");
+  if (glm::any(glm::lessThan(light.color, glm::vec3(0.0f))))
+    throw InputError("light.color", "must not be negative");
+  if (!std::isfinite(light.ambient) || light.ambient < 0.0f || light.ambient > 1.0f)
+    throw InputError("light.ambient", "must be in [0, 1]");
+  check_vec3(scene.background, "background");
+  if (glm::any(glm::lessThan(scene.background, glm::vec3(0.0f))))
+    throw InputError("background", "must not be negative");
+}
+
+}  // namespace seamcl

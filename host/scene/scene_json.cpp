@@ -1,0 +1,367 @@
+#include <seamcl/scene/scene_json.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include <seamcl/core/input_error.h>
+
+namespace seamcl {
+namespace {
+
+using nlohmann::json;
+
+constexpr int kMaxTextureSide = 4096;
+// Level-0 texels over all faces (a full scene then takes ~1.4 GB): a bound that keeps a small
+// file from asking for more memory than the machine has.
+constexpr size_t kMaxSceneTexels = size_t{1} << 26;
+
+std::string member_path(const std::string& parent, std::string_view key) {
+  return parent.empty() ? std::string(key) : parent + "." + std::string(key);
+}
+
+std::string element_path(const std::string& parent, size_t index) {
+  return parent + "[" + std::to_string(index) + "]";
+}
+
+std::string describe_type(const json& value) { return value.type_name(); }
+
+template <typename Names>
+std::string join(const Names& names) {
+  std::string joined;
+  for (const auto& name : names) joined += (joined.empty() ? "" : ", ") + std::string(name);
+  return joined;
+}
+
+std::string known_generator_names() {
+  std::vector<std::string> names;
+  for (const GeneratorInfo& info : scene_generators()) names.push_back(info.name);
+  return join(names);
+}
+
+bool is_generator_name(const std::string& name) {
+  const auto& known = scene_generators();
+  return std::any_of(known.begin(), known.end(),
+                     [&](const GeneratorInfo& info) { return info.name == name; });
+}
+
+// The fields of one JSON object. Fields not named in `known` are rejected up front, so that a
+// misspelt optional field is an error instead of a silently applied default.
+class ObjectFields {
+ public:
+  ObjectFields(const json& value, std::string path, std::initializer_list<std::string_view> known)
+      : value_(value), path_(std::move(path)) {
+    if (!value.is_object())
+      throw InputError(path_.empty() ? "scene" : path_,
+                       "must be an object, got " + describe_type(value));
+    for (const auto& [key, unused] : value.items()) {
+      if (std::find(known.begin(), known.end(), key) == known.end())
+        throw InputError(path_of(key), "unknown field (known: " + join(known) + ")");
+    }
+  }
+
+  std::string path_of(std::string_view key) const { return member_path(path_, key); }
+
+  const json* optional(std::string_view key) const {
+    const auto it = value_.find(key);
+    return it == value_.end() ? nullptr : &*it;
+  }
+
+  const json& required(std::string_view key) const {
+    const json* field = optional(key);
+    if (!field) throw InputError(path_of(key), "is required");
+    return *field;
+  }
+
+ private:
+  const json& value_;
+  std::string path_;
+};
+
+float read_float(const json& value, const std::string& path) {
+  if (!value.is_number()) throw InputError(path, "must be a number, got " + describe_type(value));
+  const auto number = static_cast<float>(value.get<double>());
+  if (!std::isfinite(number)) throw InputError(path, "must be a finite number (as a float)");
+  return number;
+}
+
+int read_int(const json& value, const std::string& path, int min, int max) {
+  if (!value.is_number_integer())
+    throw InputError(path, "must be an integer, got " +
+                               (value.is_number() ? value.dump() : describe_type(value)));
+  // Checked first, so that the signed read below cannot wrap.
+  const bool too_large =
+      value.is_number_unsigned() && value.get<uint64_t>() > static_cast<uint64_t>(max);
+  if (too_large || value.get<int64_t>() < min || value.get<int64_t>() > max)
+    throw InputError(path, "must be in [" + std::to_string(min) + ", " + std::to_string(max) +
+                               "], got " + value.dump());
+  return static_cast<int>(value.get<int64_t>());
+}
+
+bool read_bool(const json& value, const std::string& path) {
+  if (!value.is_boolean())
+    throw InputError(path, "must be true or false, got " + describe_type(value));
+  return value.get<bool>();
+}
+
+std::string read_string(const json& value, const std::string& path) {
+  if (!value.is_string()) throw InputError(path, "must be a string, got " + describe_type(value));
+  return value.get<std::string>();
+}
+
+const json& read_array(const json& value, const std::string& path) {
+  if (!value.is_array()) throw InputError(path, "must be an array, got " + describe_type(value));
+  return value;
+}
+
+glm::vec3 read_vec3(const json& value, const std::string& path) {
+  if (!value.is_array() || value.size() != 3)
+    throw InputError(path, "must be an array of 3 numbers, got " +
+                               (value.is_array() ? std::to_string(value.size()) + " elements"
+                                                 : describe_type(value)));
+  return {read_float(value[0], element_path(path, 0)), read_float(value[1], element_path(path, 1)),
+          read_float(value[2], element_path(path, 2))};
+}
+
+glm::vec3 read_color(const json& value, const std::string& path) {
+  const glm::vec3 color = read_vec3(value, path);
+  for (int c = 0; c < 3; ++c)
+    if (color[c] < 0.0f)
+      throw InputError(element_path(path, static_cast<size_t>(c)), "must not be negative");
+  return color;
+}
+
+GeneratorOptions read_generator_options(const json& value, const std::string& path) {
+  const ObjectFields fields(value, path, {"tint", "constant_color"});
+  GeneratorOptions options;
+  if (const json* tint = fields.optional("tint"))
+    options.tint = read_bool(*tint, fields.path_of("tint"));
+  if (const json* color = fields.optional("constant_color"))
+    options.constant_color = read_color(*color, fields.path_of("constant_color"));
+  return options;
+}
+
+struct GeneratorRequest {
+  std::string name;
+  GeneratorOptions options;
+};
+
+GeneratorRequest read_generator_request(const json& doc) {
+  const ObjectFields fields(doc, "", {"generator", "options"});
+  GeneratorRequest request;
+  request.name = read_string(fields.required("generator"), "generator");
+  if (!is_generator_name(request.name))
+    throw InputError("generator", "unknown generator '" + request.name +
+                                      "' (known: " + known_generator_names() + ")");
+  if (const json* options = fields.optional("options"))
+    request.options = read_generator_options(*options, "options");
+  return request;
+}
+
+// What a face's texture is painted with, kept until every face's corners are known.
+struct TexturePlan {
+  int width = 0;
+  int height = 0;
+  bool constant = false;
+  glm::vec3 color{1.0f};
+};
+
+TexturePlan read_texture(const json& value, const std::string& path) {
+  const ObjectFields fields(value, path, {"width", "height", "content", "color"});
+  TexturePlan plan;
+  auto read_side = [&fields](std::string_view side) {
+    const std::string side_path = fields.path_of(side);
+    const int size = read_int(fields.required(side), side_path, 1, kMaxTextureSide);
+    if ((size & (size - 1)) != 0)
+      throw InputError(side_path, "must be a power of two, got " + std::to_string(size));
+    return size;
+  };
+  plan.width = read_side("width");
+  plan.height = read_side("height");
+  if (const json* content = fields.optional("content")) {
+    const std::string kind = read_string(*content, fields.path_of("content"));
+    if (kind != "surface" && kind != "constant")
+      throw InputError(fields.path_of("content"),
+                       "must be \"surface\" or \"constant\", got \"" + kind + "\"");
+    plan.constant = kind == "constant";
+  }
+  if (const json* color = fields.optional("color"))
+    plan.color = read_color(*color, fields.path_of("color"));
+  return plan;
+}
+
+Camera read_camera(const json& value) {
+  const ObjectFields fields(value, "camera", {"eye", "target", "up", "fov_y_degrees"});
+  Camera camera;
+  camera.eye = read_vec3(fields.required("eye"), "camera.eye");
+  camera.target = read_vec3(fields.required("target"), "camera.target");
+  if (const json* up = fields.optional("up")) camera.up = read_vec3(*up, "camera.up");
+  if (const json* fov = fields.optional("fov_y_degrees"))
+    camera.fov_y_degrees = read_float(*fov, "camera.fov_y_degrees");
+  return camera;
+}
+
+Orbit read_orbit(const json& value) {
+  const ObjectFields fields(value, "orbit", {"center", "radius", "height", "start_degrees"});
+  Orbit orbit;
+  orbit.center = read_vec3(fields.required("center"), "orbit.center");
+  orbit.radius = read_float(fields.required("radius"), "orbit.radius");
+  orbit.height = 0.0f;  // documented default: the eye circles level with the centre
+  if (const json* height = fields.optional("height"))
+    orbit.height = read_float(*height, "orbit.height");
+  if (const json* start = fields.optional("start_degrees"))
+    orbit.start_degrees = read_float(*start, "orbit.start_degrees");
+  return orbit;
+}
+
+Light read_light(const json& value) {
+  const ObjectFields fields(value, "light", {"to_light", "color", "ambient"});
+  Light light;
+  if (const json* to_light = fields.optional("to_light")) {
+    const glm::vec3 direction = read_vec3(*to_light, "light.to_light");
+    const float length = glm::length(direction);
+    if (!(length > 0.0f) || !std::isfinite(length))
+      throw InputError("light.to_light", "must be a non-zero vector");
+    light.to_light = direction / length;
+  }
+  if (const json* color = fields.optional("color")) light.color = read_color(*color, "light.color");
+  if (const json* ambient = fields.optional("ambient"))
+    light.ambient = read_float(*ambient, "light.ambient");
+  return light;
+}
+
+Scene read_explicit_scene(const json& doc, const std::string& default_name) {
+  const ObjectFields fields(
+      doc, "", {"name", "positions", "faces", "camera", "orbit", "light", "background"});
+  Scene scene;
+  scene.name = default_name;
+  if (const json* name = fields.optional("name")) scene.name = read_string(*name, "name");
+
+  const json& positions = read_array(fields.required("positions"), "positions");
+  for (size_t i = 0; i < positions.size(); ++i)
+    scene.positions.push_back(read_vec3(positions[i], element_path("positions", i)));
+
+  const json& faces = read_array(fields.required("faces"), "faces");
+  if (faces.empty()) throw InputError("faces", "must have at least one face");
+  std::vector<TexturePlan> plans;
+  size_t total_texels = 0;
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const std::string face_path = element_path("faces", f);
+    const ObjectFields face_fields(faces[f], face_path, {"vertices", "texture"});
+    const std::string vertices_path = face_fields.path_of("vertices");
+    const json& vertices = read_array(face_fields.required("vertices"), vertices_path);
+    if (vertices.size() != 4)
+      throw InputError(vertices_path,
+                       "must have 4 vertex indices, got " + std::to_string(vertices.size()));
+    Face face;
+    for (size_t k = 0; k < 4; ++k) {
+      const std::string index_path = element_path(vertices_path, k);
+      const int index = read_int(vertices[k], index_path, 0, std::numeric_limits<int>::max());
+      if (static_cast<size_t>(index) >= scene.positions.size())
+        throw InputError(index_path, "index " + std::to_string(index) + " out of range (" +
+                                         std::to_string(scene.positions.size()) + " positions)");
+      face.vertices[k] = static_cast<uint32_t>(index);
+    }
+    const std::string texture_path = face_fields.path_of("texture");
+    plans.push_back(read_texture(face_fields.required("texture"), texture_path));
+    total_texels += static_cast<size_t>(plans.back().width) * plans.back().height;
+    if (total_texels > kMaxSceneTexels)
+      throw InputError(texture_path, "the scene's textures exceed " +
+                                         std::to_string(kMaxSceneTexels) + " texels in all");
+    scene.faces.push_back(std::move(face));
+  }
+
+  scene.camera = read_camera(fields.required("camera"));
+  if (const json* orbit = fields.optional("orbit")) scene.orbit = read_orbit(*orbit);
+  if (const json* light = fields.optional("light")) scene.light = read_light(*light);
+  if (const json* background = fields.optional("background"))
+    scene.background = read_color(*background, "background");
+
+  // Textures last: baking is the expensive part, so a document is checked in full first.
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    const TexturePlan& plan = plans[f];
+    const glm::vec4 color(plan.color, 1.0f);
+    TextureLevel level0 =
+        plan.constant
+            ? TextureLevel{plan.width, plan.height,
+                           std::vector<glm::vec4>(static_cast<size_t>(plan.width) * plan.height,
+                                                  color)}
+            : bake_face_texture(scene.corners(scene.faces[f]), plan.width, plan.height,
+                                [&color](glm::vec3 p) { return surface_pattern(p) * color; });
+    scene.faces[f].texture = build_mip_chain(std::move(level0));
+  }
+  validate_scene(scene);
+  return scene;
+}
+
+using SceneSource = std::variant<GeneratorRequest, Scene>;
+
+SceneSource read_document(const json& doc, const std::string& default_name) {
+  if (doc.is_object() && doc.contains("generator")) return read_generator_request(doc);
+  return read_explicit_scene(doc, default_name);
+}
+
+Scene realize(SceneSource source, const GeneratorOptions& extra) {
+  if (auto* request = std::get_if<GeneratorRequest>(&source)) {
+    GeneratorOptions options = request->options;
+    options.tint = options.tint || extra.tint;
+    if (extra.constant_color) options.constant_color = extra.constant_color;
+    return generate_scene(request->name, options);
+  }
+  Scene scene = std::move(std::get<Scene>(source));
+  apply_generator_options(scene, extra);
+  return scene;
+}
+
+// The message of an InputError without its "field: " prefix.
+std::string message_of(const InputError& error) {
+  return std::string(error.what()).substr(error.field().size() + 2);
+}
+
+SceneSource read_scene_file(const std::string& path) {
+  std::error_code error_code;
+  if (!std::filesystem::exists(path, error_code))
+    throw InputError("scene", "cannot read scene file '" + path + "': no such file");
+  if (!std::filesystem::is_regular_file(path, error_code))
+    throw InputError("scene", "cannot read scene file '" + path + "': not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("scene", "cannot read scene file '" + path + "'");
+  json doc;
+  try {
+    doc = json::parse(in);
+  } catch (const json::exception& error) {
+    throw InputError("scene", "scene file '" + path + "' is not valid JSON: " + error.what());
+  }
+  try {
+    return read_document(doc, std::filesystem::path(path).stem().string());
+  } catch (const InputError& error) {
+    throw InputError(error.field(), message_of(error) + " (in '" + path + "')");
+  }
+}
+
+}  // namespace
+
+Scene parse_scene_json(const nlohmann::json& doc) {
+  return realize(read_document(doc, "scene"), {});
+}
+
+Scene load_scene_file(const std::string& path) { return realize(read_scene_file(path), {}); }
+
+Scene load_scene(const std::string& name_or_path, const GeneratorOptions& options) {
+  if (is_generator_name(name_or_path)) return generate_scene(name_or_path, options);
+  std::error_code ignored;
+  if (name_or_path.ends_with(".json") || std::filesystem::exists(name_or_path, ignored))
+    return realize(read_scene_file(name_or_path), options);
+  throw InputError("scene", "unknown scene '" + name_or_path + "' (known: " +
+                                known_generator_names() + "; or the path of a .json scene file)");
+}
+
+}  // namespace seamcl

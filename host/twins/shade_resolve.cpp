@@ -1,0 +1,118 @@
+#include "twins/shade_resolve.h"
+
+#include <algorithm>
+
+#include "twins/raster.h"
+#include "twins/sample_pattern.h"
+#include "twins/texture_sample.h"
+
+namespace seamcl {
+
+SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y) {
+  const float dx = x - t.ref_x;
+  const float dy = y - t.ref_y;
+  const float inv_w = t.inv_w[0] + t.inv_w[1] * dx + t.inv_w[2] * dy;
+  const float u_w = t.u_over_w[0] + t.u_over_w[1] * dx + t.u_over_w[2] * dy;
+  const float v_w = t.v_over_w[0] + t.v_over_w[1] * dx + t.v_over_w[2] * dy;
+  const float w = 1.0f / inv_w;
+  SurfaceUv r{};
+  r.u = u_w * w;
+  r.v = v_w * w;
+  // u = (u/w) / (1/w): quotient rule for the derivatives.
+  r.dudx = (t.u_over_w[1] - r.u * t.inv_w[1]) * w;
+  r.dudy = (t.u_over_w[2] - r.u * t.inv_w[2]) * w;
+  r.dvdx = (t.v_over_w[1] - r.v * t.inv_w[1]) * w;
+  r.dvdy = (t.v_over_w[2] - r.v * t.inv_w[2]) * w;
+  return r;
+}
+
+glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& f, const TriangleSetup& t, float x, float y) {
+  const SurfaceUv s = interpolate_uv(t, x, y);
+  const glm::vec4 albedo =
+      sample_texture_reference(scene.textures(), t.face, f.sampler, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
+  const FaceGpu& face = scene.faces.at(t.face);
+  const float n_dot_l = face.normal[0] * f.light_dir[0] + face.normal[1] * f.light_dir[1] + face.normal[2] * f.light_dir[2];
+  const float lighting = f.ambient + (1.0f - f.ambient) * std::fmax(n_dot_l, 0.0f);
+  return glm::vec3(albedo.x * f.light_color[0], albedo.y * f.light_color[1], albedo.z * f.light_color[2]) * lighting;
+}
+
+PixelFragment pixel_fragment(const FrameParams& f, const TriangleSetup& t, const uint32_t* ids, uint32_t slot, int x,
+                             int y) {
+  const std::vector<SampleOffset>& pattern = sample_pattern(f.sample_count);
+  constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
+  PixelFragment out;
+  float centroid_x = 0.0f, centroid_y = 0.0f;
+  const int first = static_cast<int>(std::find(ids, ids + f.sample_count, slot) - ids);
+  for (int r = first; r < f.sample_count; ++r) {
+    if (ids[r] != slot) continue;
+    ++out.covered;
+    centroid_x += static_cast<float>(sample_fixed_x(x, pattern[r])) * to_pixels;
+    centroid_y += static_cast<float>(sample_fixed_y(y, pattern[r])) * to_pixels;
+  }
+  centroid_x /= static_cast<float>(out.covered);
+  centroid_y /= static_cast<float>(out.covered);
+  out.x = static_cast<float>(x) + 0.5f;
+  out.y = static_cast<float>(y) + 0.5f;
+  // The centroid also stands in for a centre beyond the plane's horizon (1/w <= 0).
+  if (f.shading_mode == SEAMCL_SHADE_CENTROID || !(plane_inv_w(t, out.x, out.y) > 0.0f)) {
+    out.x = centroid_x;
+    out.y = centroid_y;
+  }
+  return out;
+}
+
+bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& f,
+                                  const std::vector<TriangleSetup>& setups, const uint32_t* ids, int x, int y) {
+  for (int s = 0; s < f.sample_count; ++s) {
+    if (ids[s] == SEAMCL_NO_TRIANGLE || std::find(ids, ids + s, ids[s]) != ids + s) continue;
+    const TriangleSetup& t = setups.at(ids[s]);
+    const PixelFragment fragment = pixel_fragment(f, t, ids, ids[s], x, y);
+    const SurfaceUv uv = interpolate_uv(t, fragment.x, fragment.y);
+    const FilterSum sum =
+        method_sum_reference(scene.textures(), t.face, f.sampler, uv.u, uv.v, uv.dudx, uv.dvdx, uv.dudy, uv.dvdy);
+    if (sum.weight == 0.0f) return true;
+  }
+  return false;
+}
+
+ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& f,
+                                         const std::vector<TriangleSetup>& setups,
+                                         const std::vector<uint32_t>& sample_triangle) {
+  const int samples = f.sample_count;
+  const std::vector<SampleOffset>& pattern = sample_pattern(samples);
+  constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
+  ResolveReference out;
+  out.pixels.resize(static_cast<size_t>(f.width) * f.height);
+  const glm::vec3 background(f.background[0], f.background[1], f.background[2]);
+  for (int y = 0; y < f.height; ++y) {
+    for (int x = 0; x < f.width; ++x) {
+      const uint32_t* ids = &sample_triangle[(static_cast<size_t>(y) * f.width + x) * samples];
+      auto sample_x = [&](int s) { return static_cast<float>(sample_fixed_x(x, pattern[s])) * to_pixels; };
+      auto sample_y = [&](int s) { return static_cast<float>(sample_fixed_y(y, pattern[s])) * to_pixels; };
+      glm::vec3 sum(0.0f);
+      int uncovered = 0;
+      for (int s = 0; s < samples; ++s) {
+        const uint32_t slot = ids[s];
+        if (slot == SEAMCL_NO_TRIANGLE) {
+          ++uncovered;
+          continue;
+        }
+        const TriangleSetup& t = setups.at(slot);
+        if (f.shading_mode == SEAMCL_SHADE_SAMPLE) {
+          sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s));
+          ++out.fragments;
+          continue;
+        }
+        if (std::find(ids, ids + s, slot) != ids + s) continue;  // shaded at its first sample
+        const PixelFragment fragment = pixel_fragment(f, t, ids, slot, x, y);
+        sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y) * static_cast<float>(fragment.covered);
+        ++out.fragments;
+      }
+      sum += background * static_cast<float>(uncovered);  // once: an empty pixel is exactly the background
+      out.pixels[static_cast<size_t>(y) * f.width + x] = glm::vec4(sum / static_cast<float>(samples), 1.0f);
+    }
+  }
+  return out;
+}
+
+}  // namespace seamcl

@@ -1,0 +1,45 @@
+// Scalar twin of kernels/shade_resolve.cl: shading once per pixel and triangle (or per sample)
+// and the box resolve.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <seamcl/pipeline/gpu_types.h>
+#include <seamcl/pipeline/packed_scene.h>
+
+namespace seamcl {
+
+// uv and its screen derivatives at a pixel-space point, perspective-correct from the planes.
+struct SurfaceUv {
+  float u, v, dudx, dvdx, dudy, dvdy;
+};
+SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y);
+
+// Colour of one fragment: texture lookup times the face's Lambert lighting.
+glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& frame, const TriangleSetup& t, float x, float y);
+
+// A triangle's fragment in one pixel (pixel or centroid shading): the samples it covers and
+// where it is shaded. `ids` are the pixel's sample winners; `slot` must be among them.
+struct PixelFragment {
+  int covered = 0;
+  float x = 0, y = 0;  // pixel-space shading point
+};
+PixelFragment pixel_fragment(const FrameParams& frame, const TriangleSetup& t, const uint32_t* ids, uint32_t slot,
+                             int x, int y);
+
+// Whether some fragment of pixel (x, y) (pixel or centroid shading) has no filter tap inside its
+// face (nor, for traverse, its neighbours): the fragments zero_coverage=nan turns into NaN.
+bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& frame,
+                                  const std::vector<TriangleSetup>& setups, const uint32_t* ids, int x, int y);
+
+struct ResolveReference {
+  std::vector<glm::vec4> pixels;  // linear RGBA
+  uint32_t fragments = 0;
+};
+ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& frame,
+                                         const std::vector<TriangleSetup>& setups,
+                                         const std::vector<uint32_t>& sample_triangle);
+
+}  // namespace seamcl

@@ -1,0 +1,285 @@
+#include "twins/texture_sample.h"
+
+#include "core/srgb.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+namespace seamcl {
+
+
+namespace {
+
+struct Level {
+  uint32_t offset;    // first stored texel (the band's corner with a guard band)
+  int width, height;  // the face's texels
+  int pad;            // guard band texels on each side
+  int stride;         // stored texels per row
+};
+
+Level face_level(const TextureView& tex, const FaceGpu& face, int level) {
+  const int width = std::max(face.width >> level, 1);
+  return {tex.level_offsets->at(face.level_table + static_cast<uint32_t>(level)), width,
+          std::max(face.height >> level, 1), tex.guard_band, width + 2 * tex.guard_band};
+}
+
+void add_texel(FilterSum& sum, const TextureView& tex, uint32_t index, float weight) {
+  glm::vec4 texel;
+  if (tex.format == TexelFormat::Rgba32f) {
+    const float* p = &tex.texels32->at(4 * static_cast<size_t>(index));
+    texel = glm::vec4(p[0], p[1], p[2], p[3]);
+  } else {
+    texel = decode_srgb8(tex.texels8->at(index));
+  }
+  sum.color += weight * texel;
+  sum.weight += weight;
+}
+
+// Stored index on an axis of n texels with `pad` band texels each side; inside = 0 for a tap
+// the border address mode discards. Clamp reaches into the band, to its outer edge.
+int address_texel(int i, int n, int pad, int address, float& inside) {
+  const int clamped = std::clamp(i, -pad, n - 1 + pad);
+  inside = (address != SEAMCL_ADDRESS_BORDER || i == clamped) ? 1.0f : 0.0f;
+  return address == SEAMCL_ADDRESS_WRAP ? (i & (n - 1)) : clamped + pad;
+}
+
+float texel_coordinate(float u, int n, int pad, int address) {
+  if (address == SEAMCL_ADDRESS_WRAP) u = u - std::floor(u);
+  return std::fmin(std::fmax(u * static_cast<float>(n) - 0.5f, -2.0f - static_cast<float>(pad)),
+                   static_cast<float>(n + 1 + pad));
+}
+
+void accumulate_bilinear(FilterSum& sum, const TextureView& tex, Level level, float u, float v, float weight, int address) {
+  const float x = texel_coordinate(u, level.width, level.pad, address);
+  const float y = texel_coordinate(v, level.height, level.pad, address);
+  const float x_floor = std::floor(x), y_floor = std::floor(y);
+  const float fx = x - x_floor, fy = y - y_floor;
+  float in_x0, in_x1, in_y0, in_y1;
+  const int x0 = address_texel(static_cast<int>(x_floor), level.width, level.pad, address, in_x0);
+  const int x1 = address_texel(static_cast<int>(x_floor) + 1, level.width, level.pad, address, in_x1);
+  const int y0 = address_texel(static_cast<int>(y_floor), level.height, level.pad, address, in_y0);
+  const int y1 = address_texel(static_cast<int>(y_floor) + 1, level.height, level.pad, address, in_y1);
+  const uint32_t row0 = level.offset + static_cast<uint32_t>(y0 * level.stride);
+  const uint32_t row1 = level.offset + static_cast<uint32_t>(y1 * level.stride);
+  // The kernel derives each weight from the one before (to keep LLVM's SLP pass from pairing
+  // them); the twin rounds the same way: w10 = (1-fy) - w00 rather than fx (1-fy).
+  const float w00 = (1.0f - fx) * (1.0f - fy);
+  const float w10 = (1.0f - fy) - w00;
+  const float w01 = (1.0f - fx) - w00;
+  const float w11 = fy - w01;
+  add_texel(sum, tex, row0 + static_cast<uint32_t>(x0), weight * w00 * in_x0 * in_y0);
+  add_texel(sum, tex, row0 + static_cast<uint32_t>(x1), weight * w10 * in_x1 * in_y0);
+  add_texel(sum, tex, row1 + static_cast<uint32_t>(x0), weight * w01 * in_x0 * in_y1);
+  add_texel(sum, tex, row1 + static_cast<uint32_t>(x1), weight * w11 * in_x1 * in_y1);
+}
+
+void accumulate_trilinear(FilterSum& sum, const TextureView& tex, const FaceGpu& face, float u, float v, float lod,
+                          float weight, int address) {
+  lod = std::fmin(std::fmax(lod, 0.0f), static_cast<float>(face.level_count - 1));
+  const int level0 = static_cast<int>(lod);
+  const int level1 = std::min(level0 + 1, face.level_count - 1);
+  const float t = lod - static_cast<float>(level0);
+  accumulate_bilinear(sum, tex, face_level(tex, face, level0), u, v, weight * (1.0f - t), address);
+  accumulate_bilinear(sum, tex, face_level(tex, face, level1), u, v, weight * t, address);
+}
+
+// The footprint's screen axes: uv per pixel, and squared lengths in level-0 texels.
+struct Footprint {
+  float ax_u, ax_v, ay_u, ay_v;
+  float len2_x, len2_y;
+  bool finite;
+};
+
+Footprint footprint(const FaceGpu& face, float dudx, float dvdx, float dudy, float dvdy) {
+  const float w = static_cast<float>(face.width), h = static_cast<float>(face.height);
+  Footprint f{dudx, dvdx, dudy, dvdy, 0, 0, false};
+  f.len2_x = (dudx * w) * (dudx * w) + (dvdx * h) * (dvdx * h);
+  f.len2_y = (dudy * w) * (dudy * w) + (dvdy * h) * (dvdy * h);
+  f.finite = f.len2_x < INFINITY && f.len2_y < INFINITY;
+  return f;
+}
+
+float lod_of(float len2) { return 0.5f * approx_log2(std::fmax(len2, 1e-30f)); }
+
+void accumulate_aniso(FilterSum& sum, const TextureView& tex, const FaceGpu& face, float u, float v, const Footprint& f,
+                      int max_aniso, int address) {
+  const bool x_major = f.len2_x >= f.len2_y;
+  const float major2 = x_major ? f.len2_x : f.len2_y;
+  const float minor2 = x_major ? f.len2_y : f.len2_x;
+  // N = min(ceil(major / minor), max_aniso) trilinear probes at log2(major / N).
+  // A line footprint takes the most probes; a point footprint one.
+  const float ratio = minor2 > 0.0f ? std::sqrt(major2 / minor2) : major2 > 0.0f ? static_cast<float>(max_aniso) : 1.0f;
+  const int probes = f.finite ? std::clamp(static_cast<int>(std::ceil(std::fmin(ratio, 16.0f))), 1, max_aniso) : 1;
+  const float inv_probes = 1.0f / static_cast<float>(probes);
+  const float lod = f.finite ? lod_of(major2) - approx_log2(static_cast<float>(probes))
+                             : static_cast<float>(face.level_count - 1);
+  const float step_u = (x_major ? f.ax_u : f.ay_u) * inv_probes;
+  const float step_v = (x_major ? f.ax_v : f.ay_v) * inv_probes;
+  // Probe i at (i + 0.5) / N - 0.5 of the major axis from the centre.
+  float pu = f.finite ? u + step_u * (0.5f - 0.5f * static_cast<float>(probes)) : u;
+  float pv = f.finite ? v + step_v * (0.5f - 0.5f * static_cast<float>(probes)) : v;
+  for (int i = 0; i < probes; ++i) {
+    accumulate_trilinear(sum, tex, face, pu, pv, lod, inv_probes, address);
+    pu += step_u;
+    pv += step_v;
+  }
+}
+
+// pbrt-v4's EWA on one level (Gaussian, alpha 2), weights divided by their total over the
+// ellipse: sum.weight is then the fraction of the ellipse inside the face.
+void accumulate_ewa_level(FilterSum& sum, const TextureView& tex, const FaceGpu& face, int level_index, float u, float v,
+                          float a_u, float a_v, float b_u, float b_v, float weight, int address) {
+  const Level level = face_level(tex, face, level_index);
+  const float w = static_cast<float>(level.width), h = static_cast<float>(level.height);
+  float s = u, t = v;
+  if (address == SEAMCL_ADDRESS_WRAP) {
+    s = s - std::floor(s);
+    t = t - std::floor(t);
+  }
+  const float cs = std::fmin(std::fmax(s * w - 0.5f, -2.0f * w - 2.0f), 3.0f * w + 2.0f);
+  const float ct = std::fmin(std::fmax(t * h - 0.5f, -2.0f * h - 2.0f), 3.0f * h + 2.0f);
+  const float x0 = a_u * w, y0 = a_v * h, x1 = b_u * w, y1 = b_v * h;
+  // Implicit ellipse A s^2 + B s t + C t^2 < 1, widened by a texel (the + 1) so it never misses all texels.
+  float A = y0 * y0 + y1 * y1 + 1.0f;
+  float B = -2.0f * (x0 * y0 + x1 * y1);
+  float C = x0 * x0 + x1 * x1 + 1.0f;
+  const float inv_f = 1.0f / (A * C - B * B * 0.25f);
+  A *= inv_f;
+  B *= inv_f;
+  C *= inv_f;
+  const float det = -B * B + 4.0f * A * C;
+  const float inv_det = 1.0f / det;
+  const float u_extent = 2.0f * inv_det * std::sqrt(det * C);
+  const float v_extent = 2.0f * inv_det * std::sqrt(A * det);
+  // At most two level widths around the level: a wider ellipse only repeats what it holds.
+  const int s0 = static_cast<int>(std::fmax(std::ceil(cs - u_extent), -2.0f * w - 2.0f));
+  const int s1 = static_cast<int>(std::fmin(std::floor(cs + u_extent), 3.0f * w + 2.0f));
+  const int t0 = static_cast<int>(std::fmax(std::ceil(ct - v_extent), -2.0f * h - 2.0f));
+  const int t1 = static_cast<int>(std::fmin(std::floor(ct + v_extent), 3.0f * h + 2.0f));
+  FilterSum level_sum;
+  float total = 0.0f;
+  for (int it = t0; it <= t1; ++it) {
+    const float tt = static_cast<float>(it) - ct;
+    float in_y;
+    const int iy = address_texel(it, level.height, level.pad, address, in_y);
+    for (int is = s0; is <= s1; ++is) {
+      const float ss = static_cast<float>(is) - cs;
+      const float r2 = A * ss * ss + B * ss * tt + C * tt * tt;
+      if (r2 >= 1.0f) continue;
+      const float gauss = std::exp(-2.0f * r2) - std::exp(-2.0f);
+      float in_x;
+      const int ix = address_texel(is, level.width, level.pad, address, in_x);
+      total += gauss;
+      add_texel(level_sum, tex, level.offset + static_cast<uint32_t>(iy * level.stride + ix), gauss * in_x * in_y);
+    }
+  }
+  const float scale = total > 0.0f ? weight / total : 0.0f;
+  sum.color += level_sum.color * scale;
+  sum.weight += level_sum.weight * scale;
+}
+
+void accumulate_ewa(FilterSum& sum, const TextureView& tex, const FaceGpu& face, float u, float v, const Footprint& f,
+                    int max_aniso, int address) {
+  if (!f.finite) {
+    accumulate_trilinear(sum, tex, face, u, v, static_cast<float>(face.level_count - 1), 1.0f, address);
+    return;
+  }
+  const bool x_major = f.len2_x >= f.len2_y;
+  const float a_u = x_major ? f.ax_u : f.ay_u, a_v = x_major ? f.ax_v : f.ay_v;
+  float b_u = x_major ? f.ay_u : f.ax_u, b_v = x_major ? f.ay_v : f.ax_v;
+  const float major2 = x_major ? f.len2_x : f.len2_y;
+  float minor2 = x_major ? f.len2_y : f.len2_x;
+  // Clamp the eccentricity to max_aniso by growing the minor axis.
+  const float limit = static_cast<float>(max_aniso * max_aniso);
+  if (minor2 * limit < major2 && minor2 > 0.0f) {
+    const float scale = std::sqrt(major2 / (minor2 * limit));
+    b_u *= scale;
+    b_v *= scale;
+    minor2 = major2 / limit;
+  }
+  if (!(minor2 > 0.0f)) {
+    accumulate_bilinear(sum, tex, face_level(tex, face, 0), u, v, 1.0f, address);
+    return;
+  }
+  // The level where the minor axis spans about one texel.
+  const float lod = std::fmin(std::fmax(lod_of(minor2), 0.0f), static_cast<float>(face.level_count - 1));
+  const int level0 = static_cast<int>(lod);
+  const int level1 = std::min(level0 + 1, face.level_count - 1);
+  const float t = lod - static_cast<float>(level0);
+  accumulate_ewa_level(sum, tex, face, level0, u, v, a_u, a_v, b_u, b_v, 1.0f - t, address);
+  if (t > 0.0f) accumulate_ewa_level(sum, tex, face, level1, u, v, a_u, a_v, b_u, b_v, t, address);
+}
+
+}  // namespace
+
+float approx_log2(float x) {
+  const auto bits = std::bit_cast<int32_t>(x);
+  const float exponent = static_cast<float>(((bits >> 23) & 255) - 127);
+  const float m = std::bit_cast<float>((bits & 0x007fffff) | 0x3f800000) - 1.0f;
+  const float p = m * (1.442517034f + m * (-0.7178983813f + m * (0.4568941740f + m * (-0.2773650501f +
+                  m * (0.1219141394f + m * -0.02606630148f)))));
+  return exponent + p;
+}
+
+FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, const SamplerParams& sampler, int address,
+                                   float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
+  const FaceGpu& face = tex.faces->at(face_index);
+  FilterSum sum;
+  const Footprint f = footprint(face, dudx, dvdx, dudy, dvdy);
+  switch (sampler.filter) {
+    case SEAMCL_FILTER_BILINEAR:
+      accumulate_bilinear(sum, tex, face_level(tex, face, 0), u, v, 1.0f, address);
+      break;
+    case SEAMCL_FILTER_TRILINEAR: {
+      const float lod = f.finite ? lod_of(std::fmax(f.len2_x, f.len2_y)) : static_cast<float>(face.level_count - 1);
+      accumulate_trilinear(sum, tex, face, u, v, lod, 1.0f, address);
+      break;
+    }
+    case SEAMCL_FILTER_ANISO:
+      accumulate_aniso(sum, tex, face, u, v, f, sampler.max_aniso, address);
+      break;
+    default:
+      accumulate_ewa(sum, tex, face, u, v, f, sampler.max_aniso, address);
+      break;
+  }
+  return sum;
+}
+
+FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const SamplerParams& sampler, float u, float v,
+                               float dudx, float dvdx, float dudy, float dvdy) {
+  FilterSum sum = filter_texture_reference(tex, face, sampler, sampler.address, u, v, dudx, dvdx, dudy, dvdy);
+  if (!sampler.traverse) return sum;
+  // Traverse: each edge neighbour at this point and footprint carried into its uv, border-
+  // addressed. Diagonal faces are not edge neighbours: taps past a corner are not read.
+  const FaceNeighbors& n = tex.neighbors->at(face);
+  for (int k = 0; k < 4; ++k) {
+    if (n.neighbor[k] < 0) continue;
+    const float* t = n.transform[k];
+    const FilterSum s = filter_texture_reference(tex, static_cast<uint32_t>(n.neighbor[k]), sampler, SEAMCL_ADDRESS_BORDER,
+                                                 t[0] * u + t[1] * v + t[2], t[3] * u + t[4] * v + t[5],
+                                                 t[0] * dudx + t[1] * dvdx, t[3] * dudx + t[4] * dvdx,
+                                                 t[0] * dudy + t[1] * dvdy, t[3] * dudy + t[4] * dvdy);
+    sum.color += s.color;
+    sum.weight += s.weight;
+  }
+  return sum;
+}
+
+glm::vec4 sample_texture_reference(const TextureView& tex, uint32_t face, const SamplerParams& sampler, float u, float v,
+                                   float dudx, float dvdx, float dudy, float dvdy) {
+  FilterSum sum = method_sum_reference(tex, face, sampler, u, v, dudx, dvdx, dudy, dvdy);
+  if (!sampler.renormalize) return sum.color;
+  if (sum.weight == 0.0f && sampler.zero_coverage == SEAMCL_ZERO_COVERAGE_CLAMP) {
+    // Every tap fell outside: a clamped trilinear lookup at the centre clamped to the face.
+    SamplerParams fallback = sampler;
+    fallback.filter = SEAMCL_FILTER_TRILINEAR;
+    sum = filter_texture_reference(tex, face, fallback, SEAMCL_ADDRESS_CLAMP, std::fmin(std::fmax(u, 0.0f), 1.0f),
+                                   std::fmin(std::fmax(v, 0.0f), 1.0f), dudx, dvdx, dudy, dvdy);
+  }
+  const float inv_weight = 1.0f / sum.weight;
+  return sum.color * inv_weight;
+}
+
+}  // namespace seamcl
