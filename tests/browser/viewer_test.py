@@ -17,6 +17,8 @@ Loopback only, bounded in time (about a minute). Exits 0 on success, 1 on failur
     tests/browser/viewer_test.py --seamcl build/seamcl [--chromium chromium] [--screenshots DIR]
 """
 import argparse
+import http.server
+import threading
 import json
 import math
 import os
@@ -121,6 +123,65 @@ def mean_distance(p, q):
     for a, b in zip(p, q):
         total += math.sqrt(sum((lut[a[k]] - lut[b[k]]) ** 2 for k in range(3)))
     return total / len(p)
+
+
+class Proxy(http.server.ThreadingHTTPServer):
+    """In front of seamcl for what the server cannot do on demand: it delays renders of one method
+    (answers that arrive late and out of order), and, where seamcl has no POST /v1/reference yet,
+    answers it with a stand-in (a traverse render of the same frame) so the page's reference path
+    runs too."""
+    daemon_threads = True
+
+    def __init__(self, upstream):
+        self.upstream, self.slow_method, self.fake_reference = upstream, None, False
+        super().__init__(("127.0.0.1", 0), ProxyHandler)
+        threading.Thread(target=self.serve_forever, daemon=True).start()
+
+    @property
+    def base(self):
+        return "http://127.0.0.1:%d" % self.server_address[1]
+
+
+class ProxyHandler(http.server.BaseHTTPRequestHandler):
+    def log_message(self, *args):
+        pass
+
+    def relay(self, method):
+        body = self.rfile.read(int(self.headers.get("Content-Length", 0) or 0)) if method == "POST" else None
+        path = self.path
+        if method == "POST" and path == "/v1/reference" and self.server.fake_reference:
+            request = json.loads(body)
+            q = {k: request[k] for k in ("scene", "size", "frame", "frames", "tint", "texels", "aniso", "filter") if k in request}
+            q["method"] = "traverse"
+            path, method, body = "/v1/render?" + urllib.parse.urlencode(q), "GET", None
+        query = urllib.parse.parse_qs(urllib.parse.urlparse(path).query)
+        if self.server.slow_method and query.get("method") == [self.server.slow_method]:
+            time.sleep(2.0)
+        request = urllib.request.Request(self.server.upstream + path, data=body, method=method,
+                                         headers={"Content-Type": self.headers.get("Content-Type", "application/json")})
+        try:
+            with urllib.request.urlopen(request, timeout=60) as r:
+                status, headers, data = r.status, r.headers, r.read()
+        except urllib.error.HTTPError as e:
+            status, headers, data = e.code, e.headers, e.read()
+        try:
+            self.send_response(status)
+            for k, v in headers.items():
+                if k.lower() in ("content-type", "retry-after") or k.lower().startswith("x-seamcl"):
+                    self.send_header(k, v)
+            if self.path == "/v1/reference" and status == 200:
+                self.send_header("X-Seamcl-Reference-Method", "traverse (stand-in)")
+            self.send_header("Content-Length", str(len(data)))
+            self.end_headers()
+            self.wfile.write(data)
+        except OSError:  # the page aborted this request
+            pass
+
+    def do_GET(self):
+        self.relay("GET")
+
+    def do_POST(self):
+        self.relay("POST")
 
 
 class Checks:
@@ -388,6 +449,40 @@ def run(base, chromium, profile, shots, t, deadline):
             t.check(page.eval("document.getElementById('chart_data').textContent") == "null", "nothing was compared")
             shot(page, "6-over-limit.png")
         t.check(not page.errors(), "no script errors in the page", str(page.errors()))
+
+        step(11)
+        # 11. Through the proxy: an answer for the old method A that arrives after the new one's
+        # must not be shown; and the heat map against the reference (a stand-in if seamcl has none).
+        proxy = Proxy(base)
+        try:
+            proxy.fake_reference = ref_status == 404
+            page3 = browser.open(proxy.base + "/#size=%s&scale=4&a=%s&b=%s&view=heat&heat=a_ref" % (SIZE, a0, b0))
+            wait_idle(page3, min(40, left()), "the page through the proxy")
+            page3.wait("document.getElementById('heat').dataset.pair === 'a_ref'", timeout=min(40, left()),
+                       what="the heat map against the reference")
+            label = page3.eval("document.getElementById('label_heat').textContent")
+            src = image_info(page3, "image_a")["src"]
+            pa, _, _ = decode_png_rgb(get(base + src)[1])
+            body = {"scene": options["scene"]["default"], "size": SIZE, "aniso": options["aniso"]["default"],
+                    "filter": options["filter"]["default"], "texels": options["texels"]["default"]}
+            pr, _, _ = decode_png_rgb(get(proxy.base + "/v1/reference", body)[1])
+            expected = mean_distance(pa, pr)
+            got = float(page3.eval("document.getElementById('heat').dataset.mean"))
+            t.check(abs(got - expected) <= 1e-6 + 1e-4 * expected and "reference: traverse" in label,
+                    "the heat map against the reference", "page %.6g, python %.6g; %s" % (got, expected, label))
+            shot(page3, "7-heat-reference.png")
+            proxy.slow_method = a1
+            set_control(page3, "method_a", a1)
+            time.sleep(0.5)  # the render for a1 is on its way (slow)
+            set_control(page3, "method_a", a2)
+            wait_idle(page3, min(20, left()), "the render of the second A")
+            time.sleep(2.2)  # the slow answer for a1 has come (or was aborted) by now
+            src = image_info(page3, "image_a")["src"]
+            t.check(method_of(src) == a2, "a late answer for the previous A is not shown", src)
+            t.check(not page3.errors(), "no script errors through the proxy", str(page3.errors()))
+        finally:
+            proxy.shutdown()
+            proxy.server_close()
     finally:
         browser.close()
 
