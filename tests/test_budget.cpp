@@ -17,6 +17,7 @@
 
 #include <seamcl/core/cancelled.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/over_budget.h>
 #include <seamcl/eval/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
@@ -223,6 +224,8 @@ TEST(Budget, ReleaseFrameBuffersFreesThemAndTheNextRenderIsIdentical) {
   EXPECT_EQ(renderer.device_bytes(), small_memory.scene_device_bytes() + small_memory.constants);
   EXPECT_EQ(renderer.last_frame_params().width, 0);
   EXPECT_TRUE(renderer.read_sample_triangles().empty());
+  EXPECT_TRUE(renderer.read_tile_lists().empty());
+  EXPECT_TRUE(renderer.read_setups().empty());
   renderer.render(scene.camera, small);
   EXPECT_EQ(renderer.device_bytes(), small_memory.device_bytes());
 
@@ -244,7 +247,7 @@ TEST(Budget, ReleaseFrameBuffersFreesThemAndTheNextRenderIsIdentical) {
   EXPECT_EQ(renderer.device_bytes(), held);
 }
 
-TEST(Budget, RepackingHoldsOneSceneAtATime) {
+TEST(Budget, RepackInAnotherFormatOrBandHoldsOnlyTheNewPacking) {
   // load_scene and a render in another format or band free the old packing before the new one.
   const Scene scene = generate_scene("cube", {});
   const RenderOptions banded = options_of(Method::Guardband, TexelFormat::Rgba32f, 1, 32, 32, 16);
@@ -255,6 +258,56 @@ TEST(Budget, RepackingHoldsOneSceneAtATime) {
   EXPECT_EQ(renderer.device_bytes(), render_memory(scene, banded).device_bytes());
   renderer.render(scene.camera, plain);
   EXPECT_EQ(renderer.device_bytes(), render_memory(scene, plain).device_bytes());
+}
+
+// `count` screen-filling quads stacked towards the camera: every triangle lands on every tile, so
+// the tile lists outgrow their initial size.
+Scene stacked_quads(int count) {
+  Scene scene;
+  scene.name = "stacked";
+  for (int k = 0; k < count; ++k) {
+    const float z = -0.01f * static_cast<float>(k);
+    const uint32_t base = static_cast<uint32_t>(scene.positions.size());
+    for (const auto& [x, y] : {std::pair{-3.0f, -3.0f}, {3.0f, -3.0f}, {3.0f, 3.0f}, {-3.0f, 3.0f}}) scene.positions.emplace_back(x, y, z);
+    Face face;
+    face.vertices = {base, base + 1, base + 2, base + 3};
+    TextureLevel texel;
+    texel.width = texel.height = 1;
+    texel.texels = {glm::vec4(0.5f, 0.4f, 0.3f, 1.0f)};
+    face.texture = build_mip_chain(std::move(texel));
+    scene.faces.push_back(std::move(face));
+  }
+  return scene;
+}
+
+TEST(Budget, TileListGrowthStaysUnderTheBoundAndALimitRefusesIt) {
+  const Scene scene = stacked_quads(24);
+  const RenderOptions options = options_of(Method::Discard, TexelFormat::Rgba8, 1, 1024, 1024);
+  const RenderMemory expected = render_memory(scene, options);
+  Renderer renderer(seamcl_tests::shared_runtime());
+  renderer.load_scene(scene);
+  const RenderResult grown = renderer.render(scene.camera, options);
+  ASSERT_EQ(grown.attempts, 2);  // the lists overflowed once
+  EXPECT_GT(renderer.device_bytes(), expected.device_bytes());
+  EXPECT_LE(renderer.device_bytes(), expected.device_bytes_bound());
+
+  // With the estimate as the limit, the growth is refused before it is allocated.
+  Renderer limited(seamcl_tests::shared_runtime());
+  limited.set_device_byte_limit(expected.device_bytes());
+  limited.load_scene(scene);
+  try {
+    limited.render(scene.camera, options);
+    ADD_FAILURE() << "no OverBudget";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "size");
+    EXPECT_EQ(e.limit_bytes(), expected.device_bytes());
+    EXPECT_GT(e.needed_bytes(), expected.device_bytes());
+  }
+  EXPECT_EQ(limited.device_bytes(), expected.device_bytes());
+  // A limit that allows the growth renders the same image.
+  limited.set_device_byte_limit(expected.device_bytes_bound());
+  const RenderResult again = limited.render(scene.camera, options);
+  EXPECT_EQ(std::memcmp(again.pixels.data(), grown.pixels.data(), grown.pixels.size() * sizeof(glm::vec4)), 0);
 }
 
 TEST(Budget, CompareMemoryBoundsWhatTheCompareHolds) {

@@ -10,7 +10,8 @@
 //   exception: the tile lists start at initial_tile_list_entries(triangles) entries and grow (to
 //   5/4 of what the frame needed, and the frame is rendered again) when the scene's triangles
 //   touch more tiles than that. `tile_lists_bound` is the upper bound after any growth: every
-//   clip slot of every triangle on every tile. A Renderer that keeps its buffers between
+//   clip slot of every triangle on every tile; Renderer::set_device_byte_limit refuses growth past
+//   a limit (OverBudget) instead. A Renderer that keeps its buffers between
 //   requests holds, per buffer, the largest size any of them needed.
 // - Host bytes are the payload of the arrays the Renderer holds (its Scene copy, the packed
 //   arrays, the read-back image): exact in element bytes; vector headers, capacity beyond size

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include <seamcl/pipeline/render_memory.h>
+#include <seamcl/core/over_budget.h>
 #include "core/srgb.h"
 #include "pipeline/frame_params.h"
 
@@ -47,6 +48,7 @@ struct Renderer::Impl {
   uint32_t bin_capacity = 0;         // tile-list entries the next frame asks for
   uint32_t tile_lists_capacity = 0;  // entries allocated
   FrameParams last_params{};
+  size_t device_byte_limit = 0;  // 0: none
 
   explicit Impl(ClRuntime& rt) : runtime(rt) {
     const auto& table = srgb_to_linear_table();
@@ -231,6 +233,8 @@ void Renderer::load_scene(const Scene& scene, TexelFormat format) {
   impl_->tile_lists = cl::Buffer();
 }
 
+void Renderer::set_device_byte_limit(size_t bytes) { impl_->device_byte_limit = bytes; }
+
 bool Renderer::has_scene() const { return impl_->scene != nullptr; }
 
 void Renderer::release_frame_buffers() { impl_->release_frame_buffers(); }
@@ -279,7 +283,15 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     if (result.stats.bin_entries > params.bin_capacity) {
       // The lists overflowed (the kernels stayed in bounds): grow with headroom and render again.
       if (result.attempts >= 3) throw std::runtime_error("tile lists overflowed three times");
-      impl_->bin_capacity = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{result.stats.bin_entries} * 5 / 4 + 1024, 1u << 31));
+      const uint32_t grown = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{result.stats.bin_entries} * 5 / 4 + 1024, 1u << 31));
+      if (impl_->device_byte_limit != 0) {
+        const size_t needed = device_bytes() - size_t{impl_->tile_lists_capacity} * sizeof(cl_uint) + size_t{grown} * sizeof(cl_uint);
+        if (needed > impl_->device_byte_limit) {
+          throw OverBudget("size", "this frame's tile lists (" + std::to_string(result.stats.bin_entries) + " entries)",
+                           needed, impl_->device_byte_limit);
+        }
+      }
+      impl_->bin_capacity = grown;
       continue;
     }
     auto sum = [](const std::vector<cl::Event>& events) {
@@ -331,6 +343,7 @@ std::vector<uint32_t> Renderer::read_tile_offsets() {
                                static_cast<size_t>(impl_->last_params.tiles_x) * impl_->last_params.tiles_y);
 }
 std::vector<uint32_t> Renderer::read_tile_lists() {
+  if (impl_->tile_lists() == nullptr || impl_->last_params.width == 0) return {};  // released (or none yet)
   FrameStats stats{};
   impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &stats);
   return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_lists, std::min(stats.bin_entries, impl_->bin_capacity));

@@ -69,6 +69,12 @@ class Renderer {
   // render_memory(...).device_bytes() predicts for a fresh Renderer after one render.
   size_t device_bytes() const;
 
+  // A ceiling for device_bytes() (0, the default: none). render_memory() predicts every buffer
+  // but the tile lists' growth on crowded frames; with a limit, a render whose lists would have
+  // to grow past it throws OverBudget (field "size") instead of allocating. The rest is the
+  // caller's to check beforehand with render_memory().
+  void set_device_byte_limit(size_t bytes);
+
   RenderResult render(const Camera& camera, const RenderOptions& options);
 
   // Renders one tiny frame of the loaded scene with these options (method, filter, texels) so
