@@ -17,12 +17,16 @@
 
 #include <httplib.h>
 
+#include <seamcl/core/cancelled.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/over_budget.h>
+#include <seamcl/eval/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/packed_scene.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
@@ -103,6 +107,30 @@ std::string server_cache_dir(const std::string& configured) {
   if (!configured.empty()) return configured;
   if (const char* dir = std::getenv("SEAMCL_CACHE_DIR"); dir && *dir) return dir;
   return (std::filesystem::temp_directory_path() / "seamcl-serve-cache").string();
+}
+
+// What an inline scene's memory depends on, read from its JSON before anything is built: the
+// vertex count and each face's texture size (a missing or malformed size counts as 1; the
+// parser refuses it later, naming the field).
+SceneSizes inline_scene_sizes(const json& scene) {
+  SceneSizes sizes;
+  if (scene.contains("positions") && scene.at("positions").is_array()) sizes.vertices = scene.at("positions").size();
+  if (!scene.contains("faces") || !scene.at("faces").is_array()) return sizes;
+  for (const json& face : scene.at("faces")) {
+    const json* texture = face.is_object() && face.contains("texture") ? &face.at("texture") : nullptr;
+    auto side = [&](const char* name) {
+      if (!texture || !texture->is_object() || !texture->contains(name) || !texture->at(name).is_number_integer()) return 1;
+      return static_cast<int>(std::clamp<long long>(texture->at(name).get<long long>(), 1, 1 << 20));
+    };
+    sizes.faces.emplace_back(side("width"), side("height"));
+  }
+  return sizes;
+}
+
+std::string mebibytes(size_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1 << 20));
+  return text;
 }
 
 }  // namespace
@@ -405,7 +433,8 @@ json HttpServer::methods_json() const { return methods_cache_; }
 
 // The scene: a built-in one (never a file path: clients name no server files) or inline.
 std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene, RenderOptions& options,
-                                                       std::string& key) const {
+                                                       std::string& key,
+                                                       const std::function<void(const SceneSizes&)>& check_budget) const {
   std::shared_ptr<const Scene> scene;
   key.clear();
   if (inline_scene.is_null()) {
@@ -417,6 +446,7 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
     }
     scene = found->second;
     key = found->first;
+    check_budget(scene_sizes(*scene));
   } else {
     // Limits first, from the JSON, before any texture is made.
     if (inline_scene.contains("faces") && inline_scene.at("faces").is_array()) {
@@ -441,6 +471,7 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
         }
       }
     }
+    check_budget(inline_scene_sizes(inline_scene));
     try {
       Scene parsed = parse_scene_json(inline_scene);
       if (options.tint) {
@@ -456,6 +487,20 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
     options.scene = scene->name;
   }
   return scene;
+}
+
+void HttpServer::refuse_over_budget(size_t device_bytes, size_t host_bytes, const std::string& field,
+                                    const std::string& what) const {
+  if (device_bytes > options_.max_request_device_bytes) {
+    throw HttpError{413, field,
+                    what + " needs about " + mebibytes(device_bytes) + " of device memory, over this server's limit of " +
+                        mebibytes(options_.max_request_device_bytes) + " per request"};
+  }
+  if (host_bytes > options_.max_request_host_bytes) {
+    throw HttpError{413, field,
+                    what + " needs about " + mebibytes(host_bytes) + " of host memory, over this server's limit of " +
+                        mebibytes(options_.max_request_host_bytes) + " per request"};
+  }
 }
 
 void HttpServer::handle_render(const json& request, httplib::Response& res) {
@@ -485,7 +530,15 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   }
 
   std::string key;
-  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, options, key);
+  RenderMemory memory;
+  const bool inline_request = !inline_scene.is_null();
+  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, options, key, [&](const SceneSizes& sizes) {
+    memory = render_memory(sizes, options);
+    const bool frame_drives = memory.frame_device_bytes() >= memory.scene_device_bytes();
+    const std::string field = frame_drives ? "size" : inline_request ? "scene" : "texels";
+    refuse_over_budget(memory.device_bytes(), saturating_add(memory.host_bytes(), inline_request ? scene_host_bytes(sizes) : 0),
+                       field, "this render");
+  });
   const Camera camera = options.frame ? orbit_camera(*scene, *options.frame, options.frames) : scene->camera;
 
   // Wait for a render slot (or 503), render, and give the slot back before encoding.
@@ -504,8 +557,16 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
         renderer = std::make_unique<Renderer>(runtime_);
         if (!key.empty()) renderer->load_scene(*scene, options.texels);
       }
+      // Tile lists grow with what a frame holds, past any estimate: bounded here.
+      renderer->set_device_byte_limit(options_.max_request_device_bytes);
       if (key.empty()) renderer->load_scene(*scene, options.texels);
       result = renderer->render(camera, options);
+      // Hold nothing request-sized between requests: the inline scene goes, large frames too.
+      if (key.empty()) {
+        renderer->release_scene();
+      } else if (memory.frame_device_bytes() > options_.keep_frame_bytes) {
+        renderer->release_frame_buffers();
+      }
     } catch (...) {
       renderer.reset();  // a failed Renderer is not reused: the next request gets a fresh one
       throw;
@@ -582,6 +643,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   }
   ReferenceSettings reference_settings;
   reference_settings.cache_dir = options_.cache_dir;
+  reference_settings.cache_max_bytes = options_.cache_max_bytes;
   if (rest.contains("reference_method")) {
     const json& value = rest.at("reference_method");
     if (!value.is_string()) throw InputError("reference_method", "must be a method name, got " + value.dump().substr(0, 100));
@@ -639,8 +701,15 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
                         ", over this server's limit of " + std::to_string(options_.max_reference_samples)};
   }
   std::string key;
-  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key);
+  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key, [&](const SceneSizes& sizes) {
+    const CompareMemory memory = compare_memory(sizes, frame, entries, reference_settings);
+    refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this compare");
+  });
   const Camera camera = frame.frame ? orbit_camera(*scene, *frame.frame, frame.frames) : scene->camera;
+  // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
+  const Clock::time_point deadline =
+      options_.deadline_ms > 0 ? start + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
+  const ShouldStop should_stop = [deadline] { return GuardedHttpServer::client_gone() || Clock::now() > deadline; };
 
   // One admitted request for the whole compare. A Renderer of its own: the 8x reference's
   // buffers are freed with it, and the slot's warm Renderers keep their scenes.
@@ -654,6 +723,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
     queue_ms = ms_since(queued);
     if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
     Renderer renderer(runtime_);
+    renderer.set_device_byte_limit(options_.max_request_device_bytes);
     renderer.load_scene(*scene, frame.texels);
     const std::vector<uint8_t> mask = seam_mask(render_face_map(renderer, camera, frame));
     seam_pixels = static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{1}));
@@ -662,7 +732,13 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
       std::lock_guard lock(reference_locks_[std::hash<std::string>{}(cache_key) % reference_locks_.size()]);
       reference = reference_image(renderer, camera, frame, reference_settings);
     }
-    measured = compare_methods(renderer, *scene, camera, entries, &reference.pixels, &mask, repeat);
+    try {
+      throw_if_stopped(should_stop, "before the entries");
+      measured = compare_methods(renderer, *scene, camera, entries, &reference.pixels, &mask, repeat, should_stop);
+    } catch (const Cancelled&) {
+      if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
+      throw HttpError{503, "deadline", "the compare ran past this server's deadline of " + std::to_string(options_.deadline_ms) + " ms", 1};
+    }
   }
 
   json results = json::array();
@@ -704,6 +780,8 @@ void HttpServer::install_routes() {
       } catch (const HttpError& e) {
         if (e.retry_after_s > 0) res.set_header("Retry-After", std::to_string(e.retry_after_s));
         send_error(res, e.status, e.field, e.field + ": " + e.message);
+      } catch (const OverBudget& e) {
+        send_error(res, 413, e.field(), e.what());
       } catch (const InputError& e) {
         send_error(res, 400, e.field(), e.what());
       } catch (const std::exception& e) {
