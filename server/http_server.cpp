@@ -182,75 +182,12 @@ HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
   if (options_.deadline_ms < 0) throw InputError("deadline", "must be at least 0 (0: none)");
   options_.cache_dir = server_cache_dir(options_.cache_dir);
 
-  // 1. The built-in scenes, plain and tinted.
-  for (const GeneratorInfo& g : scene_generators()) {
-    for (bool tint : {false, true}) {
-      GeneratorOptions generator_options;
-      generator_options.tint = tint;
-      scenes_[scene_key(g.name, tint)] = std::make_shared<const Scene>(generate_scene(g.name, generator_options));
-    }
-  }
-
-  // 2. One slot per thread. Their Renderers are made and warmed after bind() (warm_up()); a slot
-  // becomes free once warm, so early renders wait for it rather than build kernels themselves.
-  const RenderOptions defaults;
+  // The built-in scenes are generated on first use (builtin_scene), the default one by the
+  // warm-up, so the port is bound without waiting for them. One slot per thread: their Renderers
+  // are made and warmed after bind() (warm_up()); a slot becomes free once warm, so early
+  // renders wait for it rather than build kernels themselves.
   for (int i = 0; i < options_.threads; ++i) slots_.push_back(std::make_unique<Slot>());
   total_variants_ = options_.warm_all_methods ? static_cast<int>(method_names().size() * filter_names().size()) : 1;
-
-  // 3. The /v1/methods answer: texture memory of each method on the default scene, as packed for
-  // the device (rgba8; rgba32f stores the same texels at 16 bytes each).
-  const json default_json = to_json(defaults);
-  const Scene& default_scene = *scenes_.at(scene_key(defaults.scene, false));
-  json methods = json::array();
-  for (const std::string& name : method_names()) {
-    const Method method = *parse_method(name);
-    const PackedScene packed = pack_scene(default_scene, TexelFormat::Rgba8, method == Method::Guardband ? defaults.guard_band : 0);
-    const size_t float_texel_bytes = 4 * sizeof(float);
-    methods.push_back({{"name", name},
-                       {"description", method_description(name)},
-                       {"texture_bytes", {{"rgba8", packed.texture_bytes()}, {"rgba32f", packed.texel_count() * float_texel_bytes}}},
-                       {"padding_bytes", {{"rgba8", packed.padding_bytes()}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
-                       {"adjacency_bytes", method == Method::Traverse ? packed.adjacency_bytes() : 0}});
-  }
-  json scene_names = json::array();
-  for (const GeneratorInfo& g : scene_generators()) scene_names.push_back(g.name);
-  auto enum_option = [&](const std::vector<std::string>& names, const std::string& key) {
-    return json{{"type", "string"}, {"enum", names}, {"default", default_json.at(key)}};
-  };
-  methods_cache_ = {
-      {"scene", defaults.scene},
-      {"methods", methods},
-      {"options",
-       {{"scene", {{"type", "string"}, {"enum", scene_names}, {"default", defaults.scene},
-                   {"description", "a built-in scene name, or (POST only) an inline scene object as in docs/scene-format.md"}}},
-        {"method", enum_option(method_names(), "method")},
-        {"filter", enum_option(filter_names(), "filter")},
-        {"zero_coverage", enum_option(zero_coverage_names(), "zero_coverage")},
-        {"texels", enum_option(texel_format_names(), "texels")},
-        {"shading", enum_option(shading_mode_names(), "shading")},
-        {"msaa", {{"type", "integer"}, {"enum", {1, 2, 4, 8, 16}}, {"default", defaults.msaa}}},
-        {"aniso", {{"type", "integer"}, {"minimum", 1}, {"maximum", 16}, {"default", defaults.aniso}}},
-        {"guard_band", {{"type", "integer"}, {"minimum", 1}, {"maximum", kMaxGuardBand}, {"default", defaults.guard_band},
-                        {"description", "guardband: band texels per side of every level"}}},
-        {"size", {{"type", "string"}, {"pattern", "^[0-9]+x[0-9]+$"}, {"minimum", 1}, {"maximum", kMaxImageSide},
-                  {"default", default_json.at("size")},
-                  {"description", "WIDTHxHEIGHT, each side in 1.." + std::to_string(kMaxImageSide) +
-                                      ", width*height*msaa at most " + std::to_string(options_.max_samples)}}},
-        {"frame", {{"type", "integer"}, {"minimum", 0}, {"maximum", 999999},
-                   {"description", "orbit frame, less than frames (default: the scene's camera)"}}},
-        {"frames", {{"type", "integer"}, {"minimum", 1}, {"maximum", 1000000}, {"default", defaults.frames}}},
-        {"centroid", {{"type", "boolean"}, {"default", false}, {"description", "same as shading=centroid"}}},
-        {"tint", {{"type", "boolean"}, {"default", defaults.tint}}},
-        {"format", {{"type", "string"}, {"enum", {"png", "exr"}}, {"default", "png"}}}}},
-      {"limits",
-       {{"max_body_bytes", options_.max_body_bytes},
-        {"max_samples", options_.max_samples},
-        {"max_inline_faces", options_.max_inline_faces},
-        {"max_inline_texels", options_.max_inline_texels},
-        {"max_compare_pixels", options_.max_compare_pixels},
-        {"max_compare_entries", options_.max_compare_entries},
-        {"max_compare_repeat", options_.max_compare_repeat},
-        {"max_reference_samples", options_.max_reference_samples}}}};
 
   install_routes();
 }
@@ -283,7 +220,7 @@ void HttpServer::warm_up() {
       log_line("warming: slot " + std::to_string(i + 1) + "/" + std::to_string(slots_.size()) + ", scene " +
                defaults.scene + ", " + to_string(defaults.method) + " " + to_string(defaults.filter));
       auto renderer = std::make_unique<Renderer>(runtime_);
-      renderer->load_scene(*scenes_.at(default_key), defaults.texels);
+      renderer->load_scene(*builtin_scene(defaults.scene, false), defaults.texels);
       renderer->warm_up(defaults);
       {
         std::lock_guard lock(slots_mutex_);
@@ -301,7 +238,7 @@ void HttpServer::warm_up() {
     // (and PoCL's cache), so the slots find them built; renders go on meanwhile.
     if (options_.warm_all_methods) {
       Renderer renderer(runtime_);
-      renderer.load_scene(*scenes_.at(default_key), defaults.texels);
+      renderer.load_scene(*builtin_scene(defaults.scene, false), defaults.texels);
       for (const std::string& method : method_names()) {
         for (const std::string& filter : filter_names()) {
           if (stopping_.load()) return;
@@ -417,7 +354,7 @@ json HttpServer::scenes_json() const {
   json list = json::array();
   const std::string default_scene = RenderOptions{}.scene;
   for (const GeneratorInfo& g : scene_generators()) {
-    const Scene& scene = *scenes_.at(scene_key(g.name, false));
+    const Scene& scene = *builtin_scene(g.name, false);
     list.push_back({{"name", g.name},
                     {"description", g.description},
                     {"faces", scene.faces.size()},
@@ -429,7 +366,83 @@ json HttpServer::scenes_json() const {
   return {{"scenes", list}};
 }
 
-json HttpServer::methods_json() const { return methods_cache_; }
+json HttpServer::methods_json() const {
+  // Made on first use: it packs the default scene once per method, which the start need not wait for.
+  std::call_once(methods_once_, [this] { methods_cache_ = make_methods_json(); });
+  return methods_cache_;
+}
+
+json HttpServer::make_methods_json() const {
+  const RenderOptions defaults;
+  // The /v1/methods answer: texture memory of each method on the default scene, as packed for
+  // the device (rgba8; rgba32f stores the same texels at 16 bytes each).
+  const json default_json = to_json(defaults);
+  const Scene& default_scene = *builtin_scene(defaults.scene, false);
+  json methods = json::array();
+  for (const std::string& name : method_names()) {
+    const Method method = *parse_method(name);
+    const PackedScene packed = pack_scene(default_scene, TexelFormat::Rgba8, method == Method::Guardband ? defaults.guard_band : 0);
+    const size_t float_texel_bytes = 4 * sizeof(float);
+    methods.push_back({{"name", name},
+                       {"description", method_description(name)},
+                       {"texture_bytes", {{"rgba8", packed.texture_bytes()}, {"rgba32f", packed.texel_count() * float_texel_bytes}}},
+                       {"padding_bytes", {{"rgba8", packed.padding_bytes()}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
+                       {"adjacency_bytes", method == Method::Traverse ? packed.adjacency_bytes() : 0}});
+  }
+  json scene_names = json::array();
+  for (const GeneratorInfo& g : scene_generators()) scene_names.push_back(g.name);
+  auto enum_option = [&](const std::vector<std::string>& names, const std::string& key) {
+    return json{{"type", "string"}, {"enum", names}, {"default", default_json.at(key)}};
+  };
+  return {
+      {"scene", defaults.scene},
+      {"methods", methods},
+      {"options",
+       {{"scene", {{"type", "string"}, {"enum", scene_names}, {"default", defaults.scene},
+                   {"description", "a built-in scene name, or (POST only) an inline scene object as in docs/scene-format.md"}}},
+        {"method", enum_option(method_names(), "method")},
+        {"filter", enum_option(filter_names(), "filter")},
+        {"zero_coverage", enum_option(zero_coverage_names(), "zero_coverage")},
+        {"texels", enum_option(texel_format_names(), "texels")},
+        {"shading", enum_option(shading_mode_names(), "shading")},
+        {"msaa", {{"type", "integer"}, {"enum", {1, 2, 4, 8, 16}}, {"default", defaults.msaa}}},
+        {"aniso", {{"type", "integer"}, {"minimum", 1}, {"maximum", 16}, {"default", defaults.aniso}}},
+        {"guard_band", {{"type", "integer"}, {"minimum", 1}, {"maximum", kMaxGuardBand}, {"default", defaults.guard_band},
+                        {"description", "guardband: band texels per side of every level"}}},
+        {"size", {{"type", "string"}, {"pattern", "^[0-9]+x[0-9]+$"}, {"minimum", 1}, {"maximum", kMaxImageSide},
+                  {"default", default_json.at("size")},
+                  {"description", "WIDTHxHEIGHT, each side in 1.." + std::to_string(kMaxImageSide) +
+                                      ", width*height*msaa at most " + std::to_string(options_.max_samples)}}},
+        {"frame", {{"type", "integer"}, {"minimum", 0}, {"maximum", 999999},
+                   {"description", "orbit frame, less than frames (default: the scene's camera)"}}},
+        {"frames", {{"type", "integer"}, {"minimum", 1}, {"maximum", 1000000}, {"default", defaults.frames}}},
+        {"centroid", {{"type", "boolean"}, {"default", false}, {"description", "same as shading=centroid"}}},
+        {"tint", {{"type", "boolean"}, {"default", defaults.tint}}},
+        {"format", {{"type", "string"}, {"enum", {"png", "exr"}}, {"default", "png"}}}}},
+      {"limits",
+       {{"max_body_bytes", options_.max_body_bytes},
+        {"max_samples", options_.max_samples},
+        {"max_inline_faces", options_.max_inline_faces},
+        {"max_inline_texels", options_.max_inline_texels},
+        {"max_compare_pixels", options_.max_compare_pixels},
+        {"max_compare_entries", options_.max_compare_entries},
+        {"max_compare_repeat", options_.max_compare_repeat},
+        {"max_reference_samples", options_.max_reference_samples}}}};
+
+}
+
+std::shared_ptr<const Scene> HttpServer::builtin_scene(const std::string& name, bool tint) const {
+  const std::string key = scene_key(name, tint);
+  std::lock_guard lock(scenes_mutex_);
+  if (const auto found = scenes_.find(key); found != scenes_.end()) return found->second;
+  const auto& generators = scene_generators();
+  if (std::none_of(generators.begin(), generators.end(), [&](const GeneratorInfo& g) { return g.name == name; })) return nullptr;
+  GeneratorOptions generator_options;
+  generator_options.tint = tint;
+  auto scene = std::make_shared<const Scene>(generate_scene(name, generator_options));
+  scenes_[key] = scene;
+  return scene;
+}
 
 // The scene: a built-in one (never a file path: clients name no server files) or inline.
 std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene, RenderOptions& options,
@@ -438,14 +451,15 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
   std::shared_ptr<const Scene> scene;
   key.clear();
   if (inline_scene.is_null()) {
-    const auto found = scenes_.find(scene_key(options.scene, options.tint));
-    if (found == scenes_.end() || options.scene.find('+') != std::string::npos) {
+    const std::shared_ptr<const Scene> found =
+        options.scene.find('+') == std::string::npos ? builtin_scene(options.scene, options.tint) : nullptr;
+    if (!found) {
       std::string known;
       for (const GeneratorInfo& g : scene_generators()) known += (known.empty() ? "" : ", ") + g.name;
       throw HttpError{400, "scene", "unknown scene '" + options.scene + "' (built-in: " + known + "; or an inline scene object)"};
     }
-    scene = found->second;
-    key = found->first;
+    scene = found;
+    key = scene_key(options.scene, options.tint);
     check_budget(scene_sizes(*scene));
   } else {
     // Limits first, from the JSON, before any texture is made.

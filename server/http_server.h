@@ -135,6 +135,9 @@ class HttpServer {
                                              const std::function<void(const SceneSizes&)>& check_budget) const;
   void refuse_over_budget(size_t device_bytes, size_t host_bytes, const std::string& field, const std::string& what) const;
   nlohmann::json scenes_json() const;
+  nlohmann::json make_methods_json() const;
+  // A built-in scene ("paper", tinted or not), generated on first use; null for an unknown name.
+  std::shared_ptr<const Scene> builtin_scene(const std::string& name, bool tint) const;
   nlohmann::json methods_json() const;
   nlohmann::json health_json() const;
   std::unique_ptr<SlotLease> acquire_slot(std::chrono::steady_clock::time_point arrived);
@@ -148,9 +151,11 @@ class HttpServer {
   int port_ = -1;
   std::chrono::steady_clock::time_point started_;
 
-  // Built-in scenes, generated once: key "<name>" and "<name>+tint".
-  std::map<std::string, std::shared_ptr<const Scene>> scenes_;
-  nlohmann::json methods_cache_;
+  // Built-in scenes, generated on first use: key "<name>" and "<name>+tint".
+  mutable std::mutex scenes_mutex_;
+  mutable std::map<std::string, std::shared_ptr<const Scene>> scenes_;
+  mutable std::once_flag methods_once_;
+  mutable nlohmann::json methods_cache_;
 
   std::vector<std::unique_ptr<Slot>> slots_;
   std::vector<Slot*> free_slots_;
