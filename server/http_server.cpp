@@ -48,7 +48,7 @@ std::string scene_key(const std::string& name, bool tint) { return tint ? name +
 const std::map<std::string, std::vector<std::string>>& known_paths() {
   static const std::map<std::string, std::vector<std::string>> paths = {
       {"/", {"GET"}},           {"/health", {"GET"}},          {"/v1/scenes", {"GET"}},
-      {"/v1/methods", {"GET"}}, {"/v1/render", {"GET", "POST"}}, {"/v1/compare", {"POST"}},
+      {"/v1/methods", {"GET"}}, {"/v1/render", {"GET", "POST"}}, {"/v1/compare", {"POST"}}, {"/v1/reference", {"POST"}},
       {"/openapi.json", {"GET"}}};
   return paths;
 }
@@ -776,6 +776,103 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   res.set_content(out.dump(), "application/json");
 }
 
+void HttpServer::take_reference_settings(json& rest, ReferenceSettings& settings, bool& explicit_msaa) {
+  if (rest.contains("reference_method")) {
+    const json& value = rest.at("reference_method");
+    if (!value.is_string()) throw InputError("reference_method", "must be a method name, got a " + std::string(value.type_name()));
+    settings.method = value.get<std::string>();
+    rest.erase("reference_method");
+  }
+  explicit_msaa = false;
+  if (rest.contains("reference_msaa")) {
+    const json& value = rest.at("reference_msaa");
+    if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 16) {
+      throw InputError("reference_msaa", "must be 1, 2, 4, 8 or 16");
+    }
+    settings.msaa = value.get<int>();
+    explicit_msaa = true;
+    rest.erase("reference_msaa");
+  }
+}
+
+void HttpServer::check_reference_limits(const RenderOptions& frame, const ReferenceSettings& settings, bool explicit_msaa) const {
+  const long long pixels = static_cast<long long>(frame.width) * frame.height;
+  if (pixels > options_.max_compare_pixels) {
+    throw HttpError{413, "size",
+                    std::to_string(frame.width) + "x" + std::to_string(frame.height) + " = " + std::to_string(pixels) +
+                        " pixels exceeds this server's compare limit of " + std::to_string(options_.max_compare_pixels) +
+                        " (the reference renders at " + std::to_string(kReferenceScale) + "x width and height)"};
+  }
+  const RenderOptions high = reference_render_options(frame, settings);
+  const long long reference_samples = static_cast<long long>(high.width) * high.height * high.msaa;
+  if (reference_samples > options_.max_reference_samples) {
+    throw HttpError{413, explicit_msaa ? "reference_msaa" : "size",
+                    "the reference renders " + std::to_string(high.width) + "x" + std::to_string(high.height) + " x " +
+                        std::to_string(high.msaa) + " samples = " + std::to_string(reference_samples) +
+                        ", over this server's limit of " + std::to_string(options_.max_reference_samples)};
+  }
+}
+
+// POST /v1/reference: the image compare measures against (the 8x render, downsampled; from the
+// cache when it is there), for viewers that show a method's error against it.
+void HttpServer::handle_reference(const json& request, httplib::Response& res) {
+  const Clock::time_point start = Clock::now();
+  if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
+  json rest = request;
+  for (const char* key : {"method", "methods", "msaa", "repeat"}) {
+    if (rest.contains(key)) {
+      throw HttpError{400, key, std::string("the reference is one image of the frame; ") + key + " is for /v1/render or /v1/compare"};
+    }
+  }
+  ImageFormat format = ImageFormat::Png;
+  if (rest.contains("format")) {
+    const json& value = rest.at("format");
+    const auto parsed = value.is_string() ? parse_image_format(value.get<std::string>()) : std::nullopt;
+    if (!parsed) throw HttpError{400, "format", "must be \"png\" or \"exr\""};
+    format = *parsed;
+    rest.erase("format");
+  }
+  ReferenceSettings settings;
+  settings.cache_dir = options_.cache_dir;
+  settings.cache_max_bytes = options_.cache_max_bytes;
+  bool explicit_reference_msaa = false;
+  take_reference_settings(rest, settings, explicit_reference_msaa);
+  json inline_scene;
+  if (rest.contains("scene") && rest.at("scene").is_object()) {
+    inline_scene = rest.at("scene");
+    rest.erase("scene");
+  }
+  RenderOptions frame = parse_render_options(rest);
+  check_reference_limits(frame, settings, explicit_reference_msaa);
+  std::string key;
+  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key, [&](const SceneSizes& sizes) {
+    const CompareMemory memory = compare_memory(sizes, frame, {}, settings);
+    refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this reference");
+  });
+  const Camera camera = frame.frame ? orbit_camera(*scene, *frame.frame, frame.frames) : scene->camera;
+
+  const Clock::time_point queued = Clock::now();
+  double queue_ms = 0;
+  ReferenceImage reference;
+  {
+    const std::unique_ptr<SlotLease> lease = acquire_slot(start);
+    queue_ms = ms_since(queued);
+    if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
+    Renderer renderer(runtime_);
+    renderer.set_device_byte_limit(options_.max_request_device_bytes);
+    renderer.load_scene(*scene, frame.texels);
+    const std::string cache_key = reference_cache_key(*scene, camera, frame, settings);
+    std::lock_guard lock(reference_locks_[std::hash<std::string>{}(cache_key) % reference_locks_.size()]);
+    reference = reference_image(renderer, camera, frame, settings);
+  }
+  std::string image = encode_image(format, reference.width, reference.height, reference.pixels);
+  res.set_header("X-Seamcl-Reference-Method", reference.method);
+  res.set_header("X-Seamcl-Reference", reference_json(reference, false).dump());
+  res.set_header("X-Seamcl-Queue-Ms", std::to_string(queue_ms));
+  res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
+  res.set_content(std::move(image), format == ImageFormat::Png ? "image/png" : "image/x-exr");
+}
+
 void HttpServer::install_routes() {
   GuardedHttpServer& http = *http_;
   // Connections, threads, timeouts and byte budgets are server/connection.h's; bodies sent with
@@ -867,6 +964,9 @@ void HttpServer::install_routes() {
            }));
   http.Post("/v1/render", guarded([this](const httplib::Request& req, httplib::Response& res) {
               handle_render(parse_body(req), res);
+            }));
+  http.Post("/v1/reference", guarded([this](const httplib::Request& req, httplib::Response& res) {
+              handle_reference(parse_body(req), res);
             }));
   http.Post("/v1/compare", guarded([this](const httplib::Request& req, httplib::Response& res) {
               handle_compare(parse_body(req), res);

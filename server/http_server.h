@@ -32,6 +32,7 @@
 #include <nlohmann/json.hpp>
 
 #include <seamcl/cl/cl_runtime.h>
+#include <seamcl/eval/reference.h>
 #include <seamcl/pipeline/render_options.h>
 
 namespace httplib {
@@ -124,6 +125,11 @@ class HttpServer {
   void install_routes();
   void handle_render(const nlohmann::json& request, httplib::Response& res);
   void handle_compare(const nlohmann::json& request, httplib::Response& res);
+  void handle_reference(const nlohmann::json& request, httplib::Response& res);
+  // reference_method and reference_msaa taken out of a compare or reference request.
+  static void take_reference_settings(nlohmann::json& rest, ReferenceSettings& settings, bool& explicit_msaa);
+  // The frame's pixels and the 8x reference's samples within this server's limits (413).
+  void check_reference_limits(const RenderOptions& frame, const ReferenceSettings& settings, bool explicit_msaa) const;
   nlohmann::json parse_body(const httplib::Request& req) const;
   // A built-in scene by options.scene (and tint), or `inline_scene` when it is not null (limits
   // checked, parsed, validated; options.scene becomes its name). `key` is the slot Renderer's key,

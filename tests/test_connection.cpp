@@ -22,118 +22,19 @@
 #include <nlohmann/json.hpp>
 
 #include "http_server.h"
+#include "server_support.h"
 #include "test_support.h"
 
 using namespace seamcl;
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
+using seamcl_tests::LiveServer;
+using seamcl_tests::RawConnection;
+using seamcl_tests::seconds_since;
+using seamcl_tests::count_responses;
+using seamcl_tests::first_status;
 
 namespace {
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-// A raw TCP connection to the server, for what httplib::Client will not send.
-class RawConnection {
- public:
-  explicit RawConnection(int port) {
-    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_port = htons(static_cast<uint16_t>(port));
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::connect(fd_, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
-      ::close(fd_);
-      fd_ = -1;
-    }
-  }
-  ~RawConnection() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  RawConnection(const RawConnection&) = delete;
-  RawConnection& operator=(const RawConnection&) = delete;
-
-  bool connected() const { return fd_ >= 0; }
-  // False once the server has closed the connection (or the write failed).
-  bool send(const std::string& bytes) {
-    size_t sent = 0;
-    while (sent < bytes.size()) {
-      const ssize_t n = ::send(fd_, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
-      if (n <= 0) return false;
-      sent += static_cast<size_t>(n);
-    }
-    return true;
-  }
-  // Everything the server sends until it closes the connection or `timeout` passes.
-  std::string read_until_closed(std::chrono::milliseconds timeout, bool* closed = nullptr) {
-    std::string out;
-    const Clock::time_point deadline = Clock::now() + timeout;
-    if (closed) *closed = false;
-    for (;;) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
-      if (left <= 0) return out;
-      pollfd p{fd_, POLLIN, 0};
-      if (::poll(&p, 1, static_cast<int>(left)) <= 0) return out;
-      char buffer[65536];
-      const ssize_t n = ::recv(fd_, buffer, sizeof buffer, 0);
-      if (n <= 0) {
-        if (closed) *closed = true;
-        return out;
-      }
-      out.append(buffer, static_cast<size_t>(n));
-    }
-  }
-
- private:
-  int fd_ = -1;
-};
-
-int count_responses(const std::string& bytes) {
-  int count = 0;
-  for (size_t at = bytes.find("HTTP/1.1 "); at != std::string::npos; at = bytes.find("HTTP/1.1 ", at + 1)) ++count;
-  return count;
-}
-
-int first_status(const std::string& bytes) { return bytes.size() >= 12 ? std::atoi(bytes.c_str() + 9) : 0; }
-
-struct LiveServer {
-  std::unique_ptr<server::HttpServer> http;
-  std::thread thread;
-  std::mutex log_mutex;
-  std::vector<std::string> log;
-
-  explicit LiveServer(server::ServerOptions options, bool wait_until_ready = true) {
-    options.host = "127.0.0.1";
-    options.port = 0;  // an ephemeral port: tests run side by side
-    options.warm_all_methods = false;
-    options.log = [this](const std::string& line) {
-      std::lock_guard lock(log_mutex);
-      log.push_back(line);
-    };
-    http = std::make_unique<server::HttpServer>(seamcl_tests::shared_runtime(), options);
-    if (http->bind() <= 0) throw std::runtime_error("cannot bind");
-    thread = std::thread([this] { http->listen_after_bind(); });
-    for (int i = 0; i < 500 && !http->is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    if (wait_until_ready && !http->wait_ready(std::chrono::seconds(120))) throw std::runtime_error("not ready");
-  }
-  ~LiveServer() {
-    http->stop();
-    if (thread.joinable()) thread.join();
-  }
-  int port() const { return http->port(); }
-  std::vector<std::string> log_lines() {
-    std::lock_guard lock(log_mutex);
-    return log;
-  }
-  // GET /health on a fresh connection: status and seconds taken.
-  std::pair<int, double> health() const {
-    httplib::Client client("127.0.0.1", http->port());
-    client.set_connection_timeout(10, 0);
-    client.set_read_timeout(10, 0);
-    const Clock::time_point start = Clock::now();
-    const auto res = client.Get("/health");
-    return {res ? res->status : 0, seconds_since(start)};
-  }
-};
 
 class Connection : public ::testing::Test {
  protected:
