@@ -11,6 +11,7 @@
 #include <functional>
 #include <iterator>
 #include <optional>
+#include <set>
 
 #include <unistd.h>
 #include <utility>
@@ -187,6 +188,29 @@ const std::map<std::string, std::vector<std::string>>& known_paths() {
       {"/v1/methods", {"GET"}}, {"/v1/render", {"GET", "POST"}}, {"/v1/compare", {"POST"}},
       {"/openapi.json", {"GET"}}};
   return paths;
+}
+
+// The methods cpp-httplib 0.11.4 parses; any other method fails its request-line parse (400).
+bool is_httplib_method(const std::string& method) {
+  static const std::set<std::string> methods = {"GET",     "HEAD",    "POST",  "PUT",   "DELETE",
+                                                "CONNECT", "OPTIONS", "TRACE", "PATCH", "PRI"};
+  return methods.contains(method);
+}
+
+// An RFC 9110 token (a method name).
+bool is_token(std::string_view text) {
+  return !text.empty() && std::all_of(text.begin(), text.end(), [](unsigned char c) {
+    return std::isalnum(c) || std::string_view("!#$%&'*+-.^_`|~").find(static_cast<char>(c)) != std::string_view::npos;
+  });
+}
+
+// 405 for `method` on a known path that does not route it, with the Allow header listing what does.
+void send_method_not_allowed(httplib::Response& res, const std::string& method, const std::string& path,
+                             const std::vector<std::string>& allowed) {
+  std::string allow;
+  for (const std::string& m : allowed) allow += (allow.empty() ? "" : ", ") + m;
+  res.set_header("Allow", allow);
+  send_error(res, 405, "method", echo(method) + " is not allowed on " + echo(path) + " (allowed: " + allow + ")");
 }
 
 std::string method_description(const std::string& name) {
@@ -771,10 +795,7 @@ void HttpServer::install_routes() {
     const auto found = known_paths().find(req.path);
     if (found != known_paths().end() &&
         std::find(found->second.begin(), found->second.end(), req.method) == found->second.end()) {
-      std::string allow;
-      for (const std::string& m : found->second) allow += (allow.empty() ? "" : ", ") + m;
-      res.set_header("Allow", allow);
-      send_error(res, 405, "method", req.method + " is not allowed on " + req.path + " (allowed: " + allow + ")");
+      send_method_not_allowed(res, req.method, req.path, found->second);
       return httplib::Server::HandlerResponse::Handled;
     }
     return httplib::Server::HandlerResponse::Unhandled;
@@ -794,7 +815,21 @@ void HttpServer::install_routes() {
     const auto route = known_paths().find(req.path);
     const bool routes_post = route != known_paths().end() &&
                              std::find(route->second.begin(), route->second.end(), "POST") != route->second.end();
-    if (res.status == 404) {
+    if (res.status == 400 && req.path.empty() && !is_httplib_method(req.method) && is_token(req.method) &&
+        (req.version == "HTTP/1.1" || req.version == "HTTP/1.0")) {
+      // A method cpp-httplib does not know (QUERY, an extension): its request-line parse stopped
+      // before the path and the headers. Answered like a known method the path does not route;
+      // the unread headers and body must not be taken for the next request, so the client is told
+      // to close.
+      res.set_header("Connection", "close");
+      const std::string path = req.target.substr(0, req.target.find('?'));
+      const auto target_route = known_paths().find(path);
+      if (target_route != known_paths().end()) {
+        send_method_not_allowed(res, req.method, path, target_route->second);
+      } else {
+        send_error(res, 404, "path", "no such endpoint: " + echo(req.method) + " " + echo(path));
+      }
+    } else if (res.status == 404) {
       send_error(res, 404, "path", "no such endpoint: " + req.method + " " + echo(req.path));
     } else if (res.status == 400 && req.method == "POST" && routes_post && req.is_multipart_form_data()) {
       // cpp-httplib parses multipart bodies itself and answers 400 when that fails: the body is
