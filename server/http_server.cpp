@@ -144,6 +144,23 @@ void send_error(httplib::Response& res, int status, std::string_view field, std:
   res.set_content(json_text(json{{"error", bounded_message(message)}, {"field", echo(field)}}), "application/json");
 }
 
+// An InputError's message without its "<field>: " prefix. what() is a C string, so a NUL byte
+// that a client put in a key or value (JSON's \u0000, the query's %00) cuts it short: then only
+// what is left after the prefix, possibly nothing.
+std::string input_error_message(const InputError& e) {
+  const std::string_view what = e.what();
+  const size_t prefix = e.field().size() + 2;
+  if (what.size() < prefix) return "refused (the message was cut at a NUL byte)";
+  return std::string(what.substr(prefix));
+}
+
+// Whether a request carries a body that cpp-httplib reads only when the request is routed: a
+// refusal before routing leaves it on the connection, where it would be parsed as the next request.
+bool carries_body(const httplib::Request& req) {
+  return req.has_header("Transfer-Encoding") ||
+         (req.has_header("Content-Length") && req.get_header_value("Content-Length") != "0");
+}
+
 // The media type of a Content-Type value: before any parameter, without surrounding spaces, in
 // lower case (RFC 9110 8.3.1: type and subtype are case-insensitive).
 std::string media_type(std::string_view content_type) {
@@ -522,7 +539,7 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
       validate_scene(parsed);
       scene = std::make_shared<const Scene>(std::move(parsed));
     } catch (const InputError& e) {
-      throw InputError("scene." + e.field(), std::string(e.what()).substr(e.field().size() + 2));
+      throw InputError("scene." + e.field(), input_error_message(e));
     }
     options.scene = scene->name;
   }
@@ -780,7 +797,7 @@ void HttpServer::install_routes() {
         if (e.retry_after_s > 0) res.set_header("Retry-After", std::to_string(e.retry_after_s));
         send_error(res, e.status, e.field, echo(e.field) + ": " + e.message);
       } catch (const InputError& e) {
-        send_error(res, 400, e.field(), echo(e.field()) + std::string(e.what()).substr(e.field().size()));
+        send_error(res, 400, e.field(), echo(e.field()) + ": " + input_error_message(e));
       } catch (const std::exception& e) {
         log_line(std::string("error: ") + describe_cl_exception(e));
         send_error(res, 500, "server", "render failed: " + describe_cl_exception(e));
@@ -795,6 +812,12 @@ void HttpServer::install_routes() {
     const auto found = known_paths().find(req.path);
     if (found != known_paths().end() &&
         std::find(found->second.begin(), found->second.end(), req.method) == found->second.end()) {
+      // A body is read first where cpp-httplib reads bodies (POST, PUT, DELETE, PATCH): the
+      // not_routed handlers below answer after it has. It never reads one of GET, HEAD, OPTIONS,
+      // TRACE or CONNECT, so there the client is told to close the connection instead.
+      static const std::set<std::string> body_read = {"POST", "PUT", "DELETE", "PATCH"};
+      if (carries_body(req) && body_read.contains(req.method)) return httplib::Server::HandlerResponse::Unhandled;
+      if (carries_body(req)) res.set_header("Connection", "close");
       send_method_not_allowed(res, req.method, req.path, found->second);
       return httplib::Server::HandlerResponse::Handled;
     }
@@ -871,6 +894,22 @@ void HttpServer::install_routes() {
   http.Post("/v1/compare", guarded([this](const httplib::Request& req, httplib::Response& res) {
               handle_compare(parse_body(req), res);
             }));
+  // Last, for every other path and method cpp-httplib routes: 405 on a known path (reached only
+  // with a body, which cpp-httplib has read by now), 404 elsewhere.
+  const auto not_routed = [](const httplib::Request& req, httplib::Response& res) {
+    const auto found = known_paths().find(req.path);
+    if (found != known_paths().end()) {
+      send_method_not_allowed(res, req.method, req.path, found->second);
+    } else {
+      send_error(res, 404, "path", "no such endpoint: " + req.method + " " + echo(req.path));
+    }
+  };
+  http.Get(".*", not_routed);
+  http.Post(".*", not_routed);
+  http.Put(".*", not_routed);
+  http.Delete(".*", not_routed);
+  http.Patch(".*", not_routed);
+  http.Options(".*", not_routed);
 }
 
 }  // namespace seamcl::server

@@ -206,6 +206,44 @@ RawResponse raw_request(int port, const std::string& bytes) {
   return out;
 }
 
+// Two requests one after the other on one keep-alive connection, as a client with a connection
+// pool sends them: the first's head, then 100 ms later its body (a separate segment, as a client
+// that writes them separately sends them), its answer read in full, then the second request (which
+// should close the connection). Returns everything the server sent, until it closes the connection
+// or 10 s pass. (cpp-httplib 0.11.4 does not serve pipelined requests: the second must wait for
+// the first's answer.)
+std::string raw_exchange(int port, const std::string& first_head, const std::string& first_body, const std::string& second) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return "";
+  timeval timeout{10, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::string stream;
+  char buffer[4096];
+  auto first_answer_complete = [&] {
+    const size_t head_end = stream.find("\r\n\r\n");
+    const size_t length_at = stream.find("\r\nContent-Length: ");
+    if (head_end == std::string::npos || length_at == std::string::npos || length_at > head_end) return false;
+    return stream.size() >= head_end + 4 + std::stoul(stream.substr(length_at + 18));
+  };
+  auto send_all = [&](const std::string& bytes) {
+    return ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(bytes.size());
+  };
+  if (::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0 && send_all(first_head) &&
+      (std::this_thread::sleep_for(std::chrono::milliseconds(100)), send_all(first_body))) {
+    for (ssize_t n; !first_answer_complete() && (n = ::recv(fd, buffer, sizeof buffer, 0)) > 0;)
+      stream.append(buffer, static_cast<size_t>(n));
+    if (send_all(second)) {
+      for (ssize_t n; (n = ::recv(fd, buffer, sizeof buffer, 0)) > 0;) stream.append(buffer, static_cast<size_t>(n));
+    }
+  }
+  ::close(fd);
+  return stream;
+}
+
 // The number of characters (code points) of valid UTF-8 text.
 size_t utf8_characters(const std::string& text) {
   return static_cast<size_t>(std::count_if(text.begin(), text.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
@@ -742,6 +780,8 @@ std::vector<Malformed> malformed_requests() {
       post(R"({"centroid": true, "shading": "sample"})", 400, "centroid"),
       post(R"({"scene": {"faces": []}})", 400, "scene."),
       post(R"({"scene": {"generator": "nope"}})", 400, "scene."),
+      post(R"({"scene": {"generator": "paper", "a\u0000b": 1}})", 400, "scene."),
+      post(R"({"scene": {"generator": "paper", "options": {"\u0000": 1}}})", 400, "scene.options"),
       post(R"({"scene": {"positions": [[0,0,0]], "faces": [{"vertices": [0,0,0,0], "texture": {"width": 4, "height": 4}}], "camera": {"eye": [0,0,1], "target": [0,0,0]}}})",
            400, "scene.faces[0]"),
       post(R"({"scene": {"positions": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]], "faces": [{"vertices": [0,1,2,3], "texture": {"width": 3, "height": 4}}], "camera": {"eye": [0,0,1], "target": [0,0,0]}}})",
@@ -770,6 +810,10 @@ std::vector<Malformed> malformed_requests() {
       get("method=%C3%28", 400, "method"),
       get("filter=aniso%E2%82", 400, "filter"),
       get("%ff=1", 400, "\xEF\xBF\xBD"),
+      // A NUL byte in a key: InputError's what() stops there (a 500 from the cut message, found
+      // by schemathesis), in the query and in an inline scene's keys.
+      get("a%00b=1", 400, std::string("a\0b", 3)),
+      get("%02%27%00%C2%81=%F1%B9%92%A5&frame=13252", 400, std::string("\x02'\0\xC2\x81", 5)),
       Malformed{"GET", "/v1/nothing", "", "", 404, "path"},
       Malformed{"DELETE", "/v1/render", "", "", 405, "method"},
       Malformed{"PUT", "/health", "application/json", "{}", 405, "method"},
@@ -967,6 +1011,33 @@ TEST_F(Server, UnknownMethodsAre405OnKnownPaths) {
     EXPECT_EQ(res.header("Connection"), "close") << request_line;
     const json body = expect_bounded_error(request_line, res.body);
     EXPECT_EQ(body.value("field", ""), status == 405 ? "method" : "path") << request_line;
+  }
+}
+
+// A refusal that cpp-httplib answered before reading the body (405 from the pre-routing handler)
+// left the body on the connection, where it was parsed as the next request: the client's next
+// request on the same connection got that 400 (found by schemathesis). Now the body is read
+// first, so two requests on one connection get their own answers. cpp-httplib 0.11.4 never reads
+// the body of a GET or OPTIONS: those 405s tell the client to close the connection.
+TEST_F(Server, RefusedRequestBodiesAreNotTakenForTheNextRequest) {
+  const std::string body = R"({"aniso": 16, "scene": "quad2"})";
+  for (const std::string method : {"GET", "OPTIONS"}) {
+    const std::string path = method == "GET" ? "/v1/compare" : "/v1/render";
+    const RawResponse res = raw_request(server_->http->port(), method + " " + path + " HTTP/1.1\r\nHost: localhost\r\n" +
+                                                                   "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
+    EXPECT_EQ(res.status, 405) << method;
+    EXPECT_EQ(res.header("Connection"), "close") << method;
+  }
+  for (const std::string method : {"DELETE", "PUT", "PATCH", "POST"}) {
+    const std::string path = method == "POST" ? "/health" : "/v1/render";
+    const std::string head = method + " " + path + " HTTP/1.1\r\nHost: localhost\r\nContent-Type: application/json\r\n" +
+                             "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n";
+    const std::string second = "GET /health HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n";
+    const std::string stream = raw_exchange(server_->http->port(), head, body, second);
+    std::vector<int> statuses;
+    for (size_t at = stream.find("HTTP/1.1 "); at != std::string::npos; at = stream.find("HTTP/1.1 ", at + 1))
+      statuses.push_back(std::atoi(stream.c_str() + at + 9));
+    EXPECT_EQ(statuses, (std::vector<int>{405, 200})) << method << " " << path << ":\n" << stream.substr(0, 600);
   }
 }
 
