@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/eval/comparison.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/scene/scene_generators.h>
 #include "http_server.h"
@@ -157,6 +158,49 @@ TEST(OpenApi, SizeHasThePatternTheParserTakes) {
     for (const std::string& text : samples) {
       EXPECT_EQ(std::regex_search(text, pattern), parses({{"size", text}})) << where << ": '" << text << "'";
     }
+  }
+}
+
+// compare's comma lists (methods, msaa): the string form's pattern takes what compare's own list
+// parsers (split_list, parse_int_list) and the option parser take together.
+TEST(OpenApi, CompareListPatternsAreTheListParsers) {
+  auto string_form = [](const char* key) {
+    for (const json& form : schema("CompareRequest").at("properties").at(key).at("oneOf")) {
+      if (form.value("type", "") == "string") return form;
+    }
+    ADD_FAILURE() << key << " has no string form";
+    return json::object();
+  };
+  auto methods_accepted = [](const std::string& text) {
+    try {
+      for (const std::string& name : split_list(text, "methods")) {
+        if (!parse_method(name)) return false;
+      }
+      return true;
+    } catch (const InputError&) {
+      return false;
+    }
+  };
+  auto rates_accepted = [](const std::string& text) {
+    try {
+      for (int rate : parse_int_list(text, "msaa")) {
+        if (!parses({{"msaa", rate}})) return false;
+      }
+      return true;
+    } catch (const InputError&) {
+      return false;
+    }
+  };
+  const std::regex methods(string_form("methods").value("pattern", "^$"), std::regex::ECMAScript);
+  for (const std::string text : {"discard", "discard,clamp", " discard , traverse\t", "clamp,clamp", "guardband,black",
+                                 "", ",", "discard,", ",discard", "discard,,clamp", "Discard", "nearest", "discard clamp",
+                                 "discard;clamp", "discard,nope", " ", "\tclamp"}) {
+    EXPECT_EQ(std::regex_search(text, methods), methods_accepted(text)) << "methods '" << text << "'";
+  }
+  const std::regex rates(string_form("msaa").value("pattern", "^$"), std::regex::ECMAScript);
+  for (const std::string text : {"1", "1,4", "1,2,4,8,16", " 4 , 8", "+4", "004", "016", "3", "0", "32", "1,3", "",
+                                 "1,", ",1", "4.0", "0x4", "-4", "1 4", "4a", "16,16", "\t2\t"}) {
+    EXPECT_EQ(std::regex_search(text, rates), rates_accepted(text)) << "msaa '" << text << "'";
   }
 }
 
