@@ -1,5 +1,7 @@
 #include "measure_args.h"
 
+#include <seamcl/core/input_error.h>
+
 namespace seamcl::cli {
 
 void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& default_methods) {
@@ -19,6 +21,11 @@ void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& d
   command->add_option("--reference-msaa", a.reference_msaa,
                       "Samples per pixel of the 8x reference render [1 for traverse, 16 for discard]");
   command->add_option("--cache", a.cache_dir, "Reference cache directory [$SEAMCL_CACHE_DIR or ~/.cache/seamcl]");
+  command->add_option("--cache-max-mib", a.cache_max_mib,
+                      "Bound of the reference cache in MiB: least recently used references are removed after "
+                      "each write; 0: unbounded [" + std::to_string(a.cache_max_mib) + "]");
+  command->add_option("--cache-max-entries", a.cache_max_entries,
+                      "Bound of the reference cache in files (least recently used removed); 0: unbounded [0]");
   command->add_flag("--no-cache", a.no_cache, "Always render references; do not read or write the cache");
   command->add_flag("--json", a.json_out, "Print one JSON object");
 }
@@ -42,6 +49,14 @@ ReferenceSettings reference_settings(const MeasureArgs& a) {
   settings.msaa = a.reference_msaa;
   settings.cache_dir = a.cache_dir;
   settings.use_cache = !a.no_cache;
+  if (a.cache_max_mib < 0 || a.cache_max_mib > (1LL << 40)) {
+    throw InputError("cache_max_mib", "must be in 0..2^40 (0: unbounded), got " + std::to_string(a.cache_max_mib));
+  }
+  if (a.cache_max_entries < 0) {
+    throw InputError("cache_max_entries", "must be at least 0 (0: unbounded), got " + std::to_string(a.cache_max_entries));
+  }
+  settings.cache_max_bytes = static_cast<std::uintmax_t>(a.cache_max_mib) << 20;
+  settings.cache_max_entries = static_cast<size_t>(a.cache_max_entries);
   return settings;
 }
 

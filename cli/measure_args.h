@@ -20,6 +20,8 @@ struct MeasureArgs {
   std::string reference_method;
   int reference_msaa = 0;
   std::string cache_dir;
+  long long cache_max_mib = static_cast<long long>(kDefaultReferenceCacheBytes >> 20);
+  long long cache_max_entries = 0;
   bool no_cache = false;
   bool json_out = false;
 };
@@ -30,6 +32,7 @@ void add_measure_options(CLI::App* command, MeasureArgs& args, const std::string
 // The frame's render options given on the command line, as parse_render_options reads them.
 nlohmann::json measure_request(const MeasureArgs& args);
 
+// InputError("cache_max_mib" / "cache_max_entries") for a negative bound.
 ReferenceSettings reference_settings(const MeasureArgs& args);
 
 }  // namespace seamcl::cli

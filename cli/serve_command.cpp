@@ -1,6 +1,6 @@
-// seamcl serve: the HTTP render service (server/http_server.h). Builds and warms the kernels and
-// generates the built-in scenes before it listens; SIGINT/SIGTERM stop it after the requests in
-// flight have been answered.
+// seamcl serve: the HTTP render service (server/http_server.h). Generates the built-in scenes,
+// listens at once and warms the kernels in the background; SIGINT/SIGTERM stop it after the
+// requests in flight have been answered.
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -25,12 +25,18 @@ struct ServeArgs {
   int threads = 2;
   int queue = 8;
   bool quick_start = false;
+  int max_connections = 256;
+  double read_timeout_s = 10;
+  double deadline_s = 60;
 };
 
 int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   if (args.port < 0 || args.port > 65535) throw InputError("port", "must be in 0..65535");
   if (args.threads < 1 || args.threads > 64) throw InputError("threads", "must be in 1..64");
   if (args.queue < 0 || args.queue > 1024) throw InputError("queue", "must be in 0..1024");
+  if (args.max_connections < 1 || args.max_connections > 4096) throw InputError("max-connections", "must be in 1..4096");
+  if (!(args.read_timeout_s >= 0.1 && args.read_timeout_s <= 600)) throw InputError("read-timeout", "must be in 0.1..600 seconds");
+  if (!(args.deadline_s >= 0 && args.deadline_s <= 3600)) throw InputError("deadline", "must be in 0..3600 seconds (0: none)");
 
   // Block the stop signals in every thread (the pool threads inherit the mask); one thread
   // waits for them and stops the server.
@@ -49,14 +55,20 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   options.threads = args.threads;
   options.queue = args.queue;
   options.warm_all_methods = !args.quick_start;
+  options.max_connections = args.max_connections;
+  options.request_read_timeout_ms = static_cast<int>(args.read_timeout_s * 1000);
+  options.deadline_ms = static_cast<int>(args.deadline_s * 1000);
   server::HttpServer http(runtime, options);
   if (http.bind() < 0) {
-    std::fprintf(stderr, "seamcl: cannot listen on %s:%d\n", args.host.c_str(), args.port);
+    std::fprintf(stderr, "seamcl: cannot listen on %s:%d: the port is in use or the address is not this machine's\n",
+                 args.host.c_str(), args.port);
     return 1;
   }
-  const double ready_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  std::fprintf(stderr, "seamcl serve: http://%s:%d/ on %s, %d threads, queue %d (ready in %.0f ms)\n",
-               args.host.c_str(), http.port(), runtime.device_description().c_str(), args.threads, args.queue, ready_ms);
+  const double listen_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::fprintf(stderr,
+               "seamcl serve: http://%s:%d/ on %s, %d threads, queue %d; listening after %.0f ms, warming the kernels "
+               "(GET /health says \"ready\" when renders no longer wait)\n",
+               args.host.c_str(), http.port(), runtime.device_description().c_str(), args.threads, args.queue, listen_ms);
 
   std::atomic<bool> done{false};
   std::thread signal_waiter([&] {
@@ -87,6 +99,11 @@ Command add_serve_command(CLI::App& app) {
   serve->add_option("--threads", args->threads, "Renders at once, each with its own Renderer [2]");
   serve->add_option("--queue", args->queue, "Renders that may wait for a thread; more get 503 [8]");
   serve->add_flag("--quick-start", args->quick_start, "Warm only the default method, not every method x filter");
+  serve->add_option("--max-connections", args->max_connections, "Connections served at once; more get 503 and are closed [256]");
+  serve->add_option("--read-timeout", args->read_timeout_s,
+                    "Seconds a request's line, headers and body may take to arrive, however they trickle [10]");
+  serve->add_option("--deadline", args->deadline_s,
+                    "Seconds a request may wait for a render slot before it is answered 503; 0: no limit [60]");
   return Command{serve, [args](const GlobalOptions& global) { return run_serve(*args, global); }};
 }
 

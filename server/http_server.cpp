@@ -1,5 +1,7 @@
 #include "http_server.h"
 
+#include "connection.h"
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -207,20 +209,6 @@ const std::map<std::string, std::vector<std::string>>& known_paths() {
   return paths;
 }
 
-// The methods cpp-httplib 0.11.4 parses; any other method fails its request-line parse (400).
-bool is_httplib_method(const std::string& method) {
-  static const std::set<std::string> methods = {"GET",     "HEAD",    "POST",  "PUT",   "DELETE",
-                                                "CONNECT", "OPTIONS", "TRACE", "PATCH", "PRI"};
-  return methods.contains(method);
-}
-
-// An RFC 9110 token (a method name).
-bool is_token(std::string_view text) {
-  return !text.empty() && std::all_of(text.begin(), text.end(), [](unsigned char c) {
-    return std::isalnum(c) || std::string_view("!#$%&'*+-.^_`|~").find(static_cast<char>(c)) != std::string_view::npos;
-  });
-}
-
 // 405 for `method` on a known path that does not route it, with the Allow header listing what does.
 void send_method_not_allowed(httplib::Response& res, const std::string& method, const std::string& path,
                              const std::vector<std::string>& allowed) {
@@ -315,10 +303,27 @@ struct HttpServer::SlotLease {
   SlotLease& operator=(const SlotLease&) = delete;
 };
 
+namespace {
+
+ConnectionLimits connection_limits(const ServerOptions& options) {
+  ConnectionLimits limits;
+  limits.max_connections = options.max_connections;
+  limits.request_read_timeout = std::chrono::milliseconds(options.request_read_timeout_ms);
+  limits.idle_timeout = std::chrono::milliseconds(options.idle_timeout_ms);
+  // A chunked body's framing is counted too: room for the body at twice its limit, plus headers.
+  limits.max_request_bytes = 2 * options.max_body_bytes + (64 << 10);
+  return limits;
+}
+
+}  // namespace
+
 HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
-    : runtime_(runtime), options_(std::move(options)), http_(std::make_unique<httplib::Server>()) {
+    : runtime_(runtime), options_(std::move(options)), http_(std::make_unique<GuardedHttpServer>(connection_limits(options_))) {
   if (options_.threads < 1) throw InputError("threads", "must be at least 1");
   if (options_.queue < 0) throw InputError("queue", "must be at least 0");
+  if (options_.max_connections < 1) throw InputError("max_connections", "must be at least 1");
+  if (options_.request_read_timeout_ms < 1) throw InputError("request_read_timeout_ms", "must be at least 1");
+  if (options_.deadline_ms < 0) throw InputError("deadline", "must be at least 0 (0: none)");
   options_.cache_dir = server_cache_dir(options_.cache_dir);
 
   // 1. The built-in scenes, plain and tinted.
@@ -330,25 +335,11 @@ HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
     }
   }
 
-  // 2. One slot per thread, each with a Renderer for the default scene, warmed up (this builds
-  // the default program variant and compiles its kernels before anything listens).
+  // 2. One slot per thread. Their Renderers are made and warmed after bind() (warm_up()); a slot
+  // becomes free once warm, so early renders wait for it rather than build kernels themselves.
   const RenderOptions defaults;
-  for (int i = 0; i < options_.threads; ++i) {
-    auto slot = std::make_unique<Slot>();
-    auto renderer = std::make_unique<Renderer>(runtime_);
-    renderer->load_scene(*scenes_.at(scene_key(defaults.scene, false)), defaults.texels);
-    renderer->warm_up(defaults);
-    if (i == 0 && options_.warm_all_methods) {
-      for (const std::string& method : method_names()) {
-        for (const std::string& filter : filter_names()) {
-          renderer->warm_up(parse_render_options({{"method", method}, {"filter", filter}}));
-        }
-      }
-    }
-    slot->renderers[scene_key(defaults.scene, false)] = std::move(renderer);
-    free_slots_.push_back(slot.get());
-    slots_.push_back(std::move(slot));
-  }
+  for (int i = 0; i < options_.threads; ++i) slots_.push_back(std::make_unique<Slot>());
+  total_variants_ = options_.warm_all_methods ? static_cast<int>(method_names().size() * filter_names().size()) : 1;
 
   // 3. The /v1/methods answer: texture memory of each method on the default scene, as packed for
   // the device (rgba8; rgba32f stores the same texels at 16 bytes each).
@@ -408,7 +399,10 @@ HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
   install_routes();
 }
 
-HttpServer::~HttpServer() { stop(); }
+HttpServer::~HttpServer() {
+  stop();
+  if (warm_thread_.joinable()) warm_thread_.join();
+}
 
 int HttpServer::bind() {
   if (options_.port == 0) {
@@ -416,16 +410,79 @@ int HttpServer::bind() {
   } else {
     port_ = http_->bind_to_port(options_.host, options_.port) ? options_.port : -1;
   }
+  if (port_ >= 0 && !warm_thread_.joinable()) {
+    started_ = Clock::now();
+    warm_thread_ = std::thread([this] { warm_up(); });
+  }
   return port_;
 }
 
-bool HttpServer::listen_after_bind() {
-  started_ = Clock::now();
-  return http_->listen_after_bind();
+void HttpServer::warm_up() {
+  const Clock::time_point start = Clock::now();
+  const RenderOptions defaults;
+  const std::string default_key = scene_key(defaults.scene, false);
+  try {
+    // Not cut short by stop(): requests already admitted wait for these slots and are answered.
+    for (size_t i = 0; i < slots_.size(); ++i) {
+      log_line("warming: slot " + std::to_string(i + 1) + "/" + std::to_string(slots_.size()) + ", scene " +
+               defaults.scene + ", " + to_string(defaults.method) + " " + to_string(defaults.filter));
+      auto renderer = std::make_unique<Renderer>(runtime_);
+      renderer->load_scene(*scenes_.at(default_key), defaults.texels);
+      renderer->warm_up(defaults);
+      {
+        std::lock_guard lock(slots_mutex_);
+        slots_[i]->renderers[default_key] = std::move(renderer);
+        free_slots_.push_back(slots_[i].get());
+        ready_slots_.fetch_add(1);  // under the lock, before the notification: wait_ready() sees it
+      }
+      slot_freed_.notify_all();
+    }
+    warmed_variants_.store(1);
+    char line[160];
+    std::snprintf(line, sizeof line, "ready: %d slots warm in %.0f ms", ready_slots_.load(), ms_since(start));
+    log_line(line);
+    // The other variants on a Renderer of their own: the programs land in the shared ClRuntime
+    // (and PoCL's cache), so the slots find them built; renders go on meanwhile.
+    if (options_.warm_all_methods) {
+      Renderer renderer(runtime_);
+      renderer.load_scene(*scenes_.at(default_key), defaults.texels);
+      for (const std::string& method : method_names()) {
+        for (const std::string& filter : filter_names()) {
+          if (stopping_.load()) return;
+          const RenderOptions variant = parse_render_options({{"method", method}, {"filter", filter}});
+          if (variant.method == defaults.method && variant.filter == defaults.filter) continue;
+          log_line("warming: " + method + " " + filter + " (" + std::to_string(warmed_variants_.load() + 1) + "/" +
+                   std::to_string(total_variants_) + ")");
+          renderer.warm_up(variant);
+          warmed_variants_.fetch_add(1);
+        }
+      }
+      std::snprintf(line, sizeof line, "warm: %d variants in %.0f ms", warmed_variants_.load(), ms_since(start));
+      log_line(line);
+    }
+  } catch (const std::exception& e) {
+    const std::string message = describe_cl_exception(e);
+    log_line("error: warm-up failed: " + message);
+    {
+      std::lock_guard lock(slots_mutex_);
+      if (ready_slots_.load() == 0) warm_error_ = message;
+    }
+    slot_freed_.notify_all();
+  }
 }
 
+bool HttpServer::wait_ready(std::chrono::milliseconds timeout) {
+  std::unique_lock lock(slots_mutex_);
+  slot_freed_.wait_for(lock, timeout, [&] { return ready() || !warm_error_.empty(); });
+  return ready();
+}
+
+bool HttpServer::listen_after_bind() { return http_->listen_after_bind(); }
+
 void HttpServer::stop() {
+  stopping_.store(true);
   if (http_) http_->stop();
+  slot_freed_.notify_all();
 }
 
 bool HttpServer::is_running() const { return http_ && http_->is_running(); }
@@ -438,7 +495,7 @@ void HttpServer::log_line(const std::string& line) const {
   }
 }
 
-std::unique_ptr<HttpServer::SlotLease> HttpServer::acquire_slot() {
+std::unique_ptr<HttpServer::SlotLease> HttpServer::acquire_slot(Clock::time_point arrived) {
   const int capacity = options_.threads + options_.queue;
   if (admitted_.fetch_add(1) >= capacity) {
     admitted_.fetch_sub(1);
@@ -448,7 +505,26 @@ std::unique_ptr<HttpServer::SlotLease> HttpServer::acquire_slot() {
                     1};
   }
   std::unique_lock lock(slots_mutex_);
-  slot_freed_.wait(lock, [&] { return !free_slots_.empty(); });
+  // Wait for a slot, until the deadline, waking now and then to see whether the client has gone.
+  const Clock::time_point deadline =
+      options_.deadline_ms > 0 ? arrived + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
+  const auto usable = [&] { return !free_slots_.empty() || !warm_error_.empty(); };
+  while (!usable()) {
+    const Clock::time_point wake = std::min(deadline, Clock::now() + std::chrono::milliseconds(200));
+    slot_freed_.wait_until(lock, wake, usable);
+    if (usable()) break;
+    if (Clock::now() >= deadline || GuardedHttpServer::client_gone()) {
+      admitted_.fetch_sub(1);
+      if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
+      throw HttpError{503, "deadline",
+                      "no render slot free within this server's deadline of " + std::to_string(options_.deadline_ms) + " ms",
+                      1};
+    }
+  }
+  if (free_slots_.empty()) {
+    admitted_.fetch_sub(1);
+    throw HttpError{503, "server", "the server could not warm its kernels: " + warm_error_, 0};
+  }
   Slot* slot = free_slots_.back();
   free_slots_.pop_back();
   return std::make_unique<SlotLease>(this, slot);
@@ -464,7 +540,15 @@ void HttpServer::release_slot(Slot* slot) {
 }
 
 json HttpServer::health_json() const {
-  return {{"status", "ok"},
+  std::string status = ready() ? "ready" : "starting";
+  {
+    std::lock_guard lock(slots_mutex_);
+    if (!warm_error_.empty()) status = "failed";
+  }
+  return {{"status", status},
+          {"warming", {{"slots_ready", ready_slots_.load()}, {"variants_ready", warmed_variants_.load()},
+                       {"variants", total_variants_}}},
+          {"open_connections", http_->open_connections()},
           {"device", runtime_.device_description()},
           {"uptime_s", std::chrono::duration<double>(Clock::now() - started_).count()},
           {"requests_served", served_.load()},
@@ -581,8 +665,10 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   RenderResult result;
   double queue_ms = 0;
   {
-    const std::unique_ptr<SlotLease> lease = acquire_slot();
+    const std::unique_ptr<SlotLease> lease = acquire_slot(start);
     queue_ms = ms_since(queued);
+    // Queued for a client that has since hung up: nobody would read the image.
+    if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
     Slot& slot = *lease->slot;
     std::unique_ptr<Renderer>& renderer = key.empty() ? slot.scratch : slot.renderers[key];
     try {
@@ -741,8 +827,9 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   ReferenceImage reference;
   std::vector<EntryResult> measured;
   {
-    const std::unique_ptr<SlotLease> lease = acquire_slot();
+    const std::unique_ptr<SlotLease> lease = acquire_slot(start);
     queue_ms = ms_since(queued);
+    if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
     Renderer renderer(runtime_);
     renderer.load_scene(*scene, frame.texels);
     const std::vector<uint8_t> mask = seam_mask(render_face_map(renderer, camera, frame));
@@ -778,14 +865,10 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
 }
 
 void HttpServer::install_routes() {
-  httplib::Server& http = *http_;
-  // Enough pool threads for every admitted render plus a few for /health and refusals.
-  const size_t pool = static_cast<size_t>(options_.threads + options_.queue + 4);
-  http.new_task_queue = [pool] { return new httplib::ThreadPool(pool); };
+  GuardedHttpServer& http = *http_;
+  // Connections, threads, timeouts and byte budgets are server/connection.h's; bodies sent with
+  // a Content-Length over the limit are refused by httplib (413).
   http.set_payload_max_length(options_.max_body_bytes);
-  http.set_keep_alive_timeout(2);  // idle keep-alive connections hold a pool thread
-  http.set_read_timeout(10, 0);
-  http.set_write_timeout(10, 0);
 
   // Every handler runs inside this: refusals become {"error", "field"} with their status. The
   // field starts the message too, echoed like any client value (it can be a client's key).
@@ -838,20 +921,8 @@ void HttpServer::install_routes() {
     const auto route = known_paths().find(req.path);
     const bool routes_post = route != known_paths().end() &&
                              std::find(route->second.begin(), route->second.end(), "POST") != route->second.end();
-    if (res.status == 400 && req.path.empty() && !is_httplib_method(req.method) && is_token(req.method) &&
-        (req.version == "HTTP/1.1" || req.version == "HTTP/1.0")) {
-      // A method cpp-httplib does not know (QUERY, an extension): its request-line parse stopped
-      // before the path and the headers. Answered like a known method the path does not route;
-      // the unread headers and body must not be taken for the next request, so the client is told
-      // to close.
-      res.set_header("Connection", "close");
-      const std::string path = req.target.substr(0, req.target.find('?'));
-      const auto target_route = known_paths().find(path);
-      if (target_route != known_paths().end()) {
-        send_method_not_allowed(res, req.method, path, target_route->second);
-      } else {
-        send_error(res, 404, "path", "no such endpoint: " + echo(req.method) + " " + echo(path));
-      }
+    if (GuardedHttpServer::request_over_byte_limit()) {
+      send_error(res, 413, "body", "the request exceeds this server's limit of bytes read per request");
     } else if (res.status == 404) {
       send_error(res, 404, "path", "no such endpoint: " + req.method + " " + echo(req.path));
     } else if (res.status == 400 && req.method == "POST" && routes_post && req.is_multipart_form_data()) {

@@ -7,10 +7,10 @@
 // races), so each render slot owns its own Renderer objects (kernel objects and buffers) and a
 // slot serves one request at a time. There are --threads slots.
 //
-// Admission: cpp-httplib's thread pool queues connections without bound, so the server counts
-// admitted renders itself: at most `threads` render at once and at most `queue` wait for a slot;
-// any render beyond that is answered 503 with Retry-After at once. The pool has enough threads
-// for every admitted render plus a few more, so /health and refusals are answered while busy.
+// Admission: connections are served by server/connection.h (a thread each, bounded, with read
+// deadlines); renders are counted here: at most `threads` render at once and at most `queue` wait
+// for a slot; any render beyond that is answered 503 with Retry-After at once, and /health and
+// refusals never wait behind renders.
 // A compare (POST /v1/compare) is one admitted request like a render: it holds one slot for its
 // whole run (seam mask, 8x reference or cache hit, every method x rate).
 #pragma once
@@ -25,6 +25,7 @@
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -45,6 +46,8 @@ struct Scene;
 
 namespace seamcl::server {
 
+class GuardedHttpServer;
+
 struct ServerOptions {
   std::string host = "127.0.0.1";  // loopback unless asked otherwise
   int port = 8080;                 // 0: any free port (see HttpServer::port)
@@ -62,7 +65,14 @@ struct ServerOptions {
   long long max_reference_samples = 2048LL * 2048 * 4;  // 8W * 8H * reference_msaa: 413
   // Reference cache of POST /v1/compare. Empty: $SEAMCL_CACHE_DIR, else <temp>/seamcl-serve-cache.
   std::string cache_dir;
-  bool warm_all_methods = true;    // at start, build every method x filter (rgba8), not just the default
+  bool warm_all_methods = true;    // after start, build every method x filter (rgba8) in the background
+  // Connections (server/connection.h): open at once, read deadline of one request, keep-alive wait.
+  int max_connections = 256;
+  int request_read_timeout_ms = 10'000;
+  int idle_timeout_ms = 2'000;
+  // A request that has not started rendering this long after it arrived is answered 503
+  // ("deadline") instead; 0: no deadline. Long work also stops when the client has gone.
+  int deadline_ms = 60'000;
   std::function<void(const std::string&)> log;          // one line per request; empty: stderr
 };
 
@@ -72,14 +82,15 @@ std::string_view openapi_json();
 
 class HttpServer {
  public:
-  // Builds and warms the kernels and generates the built-in scenes (blocking, before anything
-  // listens). Throws on OpenCL failures.
+  // Generates the built-in scenes; the kernels are built and warmed after bind(), in the
+  // background, while the server already answers (/health says "starting", renders wait).
   HttpServer(ClRuntime& runtime, ServerOptions options);
   ~HttpServer();
   HttpServer(const HttpServer&) = delete;
   HttpServer& operator=(const HttpServer&) = delete;
 
-  // Binds host:port (port 0: an ephemeral port); returns the port, or -1 on failure.
+  // Binds host:port (port 0: an ephemeral port) and starts warming; returns the port, or -1 when
+  // the address cannot be bound (a port in use is never shared).
   int bind();
   int port() const { return port_; }
   // Serves until stop(); returns after every in-flight request has been answered.
@@ -87,6 +98,10 @@ class HttpServer {
   // Safe from any thread (e.g. a signal-waiting thread).
   void stop();
   bool is_running() const;
+  // Every slot has the default scene and variant warm (renders no longer wait for start-up).
+  bool ready() const { return ready_slots_.load() == options_.threads; }
+  // Blocks until ready() or the warm-up failed; false on failure or after timeout.
+  bool wait_ready(std::chrono::milliseconds timeout);
 
   long long requests_served() const { return served_.load(); }
 
@@ -107,13 +122,14 @@ class HttpServer {
   nlohmann::json scenes_json() const;
   nlohmann::json methods_json() const;
   nlohmann::json health_json() const;
-  std::unique_ptr<SlotLease> acquire_slot();
+  std::unique_ptr<SlotLease> acquire_slot(std::chrono::steady_clock::time_point arrived);
+  void warm_up();  // the start-up thread
   void release_slot(Slot* slot);
   void log_line(const std::string& line) const;
 
   ClRuntime& runtime_;
   ServerOptions options_;
-  std::unique_ptr<httplib::Server> http_;
+  std::unique_ptr<GuardedHttpServer> http_;
   int port_ = -1;
   std::chrono::steady_clock::time_point started_;
 
@@ -123,13 +139,21 @@ class HttpServer {
 
   std::vector<std::unique_ptr<Slot>> slots_;
   std::vector<Slot*> free_slots_;
-  std::mutex slots_mutex_;
+  mutable std::mutex slots_mutex_;
   std::condition_variable slot_freed_;
   std::atomic<int> admitted_{0};  // rendering + waiting
   std::atomic<long long> served_{0};
   // Two compares of the same reference at once would both render it and write the same cache
   // file: one lock per hash stripe of the cache key, held while the reference is read or made.
   std::array<std::mutex, 16> reference_locks_;
+
+  // Start-up: slots become free as they are warmed; then every method x filter, if asked.
+  std::thread warm_thread_;
+  std::atomic<bool> stopping_{false};
+  std::atomic<int> ready_slots_{0};
+  std::atomic<int> warmed_variants_{0};
+  int total_variants_ = 0;
+  std::string warm_error_;  // under slots_mutex_; not empty: the warm-up failed
 };
 
 }  // namespace seamcl::server

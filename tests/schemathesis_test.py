@@ -53,7 +53,8 @@ def wait_for_health(base, server, timeout_s):
             raise RuntimeError(f"seamcl serve exited with {server.returncode} before answering /health")
         try:
             with urllib.request.urlopen(base + "/health", timeout=2) as res:
-                if res.status == 200:
+                # A server that warms in the background says "starting" until it is ready.
+                if res.status == 200 and json.loads(res.read()).get("status", "ready") != "starting":
                     return
         except OSError:
             pass

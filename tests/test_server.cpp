@@ -997,27 +997,29 @@ TEST_F(Server, UnroutedMethodsAre405WithAllow) {
 }
 
 // A method cpp-httplib does not know (QUERY, an extension token) failed its request-line parse:
-// 400 "request". On a path the service has it is 405 with Allow, like a known method it does not
-// route; elsewhere 404. The request's headers were never read, so the answer closes the connection.
-TEST_F(Server, UnknownMethodsAre405OnKnownPaths) {
-  for (const auto& [request_line, status, allow] : std::vector<std::tuple<std::string, int, std::string>>{
-           {"QUERY /health", 405, "GET"},
-           {"QUERY /v1/render?scene=quad2", 405, "GET, POST"},
-           {"FROB /v1/compare", 405, "POST"},
-           {"QUERY /v1/nothing", 404, ""}}) {
+// 400 "request" (schemathesis: "Unsupported method QUERY returned 400"). Now 405 naming the
+// method, with an Allow header that lists what the path routes, and the connection is closed
+// (its headers and body were never read). server/connection.cpp answers these before cpp-httplib
+// parses them.
+TEST_F(Server, UnknownMethodsAre405) {
+  for (const auto& [request_line, routed] : std::vector<std::pair<std::string, std::vector<std::string>>>{
+           {"QUERY /health", {"GET"}},
+           {"QUERY /v1/render?scene=quad2", {"GET", "POST"}},
+           {"FROB /v1/compare", {"POST"}}}) {
     const RawResponse res = raw_request(server_->http->port(), request_line + " HTTP/1.1\r\nHost: localhost\r\n\r\n");
-    EXPECT_EQ(res.status, status) << request_line << ": " << res.head << res.body;
-    EXPECT_EQ(res.header("Allow"), allow) << request_line;
+    EXPECT_EQ(res.status, 405) << request_line << ": " << res.head << res.body;
+    for (const std::string& method : routed) {
+      EXPECT_NE(res.header("Allow").find(method), std::string::npos) << request_line << ": Allow: " << res.header("Allow");
+    }
     EXPECT_EQ(res.header("Connection"), "close") << request_line;
-    const json body = expect_bounded_error(request_line, res.body);
-    EXPECT_EQ(body.value("field", ""), status == 405 ? "method" : "path") << request_line;
+    EXPECT_EQ(expect_bounded_error(request_line, res.body).value("field", ""), "method") << request_line;
   }
 }
 
 // A refusal that cpp-httplib answered before reading the body (405 from the pre-routing handler)
 // left the body on the connection, where it was parsed as the next request: the client's next
 // request on the same connection got that 400 (found by schemathesis). Now the body is read
-// first, so two requests on one connection get their own answers. cpp-httplib 0.11.4 never reads
+// first, so it is never answered as a request of its own. cpp-httplib 0.11.4 never reads
 // the body of a GET or OPTIONS: those 405s tell the client to close the connection.
 TEST_F(Server, RefusedRequestBodiesAreNotTakenForTheNextRequest) {
   const std::string body = R"({"aniso": 16, "scene": "quad2"})";
@@ -1037,7 +1039,11 @@ TEST_F(Server, RefusedRequestBodiesAreNotTakenForTheNextRequest) {
     std::vector<int> statuses;
     for (size_t at = stream.find("HTTP/1.1 "); at != std::string::npos; at = stream.find("HTTP/1.1 ", at + 1))
       statuses.push_back(std::atoi(stream.c_str() + at + 9));
-    EXPECT_EQ(statuses, (std::vector<int>{405, 200})) << method << " " << path << ":\n" << stream.substr(0, 600);
+    // The second request is answered on the same connection ({405, 200}), or the connection was
+    // closed after the refusal (server/connection.cpp closes after every error answer: {405});
+    // never is the body answered as a request of its own.
+    EXPECT_TRUE(statuses == (std::vector<int>{405, 200}) || statuses == (std::vector<int>{405}))
+        << method << " " << path << ":\n" << stream.substr(0, 600);
   }
 }
 

@@ -66,10 +66,12 @@ std::vector<double> EntryResult::total_ms() const {
 }
 
 EntryResult measure_entry(Renderer& renderer, const Camera& camera, const MethodEntry& entry, int repeat,
-                          const std::vector<glm::vec4>* reference, const std::vector<uint8_t>* seam_mask) {
+                          const std::vector<glm::vec4>* reference, const std::vector<uint8_t>* seam_mask,
+                          const ShouldStop& should_stop) {
   EntryResult out;
   out.entry = entry;
   for (int i = 0; i < repeat; ++i) {
+    throw_if_stopped(should_stop, "between renders of " + entry.method_name + " at msaa " + std::to_string(entry.options.msaa));
     out.last = renderer.render(camera, entry.options);
     out.runs.push_back(out.last.ms);
   }
@@ -84,12 +86,14 @@ EntryResult measure_entry(Renderer& renderer, const Camera& camera, const Method
 std::vector<EntryResult> compare_methods(Renderer& renderer, const Scene& scene, const Camera& camera,
                                          const std::vector<MethodEntry>& entries,
                                          const std::vector<glm::vec4>* reference,
-                                         const std::vector<uint8_t>* seam_mask, int repeat) {
+                                         const std::vector<uint8_t>* seam_mask, int repeat,
+                                         const ShouldStop& should_stop) {
   std::vector<EntryResult> results;
   for (const MethodEntry& entry : entries) {
+    throw_if_stopped(should_stop, "before " + entry.method_name + " at msaa " + std::to_string(entry.options.msaa));
     renderer.load_scene(scene, entry.options.texels);
     renderer.warm_up(entry.options);
-    results.push_back(measure_entry(renderer, camera, entry, repeat, reference, seam_mask));
+    results.push_back(measure_entry(renderer, camera, entry, repeat, reference, seam_mask, should_stop));
   }
   return results;
 }

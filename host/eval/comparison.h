@@ -12,6 +12,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include <seamcl/core/cancelled.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
@@ -48,15 +49,20 @@ struct EntryResult {
 
 // Renders `options` `repeat` times with `renderer` (scene loaded, warmed up by the caller) and,
 // with a reference (and optionally a seam mask) of the same size, measures the last image.
+// should_stop is asked before every render; when it says stop, Cancelled is thrown.
 EntryResult measure_entry(Renderer& renderer, const Camera& camera, const MethodEntry& entry, int repeat,
-                          const std::vector<glm::vec4>* reference, const std::vector<uint8_t>* seam_mask);
+                          const std::vector<glm::vec4>* reference, const std::vector<uint8_t>* seam_mask,
+                          const ShouldStop& should_stop = {});
 
 // seamcl compare's loop: per entry, (re)load `scene` in the entry's texel format, warm up, then
-// measure_entry. Entries are measured one after the other (entry-major).
+// measure_entry. Entries are measured one after the other (entry-major). should_stop is asked
+// before every entry and before every timed render (so a stop waits for one render at most);
+// when it says stop, Cancelled is thrown and nothing is returned.
 std::vector<EntryResult> compare_methods(Renderer& renderer, const Scene& scene, const Camera& camera,
                                          const std::vector<MethodEntry>& entries,
                                          const std::vector<glm::vec4>* reference,
-                                         const std::vector<uint8_t>* seam_mask, int repeat);
+                                         const std::vector<uint8_t>* seam_mask, int repeat,
+                                         const ShouldStop& should_stop = {});
 
 double median_of(std::vector<double> values);
 // JSON numbers must be finite: NaN/Inf become 0.

@@ -1,5 +1,6 @@
 #include <seamcl/eval/reference.h>
 
+#include <algorithm>
 #include <functional>
 #include <thread>
 
@@ -128,7 +129,62 @@ bool write_cached(const std::string& path, const std::string& key, int width, in
   return true;
 }
 
+bool is_reference_file(const std::string& name) {
+  return name.rfind("reference-", 0) == 0 && name.size() > 14 && name.compare(name.size() - 4, 4, ".exr") == 0 &&
+         name.find(".tmp") == std::string::npos;
+}
+
+bool is_reference_temp_file(const std::string& name) {
+  return name.rfind("reference-", 0) == 0 && name.find(".exr.tmp") != std::string::npos;
+}
+
 }  // namespace
+
+CacheTrim trim_reference_cache(const std::string& dir, std::uintmax_t max_bytes, size_t max_entries) {
+  struct Entry {
+    fs::path path;
+    std::uintmax_t bytes;
+    fs::file_time_type used;
+  };
+  CacheTrim trim;
+  std::vector<Entry> entries;
+  std::error_code ec;
+  const fs::file_time_type now = fs::file_time_type::clock::now();
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code entry_ec;
+    if (!it->is_regular_file(entry_ec)) continue;
+    const std::string name = it->path().filename().string();
+    const fs::file_time_type used = it->last_write_time(entry_ec);
+    if (entry_ec) continue;
+    if (is_reference_temp_file(name)) {
+      if (now - used > std::chrono::hours(1)) fs::remove(it->path(), entry_ec);
+      continue;
+    }
+    if (!is_reference_file(name)) continue;
+    const std::uintmax_t bytes = it->file_size(entry_ec);
+    if (!entry_ec) entries.push_back({it->path(), bytes, used});
+  }
+  // Most recently used first; the name breaks ties so that the order is the same for everyone.
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    return a.used != b.used ? a.used > b.used : a.path < b.path;
+  });
+  bool full = false;  // once one entry does not fit, no older one is kept either
+  for (const Entry& e : entries) {
+    full = full || (max_bytes != 0 && trim.kept_bytes + e.bytes > max_bytes) ||
+           (max_entries != 0 && trim.kept_entries + 1 > max_entries);
+    if (!full) {
+      ++trim.kept_entries;
+      trim.kept_bytes += e.bytes;
+      continue;
+    }
+    std::error_code remove_ec;
+    if (fs::remove(e.path, remove_ec)) {
+      ++trim.removed_entries;
+      trim.removed_bytes += e.bytes;
+    }
+  }
+  return trim;
+}
 
 double mitchell_netravali(double x, double b, double c) {
   x = std::fabs(x);
@@ -231,6 +287,8 @@ ReferenceImage reference_image(const Scene& scene, const Camera& camera, const R
     if (auto cached = read_cached(ref.cache_path, key, ref.width, ref.height)) {
       ref.pixels = std::move(*cached);
       ref.from_cache = true;
+      std::error_code ec;  // the last use, for trim_reference_cache's LRU order
+      fs::last_write_time(ref.cache_path, fs::file_time_type::clock::now(), ec);
       return ref;
     }
   }
@@ -245,16 +303,25 @@ ReferenceImage reference_image(const Scene& scene, const Camera& camera, const R
     ref.pixels = downsample_mitchell(big.pixels, big.width, big.height, kReferenceScale);
   }
   ref.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  if (settings.use_cache && !write_cached(ref.cache_path, key, ref.width, ref.height, ref.pixels)) {
-    ref.cache_path.clear();
+  if (settings.use_cache) {
+    if (write_cached(ref.cache_path, key, ref.width, ref.height, ref.pixels)) {
+      trim_reference_cache(fs::path(ref.cache_path).parent_path().string(), settings.cache_max_bytes,
+                           settings.cache_max_entries);
+    }
+    std::error_code ec;
+    if (!fs::is_regular_file(ref.cache_path, ec)) ref.cache_path.clear();
   }
   return ref;
 }
 
 ReferenceImage reference_image(Renderer& renderer, const Camera& camera, const RenderOptions& frame,
                                const ReferenceSettings& settings) {
-  return reference_image(renderer.scene(), camera, frame, settings,
-                         [&](const RenderOptions& high) { return renderer.render(camera, high); });
+  return reference_image(renderer.scene(), camera, frame, settings, [&](const RenderOptions& high) {
+    RenderResult result = renderer.render(camera, high);
+    // The 8x frame's buffers are 64x a frame's: not kept for the renders that follow.
+    renderer.release_frame_buffers();
+    return result;
+  });
 }
 
 nlohmann::json reference_json(const ReferenceImage& reference, bool with_cache_path) {

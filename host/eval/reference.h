@@ -13,6 +13,8 @@
 // width (4) explicitly; tests/test_metrics.cpp holds the result to a direct evaluation of the
 // kernel and checks the installed library's default width.
 #pragma once
+#include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -45,11 +47,17 @@ std::string default_reference_method();
 // 1 sample per pixel for traverse (the paper's reference); 16 for the discard stand-in.
 int default_reference_msaa(const std::string& method);
 
+inline constexpr std::uintmax_t kDefaultReferenceCacheBytes = std::uintmax_t{256} << 20;  // 256 MiB
+
 struct ReferenceSettings {
   std::string method;      // empty: default_reference_method()
   int msaa = 0;            // 0: default_reference_msaa(method)
   std::string cache_dir;   // empty: default_cache_dir()
   bool use_cache = true;
+  // The cache's bound, applied after every write (trim_reference_cache): at most this many bytes
+  // and this many entries. 0: unbounded. A 480x540 reference is about 4 MiB (zip float EXR).
+  std::uintmax_t cache_max_bytes = kDefaultReferenceCacheBytes;
+  size_t cache_max_entries = 0;
 };
 
 // $SEAMCL_CACHE_DIR, else $HOME/.cache/seamcl, else <temp>/seamcl-cache.
@@ -82,12 +90,31 @@ struct ReferenceImage {
 using HighResRender = std::function<RenderResult(const RenderOptions&)>;
 
 // The reference for `frame` of `scene` seen from `camera`. With use_cache, a cache entry whose
-// stored key matches is returned without calling `render`; a missing, unreadable or mismatched
-// entry is rendered again and rewritten (atomically: temporary file and rename).
+// stored key matches is returned without calling `render` (and its last use set to now); a
+// missing, unreadable or mismatched entry is rendered again and rewritten (atomically: temporary
+// file and rename), then the cache is trimmed to the settings' bound. cache_path is empty when
+// the entry was not kept (not writable, or alone over the bound).
 ReferenceImage reference_image(const Scene& scene, const Camera& camera, const RenderOptions& frame,
                                const ReferenceSettings& settings, const HighResRender& render);
 
-// The usual HighResRender: `renderer` (with `scene` loaded) renders `camera`.
+// What trim_reference_cache did.
+struct CacheTrim {
+  size_t kept_entries = 0;
+  std::uintmax_t kept_bytes = 0;
+  size_t removed_entries = 0;
+  std::uintmax_t removed_bytes = 0;
+};
+
+// Bounds the reference files (reference-*.exr) in `dir`, least recently used first: an entry's
+// last use is its modification time, which a cache hit sets to now. Keeps the most recently used
+// entries while they fit in max_bytes and max_entries (0: no bound on that count) and removes the
+// rest, also the newest one when it alone is over max_bytes. Leftover temporary files of writers
+// that died (older than an hour) are removed; others' files are never touched. Errors (a file
+// removed meanwhile, a missing directory) are ignored: the cache is an optimisation.
+CacheTrim trim_reference_cache(const std::string& dir, std::uintmax_t max_bytes, size_t max_entries);
+
+// The usual HighResRender: `renderer` (with `scene` loaded) renders `camera`, then releases its
+// frame buffers (Renderer::release_frame_buffers): the 8x frame's are not kept.
 ReferenceImage reference_image(Renderer& renderer, const Camera& camera, const RenderOptions& frame,
                                const ReferenceSettings& settings);
 

@@ -1,5 +1,7 @@
 #include <seamcl/pipeline/packed_scene.h>
 
+#include <seamcl/pipeline/render_memory.h>
+
 #include "core/srgb.h"
 #include "pipeline/adjacency.h"
 #include "pipeline/guard_band.h"
@@ -18,10 +20,13 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
   out.positions.reserve(scene.positions.size());
   for (const glm::vec3& p : scene.positions) out.positions.push_back({{p.x, p.y, p.z, 1.0f}});
   out.faces.reserve(scene.faces.size());
+  // Exactly what is stored, bands included: growing by push_back would hold up to 3x meanwhile.
+  const size_t stored_texels = packed_texture_memory(scene_sizes(scene), format, guard_band).texels;
+  if (stored_texels > std::numeric_limits<uint32_t>::max() / 4) throw std::length_error("scene textures exceed 2^30 texels");
   if (format == TexelFormat::Rgba8) {
-    out.texels8.reserve(scene.texel_count());
+    out.texels8.reserve(stored_texels);
   } else {
-    out.texels32.reserve(scene.texel_count() * 4);
+    out.texels32.reserve(stored_texels * 4);
   }
   size_t texels = 0;
   for (size_t f = 0; f < scene.faces.size(); ++f) {

@@ -5,6 +5,8 @@
 #include <cassert>
 #include <stdexcept>
 
+#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/core/over_budget.h>
 #include "core/srgb.h"
 #include "pipeline/frame_params.h"
 
@@ -37,6 +39,7 @@ struct Renderer::Impl {
 
   std::unique_ptr<Scene> scene;
   PackedScene packed;
+  bool uploaded = false;  // packed and its buffers are current (a failed pack leaves neither)
   cl::Buffer positions, faces, neighbors, level_offsets, texels, srgb_table;
 
   // Frame buffers, grown on demand.
@@ -45,6 +48,7 @@ struct Renderer::Impl {
   uint32_t bin_capacity = 0;         // tile-list entries the next frame asks for
   uint32_t tile_lists_capacity = 0;  // entries allocated
   FrameParams last_params{};
+  size_t device_byte_limit = 0;  // 0: none
 
   explicit Impl(ClRuntime& rt) : runtime(rt) {
     const auto& table = srgb_to_linear_table();
@@ -75,12 +79,31 @@ struct Renderer::Impl {
 
   // Packs and uploads the loaded scene in `format` with `guard_band` texels of band per level.
   void pack_and_upload(TexelFormat format, int guard_band) {
+    // The old packing goes first, so a repack never holds two scenes' textures at once.
+    release_scene_buffers();
     packed = pack_scene(*scene, format, guard_band);
     positions = upload(packed.positions);
     faces = upload(packed.faces);
     neighbors = upload(packed.neighbors);
     level_offsets = upload(packed.level_offsets);
     texels = format == TexelFormat::Rgba8 ? upload(packed.texels8) : upload(packed.texels32);
+    uploaded = true;
+  }
+
+  void release_scene_buffers() {
+    uploaded = false;
+    packed = PackedScene{};
+    positions = faces = neighbors = level_offsets = texels = cl::Buffer();
+  }
+
+  void release_frame_buffers() {
+    setups = tile_counts = tile_offsets = tile_cursors = tile_lists = sample_triangle = image = cl::Buffer();
+    setups_capacity = tiles_capacity = samples_capacity = pixels_capacity = 0;
+    tile_lists_capacity = 0;
+    // What a scene needed once is not kept either: the lists start again at the initial size
+    // (render_memory's estimate) and grow if this scene needs it.
+    bin_capacity = scene ? initial_tile_list_entries(scene->triangle_count()) : 0;
+    last_params = FrameParams{};
   }
 
   template <typename T>
@@ -201,12 +224,36 @@ Renderer::~Renderer() = default;
 
 void Renderer::load_scene(const Scene& scene, TexelFormat format) {
   validate_scene(scene);
+  impl_->release_scene_buffers();
+  impl_->scene.reset();  // the old copy goes before the new one is made
   impl_->scene = std::make_unique<Scene>(scene);
   impl_->pack_and_upload(format, 0);
   // Start the tile lists at a few entries per triangle slot; render() grows them when needed.
-  impl_->bin_capacity = std::max<uint32_t>(impl_->bin_capacity, static_cast<uint32_t>(std::min<size_t>(
-                                                                      scene.triangle_count() * 8 + 65536, 1u << 30)));
+  impl_->bin_capacity = std::max<uint32_t>(impl_->bin_capacity, initial_tile_list_entries(scene.triangle_count()));
   impl_->tile_lists = cl::Buffer();
+}
+
+void Renderer::set_device_byte_limit(size_t bytes) { impl_->device_byte_limit = bytes; }
+
+bool Renderer::has_scene() const { return impl_->scene != nullptr; }
+
+void Renderer::release_frame_buffers() { impl_->release_frame_buffers(); }
+
+void Renderer::release_scene() {
+  impl_->release_scene_buffers();
+  impl_->scene.reset();
+  impl_->release_frame_buffers();
+}
+
+size_t Renderer::device_bytes() const {
+  const Impl& i = *impl_;
+  size_t bytes = 0;
+  for (const cl::Buffer* buffer :
+       {&i.positions, &i.faces, &i.neighbors, &i.level_offsets, &i.texels, &i.srgb_table, &i.frame_params, &i.stats,
+        &i.setups, &i.tile_counts, &i.tile_offsets, &i.tile_cursors, &i.tile_lists, &i.sample_triangle, &i.image}) {
+    if ((*buffer)() != nullptr) bytes += buffer->getInfo<CL_MEM_SIZE>();
+  }
+  return bytes;
 }
 
 const Scene& Renderer::scene() const {
@@ -219,7 +266,7 @@ const PackedScene& Renderer::packed_scene() const { return impl_->packed; }
 RenderResult Renderer::render(const Camera& camera, const RenderOptions& options) {
   if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
   const SamplerParams sampler = sampler_params(options);
-  if (options.texels != impl_->packed.format || sampler.guard_band != impl_->packed.guard_band) {
+  if (!impl_->uploaded || options.texels != impl_->packed.format || sampler.guard_band != impl_->packed.guard_band) {
     impl_->pack_and_upload(options.texels, sampler.guard_band);
   }
   impl_->use_kernels(options.texels, sampler);
@@ -236,7 +283,15 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     if (result.stats.bin_entries > params.bin_capacity) {
       // The lists overflowed (the kernels stayed in bounds): grow with headroom and render again.
       if (result.attempts >= 3) throw std::runtime_error("tile lists overflowed three times");
-      impl_->bin_capacity = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{result.stats.bin_entries} * 5 / 4 + 1024, 1u << 31));
+      const uint32_t grown = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{result.stats.bin_entries} * 5 / 4 + 1024, 1u << 31));
+      if (impl_->device_byte_limit != 0) {
+        const size_t needed = device_bytes() - size_t{impl_->tile_lists_capacity} * sizeof(cl_uint) + size_t{grown} * sizeof(cl_uint);
+        if (needed > impl_->device_byte_limit) {
+          throw OverBudget("size", "this frame's tile lists (" + std::to_string(result.stats.bin_entries) + " entries)",
+                           needed, impl_->device_byte_limit);
+        }
+      }
+      impl_->bin_capacity = grown;
       continue;
     }
     auto sum = [](const std::vector<cl::Event>& events) {
@@ -288,6 +343,7 @@ std::vector<uint32_t> Renderer::read_tile_offsets() {
                                static_cast<size_t>(impl_->last_params.tiles_x) * impl_->last_params.tiles_y);
 }
 std::vector<uint32_t> Renderer::read_tile_lists() {
+  if (impl_->tile_lists() == nullptr || impl_->last_params.width == 0) return {};  // released (or none yet)
   FrameStats stats{};
   impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &stats);
   return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_lists, std::min(stats.bin_entries, impl_->bin_capacity));

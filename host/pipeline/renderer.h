@@ -53,6 +53,27 @@ class Renderer {
   void load_scene(const Scene& scene, TexelFormat format = TexelFormat::Rgba8);
   const Scene& scene() const;
   const PackedScene& packed_scene() const;
+  bool has_scene() const;
+
+  // Frees the buffers sized by a request (triangle setups, tiles and tile lists, the sample
+  // buffer, the image) so that a kept Renderer does not hold the largest frame it ever rendered;
+  // the next render allocates them again at its own size (the tile lists back at their initial
+  // size for the scene, see render_memory.h). The last_frame_params and read_* views are empty
+  // until then. The scene stays loaded.
+  void release_frame_buffers();
+  // Frees the loaded scene too: the Renderer's Scene copy, the packed arrays and their device
+  // buffers (and the frame buffers). Rendering needs a load_scene again.
+  void release_scene();
+
+  // Bytes of the device buffers this Renderer holds now (CL_MEM_SIZE of each): what
+  // render_memory(...).device_bytes() predicts for a fresh Renderer after one render.
+  size_t device_bytes() const;
+
+  // A ceiling for device_bytes() (0, the default: none). render_memory() predicts every buffer
+  // but the tile lists' growth on crowded frames; with a limit, a render whose lists would have
+  // to grow past it throws OverBudget (field "size") instead of allocating. The rest is the
+  // caller's to check beforehand with render_memory().
+  void set_device_byte_limit(size_t bytes);
 
   RenderResult render(const Camera& camera, const RenderOptions& options);
 

@@ -1,21 +1,45 @@
 #!/usr/bin/env python3
-"""The viewer page in a real browser: headless Chromium loads GET / from a live `seamcl serve`,
-the page's script renders through /v1/render, and the <img> must have decoded a PNG of the
-default size. Loopback only, bounded in time. Exits 0 on success, 1 on failure.
+"""The viewer page in a real browser: headless Chromium, driven over the DevTools protocol
+(tests/browser/cdp.py, a pipe; nothing to install), loads GET / from a live `seamcl serve` and
+works it through the DOM after the page's scripts ran:
 
-    tests/browser/viewer_test.py --seamcl build/seamcl [--chromium chromium]
+- both images decode as PNGs of the chosen size; the page's heat map equals one computed here from
+  the same PNGs (decoded in Python);
+- changing method A (twice, quickly) while B is shown changes A's image URL to the last choice;
+- a permalink opened in a new tab restores every control and the same images;
+- dragging the wipe divider and moving the magnifier follow the pointer;
+- a compare fills the Figure 5 and speed/error chart data; changing the scene clears it; a size
+  over the server's compare limit is refused on the page, not compared at another size;
+- an error answer ({"error", "field"}) is shown; the reference is used, or said to be unavailable.
+
+Loopback only, bounded in time (about a minute). Exits 0 on success, 1 on failure.
+
+    tests/browser/viewer_test.py --seamcl build/seamcl [--chromium chromium] [--screenshots DIR]
 """
 import argparse
+import http.server
+import threading
 import json
+import math
 import os
-import re
 import shutil
 import socket
+import struct
 import subprocess
 import sys
 import tempfile
 import time
+import urllib.error
+import urllib.parse
 import urllib.request
+import zlib
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cdp import Browser, CdpError  # noqa: E402
+
+SIZE = "64x64"
+COMPARE_SIZE = "32x32"  # compare renders an 8x reference: keep it small
+BUDGET_S = 85  # the whole test, server start included
 
 
 def free_port():
@@ -24,58 +48,470 @@ def free_port():
         return s.getsockname()[1]
 
 
-def wait_ready(port, server, deadline):
+def wait_ready(base, server, deadline):
+    """Waits for /health to say the kernels are warm: "ready" (or "ok" from older servers)."""
+    last = None
     while time.monotonic() < deadline:
         if server.poll() is not None:
             raise RuntimeError("server exited with %s" % server.returncode)
         try:
-            with urllib.request.urlopen("http://127.0.0.1:%d/health" % port, timeout=2) as r:
-                if r.status == 200:
+            with urllib.request.urlopen(base + "/health", timeout=2) as r:
+                last = json.load(r).get("status")
+                if last in ("ready", "ok"):
                     return
-        except OSError:
-            time.sleep(0.3)
-    raise RuntimeError("server not ready in time")
+        except (OSError, ValueError):
+            pass
+        time.sleep(0.2)
+    raise RuntimeError("server not ready in time (last status %r)" % last)
+
+
+def get(url, body=None):
+    request = urllib.request.Request(url, data=None if body is None else json.dumps(body).encode(),
+                                     headers={"Content-Type": "application/json"})
+    try:
+        with urllib.request.urlopen(request, timeout=60) as r:
+            return r.status, r.read()
+    except urllib.error.HTTPError as e:
+        return e.code, e.read()
+
+
+def decode_png_rgb(data):
+    """8-bit RGB or RGBA, non-interlaced PNG -> list of (r, g, b) bytes, width, height."""
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    pos, idat, header = 8, b"", None
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        chunk = data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+        if kind == b"IHDR":
+            header = struct.unpack(">IIBBBBB", chunk)
+        elif kind == b"IDAT":
+            idat += chunk
+    width, height, depth, colour, _, _, interlace = header
+    assert depth == 8 and colour in (2, 6) and interlace == 0, "unsupported PNG %s" % (header,)
+    bpp = 4 if colour == 6 else 3
+    raw, stride, rows, prev = zlib.decompress(idat), width * bpp, [], bytearray(width * bpp)
+    for y in range(height):
+        kind, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - bpp] if i >= bpp else 0
+            b, c = prev[i], prev[i - bpp] if i >= bpp else 0
+            if kind == 1:
+                line[i] = (line[i] + a) & 255
+            elif kind == 2:
+                line[i] = (line[i] + b) & 255
+            elif kind == 3:
+                line[i] = (line[i] + (a + b) // 2) & 255
+            elif kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append(line)
+        prev = line
+    pixels = [tuple(row[x * bpp:x * bpp + 3]) for row in rows for x in range(width)]
+    return pixels, width, height
+
+
+def srgb_to_linear(c):
+    c /= 255.0
+    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+
+
+def mean_distance(p, q):
+    lut = [srgb_to_linear(i) for i in range(256)]
+    total = 0.0
+    for a, b in zip(p, q):
+        total += math.sqrt(sum((lut[a[k]] - lut[b[k]]) ** 2 for k in range(3)))
+    return total / len(p)
+
+
+class Proxy(http.server.ThreadingHTTPServer):
+    """In front of seamcl for what the server cannot do on demand: it delays renders of one method
+    (answers that arrive late and out of order), and, where seamcl has no POST /v1/reference yet,
+    answers it with a stand-in (a traverse render of the same frame) so the page's reference path
+    runs too."""
+    daemon_threads = True
+
+    def __init__(self, upstream):
+        self.upstream, self.slow_method, self.fake_reference = upstream, None, False
+        super().__init__(("127.0.0.1", 0), ProxyHandler)
+        threading.Thread(target=self.serve_forever, daemon=True).start()
+
+    @property
+    def base(self):
+        return "http://127.0.0.1:%d" % self.server_address[1]
+
+
+class ProxyHandler(http.server.BaseHTTPRequestHandler):
+    def log_message(self, *args):
+        pass
+
+    def relay(self, method):
+        body = self.rfile.read(int(self.headers.get("Content-Length", 0) or 0)) if method == "POST" else None
+        path = self.path
+        if method == "POST" and path == "/v1/reference" and self.server.fake_reference:
+            request = json.loads(body)
+            q = {k: request[k] for k in ("scene", "size", "frame", "frames", "tint", "texels", "aniso", "filter") if k in request}
+            q["method"] = "traverse"
+            path, method, body = "/v1/render?" + urllib.parse.urlencode(q), "GET", None
+        query = urllib.parse.parse_qs(urllib.parse.urlparse(path).query)
+        if self.server.slow_method and query.get("method") == [self.server.slow_method]:
+            time.sleep(2.0)
+        request = urllib.request.Request(self.server.upstream + path, data=body, method=method,
+                                         headers={"Content-Type": self.headers.get("Content-Type", "application/json")})
+        try:
+            with urllib.request.urlopen(request, timeout=60) as r:
+                status, headers, data = r.status, r.headers, r.read()
+        except urllib.error.HTTPError as e:
+            status, headers, data = e.code, e.headers, e.read()
+        try:
+            self.send_response(status)
+            for k, v in headers.items():
+                if k.lower() in ("content-type", "retry-after") or k.lower().startswith("x-seamcl"):
+                    self.send_header(k, v)
+            if self.path == "/v1/reference" and status == 200:
+                self.send_header("X-Seamcl-Reference-Method", "traverse (stand-in)")
+            self.send_header("Content-Length", str(len(data)))
+            self.end_headers()
+            self.wfile.write(data)
+        except OSError:  # the page aborted this request
+            pass
+
+    def do_GET(self):
+        self.relay("GET")
+
+    def do_POST(self):
+        self.relay("POST")
+
+
+class Checks:
+    def __init__(self):
+        self.passed, self.failed = 0, []
+
+    def check(self, ok, what, detail=""):
+        if ok:
+            self.passed += 1
+        else:
+            self.failed.append("%s %s" % (what, detail))
+            print("FAIL:", what, detail, flush=True)
+        return ok
+
+
+# JavaScript helpers run in the page.
+CONTROL_IDS = ["scene", "size", "frame", "frames", "tint", "method_a", "method_b", "filter", "msaa", "aniso", "shading",
+               "texels", "guard_band", "zero_coverage", "reference_method", "reference_msaa", "view", "scale", "zoom",
+               "heat_pair", "wipe", "flip_shown", "compare_rates", "repeat"]
+READ_CONTROLS = "Object.fromEntries(%s.map((id) => { const e = document.getElementById(id); " \
+                "return [id, e.type === 'checkbox' ? e.checked : e.value]; }))" % json.dumps(CONTROL_IDS)
+
+
+def set_controls(page, values):
+    """Sets controls as a user would (each value, then its change event), in one go."""
+    page.eval("for (const [id, v] of %s) { const e = document.getElementById(id); "
+              "if (e.type === 'checkbox') e.checked = v === true; else e.value = String(v); "
+              "e.dispatchEvent(new Event('change')); }" % json.dumps(list(values.items())))
+
+
+def set_control(page, id_, value):
+    set_controls(page, {id_: value})
+
+
+def wait_idle(page, timeout, what):
+    """Waits for the page's renders to finish; an error shown instead is a failure with its text."""
+    state = page.wait("['idle', 'error'].includes(document.body.dataset.state) && document.body.dataset.state",
+                      timeout=timeout, what=what)
+    if state == "error":
+        raise CdpError("%s: the page shows an error: %s" % (what, page.eval("document.getElementById('status').textContent")))
+
+
+def image_info(page, id_):
+    return page.eval("(() => { const e = document.getElementById(%s); return {src: e.dataset.src || '', "
+                     "size: e.dataset.size || '', type: e.dataset.type || '', complete: e.complete, "
+                     "natural: e.naturalWidth + 'x' + e.naturalHeight}; })()" % json.dumps(id_))
+
+
+def method_of(src):
+    return urllib.parse.parse_qs(src.split("?", 1)[-1]).get("method", [""])[0]
+
+
+def run(base, chromium, profile, shots, t, deadline):
+    status, body = get(base + "/v1/methods")
+    info = json.loads(body)
+    options, limits = info["options"], info.get("limits", {})
+    names = [m["name"] for m in info["methods"]]
+    a0 = options["method"]["default"]
+    others = [n for n in names if n != a0]
+    b0 = others[0]
+    _, scenes_body = get(base + "/v1/scenes")
+    scenes = json.loads(scenes_body)["scenes"]
+
+    def left():
+        return max(1.0, deadline - time.monotonic())
+
+    def step(n):
+        print("step %d at %.1f s" % (n, time.monotonic() - (deadline - BUDGET_S)), flush=True)
+
+    def shot(page, name):
+        if shots:
+            page.screenshot(os.path.join(shots, name))
+
+    browser = Browser(chromium, profile)
+    try:
+        step(1)
+        # 1. A permalink with a small size: both images decode at that size.
+        page = browser.open(base + "/#size=%s&scale=4&a=%s&b=%s&zoom=8&loupe=32,32" % (SIZE, a0, b0))
+        wait_idle(page, min(40, left()), "the first render")
+        for id_ in ("image_a", "image_b"):
+            page.wait("document.getElementById(%s).complete" % json.dumps(id_), timeout=5)
+            i = image_info(page, id_)
+            t.check(i["size"] == SIZE and i["natural"] == SIZE, id_ + " decodes at " + SIZE, str(i))
+            t.check(i["type"] == "image/png", id_ + " is a PNG", str(i))
+        ia, ib = image_info(page, "image_a"), image_info(page, "image_b")
+        t.check(method_of(ia["src"]) == a0 and method_of(ib["src"]) == b0, "A and B show the methods of the permalink",
+                "%s | %s" % (ia["src"], ib["src"]))
+        status_text = page.eval("document.getElementById('status').textContent")
+        t.check("error" not in page.eval("document.getElementById('status').className"), "no error after render",
+                status_text)
+
+        step(2)
+        # 2. The heat map equals the one computed here from the server's own PNGs.
+        pa, w, h = decode_png_rgb(get(base + ia["src"])[1])
+        pb, _, _ = decode_png_rgb(get(base + ib["src"])[1])
+        expected = mean_distance(pa, pb)
+        heat = page.eval("({...document.getElementById('heat').dataset})")
+        got = float(heat.get("mean", "nan"))
+        t.check(heat.get("size") == SIZE and abs(got - expected) <= 1e-6 + 1e-4 * expected,
+                "page heat map mean A vs B matches Python", "page %r, python %.6g" % (heat, expected))
+        set_control(page, "view", "heat")
+        shot(page, "1-heat.png")
+
+        step(3)
+        # 3. Side by side with the magnifier over A (a real pointer move).
+        set_control(page, "view", "side")
+        r = page.eval("(() => { const r = document.getElementById('image_a').getBoundingClientRect(); "
+                      "return [r.left, r.top, r.width, r.height]; })()")
+        page.mouse("mouseMoved", r[0] + r[2] * (10.5 / w), r[1] + r[3] * (20.5 / h))
+        loupe = page.eval("document.getElementById('loupe_text').textContent")
+        t.check("(10, 20)" in loupe, "the magnifier follows the pointer", loupe)
+        shot(page, "2-side.png")
+
+        step(4)
+        # 4. Wipe: dragging the divider moves it and the URL keeps it.
+        set_control(page, "view", "wipe")
+        r = page.eval("(() => { const r = document.getElementById('wipe_box').getBoundingClientRect(); "
+                      "return [r.left, r.top, r.width, r.height]; })()")
+        y = r[1] + r[3] / 2
+        page.mouse("mousePressed", r[0] + r[2] * 0.6, y, buttons=1)
+        page.mouse("mouseMoved", r[0] + r[2] * 0.3, y, buttons=1)
+        page.mouse("mouseMoved", r[0] + r[2] * 0.25, y, buttons=1)
+        page.mouse("mouseReleased", r[0] + r[2] * 0.25, y, buttons=0)
+        try:  # input events reach the page's handlers with the next frame
+            page.wait("Math.abs(document.getElementById('wipe').value - 25) <= 2", timeout=3)
+        except CdpError:
+            pass
+        wipe = page.eval("document.getElementById('wipe').value")
+        t.check(abs(int(wipe) - 25) <= 2, "dragging the wipe divider moves it", "wipe=%s" % wipe)
+        t.check("wipe=" + wipe in page.eval("location.hash"), "the wipe position is in the URL")
+        shot(page, "3-wipe.png")
+
+        step(5)
+        # 5. Stale state: with B shown (flip view), change A twice quickly; A's image must follow
+        # the last choice and the flip view show B until flipped, then the new A.
+        set_control(page, "view", "flip")
+        set_control(page, "flip_shown", "B")
+        before = image_info(page, "image_a")["src"]
+        a1, a2 = others[1 % len(others)], others[2 % len(others)] if len(others) > 2 else a0
+        set_control(page, "method_a", a1)
+        set_control(page, "method_a", a2)
+        wait_idle(page, min(30, left()), "the render after changing A")
+        after = image_info(page, "image_a")["src"]
+        t.check(method_of(after) == a2 and after != before or (a2 == a0 and after == before),
+                "changing A while B is shown updates A's image", "%s -> %s (wanted method %s)" % (before, after, a2))
+        t.check(method_of(image_info(page, "flip_image")["src"]) == b0, "the flip view still shows B")
+        set_control(page, "flip_shown", "A")
+        t.check(image_info(page, "flip_image")["src"] == after, "flipping shows the new A",
+                image_info(page, "flip_image")["src"])
+        set_control(page, "method_a", a1)
+        wait_idle(page, min(30, left()), 'a render')
+        t.check(method_of(image_info(page, "flip_image")["src"]) == a1, "changing A while A is flipped in shows it")
+
+        step(6)
+        # 6. An error answer is shown with its field.
+        set_control(page, "size", "0x5")
+        page.wait("document.body.dataset.state === 'error'", timeout=min(15, left()), what="the error answer")
+        status_text = page.eval("document.getElementById('status').textContent")
+        t.check("400" in status_text and "size" in status_text, "the error answer is shown with its field", status_text)
+        t.check(page.eval("document.getElementById('size').classList.contains('bad')"), "the size control is marked")
+        set_control(page, "size", SIZE)
+        wait_idle(page, min(20, left()), 'a render')
+
+        step(7)
+        # 7. Permalink round trip: non-default values everywhere, then a new tab at location.href.
+        def other(option, current):
+            values = [str(v) for v in options[option]["enum"]]
+            return next((v for v in values if v != str(current)), str(current))
+        orbit_scene = next((s for s in scenes if s.get("orbit") and s["name"] != options["scene"]["default"]),
+                           next((s for s in scenes if s.get("orbit")), None))
+        wanted = {
+            "filter": other("filter", options["filter"]["default"]),
+            "msaa": other("msaa", options["msaa"]["default"]),
+            "shading": other("shading", options["shading"]["default"]),
+            "texels": other("texels", options["texels"]["default"]),
+            "zero_coverage": other("zero_coverage", options["zero_coverage"]["default"]),
+            "guard_band": str(min(options["guard_band"]["maximum"], options["guard_band"]["default"] + 3)),
+            "aniso": str(max(options["aniso"]["minimum"], options["aniso"]["default"] // 2)),
+            "method_b": "guardband" if "guardband" in names else b0,
+            "tint": True, "view": "wipe", "scale": "2", "zoom": "16", "wipe": "30", "compare_rates": "chosen",
+            "repeat": "2",
+        }
+        if orbit_scene:
+            wanted.update({"scene": orbit_scene["name"], "frame": "3", "frames": "12"})
+        set_controls(page, wanted)
+        wait_idle(page, min(40, left()), "the render with every option changed")
+        before = page.eval(READ_CONTROLS)
+        images_before = [image_info(page, i)["src"] for i in ("image_a", "image_b")]
+        href = page.eval("location.href")
+        t.check(page.eval("document.getElementById('permalink').href") == href, "the permalink link is the URL")
+        set_values = {k: before[k] for k in wanted}
+        t.check(set_values == {k: (v if isinstance(v, bool) else str(v)) for k, v in wanted.items()},
+                "the page took every value", "%r" % set_values)
+        page2 = browser.open(href)
+        wait_idle(page2, min(40, left()), "the permalink's render")
+        restored = page2.eval(READ_CONTROLS)
+        diff = {k: (before[k], restored[k]) for k in before if before[k] != restored[k]}
+        t.check(not diff, "the permalink restores every control", "%r" % diff)
+        images_after = [image_info(page2, i)["src"] for i in ("image_a", "image_b")]
+        t.check(images_after == images_before, "the permalink shows the same images", "%r vs %r" % (images_before, images_after))
+        shot(page2, "4-permalink-wipe.png")
+        t.check(not page2.errors(), "no script errors in the permalink's page", str(page2.errors()))
+        page2.close()
+
+        step(8)
+        # 8. The reference: used if the server offers POST /v1/reference, else said unavailable.
+        set_control(page, "view", "heat")
+        set_control(page, "heat_pair", "a_ref")
+        ref_status, _ = get(base + "/v1/reference", {"scene": page.eval("document.getElementById('scene').value"),
+                                                     "size": SIZE})
+        if ref_status == 404:
+            page.wait("document.getElementById('notice').textContent.includes('reference is unavailable')",
+                      timeout=min(15, left()), what="the reference-unavailable notice")
+            t.check(page.eval("document.getElementById('heat').dataset.pair") == "ab", "without a reference: A vs B")
+        else:
+            page.wait("document.getElementById('heat').dataset.pair === 'a_ref'", timeout=min(40, left()),
+                      what="the heat map against the reference")
+            t.check(page.eval("document.getElementById('heat').dataset.size") == SIZE, "the reference heat map's size")
+
+        step(9)
+        # 9. Compare: at the size shown, all rates, charts filled; a scene change clears them.
+        set_controls(page, {"view": "side", "compare_rates": "all", "repeat": "1", "scene": options["scene"]["default"],
+                            "frame": "", "tint": False, "shading": options["shading"]["default"],
+                            "texels": options["texels"]["default"], "msaa": str(options["msaa"]["default"]),
+                            "size": COMPARE_SIZE})
+        wait_idle(page, min(30, left()), 'a render')
+        page.eval("document.getElementById('compare').click()")
+        page.wait("['done', 'error'].includes(document.getElementById('compare').dataset.state)",
+                  timeout=min(60, left()), what="the compare answer")
+        data = json.loads(page.eval("document.getElementById('chart_data').textContent"))
+        status_text = page.eval("document.getElementById('compare_status').textContent")
+        rates = len(options["msaa"]["enum"])
+        methods = len({page.eval("document.getElementById('method_a').value"),
+                       page.eval("document.getElementById('method_b').value")})
+        t.check(data is not None, "compare filled the chart data", status_text)
+        if data:
+            t.check(data["size"] == COMPARE_SIZE and data["request"]["size"] == COMPARE_SIZE, "compare ran at the size shown",
+                    data["size"])
+            t.check(len(data["pareto"]) == methods * rates, "speed/error chart has a point per method x MSAA",
+                    "%d points" % len(data["pareto"]))
+            t.check(all(c["points"] == 41 for c in data["curves"] + data["seam_curves"])
+                    and len(data["curves"]) == methods * rates, "Figure 5 curves of 41 points", str(data["curves"]))
+            t.check(page.eval("document.getElementById('pareto').dataset.points") == str(methods * rates),
+                    "the speed/error canvas drew every point")
+        shot(page, "5-compare.png")
+        scene2 = next((s["name"] for s in scenes if s["name"] != options["scene"]["default"]), None)
+        if scene2:
+            set_control(page, "scene", scene2)
+            t.check(page.eval("document.getElementById('chart_data').textContent") == "null"
+                    and page.eval("document.getElementById('charts').hidden"), "a scene change clears compare results")
+            wait_idle(page, min(20, left()), 'a render')
+
+        step(10)
+        # 10. Over the compare limit: refused on the page, naming the limit, nothing compared.
+        limit = limits.get("max_compare_pixels")
+        if limit:
+            side = math.isqrt(limit) + 1
+            set_control(page, "size", "%dx%d" % (side, side))
+            wait_idle(page, min(30, left()), "the render over the compare limit")
+            page.eval("document.getElementById('compare').click()")
+            state = page.eval("document.getElementById('compare').dataset.state")
+            text = page.eval("document.getElementById('compare_status').textContent")
+            t.check(state == "refused" and str(limit) in text and "%dx%d" % (side, side) in text,
+                    "a compare over the limit is refused on the page", "%s: %s" % (state, text))
+            t.check(page.eval("document.getElementById('chart_data').textContent") == "null", "nothing was compared")
+            shot(page, "6-over-limit.png")
+        t.check(not page.errors(), "no script errors in the page", str(page.errors()))
+
+        step(11)
+        # 11. Through the proxy: an answer for the old method A that arrives after the new one's
+        # must not be shown; and the heat map against the reference (a stand-in if seamcl has none).
+        proxy = Proxy(base)
+        try:
+            proxy.fake_reference = ref_status == 404
+            page3 = browser.open(proxy.base + "/#size=%s&scale=4&a=%s&b=%s&view=heat&heat=a_ref" % (SIZE, a0, b0))
+            wait_idle(page3, min(40, left()), "the page through the proxy")
+            page3.wait("document.getElementById('heat').dataset.pair === 'a_ref'", timeout=min(40, left()),
+                       what="the heat map against the reference")
+            label = page3.eval("document.getElementById('label_heat').textContent")
+            src = image_info(page3, "image_a")["src"]
+            pa, _, _ = decode_png_rgb(get(base + src)[1])
+            body = {"scene": options["scene"]["default"], "size": SIZE, "aniso": options["aniso"]["default"],
+                    "filter": options["filter"]["default"], "texels": options["texels"]["default"]}
+            pr, _, _ = decode_png_rgb(get(proxy.base + "/v1/reference", body)[1])
+            expected = mean_distance(pa, pr)
+            got = float(page3.eval("document.getElementById('heat').dataset.mean"))
+            t.check(abs(got - expected) <= 1e-6 + 1e-4 * expected and "reference: traverse" in label,
+                    "the heat map against the reference", "page %.6g, python %.6g; %s" % (got, expected, label))
+            shot(page3, "7-heat-reference.png")
+            proxy.slow_method = a1
+            set_control(page3, "method_a", a1)
+            time.sleep(0.5)  # the render for a1 is on its way (slow)
+            set_control(page3, "method_a", a2)
+            wait_idle(page3, min(20, left()), "the render of the second A")
+            time.sleep(2.2)  # the slow answer for a1 has come (or was aborted) by now
+            src = image_info(page3, "image_a")["src"]
+            t.check(method_of(src) == a2, "a late answer for the previous A is not shown", src)
+            t.check(not page3.errors(), "no script errors through the proxy", str(page3.errors()))
+        finally:
+            proxy.shutdown()
+            proxy.server_close()
+    finally:
+        browser.close()
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seamcl", required=True)
     parser.add_argument("--chromium", default=shutil.which("chromium") or "chromium")
+    parser.add_argument("--screenshots", help="write screenshots of the page here")
     args = parser.parse_args()
+    if args.screenshots:
+        os.makedirs(args.screenshots, exist_ok=True)
 
+    start = time.monotonic()
+    deadline = start + BUDGET_S
     port = free_port()
+    base = "http://127.0.0.1:%d" % port
+    cache = tempfile.mkdtemp(prefix="seamcl-viewer-cache-")
     server = subprocess.Popen([args.seamcl, "serve", "--port", str(port), "--quick-start", "--threads", "1"],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                              env=dict(os.environ, SEAMCL_CACHE_DIR=cache))
     profile = tempfile.mkdtemp(prefix="seamcl-chromium-")
+    t = Checks()
     try:
-        wait_ready(port, server, time.monotonic() + 120)
-        with urllib.request.urlopen("http://127.0.0.1:%d/v1/methods" % port, timeout=10) as r:
-            expected_size = json.load(r)["options"]["size"]["default"]
-        # Flags from shared/notes/libraries.md: no sandbox (root), no GPU, and nothing that
-        # reaches the network; a fresh profile.
-        dom = subprocess.run(
-            [args.chromium, "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-             "--disable-component-update", "--no-first-run", "--user-data-dir=" + profile,
-             "--virtual-time-budget=30000", "--dump-dom", "http://127.0.0.1:%d/" % port],
-            capture_output=True, text=True, timeout=120).stdout
-        image = re.search(r'<img id="image"[^>]*>', dom)
-        status = re.search(r'<div id="status"[^>]*>(.*?)</div>', dom, re.S)
-        failures = []
-        if not image:
-            failures.append("no <img id=image> in the page")
-        else:
-            size = re.search(r'data-size="(\d+x\d+)"', image.group(0))
-            kind = re.search(r'data-type="([^"]*)"', image.group(0))
-            if not size or size.group(1) != expected_size:
-                failures.append("image decoded as %s, expected %s" % (size.group(1) if size else "nothing", expected_size))
-            if not kind or kind.group(1) != "image/png":
-                failures.append("image type %s, expected image/png" % (kind.group(1) if kind else "missing"))
-        if not status or "render" not in status.group(1) or "error" in status.group(0):
-            failures.append("status: %s" % (status.group(0) if status else "missing"))
-        for f in failures:
-            print("FAIL:", f)
-        print("%d passed, %d failed" % (0 if failures else 1, 1 if failures else 0))
-        return 1 if failures else 0
+        wait_ready(base, server, start + 40)
+        run(base, args.chromium, profile, args.screenshots, t, deadline)
+    except (CdpError, RuntimeError, OSError, ValueError, KeyError, TypeError) as e:
+        t.failed.append("aborted: %s: %s" % (type(e).__name__, e))
+        print("FAIL: aborted:", type(e).__name__, e, flush=True)
     finally:
         server.terminate()
         try:
@@ -83,6 +519,9 @@ def main():
         except subprocess.TimeoutExpired:
             server.kill()
         shutil.rmtree(profile, ignore_errors=True)
+        shutil.rmtree(cache, ignore_errors=True)
+    print("%d passed, %d failed in %.1f s" % (t.passed, len(t.failed), time.monotonic() - start))
+    return 1 if t.failed else 0
 
 
 if __name__ == "__main__":

@@ -1,0 +1,257 @@
+#!/usr/bin/env python3
+"""Measures how `seamcl serve` holds up: start-up times, 503 latency under overload, /health
+latency behind slow clients, and RSS over a soak of mixed renders and compares. Loopback only;
+each check starts its own server on a free port and stops it.
+
+    examples/service_checks.py --seamcl build/seamcl [--checks start,overload,slowloris,soak]
+        [--soak-minutes 10] [--json]
+
+- start: time until the port answers /health, until the first render of the default scene, and
+  until /health says "ready": once with an empty PoCL kernel cache (cold), once warm.
+- overload: 32 connections send renders back to back to a server with --threads 2 --queue 8;
+  latency of the 503 answers (p50, p99) and of the 200s.
+- slowloris: 2 x (threads + queue + 4) connections trickle header bytes (httplib's old pool had
+  threads + queue + 4 threads); /health latency meanwhile (p50, p99, max).
+- soak: renders (built-in and inline scenes, all methods) and compares from 4 clients for the
+  given minutes; the server's RSS every 5 s (first, max, last).
+"""
+import argparse
+import http.client
+import json
+import os
+import random
+import socket
+import statistics
+import subprocess
+import tempfile
+import threading
+import time
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def percentile(values, p):
+    values = sorted(values)
+    if not values:
+        return float("nan")
+    return values[min(len(values) - 1, max(0, int(round(p / 100.0 * (len(values) - 1)))))]
+
+
+class Server:
+    def __init__(self, seamcl, args, env=None):
+        self.port = free_port()
+        self.started = time.monotonic()
+        self.process = subprocess.Popen([seamcl, "serve", "--port", str(self.port)] + args,
+                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+
+    def request(self, method, path, body=None, timeout=120):
+        conn = http.client.HTTPConnection("127.0.0.1", self.port, timeout=timeout)
+        try:
+            headers = {"Content-Type": "application/json"} if body is not None else {}
+            conn.request(method, path, body=json.dumps(body) if body is not None else None, headers=headers)
+            response = conn.getresponse()
+            return response.status, response.read()
+        finally:
+            conn.close()
+
+    def wait(self, predicate, limit=600):
+        deadline = time.monotonic() + limit
+        while time.monotonic() < deadline:
+            if self.process.poll() is not None:
+                raise RuntimeError("seamcl serve exited with %s" % self.process.returncode)
+            try:
+                if predicate():
+                    return time.monotonic() - self.started
+            except OSError:
+                pass
+            time.sleep(0.02)
+        raise RuntimeError("timed out")
+
+    def health(self):
+        status, body = self.request("GET", "/health", timeout=5)
+        return json.loads(body) if status == 200 else {}
+
+    def rss_mib(self):
+        with open("/proc/%d/status" % self.process.pid) as f:
+            for line in f:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1]) / 1024.0
+        return float("nan")
+
+    def stop(self):
+        self.process.terminate()
+        try:
+            self.process.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+
+
+def check_start(seamcl):
+    out = {}
+    cache = tempfile.mkdtemp(prefix="seamcl-pocl-")
+    for label in ("cold", "warm"):
+        env = dict(os.environ, POCL_CACHE_DIR=cache)
+        server = Server(seamcl, ["--threads", "2"], env)
+        try:
+            listening = server.wait(lambda: server.request("GET", "/health", timeout=2)[0] == 200)
+            first_render = server.wait(lambda: server.request("GET", "/v1/render")[0] == 200)
+            ready = server.wait(lambda: server.health().get("status") == "ready")
+            warm_all = server.wait(lambda: server.health()["warming"]["variants_ready"] >= server.health()["warming"]["variants"])
+            out[label] = {"listening_s": round(listening, 3), "first_default_render_s": round(first_render, 3),
+                          "ready_s": round(ready, 3), "all_variants_s": round(warm_all, 3)}
+        finally:
+            server.stop()
+    return out
+
+
+def check_overload(seamcl, clients=32, seconds=20):
+    server = Server(seamcl, ["--threads", "2", "--queue", "8", "--quick-start"])
+    try:
+        server.wait(lambda: server.health().get("status") == "ready")
+        results = {"503": [], "200": [], "other": []}
+        lock = threading.Lock()
+        stop_at = time.monotonic() + seconds
+
+        def client():
+            while time.monotonic() < stop_at:
+                start = time.monotonic()
+                try:
+                    status, _ = server.request("GET", "/v1/render?scene=paper&msaa=4&size=480x540")
+                except OSError:
+                    status = -1
+                ms = (time.monotonic() - start) * 1000
+                with lock:
+                    results[str(status) if status in (200, 503) else "other"].append(ms)
+                if status == 503:
+                    time.sleep(0.005)
+
+        threads = [threading.Thread(target=client) for _ in range(clients)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        return {"clients": clients, "seconds": seconds,
+                **{k: {"count": len(v), "p50_ms": round(percentile(v, 50), 2), "p99_ms": round(percentile(v, 99), 2)}
+                   for k, v in results.items()}}
+    finally:
+        server.stop()
+
+
+def check_slowloris(seamcl, threads=2, queue=8, probes=40):
+    server = Server(seamcl, ["--threads", str(threads), "--queue", str(queue), "--quick-start", "--read-timeout", "60"])
+    slow = []
+    try:
+        server.wait(lambda: server.health().get("status") == "ready")
+        count = 2 * (threads + queue + 4)
+        for _ in range(count):
+            s = socket.create_connection(("127.0.0.1", server.port))
+            s.sendall(b"GET /health HTTP/1.1\r\nHost: x\r\n")
+            slow.append(s)
+        latencies = []
+        for i in range(probes):
+            for s in slow:
+                try:
+                    s.sendall(b"X")
+                except OSError:
+                    pass
+            start = time.monotonic()
+            status, _ = server.request("GET", "/health", timeout=30)
+            latencies.append((time.monotonic() - start) * 1000)
+            assert status == 200, status
+            time.sleep(0.25)
+        return {"slow_connections": count, "probes": probes, "health_p50_ms": round(percentile(latencies, 50), 2),
+                "health_p99_ms": round(percentile(latencies, 99), 2), "health_max_ms": round(max(latencies), 2)}
+    finally:
+        for s in slow:
+            s.close()
+        server.stop()
+
+
+def check_soak(seamcl, minutes):
+    server = Server(seamcl, ["--threads", "2", "--queue", "8", "--quick-start"])
+    try:
+        server.wait(lambda: server.health().get("status") == "ready")
+        stop_at = time.monotonic() + 60 * minutes
+        counts = {}
+        lock = threading.Lock()
+        methods = json.loads(server.request("GET", "/v1/methods")[1])
+        method_names = [m["name"] for m in methods["methods"]]
+
+        def inline_scene(rng):
+            faces = []
+            for i in range(rng.randint(1, 8)):
+                faces.append({"vertices": [4 * i, 4 * i + 1, 4 * i + 2, 4 * i + 3],
+                              "texture": {"width": 2 ** rng.randint(0, 7), "height": 2 ** rng.randint(0, 7),
+                                          "content": "surface"}})
+            positions = []
+            for i in range(len(faces)):
+                x = float(i)
+                positions += [[x, 0, 0], [x + 1, 0, 0], [x + 1, 1, 0], [x, 1, 0]]
+            return {"name": "soak", "positions": positions, "faces": faces,
+                    "camera": {"eye": [len(faces) / 2, 0.5, 3], "target": [len(faces) / 2, 0.5, 0]}}
+
+        def client(seed):
+            rng = random.Random(seed)
+            while time.monotonic() < stop_at:
+                kind = rng.choice(["render", "render", "render", "inline", "compare"])
+                try:
+                    if kind == "render":
+                        q = "scene=%s&method=%s&msaa=%d&size=%dx%d" % (
+                            rng.choice(["paper", "quad2", "cube", "plane"]), rng.choice(method_names),
+                            rng.choice([1, 4, 8]), rng.randint(16, 512), rng.randint(16, 512))
+                        status, _ = server.request("GET", "/v1/render?" + q)
+                    elif kind == "inline":
+                        status, _ = server.request("POST", "/v1/render", {"scene": inline_scene(rng), "size": "128x128",
+                                                                          "method": rng.choice(method_names)})
+                    else:
+                        status, _ = server.request("POST", "/v1/compare", {
+                            "scene": rng.choice(["paper", "quad2"]), "size": "%dx%d" % (rng.randint(16, 96), rng.randint(16, 96)),
+                            "methods": "discard,clamp", "msaa": [1, 4], "repeat": 1, "frame": rng.randint(0, 59), "frames": 60})
+                except OSError:
+                    status = -1
+                with lock:
+                    key = "%s %s" % (kind, status)
+                    counts[key] = counts.get(key, 0) + 1
+
+        threads = [threading.Thread(target=client, args=(i,)) for i in range(4)]
+        for t in threads:
+            t.start()
+        rss = []
+        while any(t.is_alive() for t in threads):
+            rss.append(round(server.rss_mib(), 1))
+            time.sleep(5)
+        for t in threads:
+            t.join()
+        rss.append(round(server.rss_mib(), 1))
+        return {"minutes": minutes, "requests": counts, "rss_mib": {"first": rss[0], "max": max(rss), "last": rss[-1],
+                                                                     "samples": rss}}
+    finally:
+        server.stop()
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--seamcl", default="build/seamcl")
+    parser.add_argument("--checks", default="start,overload,slowloris")
+    parser.add_argument("--soak-minutes", type=float, default=10.0)
+    parser.add_argument("--json", action="store_true")
+    args = parser.parse_args()
+    checks = {"start": lambda: check_start(args.seamcl), "overload": lambda: check_overload(args.seamcl),
+              "slowloris": lambda: check_slowloris(args.seamcl), "soak": lambda: check_soak(args.seamcl, args.soak_minutes)}
+    out = {}
+    for name in args.checks.split(","):
+        if name not in checks:
+            parser.error("unknown check %r (start, overload, slowloris, soak)" % name)
+        out[name] = checks[name]()
+        if not args.json:
+            print(name, json.dumps(out[name]), flush=True)
+    if args.json:
+        print(json.dumps(out, indent=1))
+
+
+if __name__ == "__main__":
+    main()

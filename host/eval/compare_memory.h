@@ -1,0 +1,45 @@
+// The memory of a compare (compare_methods with its seam mask and 8x reference, as `seamcl
+// compare` and POST /v1/compare run it on one Renderer), computed from the inputs alone, before
+// any texture or buffer exists. The parts are render_memory()s (host/pipeline/render_memory.h);
+// the totals are over the phases of the run:
+//   1. load_scene, the 1-sample face-map frame (seam mask), the 8x reference render and its
+//      Mitchell downsample; reference_image(Renderer&, ...) then releases the frame buffers;
+//   2. per entry: load_scene in the entry's format, a 16x16 warm-up, `repeat` renders; each
+//      entry's image and error distances are kept until the end.
+#pragma once
+#include <cstddef>
+#include <vector>
+
+#include <seamcl/eval/comparison.h>
+#include <seamcl/eval/reference.h>
+#include <seamcl/pipeline/render_memory.h>
+
+namespace seamcl {
+
+struct CompareMemory {
+  RenderMemory face_map;              // the seam mask's frame: msaa 1, pixel shading
+  RenderMemory reference;             // the 8x render (reference_render_options)
+  std::vector<RenderMemory> entries;  // one per method x rate
+
+  // Upper bound of the device bytes the compare's Renderer holds at any moment: the larger
+  // phase, each counted as its largest scene packing plus each frame buffer at its largest size
+  // within the phase (a Renderer's frame buffers only grow until released), tile lists at their
+  // initial size (see render_memory.h on their growth). It equals the Renderer's real peak when,
+  // within the larger phase, one render has both the largest packing and the largest buffers
+  // (phase 1 whenever the frame's method packs like the reference's, e.g. not guardband).
+  size_t device_bytes = 0;
+  // The same with the tile lists at their bound.
+  size_t device_bytes_bound = 0;
+  // Estimate of the largest host payload: the Renderer's Scene copy and packed arrays, the
+  // face map and seam mask, the 8x read-back with the downsample's two frame-sized buffers
+  // (phase 1), or the reference, every entry's image and distances and one read-back (phase 2).
+  // Heap overhead, OpenImageIO's own working memory and the caller's Scene are not counted.
+  size_t host_bytes = 0;
+};
+
+// Assumes the reference is rendered (a cache hit needs less). Throws what
+// reference_render_options throws (InputError "size", "reference_method", "reference_msaa").
+CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame, const std::vector<MethodEntry>& entries,
+                             const ReferenceSettings& settings);
+
+}  // namespace seamcl

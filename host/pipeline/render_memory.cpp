@@ -1,0 +1,136 @@
+#include <seamcl/pipeline/render_memory.h>
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+
+#include <seamcl/pipeline/gpu_types.h>
+#include <seamcl/pipeline/packed_scene.h>
+
+namespace seamcl {
+namespace {
+
+size_t add(size_t a, size_t b) { return saturating_add(a, b); }
+size_t mul(size_t a, size_t b) { return saturating_mul(a, b); }
+
+// The level sizes of a full chain (MipChain): halve each side, a side stops at 1, down to 1x1.
+template <typename Visit>
+void for_each_level(int width, int height, Visit visit) {
+  size_t w = static_cast<size_t>(std::max(width, 1)), h = static_cast<size_t>(std::max(height, 1));
+  for (;;) {
+    visit(w, h);
+    if (w == 1 && h == 1) return;
+    w = std::max<size_t>(w / 2, 1);
+    h = std::max<size_t>(h / 2, 1);
+  }
+}
+
+// A device buffer of `count` elements: OpenCL refuses zero bytes, so Renderer allocates one.
+size_t device_array(size_t count, size_t element_bytes) { return mul(std::max<size_t>(count, 1), element_bytes); }
+
+}  // namespace
+
+size_t saturating_add(size_t a, size_t b) {
+  constexpr size_t kMax = std::numeric_limits<size_t>::max();
+  return a > kMax - b ? kMax : a + b;
+}
+
+size_t saturating_mul(size_t a, size_t b) {
+  constexpr size_t kMax = std::numeric_limits<size_t>::max();
+  return (a != 0 && b > kMax / a) ? kMax : a * b;
+}
+
+size_t RenderMemory::scene_device_bytes() const {
+  return add(add(add(positions, faces), add(neighbors, level_offsets)), texels);
+}
+size_t RenderMemory::frame_device_bytes() const { return add(add(add(setups, tiles), add(tile_lists, samples)), image); }
+size_t RenderMemory::device_bytes() const { return add(add(scene_device_bytes(), constants), frame_device_bytes()); }
+size_t RenderMemory::device_bytes_bound() const {
+  return add(add(scene_device_bytes(), constants), add(add(add(setups, tiles), add(tile_lists_bound, samples)), image));
+}
+size_t RenderMemory::host_bytes() const { return add(add(host_scene, host_packed), host_image); }
+
+SceneSizes scene_sizes(const Scene& scene) {
+  SceneSizes sizes;
+  sizes.vertices = scene.positions.size();
+  sizes.faces.reserve(scene.faces.size());
+  for (const Face& face : scene.faces) sizes.faces.emplace_back(face.texture.width(), face.texture.height());
+  return sizes;
+}
+
+uint32_t initial_tile_list_entries(size_t triangles) {
+  // As Renderer::load_scene: a few entries per triangle slot plus a floor, at most 2^30.
+  return static_cast<uint32_t>(std::min<size_t>(add(mul(triangles, 8), 65536), size_t{1} << 30));
+}
+
+PackedTextureMemory packed_texture_memory(const SceneSizes& scene, TexelFormat format, int guard_band) {
+  if (guard_band < 0 || guard_band > kMaxGuardBand) throw std::invalid_argument("guard band out of range");
+  PackedTextureMemory m;
+  const size_t band = static_cast<size_t>(guard_band);
+  for (const auto& [width, height] : scene.faces) {
+    for_each_level(width, height, [&](size_t w, size_t h) {
+      const size_t own = mul(w, h);
+      const size_t stored = mul(add(w, 2 * band), add(h, 2 * band));
+      m.levels = add(m.levels, 1);
+      m.texels = add(m.texels, stored);
+      m.band_texels = add(m.band_texels, stored - own);
+    });
+  }
+  const size_t texel_bytes = format == TexelFormat::Rgba8 ? sizeof(uint32_t) : 4 * sizeof(float);
+  m.texture_bytes = mul(m.texels, texel_bytes);
+  m.padding_bytes = mul(m.band_texels, texel_bytes);
+  m.adjacency_bytes = mul(scene.faces.size(), sizeof(FaceNeighbors));
+  return m;
+}
+
+size_t scene_host_bytes(const SceneSizes& scene) {
+  size_t bytes = add(mul(scene.vertices, sizeof(glm::vec3)), mul(scene.faces.size(), sizeof(Face)));
+  for (const auto& [width, height] : scene.faces) {
+    for_each_level(width, height, [&](size_t w, size_t h) {
+      bytes = add(bytes, add(sizeof(TextureLevel), mul(mul(w, h), sizeof(glm::vec4))));
+    });
+  }
+  return bytes;
+}
+
+RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options) {
+  RenderMemory m;
+  m.textures = packed_texture_memory(scene, options.texels, sampler_params(options).guard_band);
+
+  const size_t faces = scene.faces.size();
+  m.positions = device_array(scene.vertices, sizeof(cl_float4));
+  m.faces = device_array(faces, sizeof(FaceGpu));
+  m.neighbors = device_array(faces, sizeof(FaceNeighbors));
+  m.level_offsets = device_array(m.textures.levels, sizeof(uint32_t));
+  m.texels = device_array(m.textures.texels, options.texels == TexelFormat::Rgba8 ? sizeof(uint32_t) : 4 * sizeof(float));
+
+  m.constants = 256 * sizeof(float) + sizeof(FrameParams) + sizeof(FrameStats);
+
+  const size_t width = static_cast<size_t>(std::max(options.width, 1));
+  const size_t height = static_cast<size_t>(std::max(options.height, 1));
+  const size_t pixels = mul(width, height);
+  const size_t tile_count = mul((width + SEAMCL_TILE_SIZE - 1) / SEAMCL_TILE_SIZE, (height + SEAMCL_TILE_SIZE - 1) / SEAMCL_TILE_SIZE);
+  const size_t slots = mul(scene.triangle_count(), SEAMCL_CLIP_SLOTS);
+  m.setups = device_array(slots, sizeof(TriangleSetup));
+  m.tiles = mul(3 * sizeof(cl_uint), tile_count);
+  const size_t initial_entries = initial_tile_list_entries(scene.triangle_count());
+  m.tile_lists = mul(initial_entries, sizeof(cl_uint));
+  m.samples = device_array(mul(pixels, static_cast<size_t>(std::max(options.msaa, 1))), sizeof(cl_uint));
+  m.image = device_array(pixels, sizeof(cl_float4));
+  // Render grows the lists to bin_entries * 5/4 + 1024 (at most 2^31), and bin_entries is at most
+  // one per slot per tile.
+  const size_t grown_entries = std::min<size_t>(add(mul(mul(slots, tile_count) / 4 + 1, 5), 1024), size_t{1} << 31);
+  m.tile_lists_bound = mul(std::max(initial_entries, grown_entries), sizeof(cl_uint));
+
+  m.host_scene = scene_host_bytes(scene);
+  m.host_packed = add(add(mul(scene.vertices, sizeof(cl_float4)), mul(faces, sizeof(FaceGpu) + sizeof(FaceNeighbors))),
+                      add(mul(m.textures.levels, sizeof(uint32_t)), m.textures.texture_bytes));
+  m.host_image = mul(pixels, sizeof(glm::vec4));
+  return m;
+}
+
+RenderMemory render_memory(const Scene& scene, const RenderOptions& options) {
+  return render_memory(scene_sizes(scene), options);
+}
+
+}  // namespace seamcl

@@ -1,0 +1,110 @@
+// The memory a render needs, computed from the inputs alone (no texture is built, no buffer is
+// allocated), so that a service can refuse a request before any allocation. Every figure is the
+// size of something the library really allocates; tests/test_budget.cpp holds them to
+// PackedScene's byte counts and to Renderer::device_bytes() for many scenes, formats and bands.
+//
+// How exact:
+// - Device bytes are exact (byte for byte what Renderer allocates: the same element counts, the
+//   same one-element minimum OpenCL needs for empty arrays) for a Renderer that has loaded this
+//   scene and rendered this request first, or right after release_frame_buffers(), with one
+//   exception: the tile lists start at initial_tile_list_entries(triangles) entries and grow (to
+//   5/4 of what the frame needed, and the frame is rendered again) when the scene's triangles
+//   touch more tiles than that. `tile_lists_bound` is the upper bound after any growth: every
+//   clip slot of every triangle on every tile; Renderer::set_device_byte_limit refuses growth past
+//   a limit (OverBudget) instead. A Renderer that keeps its buffers between
+//   requests holds, per buffer, the largest size any of them needed.
+// - Host bytes are the payload of the arrays the Renderer holds (its Scene copy, the packed
+//   arrays, the read-back image): exact in element bytes; vector headers, capacity beyond size
+//   and heap overhead are not counted. The caller's own Scene is not counted either
+//   (scene_host_bytes() says what one costs).
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/scene/scene.h>
+
+namespace seamcl {
+
+// What memory depends on in a scene, known before its textures exist (e.g. from a scene JSON):
+// the vertex count and each face's level-0 texture size. Every face has the full chain down to
+// 1x1 (MipChain). Sides are expected to be powers of two (validate_scene refuses others); any
+// positive size is accepted here, sides below 1 count as 1, and sums saturate at SIZE_MAX rather
+// than wrap, so absurd sizes give an absurd (refusable) estimate, never a small one.
+struct SceneSizes {
+  size_t vertices = 0;
+  std::vector<std::pair<int, int>> faces;  // level-0 texture width x height, per face
+
+  size_t triangle_count() const { return faces.size() * 2; }
+};
+
+SceneSizes scene_sizes(const Scene& scene);
+
+// Tile-list entries a Renderer allocates for a scene of `triangles` before it learns better.
+uint32_t initial_tile_list_entries(size_t triangles);
+
+// Packed textures in a format with a guard band (0: none): what pack_scene makes.
+struct PackedTextureMemory {
+  size_t levels = 0;           // mip levels of all faces (level_offsets entries)
+  size_t texels = 0;           // stored texels, bands included
+  size_t band_texels = 0;      // of those, the ones in guard bands
+  size_t texture_bytes = 0;    // == PackedScene::texture_bytes()
+  size_t padding_bytes = 0;    // == PackedScene::padding_bytes() (part of texture_bytes)
+  size_t adjacency_bytes = 0;  // == PackedScene::adjacency_bytes(); packed and uploaded for every method
+};
+
+// Exact. Throws std::invalid_argument for a band outside 0..kMaxGuardBand, as pack_scene does.
+PackedTextureMemory packed_texture_memory(const SceneSizes& scene, TexelFormat format, int guard_band);
+
+// One render's memory, itemised. Device buffers in the order Renderer holds them.
+struct RenderMemory {
+  PackedTextureMemory textures;  // in the request's texel format and guard band (0 unless guardband)
+
+  // Device: the scene, as uploaded (each buffer at least one element).
+  size_t positions = 0;      // float4 per vertex
+  size_t faces = 0;          // FaceGpu per face
+  size_t neighbors = 0;      // FaceNeighbors per face (adjacency_bytes)
+  size_t level_offsets = 0;  // uint per level
+  size_t texels = 0;         // texture_bytes
+  // Device: per Renderer, whatever the request.
+  size_t constants = 0;      // sRGB table, FrameParams, FrameStats
+  // Device: sized by the request (what release_frame_buffers frees).
+  size_t setups = 0;         // TriangleSetup per clip slot (triangles x SEAMCL_CLIP_SLOTS)
+  size_t tiles = 0;          // tile counts, offsets and cursors: 3 uint per 16x16 tile
+  size_t tile_lists = 0;     // uint per entry, initial_tile_list_entries
+  size_t samples = 0;        // the winning triangle per sample: uint x width x height x msaa
+  size_t image = 0;          // float4 per pixel
+  size_t tile_lists_bound = 0;  // upper bound of tile_lists after growth (see above)
+
+  // Host.
+  size_t host_scene = 0;   // the Renderer's Scene copy: positions, faces, float RGBA texels of every level
+  size_t host_packed = 0;  // PackedScene's arrays (the device scene buffers without their minimum)
+  size_t host_image = 0;   // RenderResult::pixels, float4 per pixel
+
+  // The sums saturate at SIZE_MAX like every figure here.
+  size_t scene_device_bytes() const;  // positions + faces + neighbors + level_offsets + texels
+  size_t frame_device_bytes() const;  // setups + tiles + tile_lists + samples + image
+  // Exact as described above (tile lists at their initial size).
+  size_t device_bytes() const;        // scene + constants + frame
+  // The same with the tile lists at their bound: no render of this request can need more.
+  size_t device_bytes_bound() const;
+  size_t host_bytes() const;          // host_scene + host_packed + host_image
+};
+
+// The request's own options decide everything: size, msaa, texels, and the guard band when the
+// method is guardband (sampler_params). The scene must be non-empty in the sense of validate_scene
+// only for the render itself; the estimate takes any sizes.
+RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options);
+RenderMemory render_memory(const Scene& scene, const RenderOptions& options);
+
+// a + b and a * b, at most SIZE_MAX: budgets must never wrap to a small number.
+size_t saturating_add(size_t a, size_t b);
+size_t saturating_mul(size_t a, size_t b);
+
+// What one Scene holds in memory (positions, faces, every level's float RGBA texels): the
+// Renderer's copy, or the caller's.
+size_t scene_host_bytes(const SceneSizes& scene);
+
+}  // namespace seamcl
