@@ -5,6 +5,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdint>
 #include <ctime>
 #include <thread>
 
@@ -28,6 +29,9 @@ struct ServeArgs {
   int max_connections = 256;
   double read_timeout_s = 10;
   double deadline_s = 60;
+  std::string cache_dir;
+  long long cache_max_mib = 256;
+  long long request_memory_mib = 1024;
 };
 
 int run_serve(const ServeArgs& args, const GlobalOptions& global) {
@@ -37,6 +41,10 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   if (args.max_connections < 1 || args.max_connections > 4096) throw InputError("max-connections", "must be in 1..4096");
   if (!(args.read_timeout_s >= 0.1 && args.read_timeout_s <= 600)) throw InputError("read-timeout", "must be in 0.1..600 seconds");
   if (!(args.deadline_s >= 0 && args.deadline_s <= 3600)) throw InputError("deadline", "must be in 0..3600 seconds (0: none)");
+  if (args.cache_max_mib < 0) throw InputError("cache-max-mib", "must be at least 0 (0: no bound)");
+  if (args.request_memory_mib < 1 || args.request_memory_mib > (1LL << 20)) {
+    throw InputError("request-memory-mib", "must be in 1..1048576");
+  }
 
   // Block the stop signals in every thread (the pool threads inherit the mask); one thread
   // waits for them and stops the server.
@@ -58,6 +66,10 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   options.max_connections = args.max_connections;
   options.request_read_timeout_ms = static_cast<int>(args.read_timeout_s * 1000);
   options.deadline_ms = static_cast<int>(args.deadline_s * 1000);
+  options.cache_dir = args.cache_dir;
+  options.cache_max_bytes = static_cast<std::uintmax_t>(args.cache_max_mib) << 20;
+  options.max_request_device_bytes = static_cast<size_t>(args.request_memory_mib) << 20;
+  options.max_request_host_bytes = static_cast<size_t>(args.request_memory_mib) << 20;
   server::HttpServer http(runtime, options);
   if (http.bind() < 0) {
     std::fprintf(stderr, "seamcl: cannot listen on %s:%d: the port is in use or the address is not this machine's\n",
@@ -102,6 +114,11 @@ Command add_serve_command(CLI::App& app) {
   serve->add_option("--max-connections", args->max_connections, "Connections served at once; more get 503 and are closed [256]");
   serve->add_option("--read-timeout", args->read_timeout_s,
                     "Seconds a request's line, headers and body may take to arrive, however they trickle [10]");
+  serve->add_option("--cache-dir", args->cache_dir,
+                    "Reference cache of POST /v1/compare [$SEAMCL_CACHE_DIR, else <temp>/seamcl-serve-cache]");
+  serve->add_option("--cache-max-mib", args->cache_max_mib, "Reference cache bound, least recently used go first; 0: none [256]");
+  serve->add_option("--request-memory-mib", args->request_memory_mib,
+                    "Device and host memory one request may need, estimated before anything is allocated; more: 413 [1024]");
   serve->add_option("--deadline", args->deadline_s,
                     "Seconds a request may wait for a render slot before it is answered 503; 0: no limit [60]");
   return Command{serve, [args](const GlobalOptions& global) { return run_serve(*args, global); }};

@@ -20,12 +20,16 @@
 
 #include <httplib.h>
 
+#include <seamcl/core/cancelled.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/over_budget.h>
+#include <seamcl/eval/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/packed_scene.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
@@ -277,6 +281,30 @@ std::string server_cache_dir(const std::string& configured) {
   return (std::filesystem::temp_directory_path() / "seamcl-serve-cache").string();
 }
 
+// What an inline scene's memory depends on, read from its JSON before anything is built: the
+// vertex count and each face's texture size (a missing or malformed size counts as 1; the
+// parser refuses it later, naming the field).
+SceneSizes inline_scene_sizes(const json& scene) {
+  SceneSizes sizes;
+  if (scene.contains("positions") && scene.at("positions").is_array()) sizes.vertices = scene.at("positions").size();
+  if (!scene.contains("faces") || !scene.at("faces").is_array()) return sizes;
+  for (const json& face : scene.at("faces")) {
+    const json* texture = face.is_object() && face.contains("texture") ? &face.at("texture") : nullptr;
+    auto side = [&](const char* name) {
+      if (!texture || !texture->is_object() || !texture->contains(name) || !texture->at(name).is_number_integer()) return 1;
+      return static_cast<int>(std::clamp<long long>(texture->at(name).get<long long>(), 1, 1 << 20));
+    };
+    sizes.faces.emplace_back(side("width"), side("height"));
+  }
+  return sizes;
+}
+
+std::string mebibytes(size_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1 << 20));
+  return text;
+}
+
 }  // namespace
 
 // A refusal: status, the field at fault and a message, answered as {"error", "field"}.
@@ -326,75 +354,12 @@ HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
   if (options_.deadline_ms < 0) throw InputError("deadline", "must be at least 0 (0: none)");
   options_.cache_dir = server_cache_dir(options_.cache_dir);
 
-  // 1. The built-in scenes, plain and tinted.
-  for (const GeneratorInfo& g : scene_generators()) {
-    for (bool tint : {false, true}) {
-      GeneratorOptions generator_options;
-      generator_options.tint = tint;
-      scenes_[scene_key(g.name, tint)] = std::make_shared<const Scene>(generate_scene(g.name, generator_options));
-    }
-  }
-
-  // 2. One slot per thread. Their Renderers are made and warmed after bind() (warm_up()); a slot
-  // becomes free once warm, so early renders wait for it rather than build kernels themselves.
-  const RenderOptions defaults;
+  // The built-in scenes are generated on first use (builtin_scene), the default one by the
+  // warm-up, so the port is bound without waiting for them. One slot per thread: their Renderers
+  // are made and warmed after bind() (warm_up()); a slot becomes free once warm, so early
+  // renders wait for it rather than build kernels themselves.
   for (int i = 0; i < options_.threads; ++i) slots_.push_back(std::make_unique<Slot>());
   total_variants_ = options_.warm_all_methods ? static_cast<int>(method_names().size() * filter_names().size()) : 1;
-
-  // 3. The /v1/methods answer: texture memory of each method on the default scene, as packed for
-  // the device (rgba8; rgba32f stores the same texels at 16 bytes each).
-  const json default_json = to_json(defaults);
-  const Scene& default_scene = *scenes_.at(scene_key(defaults.scene, false));
-  json methods = json::array();
-  for (const std::string& name : method_names()) {
-    const Method method = *parse_method(name);
-    const PackedScene packed = pack_scene(default_scene, TexelFormat::Rgba8, method == Method::Guardband ? defaults.guard_band : 0);
-    const size_t float_texel_bytes = 4 * sizeof(float);
-    methods.push_back({{"name", name},
-                       {"description", method_description(name)},
-                       {"texture_bytes", {{"rgba8", packed.texture_bytes()}, {"rgba32f", packed.texel_count() * float_texel_bytes}}},
-                       {"padding_bytes", {{"rgba8", packed.padding_bytes()}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
-                       {"adjacency_bytes", method == Method::Traverse ? packed.adjacency_bytes() : 0}});
-  }
-  json scene_names = json::array();
-  for (const GeneratorInfo& g : scene_generators()) scene_names.push_back(g.name);
-  auto enum_option = [&](const std::vector<std::string>& names, const std::string& key) {
-    return json{{"type", "string"}, {"enum", names}, {"default", default_json.at(key)}};
-  };
-  methods_cache_ = {
-      {"scene", defaults.scene},
-      {"methods", methods},
-      {"options",
-       {{"scene", {{"type", "string"}, {"enum", scene_names}, {"default", defaults.scene},
-                   {"description", "a built-in scene name, or (POST only) an inline scene object as in docs/scene-format.md"}}},
-        {"method", enum_option(method_names(), "method")},
-        {"filter", enum_option(filter_names(), "filter")},
-        {"zero_coverage", enum_option(zero_coverage_names(), "zero_coverage")},
-        {"texels", enum_option(texel_format_names(), "texels")},
-        {"shading", enum_option(shading_mode_names(), "shading")},
-        {"msaa", {{"type", "integer"}, {"enum", {1, 2, 4, 8, 16}}, {"default", defaults.msaa}}},
-        {"aniso", {{"type", "integer"}, {"minimum", 1}, {"maximum", 16}, {"default", defaults.aniso}}},
-        {"guard_band", {{"type", "integer"}, {"minimum", 1}, {"maximum", kMaxGuardBand}, {"default", defaults.guard_band},
-                        {"description", "guardband: band texels per side of every level"}}},
-        {"size", {{"type", "string"}, {"pattern", kSizePattern}, {"minimum", 1}, {"maximum", kMaxImageSide},
-                  {"default", default_json.at("size")},
-                  {"description", "WIDTHxHEIGHT, each side in 1.." + std::to_string(kMaxImageSide) +
-                                      ", width*height*msaa at most " + std::to_string(options_.max_samples)}}},
-        {"frame", {{"type", "integer"}, {"minimum", 0}, {"maximum", 999999},
-                   {"description", "orbit frame, less than frames (default: the scene's camera)"}}},
-        {"frames", {{"type", "integer"}, {"minimum", 1}, {"maximum", 1000000}, {"default", defaults.frames}}},
-        {"centroid", {{"type", "boolean"}, {"default", false}, {"description", "same as shading=centroid"}}},
-        {"tint", {{"type", "boolean"}, {"default", defaults.tint}}},
-        {"format", {{"type", "string"}, {"enum", {"png", "exr"}}, {"default", "png"}}}}},
-      {"limits",
-       {{"max_body_bytes", options_.max_body_bytes},
-        {"max_samples", options_.max_samples},
-        {"max_inline_faces", options_.max_inline_faces},
-        {"max_inline_texels", options_.max_inline_texels},
-        {"max_compare_pixels", options_.max_compare_pixels},
-        {"max_compare_entries", options_.max_compare_entries},
-        {"max_compare_repeat", options_.max_compare_repeat},
-        {"max_reference_samples", options_.max_reference_samples}}}};
 
   install_routes();
 }
@@ -427,7 +392,7 @@ void HttpServer::warm_up() {
       log_line("warming: slot " + std::to_string(i + 1) + "/" + std::to_string(slots_.size()) + ", scene " +
                defaults.scene + ", " + to_string(defaults.method) + " " + to_string(defaults.filter));
       auto renderer = std::make_unique<Renderer>(runtime_);
-      renderer->load_scene(*scenes_.at(default_key), defaults.texels);
+      renderer->load_scene(*builtin_scene(defaults.scene, false), defaults.texels);
       renderer->warm_up(defaults);
       {
         std::lock_guard lock(slots_mutex_);
@@ -445,7 +410,7 @@ void HttpServer::warm_up() {
     // (and PoCL's cache), so the slots find them built; renders go on meanwhile.
     if (options_.warm_all_methods) {
       Renderer renderer(runtime_);
-      renderer.load_scene(*scenes_.at(default_key), defaults.texels);
+      renderer.load_scene(*builtin_scene(defaults.scene, false), defaults.texels);
       for (const std::string& method : method_names()) {
         for (const std::string& filter : filter_names()) {
           if (stopping_.load()) return;
@@ -561,7 +526,7 @@ json HttpServer::scenes_json() const {
   json list = json::array();
   const std::string default_scene = RenderOptions{}.scene;
   for (const GeneratorInfo& g : scene_generators()) {
-    const Scene& scene = *scenes_.at(scene_key(g.name, false));
+    const Scene& scene = *builtin_scene(g.name, false);
     list.push_back({{"name", g.name},
                     {"description", g.description},
                     {"faces", scene.faces.size()},
@@ -573,22 +538,101 @@ json HttpServer::scenes_json() const {
   return {{"scenes", list}};
 }
 
-json HttpServer::methods_json() const { return methods_cache_; }
+json HttpServer::methods_json() const {
+  // Made on first use: it packs the default scene once per method, which the start need not wait for.
+  std::call_once(methods_once_, [this] { methods_cache_ = make_methods_json(); });
+  return methods_cache_;
+}
+
+json HttpServer::make_methods_json() const {
+  const RenderOptions defaults;
+  // The /v1/methods answer: texture memory of each method on the default scene, as packed for
+  // the device (rgba8; rgba32f stores the same texels at 16 bytes each).
+  const json default_json = to_json(defaults);
+  const Scene& default_scene = *builtin_scene(defaults.scene, false);
+  json methods = json::array();
+  for (const std::string& name : method_names()) {
+    const Method method = *parse_method(name);
+    const PackedScene packed = pack_scene(default_scene, TexelFormat::Rgba8, method == Method::Guardband ? defaults.guard_band : 0);
+    const size_t float_texel_bytes = 4 * sizeof(float);
+    methods.push_back({{"name", name},
+                       {"description", method_description(name)},
+                       {"texture_bytes", {{"rgba8", packed.texture_bytes()}, {"rgba32f", packed.texel_count() * float_texel_bytes}}},
+                       {"padding_bytes", {{"rgba8", packed.padding_bytes()}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
+                       {"adjacency_bytes", method == Method::Traverse ? packed.adjacency_bytes() : 0}});
+  }
+  json scene_names = json::array();
+  for (const GeneratorInfo& g : scene_generators()) scene_names.push_back(g.name);
+  auto enum_option = [&](const std::vector<std::string>& names, const std::string& key) {
+    return json{{"type", "string"}, {"enum", names}, {"default", default_json.at(key)}};
+  };
+  return {
+      {"scene", defaults.scene},
+      {"methods", methods},
+      {"options",
+       {{"scene", {{"type", "string"}, {"enum", scene_names}, {"default", defaults.scene},
+                   {"description", "a built-in scene name, or (POST only) an inline scene object as in docs/scene-format.md"}}},
+        {"method", enum_option(method_names(), "method")},
+        {"filter", enum_option(filter_names(), "filter")},
+        {"zero_coverage", enum_option(zero_coverage_names(), "zero_coverage")},
+        {"texels", enum_option(texel_format_names(), "texels")},
+        {"shading", enum_option(shading_mode_names(), "shading")},
+        {"msaa", {{"type", "integer"}, {"enum", {1, 2, 4, 8, 16}}, {"default", defaults.msaa}}},
+        {"aniso", {{"type", "integer"}, {"minimum", 1}, {"maximum", 16}, {"default", defaults.aniso}}},
+        {"guard_band", {{"type", "integer"}, {"minimum", 1}, {"maximum", kMaxGuardBand}, {"default", defaults.guard_band},
+                        {"description", "guardband: band texels per side of every level"}}},
+        {"size", {{"type", "string"}, {"pattern", kSizePattern}, {"minimum", 1}, {"maximum", kMaxImageSide},
+                  {"default", default_json.at("size")},
+                  {"description", "WIDTHxHEIGHT, each side in 1.." + std::to_string(kMaxImageSide) +
+                                      ", width*height*msaa at most " + std::to_string(options_.max_samples)}}},
+        {"frame", {{"type", "integer"}, {"minimum", 0}, {"maximum", 999999},
+                   {"description", "orbit frame, less than frames (default: the scene's camera)"}}},
+        {"frames", {{"type", "integer"}, {"minimum", 1}, {"maximum", 1000000}, {"default", defaults.frames}}},
+        {"centroid", {{"type", "boolean"}, {"default", false}, {"description", "same as shading=centroid"}}},
+        {"tint", {{"type", "boolean"}, {"default", defaults.tint}}},
+        {"format", {{"type", "string"}, {"enum", {"png", "exr"}}, {"default", "png"}}}}},
+      {"limits",
+       {{"max_body_bytes", options_.max_body_bytes},
+        {"max_samples", options_.max_samples},
+        {"max_inline_faces", options_.max_inline_faces},
+        {"max_inline_texels", options_.max_inline_texels},
+        {"max_compare_pixels", options_.max_compare_pixels},
+        {"max_compare_entries", options_.max_compare_entries},
+        {"max_compare_repeat", options_.max_compare_repeat},
+        {"max_reference_samples", options_.max_reference_samples}}}};
+
+}
+
+std::shared_ptr<const Scene> HttpServer::builtin_scene(const std::string& name, bool tint) const {
+  const std::string key = scene_key(name, tint);
+  std::lock_guard lock(scenes_mutex_);
+  if (const auto found = scenes_.find(key); found != scenes_.end()) return found->second;
+  const auto& generators = scene_generators();
+  if (std::none_of(generators.begin(), generators.end(), [&](const GeneratorInfo& g) { return g.name == name; })) return nullptr;
+  GeneratorOptions generator_options;
+  generator_options.tint = tint;
+  auto scene = std::make_shared<const Scene>(generate_scene(name, generator_options));
+  scenes_[key] = scene;
+  return scene;
+}
 
 // The scene: a built-in one (never a file path: clients name no server files) or inline.
 std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene, RenderOptions& options,
-                                                       std::string& key) const {
+                                                       std::string& key,
+                                                       const std::function<void(const SceneSizes&)>& check_budget) const {
   std::shared_ptr<const Scene> scene;
   key.clear();
   if (inline_scene.is_null()) {
-    const auto found = scenes_.find(scene_key(options.scene, options.tint));
-    if (found == scenes_.end() || options.scene.find('+') != std::string::npos) {
+    const std::shared_ptr<const Scene> found =
+        options.scene.find('+') == std::string::npos ? builtin_scene(options.scene, options.tint) : nullptr;
+    if (!found) {
       std::string known;
       for (const GeneratorInfo& g : scene_generators()) known += (known.empty() ? "" : ", ") + g.name;
       throw HttpError{400, "scene", "unknown scene '" + options.scene + "' (built-in: " + known + "; or an inline scene object)"};
     }
-    scene = found->second;
-    key = found->first;
+    scene = found;
+    key = scene_key(options.scene, options.tint);
+    check_budget(scene_sizes(*scene));
   } else {
     // Limits first, from the JSON, before any texture is made.
     if (inline_scene.contains("faces") && inline_scene.at("faces").is_array()) {
@@ -613,6 +657,7 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
         }
       }
     }
+    check_budget(inline_scene_sizes(inline_scene));
     try {
       Scene parsed = parse_scene_json(inline_scene);
       if (options.tint) {
@@ -628,6 +673,20 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
     options.scene = scene->name;
   }
   return scene;
+}
+
+void HttpServer::refuse_over_budget(size_t device_bytes, size_t host_bytes, const std::string& field,
+                                    const std::string& what) const {
+  if (device_bytes > options_.max_request_device_bytes) {
+    throw HttpError{413, field,
+                    what + " needs about " + mebibytes(device_bytes) + " of device memory, over this server's limit of " +
+                        mebibytes(options_.max_request_device_bytes) + " per request"};
+  }
+  if (host_bytes > options_.max_request_host_bytes) {
+    throw HttpError{413, field,
+                    what + " needs about " + mebibytes(host_bytes) + " of host memory, over this server's limit of " +
+                        mebibytes(options_.max_request_host_bytes) + " per request"};
+  }
 }
 
 void HttpServer::handle_render(const json& request, httplib::Response& res) {
@@ -657,7 +716,15 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   }
 
   std::string key;
-  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, options, key);
+  RenderMemory memory;
+  const bool inline_request = !inline_scene.is_null();
+  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, options, key, [&](const SceneSizes& sizes) {
+    memory = render_memory(sizes, options);
+    const bool frame_drives = memory.frame_device_bytes() >= memory.scene_device_bytes();
+    const std::string field = frame_drives ? "size" : inline_request ? "scene" : "texels";
+    refuse_over_budget(memory.device_bytes(), saturating_add(memory.host_bytes(), inline_request ? scene_host_bytes(sizes) : 0),
+                       field, "this render");
+  });
   const Camera camera = options.frame ? orbit_camera(*scene, *options.frame, options.frames) : scene->camera;
 
   // Wait for a render slot (or 503), render, and give the slot back before encoding.
@@ -676,8 +743,16 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
         renderer = std::make_unique<Renderer>(runtime_);
         if (!key.empty()) renderer->load_scene(*scene, options.texels);
       }
+      // Tile lists grow with what a frame holds, past any estimate: bounded here.
+      renderer->set_device_byte_limit(options_.max_request_device_bytes);
       if (key.empty()) renderer->load_scene(*scene, options.texels);
       result = renderer->render(camera, options);
+      // Hold nothing request-sized between requests: the inline scene goes, large frames too.
+      if (key.empty()) {
+        renderer->release_scene();
+      } else if (memory.frame_device_bytes() > options_.keep_frame_bytes) {
+        renderer->release_frame_buffers();
+      }
     } catch (...) {
       renderer.reset();  // a failed Renderer is not reused: the next request gets a fresh one
       throw;
@@ -755,6 +830,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   }
   ReferenceSettings reference_settings;
   reference_settings.cache_dir = options_.cache_dir;
+  reference_settings.cache_max_bytes = options_.cache_max_bytes;
   if (rest.contains("reference_method")) {
     const json& value = rest.at("reference_method");
     if (!value.is_string()) throw InputError("reference_method", "must be a method name, got " + echo(json_text(value)));
@@ -816,8 +892,15 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
                         ", over this server's limit of " + std::to_string(options_.max_reference_samples)};
   }
   std::string key;
-  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key);
+  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key, [&](const SceneSizes& sizes) {
+    const CompareMemory memory = compare_memory(sizes, frame, entries, reference_settings);
+    refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this compare");
+  });
   const Camera camera = frame.frame ? orbit_camera(*scene, *frame.frame, frame.frames) : scene->camera;
+  // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
+  const Clock::time_point deadline =
+      options_.deadline_ms > 0 ? start + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
+  const ShouldStop should_stop = [deadline] { return GuardedHttpServer::client_gone() || Clock::now() > deadline; };
 
   // One admitted request for the whole compare. A Renderer of its own: the 8x reference's
   // buffers are freed with it, and the slot's warm Renderers keep their scenes.
@@ -831,6 +914,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
     queue_ms = ms_since(queued);
     if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
     Renderer renderer(runtime_);
+    renderer.set_device_byte_limit(options_.max_request_device_bytes);
     renderer.load_scene(*scene, frame.texels);
     const std::vector<uint8_t> mask = seam_mask(render_face_map(renderer, camera, frame));
     seam_pixels = static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{1}));
@@ -839,7 +923,13 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
       std::lock_guard lock(reference_locks_[std::hash<std::string>{}(cache_key) % reference_locks_.size()]);
       reference = reference_image(renderer, camera, frame, reference_settings);
     }
-    measured = compare_methods(renderer, *scene, camera, entries, &reference.pixels, &mask, repeat);
+    try {
+      throw_if_stopped(should_stop, "before the entries");
+      measured = compare_methods(renderer, *scene, camera, entries, &reference.pixels, &mask, repeat, should_stop);
+    } catch (const Cancelled&) {
+      if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
+      throw HttpError{503, "deadline", "the compare ran past this server's deadline of " + std::to_string(options_.deadline_ms) + " ms", 1};
+    }
   }
 
   json results = json::array();
@@ -879,6 +969,8 @@ void HttpServer::install_routes() {
       } catch (const HttpError& e) {
         if (e.retry_after_s > 0) res.set_header("Retry-After", std::to_string(e.retry_after_s));
         send_error(res, e.status, e.field, echo(e.field) + ": " + e.message);
+      } catch (const OverBudget& e) {
+        send_error(res, 413, e.field(), echo(e.field()) + ": " + input_error_message(e));
       } catch (const InputError& e) {
         send_error(res, 400, e.field(), echo(e.field()) + ": " + input_error_message(e));
       } catch (const std::exception& e) {

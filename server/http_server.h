@@ -19,6 +19,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -42,6 +43,7 @@ struct Response;
 namespace seamcl {
 class Renderer;
 struct Scene;
+struct SceneSizes;
 }  // namespace seamcl
 
 namespace seamcl::server {
@@ -65,6 +67,15 @@ struct ServerOptions {
   long long max_reference_samples = 2048LL * 2048 * 4;  // 8W * 8H * reference_msaa: 413
   // Reference cache of POST /v1/compare. Empty: $SEAMCL_CACHE_DIR, else <temp>/seamcl-serve-cache.
   std::string cache_dir;
+  std::uintmax_t cache_max_bytes = std::uintmax_t{256} << 20;  // least recently used entries go; 0: no bound
+  // Memory one request may need, estimated before anything is allocated (render_memory.h,
+  // compare_memory.h): textures in the chosen format with guard bands, frame buffers at the
+  // sample count, the 8x reference. Over either: 413 naming the field that drives it.
+  size_t max_request_device_bytes = size_t{1} << 30;
+  size_t max_request_host_bytes = size_t{1} << 30;
+  // A slot's Renderer keeps its frame buffers between requests up to this size; larger ones are
+  // freed after the request, so one big request does not stay held.
+  size_t keep_frame_bytes = size_t{64} << 20;
   bool warm_all_methods = true;    // after start, build every method x filter (rgba8) in the background
   // Connections (server/connection.h): open at once, read deadline of one request, keep-alive wait.
   int max_connections = 256;
@@ -117,9 +128,16 @@ class HttpServer {
   // A built-in scene by options.scene (and tint), or `inline_scene` when it is not null (limits
   // checked, parsed, validated; options.scene becomes its name). `key` is the slot Renderer's key,
   // empty for an inline scene.
+  // `check_budget` sees the scene's sizes before any of its textures is built (an inline scene's
+  // from its JSON) and throws to refuse it.
   std::shared_ptr<const Scene> resolve_scene(const nlohmann::json& inline_scene, RenderOptions& options,
-                                             std::string& key) const;
+                                             std::string& key,
+                                             const std::function<void(const SceneSizes&)>& check_budget) const;
+  void refuse_over_budget(size_t device_bytes, size_t host_bytes, const std::string& field, const std::string& what) const;
   nlohmann::json scenes_json() const;
+  nlohmann::json make_methods_json() const;
+  // A built-in scene ("paper", tinted or not), generated on first use; null for an unknown name.
+  std::shared_ptr<const Scene> builtin_scene(const std::string& name, bool tint) const;
   nlohmann::json methods_json() const;
   nlohmann::json health_json() const;
   std::unique_ptr<SlotLease> acquire_slot(std::chrono::steady_clock::time_point arrived);
@@ -133,9 +151,11 @@ class HttpServer {
   int port_ = -1;
   std::chrono::steady_clock::time_point started_;
 
-  // Built-in scenes, generated once: key "<name>" and "<name>+tint".
-  std::map<std::string, std::shared_ptr<const Scene>> scenes_;
-  nlohmann::json methods_cache_;
+  // Built-in scenes, generated on first use: key "<name>" and "<name>+tint".
+  mutable std::mutex scenes_mutex_;
+  mutable std::map<std::string, std::shared_ptr<const Scene>> scenes_;
+  mutable std::once_flag methods_once_;
+  mutable nlohmann::json methods_cache_;
 
   std::vector<std::unique_ptr<Slot>> slots_;
   std::vector<Slot*> free_slots_;

@@ -103,7 +103,7 @@ struct LiveServer {
 
   explicit LiveServer(server::ServerOptions options, bool wait_until_ready = true) {
     options.host = "127.0.0.1";
-    if (options.port < 0) options.port = 0;
+    options.port = 0;  // an ephemeral port: tests run side by side
     options.warm_all_methods = false;
     options.log = [this](const std::string& line) {
       std::lock_guard lock(log_mutex);
@@ -331,6 +331,64 @@ TEST_F(Connection, RequestWaitingPastTheDeadlineGets503) {
   EXPECT_EQ(res->status, 503) << res->body;
   EXPECT_EQ(json::parse(res->body).at("field"), "deadline") << res->body;
   EXPECT_EQ(res->get_header_value("Retry-After"), "1");
+}
+
+}  // namespace
+
+namespace {
+
+// Memory budgets: a small request that asks for gigabytes (thin faces, wide guard bands, float
+// texels) is refused before anything is built, naming the field that drives it.
+TEST_F(Connection, RequestsOverTheMemoryBudgetAre413) {
+  server::ServerOptions options;
+  options.max_request_device_bytes = size_t{256} << 20;
+  options.max_request_host_bytes = size_t{256} << 20;
+  LiveServer server(options);
+  httplib::Client client("127.0.0.1", server.port());
+  client.set_read_timeout(60, 0);
+  // The issue's case: 1024 faces of 2048x1 texels, guardband 16, rgba32f (3.6 GB before).
+  json faces = json::array();
+  json positions = json::array();
+  for (int i = 0; i < 1024; ++i) {
+    const float x = static_cast<float>(i);
+    positions.push_back({x, 0, 0});
+    positions.push_back({x + 1, 0, 0});
+    positions.push_back({x + 1, 1, 0});
+    positions.push_back({x, 1, 0});
+    faces.push_back({{"vertices", {4 * i, 4 * i + 1, 4 * i + 2, 4 * i + 3}}, {"texture", {{"width", 2048}, {"height", 1}}}});
+  }
+  const json camera = {{"eye", {512, 0.5, 900}}, {"target", {512, 0.5, 0}}};
+  const json body = {{"scene", {{"name", "thin"}, {"positions", positions}, {"faces", faces}, {"camera", camera}}},
+                     {"method", "guardband"}, {"guard_band", 16}, {"texels", "rgba32f"}, {"size", "64x64"}};
+  const Clock::time_point start = Clock::now();
+  const auto res = client.Post("/v1/render", body.dump(), "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 413) << res->body;
+  const json error = json::parse(res->body);
+  EXPECT_EQ(error.at("field"), "scene") << res->body;
+  EXPECT_NE(error.at("error").get<std::string>().find("over this server's limit of 256.0 MiB"), std::string::npos) << res->body;
+  EXPECT_LT(seconds_since(start), 10.0);
+  // The same scene as rgba8 without bands fits.
+  json small = body;
+  small["method"] = "discard";
+  small.erase("guard_band");
+  small["texels"] = "rgba8";
+  const auto fits = client.Post("/v1/render", small.dump(), "application/json");
+  ASSERT_TRUE(fits);
+  EXPECT_EQ(fits->status, 200) << fits->body.substr(0, 300);
+  // A built-in scene whose frame drives the estimate names `size`.
+  server::ServerOptions tight = options;
+  tight.max_request_device_bytes = size_t{8} << 20;
+  LiveServer small_server(tight);
+  httplib::Client small_client("127.0.0.1", small_server.port());
+  const auto big_frame = small_client.Get("/v1/render?scene=quad2&size=1024x1024&msaa=4");
+  ASSERT_TRUE(big_frame);
+  EXPECT_EQ(big_frame->status, 413) << big_frame->body;
+  EXPECT_EQ(json::parse(big_frame->body).at("field"), "size") << big_frame->body;
+  const auto big_compare = small_client.Post("/v1/compare", R"({"scene": "quad2", "size": "256x256", "msaa": [1]})", "application/json");
+  ASSERT_TRUE(big_compare);
+  EXPECT_EQ(big_compare->status, 413) << big_compare->body;
+  EXPECT_EQ(json::parse(big_compare->body).at("field"), "size") << big_compare->body;
 }
 
 }  // namespace
