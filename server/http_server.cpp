@@ -3,7 +3,9 @@
 #include "connection.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
@@ -11,6 +13,7 @@
 #include <functional>
 #include <iterator>
 #include <optional>
+#include <set>
 
 #include <unistd.h>
 #include <utility>
@@ -42,6 +45,163 @@ double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
+// ---- What an error body may echo. A client can send any bytes of any length: invalid UTF-8
+// decoded from %XX in the path or query, a header byte, a 1 MiB name. An error body must be valid
+// UTF-8 (nlohmann's dump throws otherwise, and that throw inside cpp-httplib's error handler was
+// std::terminate) and small, so every echoed value goes through echo().
+constexpr size_t kMaxEchoChars = 100;   // one echoed value, in characters
+constexpr size_t kMaxErrorChars = 300;  // a whole message: fixed text and its echoes
+constexpr std::string_view kReplacementCharacter = "\xEF\xBF\xBD";  // U+FFFD
+constexpr std::string_view kEllipsis = "\xE2\x80\xA6";               // U+2026
+
+// The length of the well-formed UTF-8 sequence at text[at] (Unicode table 3-7: no overlong forms,
+// no surrogates, nothing above U+10FFFF), or 0 when the byte there starts none.
+size_t utf8_sequence_length(std::string_view text, size_t at) {
+  const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[at + k]); };
+  const unsigned char lead = byte(0);
+  if (lead < 0x80) return 1;
+  size_t length = 0;
+  unsigned char second_lo = 0x80, second_hi = 0xBF;
+  if (lead >= 0xC2 && lead <= 0xDF) {
+    length = 2;
+  } else if (lead >= 0xE0 && lead <= 0xEF) {
+    length = 3;
+    if (lead == 0xE0) second_lo = 0xA0;  // overlong
+    if (lead == 0xED) second_hi = 0x9F;  // surrogates
+  } else if (lead >= 0xF0 && lead <= 0xF4) {
+    length = 4;
+    if (lead == 0xF0) second_lo = 0x90;  // overlong
+    if (lead == 0xF4) second_hi = 0x8F;  // above U+10FFFF
+  } else {
+    return 0;  // a continuation byte, C0/C1 (overlong) or F5..FF
+  }
+  if (at + length > text.size()) return 0;
+  for (size_t k = 1; k < length; ++k) {
+    const unsigned char lo = k == 1 ? second_lo : 0x80, hi = k == 1 ? second_hi : 0xBF;
+    if (byte(k) < lo || byte(k) > hi) return 0;
+  }
+  return length;
+}
+
+bool is_valid_utf8(std::string_view text) {
+  for (size_t i = 0; i < text.size();) {
+    const size_t length = utf8_sequence_length(text, i);
+    if (length == 0) return false;
+    i += length;
+  }
+  return true;
+}
+
+// `text` as it may appear in an error body: valid UTF-8 (each byte that starts no well-formed
+// sequence becomes U+FFFD) and at most `max_chars` characters, cut on a character boundary and
+// ending in an ellipsis when cut. Reads at most max_chars + 1 characters of `text`.
+std::string echo(std::string_view text, size_t max_chars = kMaxEchoChars) {
+  std::string out;
+  size_t chars = 0;
+  size_t cut = 0;  // out's size after max_chars - 1 characters: where an ellipsis goes
+  for (size_t i = 0; i < text.size();) {
+    if (chars == max_chars - 1) cut = out.size();
+    if (chars == max_chars) {
+      out.resize(cut);
+      out += kEllipsis;
+      return out;
+    }
+    const size_t length = utf8_sequence_length(text, i);
+    if (length == 0) {
+      out += kReplacementCharacter;
+      i += 1;
+    } else {
+      out.append(text.substr(i, length));
+      i += length;
+    }
+    ++chars;
+  }
+  return out;
+}
+
+// A whole error message, whoever wrote it (the library's parsers quote the values they echo):
+// every quoted run ('...' or "...") is echoed, then the message as a whole.
+std::string bounded_message(std::string_view message) {
+  std::string out;
+  for (size_t i = 0; i < message.size();) {
+    const char c = message[i];
+    const size_t close = c == '\'' || c == '"' ? message.find(c, i + 1) : std::string_view::npos;
+    if (close == std::string_view::npos) {
+      out += c;
+      ++i;
+      continue;
+    }
+    out += c;
+    out += echo(message.substr(i + 1, close - i - 1));
+    out += c;
+    i = close + 1;
+  }
+  return echo(out, kMaxErrorChars);
+}
+
+// Every JSON answer is dumped with this: it cannot throw (invalid UTF-8 that got past echo()
+// becomes U+FFFD rather than an exception inside cpp-httplib).
+std::string json_text(const json& value) { return value.dump(-1, ' ', false, json::error_handler_t::replace); }
+
+// {"error", "field"} with its status. Never throws on the client's bytes: it runs inside
+// cpp-httplib's error and exception handlers, where an exception terminates the process.
+void send_error(httplib::Response& res, int status, std::string_view field, std::string_view message) {
+  res.status = status;
+  res.set_content(json_text(json{{"error", bounded_message(message)}, {"field", echo(field)}}), "application/json");
+}
+
+// An InputError's message without its "<field>: " prefix. what() is a C string, so a NUL byte
+// that a client put in a key or value (JSON's \u0000, the query's %00) cuts it short: then only
+// what is left after the prefix, possibly nothing.
+std::string input_error_message(const InputError& e) {
+  const std::string_view what = e.what();
+  const size_t prefix = e.field().size() + 2;
+  if (what.size() < prefix) return "refused (the message was cut at a NUL byte)";
+  return std::string(what.substr(prefix));
+}
+
+// Whether a request carries a body that cpp-httplib reads only when the request is routed: a
+// refusal before routing leaves it on the connection, where it would be parsed as the next request.
+bool carries_body(const httplib::Request& req) {
+  return req.has_header("Transfer-Encoding") ||
+         (req.has_header("Content-Length") && req.get_header_value("Content-Length") != "0");
+}
+
+// The media type of a Content-Type value: before any parameter, without surrounding spaces, in
+// lower case (RFC 9110 8.3.1: type and subtype are case-insensitive).
+std::string media_type(std::string_view content_type) {
+  std::string_view type = content_type.substr(0, content_type.find(';'));
+  while (!type.empty() && (type.front() == ' ' || type.front() == '\t')) type.remove_prefix(1);
+  while (!type.empty() && (type.back() == ' ' || type.back() == '\t')) type.remove_suffix(1);
+  std::string lower(type);
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return lower;
+}
+
+bool is_json_media_type(std::string_view content_type) { return media_type(content_type) == "application/json"; }
+
+// The sizes parse_size takes, WIDTHxHEIGHT with each side in 1..kMaxImageSide (16384; leading
+// zeros are read too), as a pattern for /v1/methods and the OpenAPI document (tests/test_openapi.cpp
+// holds the document's copy to the parser).
+constexpr const char* kSizePattern =
+    "^0*(?:[1-9][0-9]{0,3}|1[0-5][0-9]{3}|16[0-2][0-9]{2}|163[0-7][0-9]|1638[0-4])"
+    "x0*(?:[1-9][0-9]{0,3}|1[0-5][0-9]{3}|16[0-2][0-9]{2}|163[0-7][0-9]|1638[0-4])$";
+static_assert(kMaxImageSide == 16384, "kSizePattern spells out the largest side");
+
+// POST /v1/compare without a size: the render default (480x540) is over the compare limit, so
+// the largest size of the default's aspect within max_pixels (each side floored, at least 1).
+std::string default_compare_size(long long max_pixels) {
+  const RenderOptions defaults;
+  long long width = defaults.width, height = defaults.height;
+  if (width * height > max_pixels) {
+    const double scale = std::sqrt(static_cast<double>(max_pixels) / static_cast<double>(width * height));
+    width = std::max(1LL, static_cast<long long>(std::floor(static_cast<double>(defaults.width) * scale)));
+    height = std::max(1LL, static_cast<long long>(std::floor(static_cast<double>(defaults.height) * scale)));
+    while (width * height > max_pixels && (width > 1 || height > 1)) (width >= height ? width : height) -= 1;
+  }
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
 std::string scene_key(const std::string& name, bool tint) { return tint ? name + "+tint" : name; }
 
 // The paths the server answers and the methods each allows (others: 405).
@@ -51,6 +211,15 @@ const std::map<std::string, std::vector<std::string>>& known_paths() {
       {"/v1/methods", {"GET"}}, {"/v1/render", {"GET", "POST"}}, {"/v1/compare", {"POST"}}, {"/v1/reference", {"POST"}},
       {"/openapi.json", {"GET"}}};
   return paths;
+}
+
+// 405 for `method` on a known path that does not route it, with the Allow header listing what does.
+void send_method_not_allowed(httplib::Response& res, const std::string& method, const std::string& path,
+                             const std::vector<std::string>& allowed) {
+  std::string allow;
+  for (const std::string& m : allowed) allow += (allow.empty() ? "" : ", ") + m;
+  res.set_header("Allow", allow);
+  send_error(res, 405, "method", echo(method) + " is not allowed on " + echo(path) + " (allowed: " + allow + ")");
 }
 
 std::string method_description(const std::string& name) {
@@ -68,6 +237,9 @@ std::string method_description(const std::string& name) {
 json query_to_json(const httplib::Params& params) {
   json out = json::object();
   for (const auto& [key, value] : params) {
+    // %XX decodes to any byte: refused here, naming the key, before anything echoes it.
+    if (!is_valid_utf8(key)) throw InputError(echo(key), "this query key is not valid UTF-8");
+    if (!is_valid_utf8(value)) throw InputError(key, "not valid UTF-8: '" + echo(value) + "'");
     if (out.contains(key)) throw InputError(key, "given more than once");
     long long number = 0;
     const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), number);
@@ -90,11 +262,11 @@ std::string compare_list_text(const json& value, const std::string& field, bool 
                                   : "a comma list string (\"discard,traverse\") or an array of strings";
   if (value.is_string()) return value.get<std::string>();
   if (integers && value.is_number_integer()) return value.dump();
-  if (!value.is_array() || value.empty()) throw InputError(field, std::string("must be ") + expected + ", got " + value.dump().substr(0, 100));
+  if (!value.is_array() || value.empty()) throw InputError(field, std::string("must be ") + expected + ", got " + echo(json_text(value)));
   std::string text;
   for (const json& item : value) {
     if (integers ? !item.is_number_integer() : !item.is_string()) {
-      throw InputError(field, std::string("must be ") + expected + ", got the item " + item.dump().substr(0, 100));
+      throw InputError(field, std::string("must be ") + expected + ", got the item " + echo(json_text(item)));
     }
     if (!text.empty()) text += ',';
     text += integers ? item.dump() : item.get<std::string>();
@@ -409,7 +581,7 @@ json HttpServer::make_methods_json() const {
         {"aniso", {{"type", "integer"}, {"minimum", 1}, {"maximum", 16}, {"default", defaults.aniso}}},
         {"guard_band", {{"type", "integer"}, {"minimum", 1}, {"maximum", kMaxGuardBand}, {"default", defaults.guard_band},
                         {"description", "guardband: band texels per side of every level"}}},
-        {"size", {{"type", "string"}, {"pattern", "^[0-9]+x[0-9]+$"}, {"minimum", 1}, {"maximum", kMaxImageSide},
+        {"size", {{"type", "string"}, {"pattern", kSizePattern}, {"minimum", 1}, {"maximum", kMaxImageSide},
                   {"default", default_json.at("size")},
                   {"description", "WIDTHxHEIGHT, each side in 1.." + std::to_string(kMaxImageSide) +
                                       ", width*height*msaa at most " + std::to_string(options_.max_samples)}}},
@@ -496,7 +668,7 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
       validate_scene(parsed);
       scene = std::make_shared<const Scene>(std::move(parsed));
     } catch (const InputError& e) {
-      throw InputError("scene." + e.field(), std::string(e.what()).substr(e.field().size() + 2));
+      throw InputError("scene." + e.field(), input_error_message(e));
     }
     options.scene = scene->name;
   }
@@ -527,7 +699,7 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   if (rest.contains("format")) {
     const json& value = rest.at("format");
     const auto parsed = value.is_string() ? parse_image_format(value.get<std::string>()) : std::nullopt;
-    if (!parsed) throw HttpError{400, "format", "must be \"png\" or \"exr\", got " + value.dump()};
+    if (!parsed) throw HttpError{400, "format", "must be \"png\" or \"exr\", got " + echo(json_text(value))};
     format = *parsed;
     rest.erase("format");
   }
@@ -593,19 +765,19 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   const json stage_ms = {{"setup", result.ms.setup},   {"binning", result.ms.binning},   {"raster", result.ms.raster},
                          {"shade", result.ms.shade},   {"readback", result.ms.readback}, {"total", result.ms.total}};
   res.set_header("X-Seamcl-Render-Ms", std::to_string(result.ms.total));
-  res.set_header("X-Seamcl-Stage-Ms", stage_ms.dump());
+  res.set_header("X-Seamcl-Stage-Ms", json_text(stage_ms));
   res.set_header("X-Seamcl-Queue-Ms", std::to_string(queue_ms));
   res.set_header("X-Seamcl-Encode-Ms", std::to_string(encode_ms));
   res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
-  res.set_header("X-Seamcl-Options", to_json(options).dump());
+  res.set_header("X-Seamcl-Options", json_text(to_json(options)));
   res.set_header("X-Seamcl-Fragments", std::to_string(result.stats.fragments));
   res.set_content(std::move(image), format == ImageFormat::Png ? "image/png" : "image/x-exr");
 }
 
 json HttpServer::parse_body(const httplib::Request& req) const {
   const std::string type = req.get_header_value("Content-Type");
-  if (type.substr(0, type.find(';')) != "application/json") {
-    throw HttpError{415, "Content-Type", "must be application/json, got '" + type.substr(0, 100) + "'"};
+  if (!is_json_media_type(type)) {
+    throw HttpError{415, "Content-Type", "must be application/json, got '" + echo(type) + "'"};
   }
   // Parse with a depth limit: the library's error messages print values, recursively.
   bool too_deep = false;
@@ -617,6 +789,7 @@ json HttpServer::parse_body(const httplib::Request& req) const {
       return !too_deep;
     });
   } catch (const json::exception& e) {
+    // The parser's message quotes what it last read: bounded_message cuts it (send_error).
     throw HttpError{400, "body", std::string("not valid JSON: ") + e.what()};
   }
   if (too_deep) throw HttpError{400, "body", "nested deeper than " + std::to_string(max_depth) + " levels"};
@@ -650,7 +823,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
     const json& value = rest.at("repeat");
     if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > options_.max_compare_repeat) {
       throw InputError("repeat", "must be an integer in 1.." + std::to_string(options_.max_compare_repeat) + ", got " +
-                                     value.dump().substr(0, 100));
+                                     echo(json_text(value)));
     }
     repeat = value.get<int>();
     rest.erase("repeat");
@@ -660,7 +833,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   reference_settings.cache_max_bytes = options_.cache_max_bytes;
   if (rest.contains("reference_method")) {
     const json& value = rest.at("reference_method");
-    if (!value.is_string()) throw InputError("reference_method", "must be a method name, got " + value.dump().substr(0, 100));
+    if (!value.is_string()) throw InputError("reference_method", "must be a method name, got " + echo(json_text(value)));
     reference_settings.method = value.get<std::string>();
     rest.erase("reference_method");
   }
@@ -668,7 +841,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   if (rest.contains("reference_msaa")) {
     const json& value = rest.at("reference_msaa");
     if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 16) {
-      throw InputError("reference_msaa", "must be 1, 2, 4, 8 or 16, got " + value.dump().substr(0, 100));
+      throw InputError("reference_msaa", "must be 1, 2, 4, 8 or 16, got " + echo(json_text(value)));
     }
     reference_settings.msaa = value.get<int>();
     explicit_reference_msaa = true;
@@ -679,6 +852,10 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
     inline_scene = rest.at("scene");
     rest.erase("scene");
   }
+  // No size: the render default would be over this server's compare limit, so compare's own
+  // default fits it. The answer says which size was used and where it came from.
+  const bool size_given = rest.contains("size");
+  if (!size_given) rest["size"] = default_compare_size(options_.max_compare_pixels);
 
   // Validate everything before any work, in seamcl compare's order.
   RenderOptions frame = parse_render_options(rest);
@@ -759,6 +936,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   for (const EntryResult& m : measured) results.push_back(compare_result_json(m));
   json out = {{"scene", scene->name},
               {"size", std::to_string(frame.width) + "x" + std::to_string(frame.height)},
+              {"size_from", size_given ? "request" : "default"},
               {"device", runtime_.device_description()},
               {"reference_method", reference.method},
               {"reference", reference_json(reference, false)},
@@ -773,7 +951,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   }
   out["queue_ms"] = queue_ms;
   out["server_ms"] = ms_since(start);
-  res.set_content(out.dump(), "application/json");
+  res.set_content(json_text(out), "application/json");
 }
 
 void HttpServer::take_reference_settings(json& rest, ReferenceSettings& settings, bool& explicit_msaa) {
@@ -879,22 +1057,19 @@ void HttpServer::install_routes() {
   // a Content-Length over the limit are refused by httplib (413).
   http.set_payload_max_length(options_.max_body_bytes);
 
-  auto send_error = [](httplib::Response& res, int status, const std::string& field, const std::string& message) {
-    res.status = status;
-    res.set_content(json{{"error", message}, {"field", field}}.dump(), "application/json");
-  };
-  // Every handler runs inside this: refusals become {"error", "field"} with their status.
-  auto guarded = [this, send_error](auto handler) {
-    return [this, send_error, handler](const httplib::Request& req, httplib::Response& res) {
+  // Every handler runs inside this: refusals become {"error", "field"} with their status. The
+  // field starts the message too, echoed like any client value (it can be a client's key).
+  auto guarded = [this](auto handler) {
+    return [this, handler](const httplib::Request& req, httplib::Response& res) {
       try {
         handler(req, res);
       } catch (const HttpError& e) {
         if (e.retry_after_s > 0) res.set_header("Retry-After", std::to_string(e.retry_after_s));
-        send_error(res, e.status, e.field, e.field + ": " + e.message);
+        send_error(res, e.status, e.field, echo(e.field) + ": " + e.message);
       } catch (const OverBudget& e) {
-        send_error(res, 413, e.field(), e.what());
+        send_error(res, 413, e.field(), echo(e.field()) + ": " + input_error_message(e));
       } catch (const InputError& e) {
-        send_error(res, 400, e.field(), e.what());
+        send_error(res, 400, e.field(), echo(e.field()) + ": " + input_error_message(e));
       } catch (const std::exception& e) {
         log_line(std::string("error: ") + describe_cl_exception(e));
         send_error(res, 500, "server", "render failed: " + describe_cl_exception(e));
@@ -904,15 +1079,18 @@ void HttpServer::install_routes() {
 
   // Per-request start time, for the log line (the logger runs on the same thread, after).
   static thread_local Clock::time_point request_start{};
-  http.set_pre_routing_handler([send_error](const httplib::Request& req, httplib::Response& res) {
+  http.set_pre_routing_handler([](const httplib::Request& req, httplib::Response& res) {
     request_start = Clock::now();
     const auto found = known_paths().find(req.path);
     if (found != known_paths().end() &&
         std::find(found->second.begin(), found->second.end(), req.method) == found->second.end()) {
-      std::string allow;
-      for (const std::string& m : found->second) allow += (allow.empty() ? "" : ", ") + m;
-      res.set_header("Allow", allow);
-      send_error(res, 405, "method", req.method + " is not allowed on " + req.path + " (allowed: " + allow + ")");
+      // A body is read first where cpp-httplib reads bodies (POST, PUT, DELETE, PATCH): the
+      // not_routed handlers below answer after it has. It never reads one of GET, HEAD, OPTIONS,
+      // TRACE or CONNECT, so there the client is told to close the connection instead.
+      static const std::set<std::string> body_read = {"POST", "PUT", "DELETE", "PATCH"};
+      if (carries_body(req) && body_read.contains(req.method)) return httplib::Server::HandlerResponse::Unhandled;
+      if (carries_body(req)) res.set_header("Connection", "close");
+      send_method_not_allowed(res, req.method, req.path, found->second);
       return httplib::Server::HandlerResponse::Handled;
     }
     return httplib::Server::HandlerResponse::Unhandled;
@@ -922,17 +1100,25 @@ void HttpServer::install_routes() {
     request_start = Clock::time_point{};
     served_.fetch_add(1);
     char line[512];
-    std::snprintf(line, sizeof line, "%s %s %d %zu B %.1f ms", req.method.c_str(), req.path.substr(0, 200).c_str(),
+    std::snprintf(line, sizeof line, "%s %s %d %zu B %.1f ms", req.method.c_str(), echo(req.path, 200).c_str(),
                   res.status, res.body.size(), ms);
     log_line(line);
   });
   // Statuses httplib sets itself (404, 413, 400 for a malformed request line) get the JSON body too.
-  http.set_error_handler(httplib::Server::HandlerWithResponse([send_error](const httplib::Request& req, httplib::Response& res) {
+  http.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request& req, httplib::Response& res) {
     if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+    const auto route = known_paths().find(req.path);
+    const bool routes_post = route != known_paths().end() &&
+                             std::find(route->second.begin(), route->second.end(), "POST") != route->second.end();
     if (GuardedHttpServer::request_over_byte_limit()) {
       send_error(res, 413, "body", "the request exceeds this server's limit of bytes read per request");
     } else if (res.status == 404) {
-      send_error(res, 404, "path", "no such endpoint: " + req.method + " " + req.path.substr(0, 200));
+      send_error(res, 404, "path", "no such endpoint: " + req.method + " " + echo(req.path));
+    } else if (res.status == 400 && req.method == "POST" && routes_post && req.is_multipart_form_data()) {
+      // cpp-httplib parses multipart bodies itself and answers 400 when that fails: the body is
+      // of a media type these routes do not take, however well formed.
+      send_error(res, 415, "Content-Type",
+                 "Content-Type: must be application/json, got '" + echo(req.get_header_value("Content-Type")) + "'");
     } else if (res.status == 413) {
       send_error(res, 413, "body", "the request body exceeds this server's limit");
     } else {
@@ -940,7 +1126,7 @@ void HttpServer::install_routes() {
     }
     return httplib::Server::HandlerResponse::Handled;
   }));
-  http.set_exception_handler([send_error](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
+  http.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
     send_error(res, 500, "server", "internal error");
   });
 
@@ -951,13 +1137,13 @@ void HttpServer::install_routes() {
     res.set_content(std::string(openapi_json()), "application/json");
   });
   http.Get("/health", guarded([this](const httplib::Request&, httplib::Response& res) {
-             res.set_content(health_json().dump(), "application/json");
+             res.set_content(json_text(health_json()), "application/json");
            }));
   http.Get("/v1/scenes", guarded([this](const httplib::Request&, httplib::Response& res) {
-             res.set_content(scenes_json().dump(), "application/json");
+             res.set_content(json_text(scenes_json()), "application/json");
            }));
   http.Get("/v1/methods", guarded([this](const httplib::Request&, httplib::Response& res) {
-             res.set_content(methods_json().dump(), "application/json");
+             res.set_content(json_text(methods_json()), "application/json");
            }));
   http.Get("/v1/render", guarded([this](const httplib::Request& req, httplib::Response& res) {
              handle_render(query_to_json(req.params), res);
@@ -971,6 +1157,22 @@ void HttpServer::install_routes() {
   http.Post("/v1/compare", guarded([this](const httplib::Request& req, httplib::Response& res) {
               handle_compare(parse_body(req), res);
             }));
+  // Last, for every other path and method cpp-httplib routes: 405 on a known path (reached only
+  // with a body, which cpp-httplib has read by now), 404 elsewhere.
+  const auto not_routed = [](const httplib::Request& req, httplib::Response& res) {
+    const auto found = known_paths().find(req.path);
+    if (found != known_paths().end()) {
+      send_method_not_allowed(res, req.method, req.path, found->second);
+    } else {
+      send_error(res, 404, "path", "no such endpoint: " + req.method + " " + echo(req.path));
+    }
+  };
+  http.Get(".*", not_routed);
+  http.Post(".*", not_routed);
+  http.Put(".*", not_routed);
+  http.Delete(".*", not_routed);
+  http.Patch(".*", not_routed);
+  http.Options(".*", not_routed);
 }
 
 }  // namespace seamcl::server
