@@ -309,8 +309,8 @@ bool GuardedHttpServer::process_and_close_socket(socket_t sock) {
     if (method.empty()) break;
     if (!httplib_knows_method(method)) {
       write_json_response(sock, 405, "Method Not Allowed",
-                          R"json({"error":"method: not a method this server knows (allowed: GET, HEAD, POST)","field":"method"})json",
-                          "Allow: GET, HEAD, POST\r\n");
+                          R"json({"error":"method: not a method this server knows (allowed: GET, POST)","field":"method"})json",
+                          "Allow: GET, POST\r\n");
       break;
     }
     bool connection_closed = false;

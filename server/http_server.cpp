@@ -831,22 +831,8 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   ReferenceSettings reference_settings;
   reference_settings.cache_dir = options_.cache_dir;
   reference_settings.cache_max_bytes = options_.cache_max_bytes;
-  if (rest.contains("reference_method")) {
-    const json& value = rest.at("reference_method");
-    if (!value.is_string()) throw InputError("reference_method", "must be a method name, got " + echo(json_text(value)));
-    reference_settings.method = value.get<std::string>();
-    rest.erase("reference_method");
-  }
   bool explicit_reference_msaa = false;
-  if (rest.contains("reference_msaa")) {
-    const json& value = rest.at("reference_msaa");
-    if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 16) {
-      throw InputError("reference_msaa", "must be 1, 2, 4, 8 or 16, got " + echo(json_text(value)));
-    }
-    reference_settings.msaa = value.get<int>();
-    explicit_reference_msaa = true;
-    rest.erase("reference_msaa");
-  }
+  take_reference_settings(rest, reference_settings, explicit_reference_msaa);
   json inline_scene;
   if (rest.contains("scene") && rest.at("scene").is_object()) {
     inline_scene = rest.at("scene");
@@ -859,13 +845,8 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
 
   // Validate everything before any work, in seamcl compare's order.
   RenderOptions frame = parse_render_options(rest);
+  check_reference_limits(frame, reference_settings, explicit_reference_msaa);
   const long long pixels = static_cast<long long>(frame.width) * frame.height;
-  if (pixels > options_.max_compare_pixels) {
-    throw HttpError{413, "size",
-                    std::to_string(frame.width) + "x" + std::to_string(frame.height) + " = " + std::to_string(pixels) +
-                        " pixels exceeds this server's compare limit of " + std::to_string(options_.max_compare_pixels) +
-                        " (the reference renders at " + std::to_string(kReferenceScale) + "x width and height)"};
-  }
   const std::vector<std::string> methods = split_list(methods_text, "methods");
   const std::vector<int> rates = parse_int_list(msaa_text, "msaa");
   if (methods.size() * rates.size() > static_cast<size_t>(options_.max_compare_entries)) {
@@ -881,15 +862,6 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
                       "width x height x msaa = " + std::to_string(pixels * entry.options.msaa) +
                           " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
     }
-  }
-  const RenderOptions high = reference_render_options(frame, reference_settings);
-  const long long reference_samples = static_cast<long long>(high.width) * high.height * high.msaa;
-  if (reference_samples > options_.max_reference_samples) {
-    const std::string field = explicit_reference_msaa ? "reference_msaa" : "size";
-    throw HttpError{413, field,
-                    "the reference renders " + std::to_string(high.width) + "x" + std::to_string(high.height) + " x " +
-                        std::to_string(high.msaa) + " samples = " + std::to_string(reference_samples) +
-                        ", over this server's limit of " + std::to_string(options_.max_reference_samples)};
   }
   std::string key;
   const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key, [&](const SceneSizes& sizes) {
@@ -957,7 +929,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
 void HttpServer::take_reference_settings(json& rest, ReferenceSettings& settings, bool& explicit_msaa) {
   if (rest.contains("reference_method")) {
     const json& value = rest.at("reference_method");
-    if (!value.is_string()) throw InputError("reference_method", "must be a method name, got a " + std::string(value.type_name()));
+    if (!value.is_string()) throw InputError("reference_method", "must be a method name, got " + echo(json_text(value)));
     settings.method = value.get<std::string>();
     rest.erase("reference_method");
   }
@@ -965,7 +937,7 @@ void HttpServer::take_reference_settings(json& rest, ReferenceSettings& settings
   if (rest.contains("reference_msaa")) {
     const json& value = rest.at("reference_msaa");
     if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 16) {
-      throw InputError("reference_msaa", "must be 1, 2, 4, 8 or 16");
+      throw InputError("reference_msaa", "must be 1, 2, 4, 8 or 16, got " + echo(json_text(value)));
     }
     settings.msaa = value.get<int>();
     explicit_msaa = true;

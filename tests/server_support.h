@@ -113,6 +113,8 @@ struct LiveServer {
   ~LiveServer() {
     http->stop();
     if (thread.joinable()) thread.join();
+    // Now, while the log is alive: the server's warm-up thread may still write to it.
+    http.reset();
   }
   int port() const { return http->port(); }
   std::vector<std::string> log_lines() {

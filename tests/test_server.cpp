@@ -329,6 +329,8 @@ struct RunningServer {
   ~RunningServer() {
     http->stop();
     if (thread.joinable()) thread.join();
+    // Now, while the log is alive: the server's warm-up thread may still write to it.
+    http.reset();
   }
   httplib::Client client() const {
     httplib::Client c("127.0.0.1", http->port());
