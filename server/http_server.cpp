@@ -281,22 +281,21 @@ std::string server_cache_dir(const std::string& configured) {
   return (std::filesystem::temp_directory_path() / "seamcl-serve-cache").string();
 }
 
-// What an inline scene's memory depends on, read from its JSON before anything is built: the
-// vertex count and each face's texture size (a missing or malformed size counts as 1; the
-// parser refuses it later, naming the field).
-SceneSizes inline_scene_sizes(const json& scene) {
-  SceneSizes sizes;
-  if (scene.contains("positions") && scene.at("positions").is_array()) sizes.vertices = scene.at("positions").size();
-  if (!scene.contains("faces") || !scene.at("faces").is_array()) return sizes;
-  for (const json& face : scene.at("faces")) {
-    const json* texture = face.is_object() && face.contains("texture") ? &face.at("texture") : nullptr;
-    auto side = [&](const char* name) {
-      if (!texture || !texture->is_object() || !texture->contains(name) || !texture->at(name).is_number_integer()) return 1;
-      return static_cast<int>(std::clamp<long long>(texture->at(name).get<long long>(), 1, 1 << 20));
-    };
-    sizes.faces.emplace_back(side("width"), side("height"));
+// An inline scene with every face texture's width and height that is a power of two in 1..4096
+// (what the parser accepts) replaced by 1: the same structure to validate, at no cost. Sizes the
+// parser refuses are kept, so it still refuses them.
+json with_tiny_textures(json scene) {
+  if (!scene.is_object() || !scene.contains("faces") || !scene.at("faces").is_array()) return scene;
+  for (json& face : scene.at("faces")) {
+    if (!face.is_object() || !face.contains("texture") || !face.at("texture").is_object()) continue;
+    json& texture = face.at("texture");
+    for (const char* side : {"width", "height"}) {
+      if (!texture.contains(side) || !texture.at(side).is_number_integer()) continue;
+      const long long size = texture.at(side).get<long long>();
+      if (size >= 1 && size <= 4096 && (size & (size - 1)) == 0) texture[side] = 1;
+    }
   }
-  return sizes;
+  return scene;
 }
 
 std::string mebibytes(size_t bytes) {
@@ -618,8 +617,7 @@ std::shared_ptr<const Scene> HttpServer::builtin_scene(const std::string& name, 
 
 // The scene: a built-in one (never a file path: clients name no server files) or inline.
 std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene, RenderOptions& options,
-                                                       std::string& key,
-                                                       const std::function<void(const SceneSizes&)>& check_budget) const {
+                                                       std::string& key) const {
   std::shared_ptr<const Scene> scene;
   key.clear();
   if (inline_scene.is_null()) {
@@ -632,9 +630,16 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
     }
     scene = found;
     key = scene_key(options.scene, options.tint);
-    check_budget(scene_sizes(*scene));
   } else {
-    // Limits first, from the JSON, before any texture is made.
+    // Its structure first, on a copy whose valid texture sizes are shrunk to 1x1 (so nothing big
+    // is built), so that a malformed scene is a 400 whatever its size; then the size limits, from
+    // the JSON, before any texture is made.
+    try {
+      Scene shape = parse_scene_json(with_tiny_textures(inline_scene));
+      validate_scene(shape);
+    } catch (const InputError& e) {
+      throw InputError("scene." + e.field(), input_error_message(e));
+    }
     if (inline_scene.contains("faces") && inline_scene.at("faces").is_array()) {
       const json& faces = inline_scene.at("faces");
       if (faces.size() > options_.max_inline_faces) {
@@ -657,7 +662,6 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
         }
       }
     }
-    check_budget(inline_scene_sizes(inline_scene));
     try {
       Scene parsed = parse_scene_json(inline_scene);
       if (options.tint) {
@@ -709,23 +713,23 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
     rest.erase("scene");
   }
   RenderOptions options = parse_render_options(rest);
+  std::string key;
+  const bool inline_request = !inline_scene.is_null();
+  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, options, key);
+  const Camera camera = options.frame ? orbit_camera(*scene, *options.frame, options.frames) : scene->camera;
+  // Limits after every syntax check (a malformed request is a 400 whatever its size) and before
+  // anything is packed or put on the device (an inline scene's own size is bounded by the face
+  // and texel limits checked before it is parsed).
   if (static_cast<long long>(options.width) * options.height * options.msaa > options_.max_samples) {
     throw HttpError{413, "size",
                     "width x height x msaa = " + std::to_string(static_cast<long long>(options.width) * options.height * options.msaa) +
                         " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
   }
-
-  std::string key;
-  RenderMemory memory;
-  const bool inline_request = !inline_scene.is_null();
-  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, options, key, [&](const SceneSizes& sizes) {
-    memory = render_memory(sizes, options);
-    const bool frame_drives = memory.frame_device_bytes() >= memory.scene_device_bytes();
-    const std::string field = frame_drives ? "size" : inline_request ? "scene" : "texels";
-    refuse_over_budget(memory.device_bytes(), saturating_add(memory.host_bytes(), inline_request ? scene_host_bytes(sizes) : 0),
-                       field, "this render");
-  });
-  const Camera camera = options.frame ? orbit_camera(*scene, *options.frame, options.frames) : scene->camera;
+  const SceneSizes sizes = scene_sizes(*scene);
+  const RenderMemory memory = render_memory(sizes, options);
+  const bool frame_drives = memory.frame_device_bytes() >= memory.scene_device_bytes();
+  refuse_over_budget(memory.device_bytes(), saturating_add(memory.host_bytes(), inline_request ? scene_host_bytes(sizes) : 0),
+                     frame_drives ? "size" : inline_request ? "scene" : "texels", "this render");
 
   // Wait for a render slot (or 503), render, and give the slot back before encoding.
   const Clock::time_point queued = Clock::now();
@@ -845,7 +849,6 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
 
   // Validate everything before any work, in seamcl compare's order.
   RenderOptions frame = parse_render_options(rest);
-  check_reference_limits(frame, reference_settings, explicit_reference_msaa);
   const long long pixels = static_cast<long long>(frame.width) * frame.height;
   const std::vector<std::string> methods = split_list(methods_text, "methods");
   const std::vector<int> rates = parse_int_list(msaa_text, "msaa");
@@ -856,6 +859,11 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
                         " renders exceeds this server's limit of " + std::to_string(options_.max_compare_entries)};
   }
   const std::vector<MethodEntry> entries = method_entries(rest, methods, rates);
+  std::string key;
+  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key);
+  const Camera camera = frame.frame ? orbit_camera(*scene, *frame.frame, frame.frames) : scene->camera;
+  // Limits after every syntax check: a malformed request is a 400 whatever its size.
+  check_reference_limits(frame, reference_settings, explicit_reference_msaa);
   for (const MethodEntry& entry : entries) {
     if (pixels * entry.options.msaa > options_.max_samples) {
       throw HttpError{413, "size",
@@ -863,12 +871,8 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
                           " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
     }
   }
-  std::string key;
-  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key, [&](const SceneSizes& sizes) {
-    const CompareMemory memory = compare_memory(sizes, frame, entries, reference_settings);
-    refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this compare");
-  });
-  const Camera camera = frame.frame ? orbit_camera(*scene, *frame.frame, frame.frames) : scene->camera;
+  const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, entries, reference_settings);
+  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this compare");
   // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
   const Clock::time_point deadline =
       options_.deadline_ms > 0 ? start + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
@@ -931,6 +935,9 @@ void HttpServer::take_reference_settings(json& rest, ReferenceSettings& settings
     const json& value = rest.at("reference_method");
     if (!value.is_string()) throw InputError("reference_method", "must be a method name, got " + echo(json_text(value)));
     settings.method = value.get<std::string>();
+    if (!parse_method(settings.method)) {
+      throw InputError("reference_method", "unknown method '" + echo(settings.method) + "'");
+    }
     rest.erase("reference_method");
   }
   explicit_msaa = false;
@@ -993,13 +1000,12 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
     rest.erase("scene");
   }
   RenderOptions frame = parse_render_options(rest);
-  check_reference_limits(frame, settings, explicit_reference_msaa);
   std::string key;
-  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key, [&](const SceneSizes& sizes) {
-    const CompareMemory memory = compare_memory(sizes, frame, {}, settings);
-    refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this reference");
-  });
+  const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key);
   const Camera camera = frame.frame ? orbit_camera(*scene, *frame.frame, frame.frames) : scene->camera;
+  check_reference_limits(frame, settings, explicit_reference_msaa);
+  const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, {}, settings);
+  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this reference");
 
   const Clock::time_point queued = Clock::now();
   double queue_ms = 0;

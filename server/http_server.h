@@ -134,11 +134,8 @@ class HttpServer {
   // A built-in scene by options.scene (and tint), or `inline_scene` when it is not null (limits
   // checked, parsed, validated; options.scene becomes its name). `key` is the slot Renderer's key,
   // empty for an inline scene.
-  // `check_budget` sees the scene's sizes before any of its textures is built (an inline scene's
-  // from its JSON) and throws to refuse it.
   std::shared_ptr<const Scene> resolve_scene(const nlohmann::json& inline_scene, RenderOptions& options,
-                                             std::string& key,
-                                             const std::function<void(const SceneSizes&)>& check_budget) const;
+                                             std::string& key) const;
   void refuse_over_budget(size_t device_bytes, size_t host_bytes, const std::string& field, const std::string& what) const;
   nlohmann::json scenes_json() const;
   nlohmann::json make_methods_json() const;
