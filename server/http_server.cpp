@@ -298,6 +298,27 @@ json with_tiny_textures(json scene) {
   return scene;
 }
 
+// An inline scene object taken out of a request (the rest goes to the option parser); null when
+// `scene` is a built-in name or absent.
+json take_inline_scene(json& rest) {
+  json scene;
+  if (rest.contains("scene") && rest.at("scene").is_object()) {
+    scene = rest.at("scene");
+    rest.erase("scene");
+  }
+  return scene;
+}
+
+// The answer's image format, taken out of a request: png unless `format` says exr.
+ImageFormat take_image_format(json& rest) {
+  if (!rest.contains("format")) return ImageFormat::Png;
+  const json& value = rest.at("format");
+  const auto parsed = value.is_string() ? parse_image_format(value.get<std::string>()) : std::nullopt;
+  if (!parsed) throw InputError("format", "must be \"png\" or \"exr\", got " + echo(json_text(value)));
+  rest.erase("format");
+  return *parsed;
+}
+
 std::string mebibytes(size_t bytes) {
   char text[32];
   std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1 << 20));
@@ -699,19 +720,8 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
 
   // The server's own keys (format, an inline scene); the rest goes to the shared parser.
   json rest = request;
-  ImageFormat format = ImageFormat::Png;
-  if (rest.contains("format")) {
-    const json& value = rest.at("format");
-    const auto parsed = value.is_string() ? parse_image_format(value.get<std::string>()) : std::nullopt;
-    if (!parsed) throw HttpError{400, "format", "must be \"png\" or \"exr\", got " + echo(json_text(value))};
-    format = *parsed;
-    rest.erase("format");
-  }
-  json inline_scene;
-  if (rest.contains("scene") && rest.at("scene").is_object()) {
-    inline_scene = rest.at("scene");
-    rest.erase("scene");
-  }
+  const ImageFormat format = take_image_format(rest);
+  const json inline_scene = take_inline_scene(rest);
   RenderOptions options = parse_render_options(rest);
   std::string key;
   const bool inline_request = !inline_scene.is_null();
@@ -832,16 +842,9 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
     repeat = value.get<int>();
     rest.erase("repeat");
   }
-  ReferenceSettings reference_settings;
-  reference_settings.cache_dir = options_.cache_dir;
-  reference_settings.cache_max_bytes = options_.cache_max_bytes;
   bool explicit_reference_msaa = false;
-  take_reference_settings(rest, reference_settings, explicit_reference_msaa);
-  json inline_scene;
-  if (rest.contains("scene") && rest.at("scene").is_object()) {
-    inline_scene = rest.at("scene");
-    rest.erase("scene");
-  }
+  const ReferenceSettings reference_settings = take_reference_settings(rest, explicit_reference_msaa);
+  const json inline_scene = take_inline_scene(rest);
   // No size: the render default would be over this server's compare limit, so compare's own
   // default fits it. The answer says which size was used and where it came from.
   const bool size_given = rest.contains("size");
@@ -930,7 +933,10 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   res.set_content(json_text(out), "application/json");
 }
 
-void HttpServer::take_reference_settings(json& rest, ReferenceSettings& settings, bool& explicit_msaa) {
+ReferenceSettings HttpServer::take_reference_settings(json& rest, bool& explicit_msaa) const {
+  ReferenceSettings settings;
+  settings.cache_dir = options_.cache_dir;
+  settings.cache_max_bytes = options_.cache_max_bytes;
   if (rest.contains("reference_method")) {
     const json& value = rest.at("reference_method");
     if (!value.is_string()) throw InputError("reference_method", "must be a method name, got " + echo(json_text(value)));
@@ -950,6 +956,7 @@ void HttpServer::take_reference_settings(json& rest, ReferenceSettings& settings
     explicit_msaa = true;
     rest.erase("reference_msaa");
   }
+  return settings;
 }
 
 void HttpServer::check_reference_limits(const RenderOptions& frame, const ReferenceSettings& settings, bool explicit_msaa) const {
@@ -981,24 +988,10 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
       throw HttpError{400, key, std::string("the reference is one image of the frame; ") + key + " is for /v1/render or /v1/compare"};
     }
   }
-  ImageFormat format = ImageFormat::Png;
-  if (rest.contains("format")) {
-    const json& value = rest.at("format");
-    const auto parsed = value.is_string() ? parse_image_format(value.get<std::string>()) : std::nullopt;
-    if (!parsed) throw HttpError{400, "format", "must be \"png\" or \"exr\""};
-    format = *parsed;
-    rest.erase("format");
-  }
-  ReferenceSettings settings;
-  settings.cache_dir = options_.cache_dir;
-  settings.cache_max_bytes = options_.cache_max_bytes;
+  const ImageFormat format = take_image_format(rest);
   bool explicit_reference_msaa = false;
-  take_reference_settings(rest, settings, explicit_reference_msaa);
-  json inline_scene;
-  if (rest.contains("scene") && rest.at("scene").is_object()) {
-    inline_scene = rest.at("scene");
-    rest.erase("scene");
-  }
+  const ReferenceSettings settings = take_reference_settings(rest, explicit_reference_msaa);
+  const json inline_scene = take_inline_scene(rest);
   RenderOptions frame = parse_render_options(rest);
   std::string key;
   const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key);

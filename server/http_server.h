@@ -127,7 +127,7 @@ class HttpServer {
   void handle_compare(const nlohmann::json& request, httplib::Response& res);
   void handle_reference(const nlohmann::json& request, httplib::Response& res);
   // reference_method and reference_msaa taken out of a compare or reference request.
-  static void take_reference_settings(nlohmann::json& rest, ReferenceSettings& settings, bool& explicit_msaa);
+  ReferenceSettings take_reference_settings(nlohmann::json& rest, bool& explicit_msaa) const;
   // The frame's pixels and the 8x reference's samples within this server's limits (413).
   void check_reference_limits(const RenderOptions& frame, const ReferenceSettings& settings, bool explicit_msaa) const;
   nlohmann::json parse_body(const httplib::Request& req) const;
