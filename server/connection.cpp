@@ -43,7 +43,11 @@ class ThreadPerConnection : public httplib::TaskQueue {
  private:
   void run(std::function<void()> task) {
     for (;;) {
-      task();
+      try {
+        task();
+      } catch (...) {
+        // One connection's failure (bad_alloc, say) must not end the process: it is dropped.
+      }
       std::lock_guard lock(mutex_);
       if (waiting_.empty()) {
         --threads_;
@@ -72,6 +76,8 @@ int milliseconds_until(Clock::time_point deadline) {
 // poll() for `events` until `deadline`, retrying on EINTR. >0 ready, 0 timed out, <0 error.
 int poll_until(int fd, short events, Clock::time_point deadline) {
   for (;;) {
+    // A deadline that has passed is a timeout, not a zero-wait poll that may still say "ready".
+    if (Clock::now() >= deadline) return 0;
     pollfd p{fd, events, 0};
     const int ready = ::poll(&p, 1, milliseconds_until(deadline));
     if (ready < 0 && errno == EINTR) continue;
@@ -140,11 +146,17 @@ class GuardedStream : public httplib::Stream {
   }
 
   ssize_t write(const char* ptr, size_t size) override {
+    // A "100 Continue" goes first when the client asked for it: the status that counts is the
+    // final one, written next.
+    if (size >= 7 && std::memcmp(ptr, "HTTP/1.", 7) == 0 && response_status() >= 100 && response_status() < 200) {
+      response_head_.clear();
+    }
     if (response_head_.size() < 16) response_head_.append(ptr, std::min<size_t>(size, 16 - response_head_.size()));
-    if (!is_writable()) return -1;
     for (;;) {
-      const ssize_t n = ::send(fd_, ptr, size, MSG_NOSIGNAL);
-      if (n < 0 && errno == EINTR) continue;
+      if (!is_writable()) return -1;
+      // Never blocks: a client that reads slowly cannot hold the thread past the write deadline.
+      const ssize_t n = ::send(fd_, ptr, size, MSG_NOSIGNAL | MSG_DONTWAIT);
+      if (n < 0 && (errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK)) continue;
       return n;
     }
   }
@@ -258,8 +270,20 @@ void write_json_response(int fd, int status, const char* reason, const std::stri
                     extra_headers + "Content-Length: " + std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body);
 }
 
-void close_socket(int fd) {
-  ::shutdown(fd, SHUT_RDWR);
+// After an error answer the client may still be sending a body we did not read; closing with
+// unread input would reset the connection and could destroy the answer before the client reads
+// it. So: end our side, read and drop what comes for a moment (bounded), then close.
+void close_socket(int fd, bool drain = false) {
+  ::shutdown(fd, drain ? SHUT_WR : SHUT_RDWR);
+  if (drain) {
+    const Clock::time_point until = Clock::now() + std::chrono::milliseconds(200);
+    char sink[16384];
+    for (size_t dropped = 0; dropped < (size_t{1} << 20) && poll_until(fd, POLLIN, until) > 0;) {
+      const ssize_t n = ::recv(fd, sink, sizeof sink, MSG_DONTWAIT);
+      if (n <= 0) break;
+      dropped += static_cast<size_t>(n);
+    }
+  }
   ::close(fd);
 }
 
@@ -280,6 +304,17 @@ GuardedHttpServer::GuardedHttpServer(ConnectionLimits limits) : limits_(limits) 
 }
 
 GuardedHttpServer::~GuardedHttpServer() = default;
+
+void GuardedHttpServer::begin_shutdown() {
+  shutting_down_.store(true);
+  // Also when listening has not started yet (httplib's stop() then does nothing): the listening
+  // socket is closed, so listen_after_bind() returns at once instead of serving.
+  const socket_t listening = svr_sock_.exchange(INVALID_SOCKET);
+  if (listening != INVALID_SOCKET) {
+    ::shutdown(listening, SHUT_RDWR);
+    ::close(listening);
+  }
+}
 
 bool GuardedHttpServer::client_gone() { return current_stream != nullptr && current_stream->peer_closed(); }
 
@@ -302,12 +337,14 @@ bool GuardedHttpServer::process_and_close_socket(socket_t sock) {
 
   GuardedStream stream(sock, limits_);
   current_stream = &stream;
-  for (int served = 0; served < limits_.max_requests_per_connection && is_running(); ++served) {
+  bool answered_error = false;
+  for (int served = 0; served < limits_.max_requests_per_connection && !shutting_down_.load(); ++served) {
     if (!stream.wait_for_request(served == 0 ? limits_.request_read_timeout : limits_.idle_timeout)) break;
     stream.begin_request();
     const std::string method = stream.peek_method();
     if (method.empty()) break;
     if (!httplib_knows_method(method)) {
+      answered_error = true;
       write_json_response(sock, 405, "Method Not Allowed",
                           R"json({"error":"method: not a method this server knows (allowed: GET, POST)","field":"method"})json",
                           "Allow: GET, POST\r\n");
@@ -317,10 +354,12 @@ bool GuardedHttpServer::process_and_close_socket(socket_t sock) {
     const bool last = served + 1 == limits_.max_requests_per_connection;
     const bool ok = process_request(stream, last, connection_closed, nullptr);
     // After an error answer the request's body may be unread: never parse it as a request.
-    if (!ok || connection_closed || stream.response_status() >= 400 || stream.response_status() == 0) break;
+    const int status = stream.response_status();
+    answered_error = status >= 400;
+    if (!ok || connection_closed || status < 200 || status >= 400) break;
   }
   current_stream = nullptr;
-  close_socket(sock);
+  close_socket(sock, answered_error);
   return true;
 }
 

@@ -40,6 +40,9 @@ class GuardedHttpServer : public httplib::Server {
   ~GuardedHttpServer() override;
 
   const ConnectionLimits& limits() const { return limits_; }
+  // After httplib's stop(): connections end after the request they are serving (keep-alive
+  // stops), and a server that has not started listening never will.
+  void begin_shutdown();
   int open_connections() const { return open_connections_.load(); }
   long long connections_refused() const { return refused_.load(); }
 
@@ -56,6 +59,7 @@ class GuardedHttpServer : public httplib::Server {
   ConnectionLimits limits_;
   std::atomic<int> open_connections_{0};
   std::atomic<long long> refused_{0};
+  std::atomic<bool> shutting_down_{false};
 };
 
 }  // namespace seamcl::server

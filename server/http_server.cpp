@@ -450,7 +450,10 @@ void HttpServer::warm_up() {
     log_line("error: warm-up failed: " + message);
     {
       std::lock_guard lock(slots_mutex_);
+      // With some slots warm the service goes on with those (and says so in /health); with
+      // none, renders are refused rather than left waiting.
       if (ready_slots_.load() == 0) warm_error_ = message;
+      failed_slots_.store(options_.threads - ready_slots_.load());
     }
     slot_freed_.notify_all();
   }
@@ -466,7 +469,10 @@ bool HttpServer::listen_after_bind() { return http_->listen_after_bind(); }
 
 void HttpServer::stop() {
   stopping_.store(true);
-  if (http_) http_->stop();
+  if (http_) {
+    http_->stop();
+    http_->begin_shutdown();
+  }
   slot_freed_.notify_all();
 }
 

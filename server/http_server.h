@@ -110,8 +110,9 @@ class HttpServer {
   // Safe from any thread (e.g. a signal-waiting thread).
   void stop();
   bool is_running() const;
-  // Every slot has the default scene and variant warm (renders no longer wait for start-up).
-  bool ready() const { return ready_slots_.load() == options_.threads; }
+  // Every slot has the default scene and variant warm (renders no longer wait for start-up), or
+  // failed to warm while at least one did.
+  bool ready() const { return ready_slots_.load() > 0 && ready_slots_.load() + failed_slots_.load() == options_.threads; }
   // Blocks until ready() or the warm-up failed; false on failure or after timeout.
   bool wait_ready(std::chrono::milliseconds timeout);
 
@@ -174,6 +175,7 @@ class HttpServer {
   std::thread warm_thread_;
   std::atomic<bool> stopping_{false};
   std::atomic<int> ready_slots_{0};
+  std::atomic<int> failed_slots_{0};  // slots whose warm-up failed (the rest serve)
   std::atomic<int> warmed_variants_{0};
   int total_variants_ = 0;
   std::string warm_error_;  // under slots_mutex_; not empty: the warm-up failed

@@ -138,6 +138,19 @@ TEST_F(Connection, RefusedRequestsBodyIsNeverParsedAsARequest) {
     EXPECT_GE(first_status(answer), 400) << answer;
     EXPECT_TRUE(closed) << head;
   }
+  // With "Expect: 100-continue" the interim answer comes first; the refusal still ends the
+  // connection, so the body is not answered as a request either.
+  {
+    RawConnection connection(server.port());
+    // (cpp-httplib never reads a GET's body.)
+    ASSERT_TRUE(connection.send("GET /v1/render?size=0x0 HTTP/1.1\r\nHost: x\r\nExpect: 100-continue\r\n"
+                                "Content-Length: " + length + "\r\n\r\n" + smuggled));
+    bool closed = false;
+    const std::string answer = connection.read_until_closed(std::chrono::milliseconds(5000), &closed);
+    EXPECT_EQ(answer.find("200 OK"), std::string::npos) << answer;
+    EXPECT_NE(answer.find("HTTP/1.1 400"), std::string::npos) << answer;
+    EXPECT_TRUE(closed);
+  }
   // A method httplib does not know is 405 with Allow, not 400.
   RawConnection connection(server.port());
   ASSERT_TRUE(connection.send("FROB /health HTTP/1.1\r\nHost: x\r\n\r\n"));
