@@ -3,7 +3,7 @@
 latency behind slow clients, and RSS over a soak of mixed renders and compares. Loopback only;
 each check starts its own server on a free port and stops it.
 
-    examples/service_checks.py --seamcl build/seamcl [--checks start,overload,slowloris,soak]
+    examples/service_checks.py --seamcl build/seamcl [--checks start,overload,slowloris,soak,protocol]
         [--soak-minutes 10] [--json]
 
 - start: time until the port answers /health, until the first render of the default scene, and
@@ -14,6 +14,9 @@ each check starts its own server on a free port and stops it.
   threads + queue + 4 threads); /health latency meanwhile (p50, p99, max).
 - soak: renders (built-in and inline scenes, all methods) and compares from 4 clients for the
   given minutes; the server's RSS every 5 s (first, max, last).
+- protocol: GET /%ff (does the process survive), an unknown method whose body holds a request
+  (how many answers), a 16 MiB chunked body (how much is sent before the close, the status),
+  /health behind 28 trickling connections, and a second server on the same port.
 """
 import argparse
 import http.client
@@ -233,6 +236,84 @@ def check_soak(seamcl, minutes):
         server.stop()
 
 
+def read_until_closed(sock, seconds):
+    sock.settimeout(seconds)
+    out = b""
+    try:
+        while True:
+            data = sock.recv(65536)
+            if not data:
+                return out
+            out += data
+    except OSError:
+        return out
+
+
+def check_protocol(seamcl):
+    server = Server(seamcl, ["--quick-start"])
+    out = {}
+    try:
+        server.wait(lambda: server.health().get("status") in ("ok", "ready"))
+        s = socket.create_connection(("127.0.0.1", server.port), timeout=10)
+        s.sendall(b"GET /%ff HTTP/1.1\r\nHost: x\r\n\r\n")
+        out["GET /%ff status"] = read_until_closed(s, 3)[9:12].decode(errors="replace")
+        time.sleep(0.5)
+        out["alive after GET /%ff"] = server.process.poll() is None
+        if not out["alive after GET /%ff"]:
+            server = Server(seamcl, ["--quick-start"])
+            server.wait(lambda: server.health().get("status") in ("ok", "ready"))
+        smuggled = b"GET /health HTTP/1.1\r\nHost: x\r\n\r\n"
+        s = socket.create_connection(("127.0.0.1", server.port), timeout=10)
+        s.sendall(b"FROB /v1/render HTTP/1.1\r\nHost: x\r\nContent-Length: %d\r\n\r\n" % len(smuggled) + smuggled)
+        answer = read_until_closed(s, 3)
+        out["unknown method + body: answers, first status"] = [answer.count(b"HTTP/1.1 "), answer[9:12].decode()]
+        s = socket.create_connection(("127.0.0.1", server.port), timeout=10)
+        s.sendall(b"POST /v1/render HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+                  b"Transfer-Encoding: chunked\r\n\r\n")
+        chunk = b"10000\r\n" + b" " * 65536 + b"\r\n"
+        sent = 0
+        try:
+            for _ in range(256):
+                s.sendall(chunk)
+                sent += 65536
+            s.sendall(b"0\r\n\r\n")
+        except OSError:
+            pass
+        out["16 MiB chunked: MiB sent, status"] = [sent / 2 ** 20, read_until_closed(s, 10)[9:12].decode()]
+        slow = []
+        for _ in range(28):
+            c = socket.create_connection(("127.0.0.1", server.port), timeout=10)
+            c.sendall(b"GET /health HTTP/1.1\r\nHost: x\r\n")
+            slow.append(c)
+        latencies = []
+        for _ in range(6):
+            for c in slow:
+                try:
+                    c.sendall(b"X")
+                except OSError:
+                    pass
+            start = time.monotonic()
+            try:
+                server.request("GET", "/health", timeout=30)
+            except OSError:
+                pass
+            latencies.append(round((time.monotonic() - start) * 1000, 1))
+            time.sleep(1)
+        out["/health ms behind 28 slow clients"] = latencies
+        for c in slow:
+            c.close()
+        second = subprocess.Popen([seamcl, "serve", "--port", str(server.port), "--quick-start"],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            out["second server on the port"] = "exited %d" % second.wait(timeout=25)
+        except subprocess.TimeoutExpired:
+            out["second server on the port"] = "still running after 25 s (port shared)"
+            second.kill()
+        return out
+    finally:
+        server.stop()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seamcl", default="build/seamcl")
@@ -241,11 +322,12 @@ def main():
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     checks = {"start": lambda: check_start(args.seamcl), "overload": lambda: check_overload(args.seamcl),
+              "protocol": lambda: check_protocol(args.seamcl),
               "slowloris": lambda: check_slowloris(args.seamcl), "soak": lambda: check_soak(args.seamcl, args.soak_minutes)}
     out = {}
     for name in args.checks.split(","):
         if name not in checks:
-            parser.error("unknown check %r (start, overload, slowloris, soak)" % name)
+            parser.error("unknown check %r (start, overload, slowloris, soak, protocol)" % name)
         out[name] = checks[name]()
         if not args.json:
             print(name, json.dumps(out[name]), flush=True)
