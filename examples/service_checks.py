@@ -144,33 +144,41 @@ def check_overload(seamcl, clients=32, seconds=20):
         server.stop()
 
 
-def check_slowloris(seamcl, threads=2, queue=8, probes=40):
-    server = Server(seamcl, ["--threads", str(threads), "--queue", str(queue), "--quick-start", "--read-timeout", "60"])
+def health_behind_slow_clients(server, count, probes, pause):
+    """/health latencies (ms) while `count` connections trickle one header byte per probe."""
     slow = []
     try:
-        server.wait(lambda: server.health().get("status") == "ready")
-        count = 2 * (threads + queue + 4)
         for _ in range(count):
-            s = socket.create_connection(("127.0.0.1", server.port))
-            s.sendall(b"GET /health HTTP/1.1\r\nHost: x\r\n")
-            slow.append(s)
+            c = socket.create_connection(("127.0.0.1", server.port), timeout=10)
+            c.sendall(b"GET /health HTTP/1.1\r\nHost: x\r\n")
+            slow.append(c)
         latencies = []
-        for i in range(probes):
-            for s in slow:
+        for _ in range(probes):
+            for c in slow:
                 try:
-                    s.sendall(b"X")
+                    c.sendall(b"X")
                 except OSError:
                     pass
             start = time.monotonic()
             status, _ = server.request("GET", "/health", timeout=30)
             latencies.append((time.monotonic() - start) * 1000)
             assert status == 200, status
-            time.sleep(0.25)
+            time.sleep(pause)
+        return latencies
+    finally:
+        for c in slow:
+            c.close()
+
+
+def check_slowloris(seamcl, threads=2, queue=8, probes=40):
+    server = Server(seamcl, ["--threads", str(threads), "--queue", str(queue), "--quick-start", "--read-timeout", "60"])
+    try:
+        server.wait(lambda: server.health().get("status") == "ready")
+        count = 2 * (threads + queue + 4)
+        latencies = health_behind_slow_clients(server, count, probes, 0.25)
         return {"slow_connections": count, "probes": probes, "health_p50_ms": round(percentile(latencies, 50), 2),
                 "health_p99_ms": round(percentile(latencies, 99), 2), "health_max_ms": round(max(latencies), 2)}
     finally:
-        for s in slow:
-            s.close()
         server.stop()
 
 
@@ -280,28 +288,7 @@ def check_protocol(seamcl):
         except OSError:
             pass
         out["16 MiB chunked: MiB sent, status"] = [sent / 2 ** 20, read_until_closed(s, 10)[9:12].decode()]
-        slow = []
-        for _ in range(28):
-            c = socket.create_connection(("127.0.0.1", server.port), timeout=10)
-            c.sendall(b"GET /health HTTP/1.1\r\nHost: x\r\n")
-            slow.append(c)
-        latencies = []
-        for _ in range(6):
-            for c in slow:
-                try:
-                    c.sendall(b"X")
-                except OSError:
-                    pass
-            start = time.monotonic()
-            try:
-                server.request("GET", "/health", timeout=30)
-            except OSError:
-                pass
-            latencies.append(round((time.monotonic() - start) * 1000, 1))
-            time.sleep(1)
-        out["/health ms behind 28 slow clients"] = latencies
-        for c in slow:
-            c.close()
+        out["/health ms behind 28 slow clients"] = [round(ms, 1) for ms in health_behind_slow_clients(server, 28, 6, 1.0)]
         second = subprocess.Popen([seamcl, "serve", "--port", str(server.port), "--quick-start"],
                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         try:

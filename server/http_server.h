@@ -44,7 +44,6 @@ struct Response;
 namespace seamcl {
 class Renderer;
 struct Scene;
-struct SceneSizes;
 }  // namespace seamcl
 
 namespace seamcl::server {
