@@ -24,6 +24,7 @@ ALLOWED = {
     "twins": {"core", "scene", "pipeline"},
     "io": {"core", "scene", "pipeline"},
     "eval": {"core", "cl", "scene", "pipeline", "io"},
+    "assets": {"core", "scene", "pipeline", "io"},
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 
