@@ -113,10 +113,15 @@ struct PtexTestFace {
 };
 
 // One metadata entry as stored: key size (with the NUL), key, type, value size, value.
-inline std::vector<uint8_t> metadata_entry(const std::string& key, uint8_t type, const std::vector<uint8_t>& value) {
-  std::vector<uint8_t> out{static_cast<uint8_t>(key.size() + 1)};
-  out.insert(out.end(), key.begin(), key.end());
+inline void put_key(std::vector<uint8_t>& out, const std::string& key) {
+  out.push_back(static_cast<uint8_t>(key.size() + 1));
+  for (char c : key) out.push_back(static_cast<uint8_t>(c));
   out.push_back(0);
+}
+
+inline std::vector<uint8_t> metadata_entry(const std::string& key, uint8_t type, const std::vector<uint8_t>& value) {
+  std::vector<uint8_t> out;
+  put_key(out, key);
   out.push_back(type);
   put_u32(out, static_cast<uint32_t>(value.size()));
   append(out, value);
@@ -136,9 +141,7 @@ struct PtexTestFile {
 
   void add_large_metadata(const std::string& key, uint8_t type, const std::vector<uint8_t>& value) {
     const std::vector<uint8_t> zipped = zip(value);
-    large_metadata_headers.push_back(static_cast<uint8_t>(key.size() + 1));
-    large_metadata_headers.insert(large_metadata_headers.end(), key.begin(), key.end());
-    large_metadata_headers.push_back(0);
+    put_key(large_metadata_headers, key);
     large_metadata_headers.push_back(type);
     put_u32(large_metadata_headers, static_cast<uint32_t>(value.size()));
     put_u32(large_metadata_headers, static_cast<uint32_t>(zipped.size()));

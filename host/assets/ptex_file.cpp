@@ -436,6 +436,9 @@ class PtexDecoder {
 
   // Edits (incremental updates appended to a file) are refused: only their presence is read.
   void check_no_edits() const {
+    if (header_.edit_data_bytes != 0)
+      fail("edits: the extended header records " + str(header_.edit_data_bytes) +
+           " bytes of edits, which seamcl does not read; write the file again without them");
     uint64_t position = add_saturated(metadata_position_, header_.metadata_zip_bytes);
     position = add_saturated(position, kBarrierBytes);
     position = add_saturated(position, header_.large_metadata_header_zip_bytes);
