@@ -21,8 +21,8 @@ struct SeamCheck {
 // each sample's face; uncovered samples count the background).
 inline SeamCheck compare_with_lit_constant(seamcl::Renderer& renderer, const seamcl::RenderResult& result, glm::vec3 stored_color) {
   const seamcl::Scene& scene = renderer.scene();
-  const seamcl::FrameParams frame = renderer.last_frame_params();
-  const std::vector<seamcl::TriangleSetup> setups = renderer.read_setups();
+  const FrameParams frame = renderer.last_frame_params();
+  const std::vector<TriangleSetup> setups = renderer.read_setups();
   const std::vector<uint32_t> winners = renderer.read_sample_triangles();
   const int samples = frame.sample_count;
   SeamCheck check;
