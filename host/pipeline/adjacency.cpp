@@ -75,6 +75,14 @@ std::vector<FaceNeighbors> build_adjacency(const Scene& scene) {
   return out;
 }
 
+bool has_adjacency(const std::vector<FaceNeighbors>& adjacency) {
+  if (adjacency.size() < 2) return true;
+  for (const FaceNeighbors& n : adjacency)
+    for (int k = 0; k < 4; ++k)
+      if (n.neighbor[k] >= 0) return true;
+  return false;
+}
+
 glm::vec2 transform_uv(const FaceNeighbors& n, int edge, glm::vec2 uv, bool translate) {
   const float* t = n.transform[edge];
   const float w = translate ? 1.0f : 0.0f;

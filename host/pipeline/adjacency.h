@@ -14,6 +14,12 @@ namespace seamcl {
 // exactly two faces links them; an edge of one face, or of three or more, has no neighbour.
 std::vector<FaceNeighbors> build_adjacency(const Scene& scene);
 
+// What the methods that read neighbours (traverse, guardband) need: true unless there are two or
+// more faces and no edge links two of them. A single face has nothing to read across; many faces
+// that share no vertex index (an OBJ written with split vertices, say) would quietly render as
+// discard or clamp.
+bool has_adjacency(const std::vector<FaceNeighbors>& adjacency);
+
 // Applies transform k of `n` to a uv point (or, with translate = false, to a derivative).
 glm::vec2 transform_uv(const FaceNeighbors& n, int edge, glm::vec2 uv, bool translate = true);
 

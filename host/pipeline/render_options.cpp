@@ -149,6 +149,9 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
     if (key == "scene") {
       options.scene = string_field(value, key);
       if (options.scene.empty()) throw InputError(key, "must not be empty");
+    } else if (key == "texture") {
+      options.texture = string_field(value, key);
+      if (options.texture.empty()) throw InputError(key, "must not be empty");
     } else if (key == "method") {
       options.method = enum_field(value, key, "method", kMethods);
     } else if (key == "filter") {
@@ -208,6 +211,7 @@ nlohmann::json to_json(const RenderOptions& options) {
                         {"size", std::to_string(options.width) + "x" + std::to_string(options.height)},
                         {"shading", to_string(options.shading)},
                         {"tint", options.tint}};
+  if (!options.texture.empty()) out["texture"] = options.texture;
   if (options.frame) {
     out["frame"] = *options.frame;
     out["frames"] = options.frames;

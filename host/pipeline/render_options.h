@@ -53,7 +53,8 @@ inline constexpr int kMaxImageSide = 16384;
 inline constexpr long long kMaxSamplesPerImage = 1LL << 28;  // width * height * msaa
 
 struct RenderOptions {
-  std::string scene = "paper";  // built-in name or scene file
+  std::string scene = "paper";  // built-in name or scene file (.json, .obj mesh, .ptx with its mesh)
+  std::string texture;          // a .ptx for an .obj scene; empty: none
   Method method = Method::Discard;
   Filter filter = Filter::Aniso;
   ZeroCoverage zero_coverage = ZeroCoverage::Clamp;
@@ -70,7 +71,7 @@ struct RenderOptions {
 };
 
 // Reads the keys present in `request` over the defaults. Throws InputError naming the key on a
-// wrong type, an out-of-range value or an unknown key. Keys: scene, method, filter, msaa, aniso,
+// wrong type, an out-of-range value or an unknown key. Keys: scene, texture, method, filter, msaa, aniso,
 // size ("WxH"), shading, centroid (bool, same as shading=centroid), zero_coverage, texels,
 // guard_band, frame, frames, tint.
 RenderOptions parse_render_options(const nlohmann::json& request);
