@@ -105,7 +105,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
                 {"fragments", result.stats.fragments},
                 {"texture_bytes", renderer.packed_scene().texture_bytes()},
                 {"padding_bytes", renderer.packed_scene().padding_bytes()},
-                {"adjacency_bytes", options.method == Method::Traverse ? renderer.packed_scene().adjacency_bytes() : 0},
+                {"adjacency_bytes", reads_adjacency(options.method) ? renderer.packed_scene().adjacency_bytes() : 0},
                 {"bin_entries", result.stats.bin_entries}};
     if (!args.output.empty()) out["output"] = args.output;
     std::cout << out.dump(2) << "\n";

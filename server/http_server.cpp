@@ -226,7 +226,11 @@ std::string method_description(const std::string& name) {
   if (name == "clamp") return "taps outside the face read the nearest edge texel (seams show)";
   if (name == "black") return "taps outside the face weigh zero, no renormalisation (edges darken)";
   if (name == "discard") return "taps outside the face weigh zero, the rest are renormalised (Toth 2013)";
-  if (name == "traverse") return "taps outside the face are fetched from the edge-adjacent faces (McDonald 2013)";
+  if (name == "traverse") {
+    return "taps outside the face are fetched from the edge-adjacent faces and, past valence-4 corners, the diagonal "
+           "face (McDonald 2013, with Ptex's corners)";
+  }
+  if (name == "traverse-edges") return "taps outside the face are fetched from the edge-adjacent faces only (McDonald 2013, as the paper compares)";
   if (name == "guardband") return "each mip level carries a band of texels from its neighbours (McDonald and Burley 2011)";
   return "";
 }
@@ -595,7 +599,7 @@ json HttpServer::make_methods_json() const {
                        {"description", method_description(name)},
                        {"texture_bytes", {{"rgba8", packed.texture_bytes()}, {"rgba32f", packed.texel_count() * float_texel_bytes}}},
                        {"padding_bytes", {{"rgba8", packed.padding_bytes()}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
-                       {"adjacency_bytes", method == Method::Traverse ? packed.adjacency_bytes() : 0}});
+                       {"adjacency_bytes", reads_adjacency(method) ? packed.adjacency_bytes() : 0}});
   }
   json scene_names = json::array();
   for (const GeneratorInfo& g : scene_generators()) scene_names.push_back(g.name);
