@@ -266,7 +266,7 @@ const PackedScene& Renderer::packed_scene() const { return impl_->packed; }
 
 RenderResult Renderer::render(const Camera& camera, const RenderOptions& options) {
   if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
-  if ((options.method == Method::Traverse || options.method == Method::Guardband) && !has_adjacency(impl_->packed.neighbors)) {
+  if ((reads_adjacency(options.method) || options.method == Method::Guardband) && !has_adjacency(impl_->packed.neighbors)) {
     throw InputError("method", to_string(options.method) + " reads each face's edge neighbours, and no two of the " +
                                    std::to_string(impl_->scene->faces.size()) + " faces of scene '" + impl_->scene->name +
                                    "' share an edge (faces are neighbours through shared vertex indices)");
