@@ -25,8 +25,6 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/version.h>
 #include "cl/kernel_sources.h"
-#include "twins/sample_pattern.h"
-#include "twins/shade_resolve.h"
 
 namespace seamcl {
 namespace {
@@ -391,18 +389,31 @@ ReferenceImage reference_image(Renderer& renderer, const Camera& camera, const R
   });
 }
 
+namespace {
+
+// uv of a triangle's planes at a pixel-space point, perspective-correct: the interpolation the
+// shade stage does (kernels/shade_resolve.cl, interpolate_uv), without the derivatives.
+glm::vec2 plane_uv(const TriangleSetup& t, float x, float y) {
+  const float dx = x - t.ref_x, dy = y - t.ref_y;
+  const float inv_w = t.inv_w[0] + t.inv_w[1] * dx + t.inv_w[2] * dy;
+  const float w = 1.0f / inv_w;
+  return {(t.u_over_w[0] + t.u_over_w[1] * dx + t.u_over_w[2] * dy) * w,
+          (t.v_over_w[0] + t.v_over_w[1] * dx + t.v_over_w[2] * dy) * w};
+}
+
+}  // namespace
+
 std::vector<glm::vec4> analytic_image(Renderer& renderer, const Scene& scene) {
   if (!scene.albedo) {
     throw InputError("reference", "the analytic reference needs the function the textures were baked from; scene '" +
                                       scene.name + "' has none (its textures came from files)");
   }
   const FrameParams f = renderer.last_frame_params();
+  if (f.sample_count != 1) throw std::logic_error("analytic_image: the frame must have 1 sample per pixel");
   const std::vector<uint32_t> winners = renderer.read_sample_triangles();
   const std::vector<TriangleSetup> setups = renderer.read_setups();
-  const std::vector<SampleOffset>& pattern = sample_pattern(f.sample_count);
   const PackedScene& packed = renderer.packed_scene();
   const glm::vec3 background(f.background[0], f.background[1], f.background[2]);
-  constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
   std::vector<glm::vec4> image(static_cast<size_t>(f.width) * static_cast<size_t>(f.height));
   // Rows in parallel: the 8x frame of a 480x540 image is 16.6 million albedo evaluations.
   auto shade_rows = [&](int first, int step) {
@@ -410,19 +421,17 @@ std::vector<glm::vec4> analytic_image(Renderer& renderer, const Scene& scene) {
       for (int x = 0; x < f.width; ++x) {
         const size_t pixel = static_cast<size_t>(y) * static_cast<size_t>(f.width) + static_cast<size_t>(x);
         glm::vec3 sum(0.0f);
-        for (int s = 0; s < f.sample_count; ++s) {
-          const uint32_t slot = winners[pixel * static_cast<size_t>(f.sample_count) + static_cast<size_t>(s)];
+        {
+          const uint32_t slot = winners[pixel];
           if (slot == SEAMCL_NO_TRIANGLE) {
-            sum += background;
+            image[pixel] = glm::vec4(background, 1.0f);
             continue;
           }
           const TriangleSetup& t = setups[slot];
-          const float sx = static_cast<float>(sample_fixed_x(x, pattern[static_cast<size_t>(s)])) * to_pixels;
-          const float sy = static_cast<float>(sample_fixed_y(y, pattern[static_cast<size_t>(s)])) * to_pixels;
-          const SurfaceUv uv = interpolate_uv(t, sx, sy);
-          // The sample lies inside its triangle, so uv is inside the face up to rounding.
-          const glm::vec3 point = face_point(scene.corners(scene.faces[t.face]), std::clamp(uv.u, 0.0f, 1.0f),
-                                             std::clamp(uv.v, 0.0f, 1.0f));
+          const glm::vec2 uv = plane_uv(t, static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+          // The pixel centre lies inside its triangle, so uv is inside the face up to rounding.
+          const glm::vec3 point = face_point(scene.corners(scene.faces[t.face]), std::clamp(uv.x, 0.0f, 1.0f),
+                                             std::clamp(uv.y, 0.0f, 1.0f));
           const glm::vec4 albedo = scene.albedo(t.face, point);
           const FaceGpu& face = packed.faces[t.face];
           const float n_dot_l =
@@ -431,7 +440,7 @@ std::vector<glm::vec4> analytic_image(Renderer& renderer, const Scene& scene) {
           sum += glm::vec3(albedo.x * f.light_color[0], albedo.y * f.light_color[1], albedo.z * f.light_color[2]) *
                  lighting;
         }
-        image[pixel] = glm::vec4(sum / static_cast<float>(f.sample_count), 1.0f);
+        image[pixel] = glm::vec4(sum, 1.0f);
       }
     }
   };
@@ -468,10 +477,16 @@ std::vector<ReferenceImage> reference_images(Renderer& renderer, const Camera& c
                                         scene.name + "' has none (its textures came from files)");
     }
     const auto start = std::chrono::steady_clock::now();
+    // The subsamples are the 8x frame's pixel centres: one sample per pixel whatever the other
+    // references use.
+    kind_settings.msaa = 1;
     const RenderOptions high = reference_render_options(frame, kind_settings);
-    // The analytic image reads the winners of the Renderer's last frame: render it now even when
-    // the other references came from the cache.
-    if (!high_res || renderer.last_frame_params().width != high.width) high_res = renderer.render(camera, high);
+    // The analytic image reads the winners of the Renderer's last frame: render it now unless that
+    // is this frame (the other references may have come from the cache).
+    const FrameParams last = renderer.last_frame_params();
+    if (!high_res || last.width != high.width || last.height != high.height || last.sample_count != 1) {
+      high_res = renderer.render(camera, high);
+    }
     const std::vector<glm::vec4> fine = analytic_image(renderer, scene);
     ReferenceImage ref;
     ref.kind = kind;

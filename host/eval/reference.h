@@ -35,10 +35,11 @@ namespace seamcl {
 //              Mitchell-Netravali downsample (B = C = 1/3): the paper's;
 //   box      - the same 8x render with a box downsample (the mean of each 8x8 block), as an MSAA
 //              resolve filters (Mitchell rings at silhouettes);
-//   analytic - the same 8x frame (its geometry and lighting) with each subsample's colour taken
-//              from the function the textures were baked from (Scene::albedo) at its surface
-//              point instead of from any texture lookup, then the Mitchell downsample: no seam
-//              method is favoured. Scenes without such a function are refused;
+//   analytic - the same 8x frame at 1 sample per pixel (its geometry and lighting), each of its
+//              pixel centres (the subsamples) coloured by the function the textures were baked
+//              from (Scene::albedo) at its surface point instead of any texture lookup, then the
+//              Mitchell downsample: no seam method is favoured. Scenes without such a function
+//              are refused;
 //   seamless - for a planar grid of equal-resolution faces, which is one continuous texture:
 //              the grid rendered as one face carrying the combined texture, at the measured
 //              frame's own rate, filter and anisotropy. What a perfect seam method returns, so
@@ -154,9 +155,9 @@ ReferenceImage reference_image(Renderer& renderer, const Camera& camera, const R
 std::vector<ReferenceImage> reference_images(Renderer& renderer, const Camera& camera, const RenderOptions& frame,
                                              const ReferenceSettings& settings, const std::vector<ReferenceKind>& kinds);
 
-// The analytic image of a frame already rendered by `renderer` (its last render): per sample,
-// background where nothing is covered, else albedo(face, surface point at the sample) times the
-// face's lighting, resolved with a box over the samples. Exposed for the tests.
+// The analytic image of a frame already rendered by `renderer` (its last render, 1 sample per
+// pixel): per pixel, background where nothing is covered, else albedo(face, the surface point at
+// the pixel centre) times the face's lighting. Exposed for the tests.
 std::vector<glm::vec4> analytic_image(Renderer& renderer, const Scene& scene);
 
 // The seamless reference's scene: `scene` when its faces form a planar grid (each face's right
