@@ -623,6 +623,13 @@ def image_differences(run, num="discard"):
 # Tables
 
 
+def frame_span(frames):
+    """'0, 50, ..., 950 (every 50th)' for an even stride, else the list."""
+    if len(frames) > 2 and len({b - a for a, b in zip(frames, frames[1:])}) == 1:
+        return f"frames {frames[0]}, {frames[1]}, ..., {frames[-1]} (every {frames[1] - frames[0]}th)"
+    return "frames " + ", ".join(map(str, frames))
+
+
 def fmt(v, spec=".3e"):
     return "-" if v is None else format(v, spec)
 
