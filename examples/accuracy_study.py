@@ -268,31 +268,60 @@ def quantile_from_curve(curve, q):
     return curve[-1][0]
 
 
-def off_mask_figures(result):
-    """Mean, p99 and curve over the complement of the seam mask, and where they came from."""
-    e = result.get("error", {})
-    mean = first_key(e, ["off_mean", "off_seam_mean", "complement_mean", "nonseam_mean", "interior_mean"])
-    p99 = first_key(e, ["off_p99", "off_seam_p99", "complement_p99", "nonseam_p99", "interior_p99"])
-    curve = first_key(result, ["off_curve", "off_seam_curve", "complement_curve", "nonseam_curve"])
-    source = "compare"
+def off_mask_figures(e, result, curves_ok):
+    """Mean, p99 and curve over the complement of the seam mask, and where they came from.
+    `e`: the error object of one reference; `result`'s curves only when they belong to it."""
+    mean = first_key(e, ["off_seam_mean", "off_mean", "complement_mean"])
+    p99 = first_key(e, ["off_seam_p99", "off_p99", "complement_p99"])
+    curve = first_key(result, ["off_seam_curve", "off_curve"]) if curves_ok else None
+    source = "compare" if mean is not None and p99 is not None else "derived"
     n, s = e.get("pixels"), e.get("seam_pixels")
     if mean is None and n is not None and s is not None and n > s:
         mean = (e["mean"] * n - e["seam_mean"] * s) / (n - s)
-        source = "derived"
-    if curve is None and n is not None and s is not None and n > s and result.get("curve") and result.get("seam_curve"):
+    if curve is None and curves_ok and n and s is not None and n > s and result.get("curve") and result.get("seam_curve"):
         curve = [[x, max(0.0, (fa * n - fs * s) / (n - s))] for (x, fa), (_, fs) in zip(result["curve"], result["seam_curve"])]
     if p99 is None and curve:
         p99 = quantile_from_curve(curve, 0.99)
-        source = "derived"
     return mean, p99, curve, source
 
 
-def mask_coverage(cmp):
-    m = cmp.get("mask")
-    if isinstance(m, dict) and "coverage" in m:
-        return float(m["coverage"])
+def mask_definition(cmp):
+    sm = cmp.get("seam_mask")
+    if isinstance(sm, dict) and "definition" in sm:
+        return sm["definition"]
+    return f"within {cmp.get('seam_radius', 2)} px of a face edge (from a 1-sample face map)"
+
+
+def image_size(cmp):
     w, h = (int(v) for v in cmp["size"].split("x"))
+    return w, h
+
+
+def mask_coverage(cmp, msaa):
+    """The seam mask's share of the pixels at a rate: seam_mask.by_msaa (the footprint mask, one per
+    rate) where compare gives it, else the one mask of seam_pixels."""
+    by = (cmp.get("seam_mask") or {}).get("by_msaa") if isinstance(cmp.get("seam_mask"), dict) else None
+    if by and str(msaa) in by:
+        return float(by[str(msaa)]["coverage"])
+    w, h = image_size(cmp)
     return cmp.get("seam_pixels", 0) / float(w * h)
+
+
+def reference_names(cmp):
+    """The references of one compare answer, the first (whose curves compare gives) first."""
+    refs = cmp.get("references")
+    if isinstance(refs, list) and refs and all(isinstance(r, dict) and "name" in r for r in refs):
+        return [r["name"] for r in refs]
+    ref = cmp.get("reference")
+    return [ref["name"]] if isinstance(ref, dict) and "name" in ref else ["paper"]
+
+
+def errors_for(result, name, first):
+    """results[].errors[name] with several references, else results[].error (the first's)."""
+    errs = result.get("errors")
+    if isinstance(errs, dict) and name in errs:
+        return errs[name]
+    return result.get("error", {}) if name == first else None
 
 
 def image_paths(cmp, images_dir, method, msaa):
@@ -302,12 +331,27 @@ def image_paths(cmp, images_dir, method, msaa):
     return os.path.join(images_dir, f"{method}_msaa{msaa}.png")
 
 
-def reference_image_path(cmp, images_dir):
-    return first_key(cmp, ["reference_image"], os.path.join(images_dir, "reference.png"))
+def reference_image_path(cmp, images_dir, name="paper", msaa=1):
+    """reference.png (the paper's, or the only one), reference_<name>.png, and for seamless, which
+    is rendered at the measured rate, reference_seamless_msaa<N>.png."""
+    candidates = [f"reference_{name}_msaa{msaa}.png", f"reference_{name}.png"]
+    if name == "paper" or len(reference_names(cmp)) == 1:
+        candidates.append("reference.png")
+    for c in candidates:
+        if os.path.exists(os.path.join(images_dir, c)):
+            return os.path.join(images_dir, c)
+    return os.path.join(images_dir, candidates[-1])
 
 
-def mask_image_path(cmp, images_dir):
-    return first_key(cmp, ["mask_image"], os.path.join(images_dir, "seam_mask.png"))
+def mask_image_path(cmp, images_dir, msaa=1):
+    """seam_mask_msaa<N>.png (one footprint mask per rate), else seam_mask.png."""
+    p = os.path.join(images_dir, f"seam_mask_msaa{msaa}.png")
+    return p if os.path.exists(p) else os.path.join(images_dir, "seam_mask.png")
+
+
+def read_mask(cmp, images_dir, msaa):
+    p = mask_image_path(cmp, images_dir, msaa)
+    return read_png(p)[..., 0] > 0.5 if os.path.exists(p) else None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -315,31 +359,86 @@ def mask_image_path(cmp, images_dir):
 
 
 def run_compare(binary, args, images_dir, timeout=None):
+    """Runs compare, passing its progress lines through to stderr. RuntimeError with the last
+    lines of stderr when it fails."""
     cmd = [binary.path, "compare", "--json", "--images", images_dir] + args
     t0 = time.monotonic()
-    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=None, text=True, timeout=timeout)
+    with tempfile.TemporaryFile("w+") as out:
+        proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.PIPE, text=True)
+        tail = []
+        for line in proc.stderr:
+            sys.stderr.write("  " + line)
+            tail = (tail + [line.rstrip()])[-5:]
+        proc.wait(timeout=timeout)
+        out.seek(0)
+        text = out.read()
     wall = time.monotonic() - t0
     if proc.returncode != 0:
-        raise RuntimeError(f"{shlex.join(cmd)} exited with {proc.returncode}")
-    return json.loads(proc.stdout), cmd, wall
+        raise RuntimeError(f"{shlex.join(cmd)} exited with {proc.returncode}: " + " / ".join(tail))
+    return json.loads(text), cmd, wall
 
 
-def measure_run(cmp, images_dir, with_flip=True):
-    """Per entry figures (compare's and FLIP), keyed in a list in compare's order."""
-    ref = read_png(reference_image_path(cmp, images_dir))
-    mask_path = mask_image_path(cmp, images_dir)
-    mask = read_png(mask_path)[..., 0] > 0.5 if os.path.exists(mask_path) else None
-    entries = []
+def compare_with_references(binary, args, images_dir, references):
+    """compare with as many of `references` as the scene allows: a reference the scene cannot
+    have (compare refuses it by name before rendering) is dropped and the run retried.
+    Returns (answer, command, wall seconds, [(reference, why dropped)])."""
+    refs, dropped = list(references), []
+    opt = binary.reference_option()
+    while True:
+        extra = [opt, ",".join(refs)] if opt else []
+        try:
+            cmp, cmd, wall = run_compare(binary, args + extra, images_dir)
+            return cmp, cmd, wall, dropped
+        except RuntimeError as e:
+            msg = str(e).split(": ", 1)[-1]
+            bad = [r for r in refs if re.search(r"\b" + re.escape(r) + r"\b", msg)] if opt else []
+            if not bad or len(bad) == len(refs):
+                raise
+            for r in bad:
+                refs.remove(r)
+                dropped.append((r, msg))
+                log(f"study   reference {r} dropped: {msg}")
+
+
+def png_curves(dist, mask):
+    return {"curve": curve_of(dist), "seam_curve": curve_of(dist[mask]) if mask is not None else None,
+            "off_curve": curve_of(dist[~mask]) if mask is not None else None}
+
+
+def measure_run(cmp, images_dir, name=None, with_flip=True):
+    """Per entry figures against reference `name` (default: the first), compare's and FLIP's, in
+    compare's order. Curves: compare's for its first reference; for the others, from the PNGs."""
+    names = reference_names(cmp)
+    first = names[0]
+    name = name or first
+    curves_ok = name == first
+    entries, ref_cache, mask_cache = [], {}, {}
     for r in cmp["results"]:
-        e = r.get("error", {})
-        off_mean, off_p99, off_curve, off_source = off_mask_figures(r)
-        item = {"method": r["method"], "msaa": r["msaa"], "ms": r["ms"]["median"], "ms_min": r["ms"]["min"],
+        e = errors_for(r, name, first)
+        if e is None:
+            continue
+        rate = r["msaa"]
+        off_mean, off_p99, off_curve, off_source = off_mask_figures(e, r, curves_ok)
+        item = {"method": r["method"], "msaa": rate, "ms": r["ms"]["median"], "ms_min": r["ms"]["min"],
                 "ms_max": r["ms"]["max"], "mean": e.get("mean"), "p99": e.get("p99"),
                 "seam_mean": e.get("seam_mean"), "seam_p99": e.get("seam_p99"), "off_mean": off_mean,
                 "off_p99": off_p99, "off_source": off_source, "nan_pixels": e.get("nan_pixels"),
-                "curve": r.get("curve"), "seam_curve": r.get("seam_curve"), "off_curve": off_curve}
+                "mask_coverage": first_key(e, ["seam_coverage"], mask_coverage(cmp, rate)),
+                "curve": r.get("curve") if curves_ok else None, "seam_curve": r.get("seam_curve") if curves_ok else None,
+                "off_curve": off_curve, "curve_source": "compare" if curves_ok else "png"}
+        need_png = with_flip or not curves_ok
+        if need_png:
+            ref_path = reference_image_path(cmp, images_dir, name, rate)
+            if ref_path not in ref_cache:
+                ref_cache[ref_path] = read_png(ref_path)
+            ref = ref_cache[ref_path]
+            if rate not in mask_cache:
+                mask_cache[rate] = read_mask(cmp, images_dir, rate)
+            mask = mask_cache[rate]
+            img = read_png(image_paths(cmp, images_dir, r["method"], rate))
+            if not curves_ok:
+                item.update(png_curves(distance_linear(img, ref), mask))
         if with_flip:
-            img = read_png(image_paths(cmp, images_dir, r["method"], r["msaa"]))
             fmap, fmean = flip_map(ref, img)
             item["flip_mean"] = fmean
             if mask is not None and mask.shape == fmap.shape:
@@ -515,7 +614,8 @@ def chart_figure5(regime, runs, out, differences):
                     if e and e.get(ckey):
                         xs, ys = zip(*e[ckey])
                         ax.plot(xs, np.maximum(ys, 1e-7), color="0.35" if rate == rates[0] else "0.65", ls=ls, lw=1.0)
-            ax.set_title(f"deviation from the {run['reference']} reference\n({where})", fontsize=9)
+            src = " (from the 8-bit PNGs)" if run["entries"] and run["entries"][0].get("curve_source") == "png" else ""
+            ax.set_title(f"deviation from the {run['reference']} reference\n({where}){src}", fontsize=9)
     for ax in axes.ravel():
         ax.set_xscale("log")
         ax.set_yscale("log")
@@ -547,10 +647,11 @@ def chart_heatmaps(regime, run, out, rate):
     d = run["images_dir"]
     cmp = run["compare"]
     methods = [m for m in METHODS if any(e["method"] == m and e["msaa"] == rate for e in run["entries"])]
-    if not methods or not os.path.exists(reference_image_path(cmp, d)):
+    ref_path = reference_image_path(cmp, d, run["reference"], rate)
+    if not methods or not os.path.exists(ref_path):
         return None
-    ref = read_png(reference_image_path(cmp, d))
-    mask_path = mask_image_path(cmp, d)
+    ref = read_png(ref_path)
+    mask_path = mask_image_path(cmp, d, rate)
     h, w = ref.shape[:2]
     ncol = len(methods) + 1
     panel = 2.6 * max(0.6, min(1.6, w / h))
@@ -560,7 +661,7 @@ def chart_heatmaps(regime, run, out, rate):
     if os.path.exists(mask_path):
         m = read_png(mask_path)[..., 0]
         axes[1][0].imshow(m, cmap="gray", vmin=0, vmax=1, interpolation="nearest")
-        axes[1][0].set_title(f"seam mask ({run['mask_coverage'] * 100:.0f}% of pixels)", fontsize=8)
+        axes[1][0].set_title(f"seam mask at {rate}x ({run['mask_coverage'][str(rate)] * 100:.0f}% of pixels)", fontsize=8)
     axes[2][0].axis("off")
     axes[2][0].text(0.5, 0.5, "row 3: FLIP against\nthe reference,\nper pixel (magma,\nas FLIP shows it)",
                     ha="center", va="center", fontsize=8, transform=axes[2][0].transAxes)
@@ -604,10 +705,9 @@ def image_differences(run, num="discard"):
     trav = traverse_variants(methods)
     if num not in methods or not trav:
         return {}
-    mask_path = mask_image_path(cmp, d)
-    mask = read_png(mask_path)[..., 0] > 0.5 if os.path.exists(mask_path) else None
     out = {}
     for rate in sorted({e["msaa"] for e in run["entries"]}):
+        mask = read_mask(cmp, d, rate)
         try:
             a = read_png(image_paths(cmp, d, num, rate))
             b = read_png(image_paths(cmp, d, trav[0], rate))
@@ -628,6 +728,14 @@ def frame_span(frames):
     if len(frames) > 2 and len({b - a for a, b in zip(frames, frames[1:])}) == 1:
         return f"frames {frames[0]}, {frames[1]}, ..., {frames[-1]} (every {frames[1] - frames[0]}th)"
     return "frames " + ", ".join(map(str, frames))
+
+
+def coverage_span(run):
+    """The seam mask's coverage: one figure, or its range over the rates (one mask per rate)."""
+    v = sorted(run["mask_coverage"].values())
+    if not v:
+        return "-"
+    return f"{v[0] * 100:.1f}%" if v[-1] - v[0] < 5e-4 else f"{v[0] * 100:.1f}-{v[-1] * 100:.1f}%"
 
 
 def fmt(v, spec=".3e"):
@@ -669,12 +777,12 @@ def results_md(study):
             apart = "-" if bl is None or cl is None else ("yes" if min(bl, cl) >= 2 else "no")
             if not reg.get("controls", True):
                 apart += " (control: a constant colour carries no seam error, so clamp equals traverse by construction)"
-            L.append(f"| {reg['name']} | {run['reference']} | {run['mask_coverage'] * 100:.1f}% | {fmt(bl, '.2f')} | "
+            L.append(f"| {reg['name']} | {run['reference']} | {coverage_span(run)} | {fmt(bl, '.2f')} | "
                      f"{fmt(cl, '.2f')} | {apart} |")
     for reg in study["regimes"]:
         L += ["", f"## {reg['name']}: {reg['what']}", "", f"compare arguments: `{shlex.join(reg['args'])}`", ""]
         for run in reg["runs"]:
-            L += [f"### reference `{run['reference']}` ({run['size']}, mask {run['mask_coverage'] * 100:.1f}% of pixels)",
+            L += [f"### reference `{run['reference']}` ({run['size']}, seam mask {coverage_span(run)} of the pixels)",
                   "", f"`{shlex.join(run['command'])}`", "",
                   "| method | msaa | ms | seam mean | seam p99 | off mean | off p99 | all mean | FLIP | FLIP seam | FLIP off | NaN px |",
                   "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
@@ -753,44 +861,48 @@ def main(argv=None):
             study["skipped"].append({"regime": reg["name"], "why": why})
             log(f"study: regime {reg['name']} skipped: {why}")
             continue
-        for ref in references:
-            if ref not in offered:
-                study["skipped"].append({"regime": reg["name"], "reference": ref, "why": "compare does not offer it"})
-                continue
-            todo.append((reg, ref))
+        todo.append(reg)
+    for ref in references:
+        if ref not in offered:
+            study["skipped"].append({"regime": "*", "reference": ref, "why": "compare does not offer it"})
+    references = [r for r in references if r in offered]
     t_start = time.monotonic()
     runs_by_regime = {}
-    for k, (reg, ref) in enumerate(todo, start=1):
+    for k, reg in enumerate(todo, start=1):
         elapsed = time.monotonic() - t_start
         eta = "" if k == 1 else f", about {elapsed / (k - 1) * (len(todo) - k + 1) / 60:.1f} min left"
-        log(f"study [{k}/{len(todo)}] {reg['name']} / reference {ref}: compare {len(methods)} methods x "
-            f"{len(rates)} rates at {size} ({elapsed / 60:.1f} min so far{eta})")
-        images_dir = os.path.join(work, reg["name"], ref)
+        log(f"study [{k}/{len(todo)}] {reg['name']}: compare {len(methods)} methods x {len(rates)} rates at {size} "
+            f"against {', '.join(references)} ({elapsed / 60:.1f} min so far{eta})")
+        images_dir = os.path.join(work, reg["name"])
         os.makedirs(images_dir, exist_ok=True)
         cargs = list(reg["args"]) + ["--methods", ",".join(methods), "--msaa", ",".join(map(str, rates)),
                                      "--size", size, "--repeat", str(repeat)] + args.compare_arg
-        if binary.reference_option():
-            cargs += [binary.reference_option(), ref]
         if args.cache:
             cargs += ["--cache", args.cache]
         try:
-            cmp, cmd, wall = run_compare(binary, cargs, images_dir)
+            cmp, cmd, wall, dropped = compare_with_references(binary, cargs, images_dir, references)
         except RuntimeError as e:
-            study["skipped"].append({"regime": reg["name"], "reference": ref, "why": str(e)})
+            study["skipped"].append({"regime": reg["name"], "why": str(e)})
             log(f"study: {e}; recorded in results.json")
             continue
+        for r, why in dropped:
+            study["skipped"].append({"regime": reg["name"], "reference": r, "why": why})
         study["device"] = cmp.get("device", study["device"])
-        t_flip = time.monotonic()
-        entries = measure_run(cmp, images_dir, with_flip=not args.no_flip)
-        log(f"study   compare {wall:.1f} s, FLIP {time.monotonic() - t_flip:.1f} s")
         cmd_shown = ["build/seamcl"] + cmd[1:]
         cmd_shown[cmd_shown.index("--images") + 1] = "DIR"
-        run = {"reference": ref, "reference_info": cmp.get("reference"), "size": cmp["size"],
-               "command": cmd_shown, "compare_wall_s": wall, "seam_pixels": cmp.get("seam_pixels"),
-               "mask_coverage": mask_coverage(cmp), "mask": cmp.get("mask"), "entries": entries,
-               "analysis": analyse_run(entries, reg.get("controls", True)),
-               "images_dir": images_dir, "compare": cmp}
-        runs_by_regime.setdefault(reg["name"], (reg, []))[1].append(run)
+        infos = {r.get("name", "paper"): r for r in cmp.get("references", [])} if isinstance(cmp.get("references"), list) else {}
+        for name in reference_names(cmp):
+            t_flip = time.monotonic()
+            entries = measure_run(cmp, images_dir, name, with_flip=not args.no_flip)
+            log(f"study   {reg['name']} / {name}: FLIP and curves {time.monotonic() - t_flip:.1f} s")
+            run = {"reference": name, "reference_info": infos.get(name, cmp.get("reference")), "size": cmp["size"],
+                   "command": cmd_shown, "compare_wall_s": wall, "seam_pixels": cmp.get("seam_pixels"),
+                   "mask_coverage": {str(r): mask_coverage(cmp, r) for r in rates},
+                   "mask_definition": mask_definition(cmp),
+                   "entries": entries, "analysis": analyse_run(entries, reg.get("controls", True)),
+                   "images_dir": images_dir, "compare": cmp}
+            runs_by_regime.setdefault(reg["name"], (reg, []))[1].append(run)
+        log(f"study   compare took {wall:.1f} s")
 
     figures = []
     for name, (reg, runs) in runs_by_regime.items():

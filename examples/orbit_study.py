@@ -245,8 +245,8 @@ def main(argv=None):
         device = cmp.get("device", device)
         entries = study.measure_run(cmp, images, with_flip=not args.no_flip)
         w, h = (int(v) for v in cmp["size"].split("x"))
-        mask_pixels = cmp.get("seam_pixels", 0)
         for e, raw in zip(entries, cmp["results"]):
+            mask_pixels = int(round(e["mask_coverage"] * w * h))
             pools.setdefault((e["method"], e["msaa"]), Pool()).add(e, raw, mask_pixels, w * h)
         run = {"images_dir": images, "compare": cmp, "entries": entries}
         for rate, d in study.image_differences(run).items():
