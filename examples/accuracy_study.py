@@ -49,6 +49,7 @@ import numpy as np
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.patches  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib import colors as mcolors  # noqa: E402
 from matplotlib import ticker as mticker  # noqa: E402
@@ -375,13 +376,22 @@ def run_compare(binary, args, images_dir, timeout=None):
     wall = time.monotonic() - t0
     if proc.returncode != 0:
         raise RuntimeError(f"{shlex.join(cmd)} exited with {proc.returncode}: " + " / ".join(tail))
-    return json.loads(text), cmd, wall
+    cmp = json.loads(text)
+    with open(os.path.join(images_dir, "compare.json"), "w") as f:  # for --reuse
+        json.dump({"command": cmd, "wall_s": wall, "answer": cmp}, f)
+    return cmp, cmd, wall
 
 
-def compare_with_references(binary, args, images_dir, references):
+def compare_with_references(binary, args, images_dir, references, reuse=False):
     """compare with as many of `references` as the scene allows: a reference the scene cannot
     have (compare refuses it by name before rendering) is dropped and the run retried.
     Returns (answer, command, wall seconds, [(reference, why dropped)])."""
+    saved = os.path.join(images_dir, "compare.json")
+    if reuse and os.path.exists(saved):
+        with open(saved) as f:
+            got = json.load(f)
+        log(f"study   reusing {saved}")
+        return got["answer"], got["command"], got["wall_s"], []
     refs, dropped = list(references), []
     opt = binary.reference_option()
     while True:
@@ -641,9 +651,34 @@ def chart_figure5(regime, runs, out, differences):
     return path
 
 
+def box_blur(a, r):
+    """Mean over a (2r+1)^2 window (edges clamped), by summed-area table."""
+    p = np.pad(a, r + 1, mode="edge").cumsum(0).cumsum(1)
+    k = 2 * r + 1
+    return (p[k:, k:] - p[:-k, k:] - p[k:, :-k] + p[:-k, :-k])[: a.shape[0], : a.shape[1]] / (k * k)
+
+
+def crop_window(cmp, d, rate, shape, methods):
+    """A square around where Discard and Traverse differ most (box-filtered), else the centre."""
+    h, w = shape
+    side = max(16, min(128, h // 3, w // 3))
+    cy, cx = h // 2, w // 2
+    trav = traverse_variants(methods)
+    try:
+        if "discard" in methods and trav:
+            dist = distance_linear(read_png(image_paths(cmp, d, "discard", rate)), read_png(image_paths(cmp, d, trav[0], rate)))
+            cy, cx = np.unravel_index(np.argmax(box_blur(dist, side // 4)), dist.shape)
+    except FileNotFoundError:
+        pass
+    y0 = int(min(max(0, cy - side // 2), h - side))
+    x0 = int(min(max(0, cx - side // 2), w - side))
+    return y0, x0, side
+
+
 def chart_heatmaps(regime, run, out, rate):
-    """One reference, one rate: the reference image and the mask, then per method its image, its
-    2-norm error (log colour scale) and its FLIP map, each with a colour bar."""
+    """One reference, one rate: per method its image, its 2-norm error against the reference (log
+    colour scale) and its FLIP map, full frame and a close-up (a square around where Discard and
+    Traverse differ most), with the reference and the seam mask in the first column."""
     d = run["images_dir"]
     cmp = run["compare"]
     methods = [m for m in METHODS if any(e["method"] == m and e["msaa"] == rate for e in run["entries"])]
@@ -653,17 +688,26 @@ def chart_heatmaps(regime, run, out, rate):
     ref = read_png(ref_path)
     mask_path = mask_image_path(cmp, d, rate)
     h, w = ref.shape[:2]
+    y0, x0, side = crop_window(cmp, d, rate, (h, w), methods)
+    crop = (slice(y0, y0 + side), slice(x0, x0 + side))
     ncol = len(methods) + 1
-    panel = 2.6 * max(0.6, min(1.6, w / h))
-    fig, axes = plt.subplots(3, ncol, figsize=(panel * ncol + 1.2, 2.6 * 3 + 0.8), squeeze=False)
+    panel = 2.4
+    fig, axes = plt.subplots(5, ncol, figsize=(panel * ncol * max(0.8, min(1.3, w / h)) + 1.0, panel * 5 + 0.6),
+                             squeeze=False, layout="constrained")
     axes[0][0].imshow(ref, interpolation="nearest")
-    axes[0][0].set_title(f"reference: {run['reference']}", fontsize=8)
+    axes[0][0].add_patch(matplotlib.patches.Rectangle((x0 - 0.5, y0 - 0.5), side, side, fill=False, ec="w", lw=1.2))
+    axes[0][0].set_title(f"reference: {run['reference']}\n(box: the close-up below)", fontsize=8)
+    mask = None
     if os.path.exists(mask_path):
-        m = read_png(mask_path)[..., 0]
-        axes[1][0].imshow(m, cmap="gray", vmin=0, vmax=1, interpolation="nearest")
-        axes[1][0].set_title(f"seam mask at {rate}x ({run['mask_coverage'][str(rate)] * 100:.0f}% of pixels)", fontsize=8)
+        mask = read_png(mask_path)[..., 0]
+        axes[1][0].imshow(mask, cmap="gray", vmin=0, vmax=1, interpolation="nearest")
+        axes[1][0].set_title(f"seam mask at {rate}x\n({run['mask_coverage'][str(rate)] * 100:.0f}% of the pixels)", fontsize=8)
+        axes[4][0].imshow(mask[crop], cmap="gray", vmin=0, vmax=1, interpolation="nearest")
+        axes[4][0].set_title("seam mask, close-up", fontsize=8)
+    axes[3][0].imshow(ref[crop], interpolation="nearest")
+    axes[3][0].set_title("reference, close-up", fontsize=8)
     axes[2][0].axis("off")
-    axes[2][0].text(0.5, 0.5, "row 3: FLIP against\nthe reference,\nper pixel (magma,\nas FLIP shows it)",
+    axes[2][0].text(0.5, 0.5, "FLIP against the\nreference, per pixel\n(magma, as FLIP\nshows it)",
                     ha="center", va="center", fontsize=8, transform=axes[2][0].transAxes)
     norm = mcolors.LogNorm(vmin=1e-3, vmax=1.0)
     err_im = flip_im = None
@@ -671,27 +715,33 @@ def chart_heatmaps(regime, run, out, rate):
     for col, method in enumerate(methods, start=1):
         img = read_png(image_paths(cmp, d, method, rate))
         e = b[(method, rate)]
-        axes[0][col].imshow(img, interpolation="nearest")
-        axes[0][col].set_title(f"{method} {rate}x: {e['ms']:.1f} ms", fontsize=8)
         dist = np.maximum(distance_linear(img, ref), 1e-3)
-        err_im = axes[1][col].imshow(dist, cmap="viridis", norm=norm, interpolation="nearest")
-        axes[1][col].set_title(f"2-norm error; seam mean {e['seam_mean']:.2e}", fontsize=8)
         fmap, fmean = flip_map(ref, img)
+        axes[0][col].imshow(img, interpolation="nearest")
+        axes[0][col].set_title(f"{method} {rate}x ({e['ms']:.3g} ms)", fontsize=8)
+        err_im = axes[1][col].imshow(dist, cmap="viridis", norm=norm, interpolation="nearest")
+        axes[1][col].set_title(f"2-norm error\nseam mean {e['seam_mean']:.2e}", fontsize=8)
         flip_im = axes[2][col].imshow(fmap, cmap="magma", vmin=0, vmax=1, interpolation="nearest")
-        axes[2][col].set_title(f"FLIP; mean {fmean:.3f}", fontsize=8)
+        fs = e.get("flip_seam_mean")
+        axes[2][col].set_title(f"FLIP: mean {fmean:.3f}" + (f"\nover the mask {fs:.3f}" if fs is not None else ""), fontsize=8)
+        axes[3][col].imshow(img[crop], interpolation="nearest")
+        axes[3][col].set_title(f"{method} {rate}x, close-up", fontsize=8)
+        axes[4][col].imshow(dist[crop], cmap="viridis", norm=norm, interpolation="nearest")
+        axes[4][col].set_title("2-norm error, close-up", fontsize=8)
     for ax in axes.ravel():
         ax.set_xticks([])
         ax.set_yticks([])
-    axes[0][0].set_ylabel("image (sRGB)", fontsize=8)
-    axes[1][0].set_ylabel("error vs reference", fontsize=8)
-    fig.suptitle(f"{regime['name']} at {rate}x MSAA, {run['size']}: each method's image, its per-pixel 2-norm error in "
-                 f"linear RGB (log scale; from the 8-bit PNGs) and FLIP (0 = same, 1 = most different)", fontsize=9)
-    fig.tight_layout(rect=(0, 0, 0.9, 0.95))
+    for row, label in enumerate(["image (sRGB)", "error vs reference", "", "close-up", "error, close-up"]):
+        if label:
+            axes[row][0].set_ylabel(label, fontsize=8)
     if err_im is not None:
-        cax = fig.add_axes((0.91, 0.36, 0.015, 0.26))
-        fig.colorbar(err_im, cax=cax).set_label("2-norm, linear RGB", fontsize=8)
-        cax2 = fig.add_axes((0.91, 0.05, 0.015, 0.26))
-        fig.colorbar(flip_im, cax=cax2).set_label("FLIP", fontsize=8)
+        for row in (1, 4):
+            fig.colorbar(err_im, ax=list(axes[row]), shrink=0.9, pad=0.01).set_label("2-norm, linear RGB", fontsize=8)
+        fig.colorbar(flip_im, ax=list(axes[2]), shrink=0.9, pad=0.01).set_label("FLIP", fontsize=8)
+    fig.suptitle(f"{regime['name']} at {rate}x MSAA, {run['size']}, against the {run['reference']} reference: each "
+                 f"method's image, its per-pixel 2-norm error in linear RGB\n(log scale, from the 8-bit PNGs) and FLIP "
+                 f"(0 = same, 1 = most different); rows 4-5: a {side}x{side} close-up where Discard and Traverse differ most",
+                 fontsize=9)
     path = os.path.join(out, f"heatmaps_{regime['name']}.png")
     fig.savefig(path, dpi=100)
     plt.close(fig)
@@ -820,6 +870,9 @@ def main(argv=None):
     ap.add_argument("--heatmap-msaa", type=int, default=1, help="MSAA rate of the heat maps [1]")
     ap.add_argument("--cache", help="reference cache folder (compare's --cache)")
     ap.add_argument("--images", help="keep compare's images here (default: a temporary folder, removed)")
+    ap.add_argument("--reuse", action="store_true",
+                    help="with --images: where a regime's folder holds compare.json from an earlier run, use it and its "
+                         "images instead of running compare (to redraw the charts)")
     ap.add_argument("--no-flip", action="store_true", help="skip FLIP (it is on by default and needs flip-evaluator)")
     ap.add_argument("--compare-arg", action="append", default=[], help="extra argument for every compare (repeatable)")
     args = ap.parse_args(argv)
@@ -880,7 +933,7 @@ def main(argv=None):
         if args.cache:
             cargs += ["--cache", args.cache]
         try:
-            cmp, cmd, wall, dropped = compare_with_references(binary, cargs, images_dir, references)
+            cmp, cmd, wall, dropped = compare_with_references(binary, cargs, images_dir, references, args.reuse)
         except RuntimeError as e:
             study["skipped"].append({"regime": reg["name"], "why": str(e)})
             log(f"study: {e}; recorded in results.json")

@@ -78,7 +78,9 @@ def study_checks(seamcl):
                 bad = [(e["method"], e["msaa"], k) for e in run["entries"] for k in keys if not finite(e.get(k))]
                 check(not bad, f"{where}: every figure is a finite number {bad[:3]}")
                 check(all(0.0 <= e["flip_mean"] <= 1.0 for e in run["entries"]), f"{where}: FLIP means in [0, 1]")
-                check(0.0 < run["mask_coverage"] < 1.0, f"{where}: mask coverage {run['mask_coverage']:.3f} in (0, 1)")
+                cov = run["mask_coverage"]
+                check(sorted(cov, key=int) == [str(r) for r in rates] and all(0.0 < v < 1.0 for v in cov.values()),
+                      f"{where}: the seam mask's coverage per rate lies in (0, 1): {cov}")
                 ratios = run["analysis"]["ratios"].get("traverse", {})
                 check(sorted(ratios, key=int) == [str(r) for r in rates] and all(finite(v) and v > 0 for v in ratios.values()),
                       f"{where}: a Discard/Traverse ratio per rate {ratios}")
