@@ -273,8 +273,7 @@ def main(argv=None):
            "entries": entries, "analysis": study.analyse_run(entries),
            "differences": {str(r): {"curve": [[float(x), float(f / d["n"])] for x, f in d["curve"]],
                                     "mean": d["sum"] / d["n"]} for r, d in sorted(diffs.items()) if d["n"]}}
-    with open(os.path.join(args.out, "orbit.json"), "w") as f:
-        json.dump(res, f, indent=1)
+    study.dump_json(res, os.path.join(args.out, "orbit.json"))
     with open(os.path.join(args.out, "orbit.md"), "w") as f:
         f.write(orbit_md(res))
     paths = [os.path.join(args.out, n) for n in ("orbit.json", "orbit.md")]
