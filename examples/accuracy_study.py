@@ -170,7 +170,7 @@ class Binary:
         opt = self.reference_option()
         if opt is None:
             return ["paper"]  # today's compare: the paper's reference only
-        line = next((ln for ln in self.compare_help.splitlines() if re.search(re.escape(opt) + r"\b", ln)), "")
+        line = next((ln for ln in self.compare_help.splitlines() if re.search(re.escape(opt) + r"(\s|,|=|$)", ln)), "")
         found = [r for r in REFERENCES if re.search(r"\b" + r + r"\b", line)]
         return found or list(REFERENCES)
 

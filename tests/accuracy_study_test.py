@@ -45,6 +45,54 @@ def flip_checks():
     check(0.0 < small < mean, f"FLIP of slight noise lies between (0 < {small:.3f} < {mean:.3f})")
 
 
+def reading_checks():
+    """The study reads compare's answer by name: with several references (results[].errors{name},
+    references[], seam_mask.by_msaa, reference_<name>.png, seam_mask_msaa<N>.png) as with one
+    (results[].error, reference.png, seam_mask.png). A synthetic answer and images, no seamcl."""
+    import numpy as np
+    import matplotlib.pyplot as plt
+    sys.path.insert(0, EXAMPLES)
+    import accuracy_study as study
+
+    rng = np.random.default_rng(2)
+    ref = rng.random((24, 32, 3)).astype(np.float32)
+    box = np.clip(ref * 0.9, 0, 1)
+    mask = np.zeros((24, 32, 3), np.float32)
+    mask[:, 14:18] = 1
+    curve = [[x, 0.5] for x in study.thresholds()]
+    err = {"mean": 0.02, "p99": 0.1, "seam_mean": 0.04, "seam_p99": 0.2, "off_seam_mean": 0.015,
+           "off_seam_p99": 0.08, "nan_pixels": 0, "pixels": 768, "seam_pixels": 96, "seam_coverage": 0.125}
+    with tempfile.TemporaryDirectory() as d:
+        plt.imsave(os.path.join(d, "reference.png"), ref)
+        plt.imsave(os.path.join(d, "reference_box.png"), box)
+        plt.imsave(os.path.join(d, "seam_mask_msaa4.png"), mask)
+        plt.imsave(os.path.join(d, "discard_msaa4.png"), ref)
+        plt.imsave(os.path.join(d, "traverse_msaa4.png"), np.clip(ref + 0.1, 0, 1))
+        results = [{"method": m, "msaa": 4, "ms": {"median": 1.0, "min": 1.0, "max": 1.0}, "error": err,
+                    "errors": {"paper": err, "box": dict(err, seam_mean=0.05 if m == "discard" else 0.04)},
+                    "curve": curve, "seam_curve": curve} for m in ("discard", "traverse")]
+        cmp = {"size": "32x24", "references": [{"name": "paper"}, {"name": "box"}], "results": results,
+               "seam_mask": {"definition": "footprint", "by_msaa": {"4": {"pixels": 96, "coverage": 0.125}}}}
+        check(study.reference_names(cmp) == ["paper", "box"], "reference names from references[]")
+        paper = study.measure_run(cmp, d, "paper")
+        boxed = study.measure_run(cmp, d, "box")
+        check(paper[0]["curve_source"] == "compare" and boxed[0]["curve_source"] == "png",
+              "curves: compare's for the first reference, from the PNGs for the others")
+        check(paper[0]["off_mean"] == 0.015 and paper[0]["mask_coverage"] == 0.125,
+              "off-seam mean and the mask's coverage read by name")
+        check(paper[0]["flip_mean"] == 0.0 and boxed[0]["flip_mean"] > 0.0,
+              "FLIP against each reference's own image (discard equals the paper reference here)")
+        check(abs(boxed[0]["seam_curve"][0][1] - 1.0) < 1e-9 and boxed[0]["flip_seam_mean"] is not None,
+              "the mask of the entry's rate is read (seam_mask_msaa4.png)")
+        r = study.analyse_run(boxed)["ratios"]["traverse"]
+        check(abs(r["4"] - 1.25) < 1e-9, f"Discard/Traverse ratio against the named reference ({r})")
+        one = {"size": "32x24", "reference": {"method": "traverse"}, "seam_pixels": 96,
+               "results": [{k: v for k, v in x.items() if k != "errors"} for x in results]}
+        old = study.measure_run(one, d)
+        check(old[0]["seam_mean"] == 0.04 and study.mask_coverage(one, 4) == 96 / 768.0,
+              "a one-reference answer (results[].error, seam_pixels) reads too")
+
+
 def finite(v):
     return isinstance(v, (int, float)) and math.isfinite(v)
 
@@ -124,6 +172,7 @@ def main():
               f"for /usr/bin/python3 (this is {sys.executable})")
         return 1
     flip_checks()
+    reading_checks()
     study_checks(os.path.abspath(args.seamcl))
     print(f"{len(failures)} failed" if failures else "all checks passed")
     return 1 if failures else 0
