@@ -29,6 +29,7 @@ import time
 
 import numpy as np
 
+sys.dont_write_bytecode = True  # no __pycache__ beside the sources
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import accuracy_study as study  # noqa: E402
 from accuracy_study import plt, Line2D  # noqa: E402
