@@ -839,6 +839,21 @@ def results_md(study):
         L += [f"- {s['regime']}" + (f" / {s['reference']}" if s.get("reference") else "") + f": {s['why']}"
               for s in study["skipped"]]
         L.append("")
+    L += ["## Summary: Discard / Traverse per rate, and FLIP", "",
+          "Seam error ratio r = Discard's seam mean / Traverse's (below 1: Discard better). FLIP over the seam mask, "
+          "Discard and Traverse, at 1x and 8x.", "",
+          "| regime | reference | traverse | r 1x | r 4x | r 8x | r 16x | FLIP 1x D / T | FLIP 8x D / T |",
+          "| --- | --- | --- | ---: | ---: | ---: | ---: | --- | --- |"]
+    for reg in study["regimes"]:
+        for run in reg["runs"]:
+            b = by_key(run["entries"])
+            for t, r in run["analysis"]["ratios"].items():
+                def fl(rate):
+                    d, tr = b.get(("discard", rate), {}), b.get((t, rate), {})
+                    return f"{fmt(d.get('flip_seam_mean'), '.4f')} / {fmt(tr.get('flip_seam_mean'), '.4f')}"
+                L.append(f"| {reg['name']} | {run['reference']} | {t} | " +
+                         " | ".join(fmt(r.get(k), ".3f") for k in ("1", "4", "8", "16")) + f" | {fl(1)} | {fl(8)} |")
+    L.append("")
     L += ["## The paper's claims, per regime and reference", "",
           f"Rules on the Discard / Traverse seam-error ratio r (seam mean): worse r > {1 + TIE:.2f}, even |r - 1| <= {EVEN}, "
           f"better r < {1 - TIE:.2f} (within {TIE * 100:.0f}% of 1 is a tie). Traverse is the paper's (`traverse-edges`, McDonald's) where present, and `traverse` "
