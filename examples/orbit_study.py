@@ -181,7 +181,8 @@ def orbit_md(res):
         L += [f"Discard / {t} seam error per rate: " + ", ".join(f"{k}x {v:.3f}" for k, v in r.items()) +
               (("; FLIP over the mask: " + ", ".join(f"{k}x {v:.3f}" for k, v in fr.items())) if fr else ""), ""]
         L += ["| claim | rule | ratio | verdict |", "| --- | --- | ---: | --- |"]
-        L += [f"| {c['claim']} | {c['rule']} | {f(c['ratio'], '.3f')} | {c['verdict']} |" for c in claims]
+        L += [f"| {c['claim']} | {c['rule'].replace('|', chr(92) + '|')} | {f(c['ratio'], '.3f')} | {c['verdict']} |"
+              for c in claims]
         L.append("")
     return "\n".join(L) + "\n"
 
