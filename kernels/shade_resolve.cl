@@ -1,7 +1,8 @@
 /* Stage 4: shade and resolve. One work-item per pixel, work-groups of one tile.
  *
  * SEAMCL_SHADE_PIXEL / _CENTROID: each distinct triangle among the pixel's samples is shaded once,
- * at the pixel centre (or the mean of the positions of the samples it covers), and its colour
+ * at the pixel centre (or, when it covers some but not all of them, the mean of the positions of
+ * the samples it covers), and its colour
  * counts for the samples it covers; samples no triangle covers count the background. A centre
  * where the triangle's plane has 1/w <= 0 (extrapolated past the horizon) falls back to the
  * centroid, whose samples lie inside the triangle. SEAMCL_SHADE_SAMPLE shades every sample at its
@@ -99,7 +100,11 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
       centroid_y /= (float)covered;
       float shade_x = (float)x + 0.5f;
       float shade_y = (float)y + 0.5f;
-      if (frame->shading_mode == SEAMCL_SHADE_CENTROID || !(plane_inv_w(setups + slot, shade_x, shade_y) > 0.0f)) {
+      /* Centroid shading keeps the centre when every sample is covered (as D3D and GL do): the
+       * centroid of a full pattern is not the centre (16x: (-1/32, -1/32)). */
+      const int partly_covered = covered < samples;
+      if ((frame->shading_mode == SEAMCL_SHADE_CENTROID && partly_covered) ||
+          !(plane_inv_w(setups + slot, shade_x, shade_y) > 0.0f)) {
         shade_x = centroid_x;
         shade_y = centroid_y;
       }
