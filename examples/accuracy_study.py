@@ -76,17 +76,19 @@ REGIMES = [
     {"name": "paper", "what": "the paper's Figure 1 scene: minified, smooth texture (features 0.2-0.5 units)",
      "args": ["--scene", "paper"], "scenes": ["paper"]},
     {"name": "detail", "what": "the paper's scene with texel-scale detail (features of 2-4 texels)",
-     "args": ["--scene", "paper", "--content", "detail"], "scenes": ["paper"], "options": ["--content"]},
+     "content": ("paper", "detail"), "scenes": ["paper"]},
     {"name": "closeup-seam", "what": "magnified close-up of a seam", "args": ["--scene", "closeup-seam"],
      "scenes": ["closeup-seam"]},
     {"name": "closeup-corner", "what": "magnified close-up of a corner where faces meet",
      "args": ["--scene", "closeup-corner"], "scenes": ["closeup-corner"]},
     {"name": "grazing", "what": "a plane of 64x64 small faces at a grazing angle (anisotropic footprints)",
      "args": ["--scene", "plane"], "scenes": ["plane"]},
+    {"name": "grazing-detail", "what": "the grazing plane with texel-scale detail", "content": ("plane", "detail"),
+     "scenes": ["plane"]},
     {"name": "mixed", "what": "closed mesh, mixed resolutions, rotated and mirrored neighbours, valence 3/4/5",
      "args": ["--scene", "mixed"], "scenes": ["mixed"]},
     {"name": "mixed-detail", "what": "the mixed mesh with texel-scale detail",
-     "args": ["--scene", "mixed", "--content", "detail"], "scenes": ["mixed"], "options": ["--content"]},
+     "content": ("mixed", "detail"), "scenes": ["mixed"]},
     {"name": "constant", "what": "control: the paper's scene in one colour, so seams carry no texture error",
      "args": ["--scene", "paper", "--constant-color", "0.5,0.4,0.3"], "scenes": ["paper"],
      "options": ["--constant-color"], "controls": False},
@@ -95,8 +97,8 @@ REGIMES = [
 QUICK_REGIMES = [
     {"name": "cube", "what": "a closed cube of six 64x64-textured faces, seen obliquely",
      "args": ["--scene", "cube"], "scenes": ["cube"]},
-    {"name": "cube-detail", "what": "the cube with texel-scale detail", "args": ["--scene", "cube", "--content", "detail"],
-     "scenes": ["cube"], "options": ["--content"]},
+    {"name": "cube-detail", "what": "the cube with texel-scale detail", "content": ("cube", "detail"),
+     "scenes": ["cube"]},
     {"name": "cube-constant", "what": "control: the cube in one colour",
      "args": ["--scene", "cube", "--constant-color", "0.5,0.4,0.3"], "scenes": ["cube"],
      "options": ["--constant-color"], "controls": False},
@@ -175,6 +177,15 @@ class Binary:
         found = [r for r in REFERENCES if re.search(r"\b" + r + r"\b", line)]
         return found or list(REFERENCES)
 
+    def has_content(self, content):
+        """Whether scene files take {"options": {"content": ...}}: a tiny render of the cube with it."""
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "probe.json")
+            with open(path, "w") as f:
+                json.dump({"generator": "cube", "options": {"content": content}}, f)
+            probe = subprocess.run([self.path, "render", "--scene", path, "--size", "8x8"], capture_output=True, text=True)
+            return probe.returncode == 0
+
     def version(self):
         try:
             return self._run(["--version"]).strip().splitlines()[0]
@@ -190,7 +201,28 @@ def regime_missing(binary, regime):
     for o in regime.get("options", []):
         if not binary.has_option(o):
             return f"`seamcl compare` has no {o}"
+    if "content" in regime and not binary.has_content(regime["content"][1]):
+        return f"this seamcl's scene files take no \"content\": \"{regime['content'][1]}\""
     return None
+
+
+def regime_args(regime, work):
+    """compare's scene arguments. A texture content is a scene file (docs/scene-format.md):
+    {"generator": G, "options": {"content": C}}, written into the work folder."""
+    if "content" not in regime:
+        return list(regime["args"])
+    generator, content = regime["content"]
+    path = os.path.join(work, f"{generator}_{content}.json")
+    with open(path, "w") as f:
+        json.dump({"generator": generator, "options": {"content": content}}, f)
+    return ["--scene", path]
+
+
+def shown_args(regime):
+    if "content" not in regime:
+        return list(regime["args"])
+    generator, content = regime["content"]
+    return ["--scene", f"{generator}_{content}.json"]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -352,9 +384,19 @@ def mask_image_path(cmp, images_dir, msaa=1):
     return p if os.path.exists(p) else os.path.join(images_dir, "seam_mask.png")
 
 
-def read_mask(cmp, images_dir, msaa):
+def read_masks(cmp, images_dir, msaa):
+    """(seam, off) boolean masks from the mask PNG: white = seam; black = off every edge; grey
+    (0.2 linear, the footprint mask's boundary pixels: silhouette rims) = neither. A two-level
+    mask (older binaries) has off = not seam."""
     p = mask_image_path(cmp, images_dir, msaa)
-    return read_png(p)[..., 0] > 0.5 if os.path.exists(p) else None
+    if not os.path.exists(p):
+        return None, None
+    v = read_png(p)[..., 0]
+    return v > 0.9, v < 0.1
+
+
+def read_mask(cmp, images_dir, msaa):
+    return read_masks(cmp, images_dir, msaa)[0]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -412,9 +454,9 @@ def compare_with_references(binary, args, images_dir, references, reuse=False):
                 log(f"study   reference {r} dropped: {msg}")
 
 
-def png_curves(dist, mask):
+def png_curves(dist, mask, off):
     return {"curve": curve_of(dist), "seam_curve": curve_of(dist[mask]) if mask is not None else None,
-            "off_curve": curve_of(dist[~mask]) if mask is not None else None}
+            "off_curve": curve_of(dist[off]) if off is not None else None}
 
 
 def measure_run(cmp, images_dir, name=None, with_flip=True):
@@ -445,17 +487,17 @@ def measure_run(cmp, images_dir, name=None, with_flip=True):
                 ref_cache[ref_path] = read_png(ref_path)
             ref = ref_cache[ref_path]
             if rate not in mask_cache:
-                mask_cache[rate] = read_mask(cmp, images_dir, rate)
-            mask = mask_cache[rate]
+                mask_cache[rate] = read_masks(cmp, images_dir, rate)
+            mask, off = mask_cache[rate]
             img = read_png(image_paths(cmp, images_dir, r["method"], rate))
             if not curves_ok:
-                item.update(png_curves(distance_linear(img, ref), mask))
+                item.update(png_curves(distance_linear(img, ref), mask, off))
         if with_flip:
             fmap, fmean = flip_map(ref, img)
             item["flip_mean"] = fmean
             if mask is not None and mask.shape == fmap.shape:
                 item["flip_seam_mean"] = float(fmap[mask].mean()) if mask.any() else None
-                item["flip_off_mean"] = float(fmap[~mask].mean()) if (~mask).any() else None
+                item["flip_off_mean"] = float(fmap[off].mean()) if off.any() else None
         entries.append(item)
     return entries
 
@@ -886,7 +928,9 @@ def results_md(study):
             L.append(f"| {reg['name']} | {run['reference']} | {coverage_span(run)} | {fmt(bl, '.2f')} | "
                      f"{fmt(cl, '.2f')} | {apart} |")
     for reg in study["regimes"]:
-        L += ["", f"## {reg['name']}: {reg['what']}", "", f"compare arguments: `{shlex.join(reg['args'])}`", ""]
+        L += ["", f"## {reg['name']}: {reg['what']}", "", f"compare arguments: `{shlex.join(reg['args'])}`" +
+              (f" (the scene file: `{json.dumps({'generator': reg['args'][1].split('_')[0], 'options': {'content': 'detail'}})}`)"
+               if reg['args'][1].endswith("_detail.json") else ""), ""]
         for run in reg["runs"]:
             L += [f"### reference `{run['reference']}` ({run['size']}, seam mask {coverage_span(run)} of the pixels)",
                   "", f"`{shlex.join(run['command'])}`", "",
@@ -984,7 +1028,7 @@ def main(argv=None):
             f"against {', '.join(references)} ({elapsed / 60:.1f} min so far{eta})")
         images_dir = os.path.join(work, reg["name"])
         os.makedirs(images_dir, exist_ok=True)
-        cargs = list(reg["args"]) + ["--methods", ",".join(methods), "--msaa", ",".join(map(str, rates)),
+        cargs = regime_args(reg, images_dir) + ["--methods", ",".join(methods), "--msaa", ",".join(map(str, rates)),
                                      "--size", size, "--repeat", str(repeat)] + args.compare_arg
         if args.cache:
             cargs += ["--cache", args.cache]
@@ -999,6 +1043,7 @@ def main(argv=None):
         study["device"] = cmp.get("device", study["device"])
         cmd_shown = ["build/seamcl"] + cmd[1:]
         cmd_shown[cmd_shown.index("--images") + 1] = "DIR"
+        cmd_shown = [os.path.basename(a) if a.startswith(images_dir) and a.endswith(".json") else a for a in cmd_shown]
         infos = {r.get("name", "paper"): r for r in cmp.get("references", [])} if isinstance(cmp.get("references"), list) else {}
         for name in reference_names(cmp):
             t_flip = time.monotonic()
@@ -1022,7 +1067,7 @@ def main(argv=None):
         if not args.no_flip:
             hm_rate = args.heatmap_msaa if args.heatmap_msaa in rates else rates[0]
             figures.append(chart_heatmaps(reg, runs[0], args.out, hm_rate))
-        keep = {"name": reg["name"], "what": reg["what"], "args": reg["args"], "controls": reg.get("controls", True),
+        keep = {"name": reg["name"], "what": reg["what"], "args": shown_args(reg), "controls": reg.get("controls", True),
                 "differences": {str(k): {kk: vv for kk, vv in v.items() if kk in ("mean", "seam_mean")} for k, v in diffs.items()},
                 "runs": [{k: v for k, v in run.items() if k not in ("images_dir", "compare")} for run in runs]}
         study["regimes"].append(keep)

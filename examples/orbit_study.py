@@ -63,7 +63,7 @@ class Pool:
     def add(self, entry, raw, mask_pixels, all_pixels):
         e = raw.get("error", {})
         n, s = e.get("pixels", all_pixels), e.get("seam_pixels", mask_pixels)
-        o = n - s
+        o = e.get("off_seam_pixels", n - s)  # the footprint mask's boundary pixels are in neither
         self.sum_all += e["mean"] * n
         self.sum_seam += e["seam_mean"] * s
         if entry.get("off_mean") is not None:
@@ -79,8 +79,8 @@ class Pool:
             self.flip_seam_sum += entry["flip_seam_mean"] * mask_pixels
             self.flip_s += mask_pixels
         if entry.get("flip_off_mean") is not None:
-            self.flip_off_sum += entry["flip_off_mean"] * (all_pixels - mask_pixels)
-            self.flip_o += all_pixels - mask_pixels
+            self.flip_off_sum += entry["flip_off_mean"] * o
+            self.flip_o += o
         self.ms.append(entry["ms"])
         self.nan += e.get("nan_pixels", 0) or 0
 
