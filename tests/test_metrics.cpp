@@ -533,7 +533,7 @@ TEST_F(Compare, Quad2JsonShape) {
   }
   EXPECT_EQ(seen, expected);
   // The images were written.
-  for (const char* f : {"reference.png", "seam_mask.png", "discard_msaa4.png", "discard_msaa4_error.png",
+  for (const char* f : {"reference.png", "seam_mask_msaa1.png", "seam_mask_msaa4.png", "discard_msaa4.png", "discard_msaa4_error.png",
                         "clamp_msaa1.png", "clamp_msaa1_error.png"}) {
     EXPECT_TRUE(fs::is_regular_file(*dir_ / "imgs" / f)) << f;
   }

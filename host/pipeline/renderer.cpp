@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include <seamcl/pipeline/render_memory.h>
+#include <seamcl/core/input_error.h>
 #include <seamcl/core/over_budget.h>
 #include "core/srgb.h"
 #include "pipeline/adjacency.h"
@@ -45,7 +46,8 @@ struct Renderer::Impl {
 
   // Frame buffers, grown on demand.
   cl::Buffer frame_params, stats, setups, tile_counts, tile_offsets, tile_cursors, tile_lists, sample_triangle, image;
-  size_t setups_capacity = 0, tiles_capacity = 0, samples_capacity = 0, pixels_capacity = 0;
+  cl::Buffer seam_mask;  // only once a render asks for the mask
+  size_t setups_capacity = 0, tiles_capacity = 0, samples_capacity = 0, pixels_capacity = 0, mask_capacity = 0;
   uint32_t bin_capacity = 0;         // tile-list entries the next frame asks for
   uint32_t tile_lists_capacity = 0;  // entries allocated
   FrameParams last_params{};
@@ -60,8 +62,8 @@ struct Renderer::Impl {
   }
 
   // Makes the kernels of the program variant for this texel format and sampler current.
-  void use_kernels(TexelFormat format, const SamplerParams& sampler) {
-    const std::string options = program_options(format, sampler);
+  void use_kernels(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask) {
+    const std::string options = program_options(format, sampler, with_seam_mask);
     auto it = kernel_sets.find(options);
     if (it == kernel_sets.end()) {
       const cl::Program& program = runtime.program(options);
@@ -98,8 +100,8 @@ struct Renderer::Impl {
   }
 
   void release_frame_buffers() {
-    setups = tile_counts = tile_offsets = tile_cursors = tile_lists = sample_triangle = image = cl::Buffer();
-    setups_capacity = tiles_capacity = samples_capacity = pixels_capacity = 0;
+    setups = tile_counts = tile_offsets = tile_cursors = tile_lists = sample_triangle = image = seam_mask = cl::Buffer();
+    setups_capacity = tiles_capacity = samples_capacity = pixels_capacity = mask_capacity = 0;
     tile_lists_capacity = 0;
     // What a scene needed once is not kept either: the lists start again at the initial size
     // (render_memory's estimate) and grow if this scene needs it.
@@ -145,7 +147,7 @@ struct Renderer::Impl {
     std::vector<cl::Event> setup, binning, raster, shade, readback;
   };
 
-  StageEvents enqueue_frame(const FrameParams& p, std::vector<glm::vec4>& pixels) {
+  StageEvents enqueue_frame(const FrameParams& p, std::vector<glm::vec4>& pixels, std::vector<uint8_t>* mask) {
     cl::CommandQueue& queue = runtime.queue();
     StageEvents ev;
     auto next = [](std::vector<cl::Event>& list) -> cl::Event* {
@@ -211,10 +213,20 @@ struct Renderer::Impl {
     shade_kernel.setArg(7, sample_triangle);
     shade_kernel.setArg(8, image);
     shade_kernel.setArg(9, stats);
+    if (mask) {
+      grow(seam_mask, mask_capacity, static_cast<size_t>(p.width) * p.height, sizeof(cl_uchar), runtime.context());
+      shade_kernel.setArg(10, seam_mask);
+    } else {
+      shade_kernel.setArg(10, sizeof(cl_mem), nullptr);  // a null buffer: the variant never touches it
+    }
     queue.enqueueNDRangeKernel(shade_kernel, cl::NullRange, tile_grid, tile_group, nullptr, next(ev.shade));
 
     pixels.resize(static_cast<size_t>(p.width) * p.height);
     queue.enqueueReadBuffer(image, CL_FALSE, 0, pixels.size() * sizeof(cl_float4), pixels.data(), nullptr, next(ev.readback));
+    if (mask) {
+      mask->resize(pixels.size());
+      queue.enqueueReadBuffer(seam_mask, CL_FALSE, 0, mask->size(), mask->data(), nullptr, next(ev.readback));
+    }
     queue.finish();
     return ev;
   }
@@ -251,7 +263,8 @@ size_t Renderer::device_bytes() const {
   size_t bytes = 0;
   for (const cl::Buffer* buffer :
        {&i.positions, &i.faces, &i.neighbors, &i.level_offsets, &i.texels, &i.srgb_table, &i.frame_params, &i.stats,
-        &i.setups, &i.tile_counts, &i.tile_offsets, &i.tile_cursors, &i.tile_lists, &i.sample_triangle, &i.image}) {
+        &i.setups, &i.tile_counts, &i.tile_offsets, &i.tile_cursors, &i.tile_lists, &i.sample_triangle, &i.image,
+        &i.seam_mask}) {
     if ((*buffer)() != nullptr) bytes += buffer->getInfo<CL_MEM_SIZE>();
   }
   return bytes;
@@ -264,18 +277,22 @@ const Scene& Renderer::scene() const {
 
 const PackedScene& Renderer::packed_scene() const { return impl_->packed; }
 
-RenderResult Renderer::render(const Camera& camera, const RenderOptions& options) {
+RenderResult Renderer::render(const Camera& camera, const RenderOptions& options, bool with_seam_mask) {
   if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
-  if ((options.method == Method::Traverse || options.method == Method::Guardband) && !has_adjacency(impl_->packed.neighbors)) {
+  if ((reads_adjacency(options.method) || options.method == Method::Guardband) && !has_adjacency(impl_->packed.neighbors)) {
     throw InputError("method", to_string(options.method) + " reads each face's edge neighbours, and no two of the " +
                                    std::to_string(impl_->scene->faces.size()) + " faces of scene '" + impl_->scene->name +
                                    "' share an edge (faces are neighbours through shared vertex indices)");
+  }
+  if (with_seam_mask && options.method == Method::Guardband) {
+    throw InputError("method", "the seam mask is measured on the faces' own texels; guardband's bands would count as "
+                               "inside (any other method gives the same mask)");
   }
   const SamplerParams sampler = sampler_params(options);
   if (!impl_->uploaded || options.texels != impl_->packed.format || sampler.guard_band != impl_->packed.guard_band) {
     impl_->pack_and_upload(options.texels, sampler.guard_band);
   }
-  impl_->use_kernels(options.texels, sampler);
+  impl_->use_kernels(options.texels, sampler, with_seam_mask);
   RenderResult result;
   result.width = options.width;
   result.height = options.height;
@@ -284,7 +301,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     impl_->ensure_frame_buffers(params);
     impl_->bin_capacity = params.bin_capacity;
     impl_->last_params = params;
-    const Impl::StageEvents ev = impl_->enqueue_frame(params, result.pixels);
+    const Impl::StageEvents ev = impl_->enqueue_frame(params, result.pixels, with_seam_mask ? &result.seam_mask : nullptr);
     impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &result.stats);
     if (result.stats.bin_entries > params.bin_capacity) {
       // The lists overflowed (the kernels stayed in bounds): grow with headroom and render again.
@@ -317,14 +334,15 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   }
 }
 
-std::string program_options(TexelFormat format, const SamplerParams& sampler) {
+std::string program_options(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask) {
   return std::string(format == TexelFormat::Rgba32f ? "-DSEAMCL_TEXELS_F32=1" : "-DSEAMCL_TEXELS_F32=0") +
          " -DSEAMCL_SAMPLER_FILTER=" + std::to_string(sampler.filter) +
          " -DSEAMCL_SAMPLER_ADDRESS=" + std::to_string(sampler.address) +
          " -DSEAMCL_SAMPLER_RENORMALIZE=" + std::to_string(sampler.renormalize) +
          " -DSEAMCL_SAMPLER_ZERO_COVERAGE=" + std::to_string(sampler.zero_coverage) +
          " -DSEAMCL_SAMPLER_TRAVERSE=" + std::to_string(sampler.traverse) +
-         " -DSEAMCL_SAMPLER_GUARD_BAND=" + std::to_string(sampler.guard_band);
+         " -DSEAMCL_SAMPLER_GUARD_BAND=" + std::to_string(sampler.guard_band) +
+         (with_seam_mask ? " -DSEAMCL_SEAM_MASK=1" : "");
 }
 
 void Renderer::warm_up(const RenderOptions& options) {
