@@ -445,7 +445,10 @@ def compare_with_references(binary, args, images_dir, references, reuse=False):
             return cmp, cmd, wall, dropped
         except RuntimeError as e:
             msg = str(e).split(": ", 1)[-1]
-            bad = [r for r in refs if re.search(r"\b" + re.escape(r) + r"\b", msg)] if opt else []
+            named = re.findall(r"\bthe (\w+) reference\b", msg)  # "the seamless reference needs ..."
+            bad = [r for r in refs if r in named] if named else \
+                [r for r in refs if re.search(r"\b" + re.escape(r) + r"\b", msg)]
+            bad = bad if opt else []
             if not bad or len(bad) == len(refs):
                 raise
             for r in bad:
