@@ -151,4 +151,52 @@ typedef struct {
   cl_uint pad0;
 } FrameStats;
 
+/* ---- Displacement (kernels/tessellate.cl; host/pipeline/displacement_packing.h) ---- */
+/* TessellationParams.method: how a patch's vertices take their displacement */
+#define SEAMCL_DISPLACEMENT_NAIVE 0     /* float domain points, each patch samples its own map */
+#define SEAMCL_DISPLACEMENT_ZIPPER 1    /* edges: mean of both sides' samples; corners: one snapped value */
+#define SEAMCL_DISPLACEMENT_OWNERSHIP 2 /* one sample through the owner's texcoord (4 per corner) */
+#define SEAMCL_DISPLACEMENT_FIXED 3     /* fixed-point domain points, own map, exact integer filtering */
+#define SEAMCL_DOMAIN_ONE 65536         /* fixed-point domain coordinates: 16 fraction bits */
+#define SEAMCL_MAX_TESSELLATION 64
+
+/* A texture coordinate that names the face whose map it addresses (ownership). */
+typedef struct {
+  cl_int face;     /* -1: none */
+  cl_float u, v;
+} DisplacementTexcoord;
+
+/* One quad patch for the tessellator. Corner k is at uv (0,0), (1,0), (1,1), (0,1); edge k runs
+ * from corner k to corner k+1. The map is a grid of columns x rows samples spanning the face from
+ * corner to corner (sample (0,0) at uv (0,0), (columns-1, rows-1) at uv (1,1)); columns == 0:
+ * the face has no displacement. */
+typedef struct {
+  cl_uint vertex[4];              /* mesh vertices: positions and normals */
+  cl_int neighbor[4];             /* face across edge k, -1 at a boundary */
+  cl_int neighbor_edge[4];        /* that face's index of the shared edge */
+  cl_int neighbor_same_way[4];    /* 1: its edge runs the same way as ours (a mirrored neighbour) */
+  cl_float corner_value[4];       /* zipper: the displacement every patch uses at corner k */
+  DisplacementTexcoord texcoord[4][4]; /* ownership: corner k; 0 own, 1 edge k's owner, 2 edge (k+3)%4's, 3 the corner's */
+  cl_uint map_offset;             /* first sample in the samples buffer */
+  cl_int columns, rows;
+  cl_int pad0;
+} DisplacementPatch;
+
+/* Per tessellation, read-only. */
+typedef struct {
+  cl_int tessellation;   /* T: every patch is a (T+1)^2 grid, 1..SEAMCL_MAX_TESSELLATION */
+  cl_int method;         /* SEAMCL_DISPLACEMENT_* */
+  cl_int patches;        /* patches in the buffer */
+  cl_float scale;        /* world units per unit of displacement (samples / 65535) */
+} TessellationParams;
+
+/* One tessellated vertex: displaced world position and the patch's own uv (for colour). */
+typedef struct {
+  cl_float position[3];
+  cl_float u, v;
+  cl_float displacement; /* in [0, 1], before scale */
+  cl_uint samples;       /* map samples taken for it (cost) */
+  cl_uint pad0;
+} TessVertex;
+
 #endif

@@ -110,8 +110,12 @@ RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options
   const size_t height = static_cast<size_t>(std::max(options.height, 1));
   const size_t pixels = mul(width, height);
   const size_t tile_count = mul((width + SEAMCL_TILE_SIZE - 1) / SEAMCL_TILE_SIZE, (height + SEAMCL_TILE_SIZE - 1) / SEAMCL_TILE_SIZE);
-  const size_t slots = mul(scene.triangle_count(), SEAMCL_CLIP_SLOTS);
+  // A displacement render sets up T^2 micro-triangles per triangle (kernels/tessellate.cl), and
+  // holds the tessellated vertices (32 bytes each, counted with the setups).
+  const size_t tess = options.displacement ? static_cast<size_t>(std::max(options.tessellation, 1)) : 1;
+  const size_t slots = mul(mul(scene.triangle_count(), mul(tess, tess)), SEAMCL_CLIP_SLOTS);
   m.setups = device_array(slots, sizeof(TriangleSetup));
+  if (options.displacement) m.setups = add(m.setups, mul(mul(faces, mul(tess + 1, tess + 1)), 32));
   m.tiles = mul(3 * sizeof(cl_uint), tile_count);
   const size_t initial_entries = initial_tile_list_entries(scene.triangle_count());
   m.tile_lists = mul(initial_entries, sizeof(cl_uint));

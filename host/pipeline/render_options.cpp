@@ -186,6 +186,16 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
       options.frames = int_field(value, key, 1, 1000000);
     } else if (key == "tint") {
       options.tint = bool_field(value, key);
+    } else if (key == "displacement_method") {
+      const std::string name = string_field(value, key);
+      options.displacement = parse_displacement_method(name);
+      if (!options.displacement) {
+        throw InputError(key, "unknown displacement method '" + name + "' (known: " + joined(displacement_method_names()) + ")");
+      }
+    } else if (key == "tessellation") {
+      options.tessellation = int_field(value, key, 1, SEAMCL_MAX_TESSELLATION);
+    } else if (key == "displacement_level") {
+      options.displacement_level = int_field(value, key, 0, 16);
     } else {
       throw InputError(key, "unknown option");
     }
@@ -217,6 +227,11 @@ nlohmann::json to_json(const RenderOptions& options) {
                         {"shading", to_string(options.shading)},
                         {"tint", options.tint}};
   if (!options.texture.empty()) out["texture"] = options.texture;
+  if (options.displacement) {
+    out["displacement_method"] = to_string(*options.displacement);
+    out["tessellation"] = options.tessellation;
+    out["displacement_level"] = options.displacement_level;
+  }
   if (options.frame) {
     out["frame"] = *options.frame;
     out["frames"] = options.frames;

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <seamcl/pipeline/texture_view.h>
+#include <seamcl/pipeline/displacement_method.h>
 
 namespace seamcl {
 
@@ -73,12 +74,17 @@ struct RenderOptions {
   std::optional<int> frame;     // orbit frame, with `frames`
   int frames = 60;
   bool tint = false;            // built-in scenes: a base colour per face
+  // Displacement (docs/displacement.md): off unless a method is asked for; then every patch is
+  // tessellated into a (T+1)^2 grid displaced by the scene's maps at displacement_level.
+  std::optional<DisplacementMethod> displacement;
+  int tessellation = 8;         // T, 1..64
+  int displacement_level = 0;   // the maps' level sampled, 0..16
 };
 
 // Reads the keys present in `request` over the defaults. Throws InputError naming the key on a
 // wrong type, an out-of-range value or an unknown key. Keys: scene, texture, method, filter, msaa, aniso,
 // size ("WxH"), shading, centroid (bool, same as shading=centroid), zero_coverage, texels,
-// guard_band, frame, frames, tint.
+// guard_band, frame, frames, tint, displacement_method, tessellation, displacement_level.
 RenderOptions parse_render_options(const nlohmann::json& request);
 nlohmann::json to_json(const RenderOptions& options);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <cassert>
 #include <stdexcept>
 
@@ -11,6 +12,7 @@
 #include "core/srgb.h"
 #include "pipeline/adjacency.h"
 #include "pipeline/frame_params.h"
+#include "pipeline/tessellation_stage.h"
 
 namespace seamcl {
 namespace {
@@ -52,6 +54,11 @@ struct Renderer::Impl {
   uint32_t tile_lists_capacity = 0;  // entries allocated
   FrameParams last_params{};
   size_t device_byte_limit = 0;  // 0: none
+  // Displacement renders only: the tessellation stage replaces triangle setup.
+  TessellationStage tessellation{runtime};
+  std::optional<DisplacementSettings> tessellation_settings;  // what `tessellation` holds
+  bool displaced = false;        // this frame runs the tessellation stage
+  std::string program_key;       // the current program variant's build options
 
   explicit Impl(ClRuntime& rt) : runtime(rt) {
     const auto& table = srgb_to_linear_table();
@@ -64,6 +71,7 @@ struct Renderer::Impl {
   // Makes the kernels of the program variant for this texel format and sampler current.
   void use_kernels(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask) {
     const std::string options = program_options(format, sampler, with_seam_mask);
+    program_key = options;
     auto it = kernel_sets.find(options);
     if (it == kernel_sets.end()) {
       const cl::Program& program = runtime.program(options);
@@ -97,6 +105,8 @@ struct Renderer::Impl {
     uploaded = false;
     packed = PackedScene{};
     positions = faces = neighbors = level_offsets = texels = cl::Buffer();
+    tessellation.release();
+    tessellation_settings.reset();
   }
 
   void release_frame_buffers() {
@@ -144,7 +154,7 @@ struct Renderer::Impl {
 
   // Queues one frame; returns the events of each stage in order.
   struct StageEvents {
-    std::vector<cl::Event> setup, binning, raster, shade, readback;
+    std::vector<cl::Event> setup, binning, raster, shade, readback, tessellate;
   };
 
   StageEvents enqueue_frame(const FrameParams& p, std::vector<glm::vec4>& pixels, std::vector<uint8_t>* mask) {
@@ -161,7 +171,9 @@ struct Renderer::Impl {
     queue.enqueueWriteBuffer(stats, CL_FALSE, 0, sizeof(FrameStats), &zero_stats, nullptr, next(ev.setup));
 
     const size_t slots = static_cast<size_t>(p.input_triangles) * SEAMCL_CLIP_SLOTS;
-    if (p.input_triangles > 0) {
+    if (displaced) {
+      tessellation.enqueue(program_key, frame_params, setups, stats, p.input_triangles, ev.tessellate, ev.setup);
+    } else if (p.input_triangles > 0) {
       setup_kernel.setArg(0, frame_params);
       setup_kernel.setArg(1, positions);
       setup_kernel.setArg(2, faces);
@@ -267,7 +279,7 @@ size_t Renderer::device_bytes() const {
         &i.seam_mask}) {
     if ((*buffer)() != nullptr) bytes += buffer->getInfo<CL_MEM_SIZE>();
   }
-  return bytes;
+  return bytes + i.tessellation.device_bytes();
 }
 
 const Scene& Renderer::scene() const {
@@ -293,11 +305,21 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     impl_->pack_and_upload(options.texels, sampler.guard_band);
   }
   impl_->use_kernels(options.texels, sampler, with_seam_mask);
+  impl_->displaced = options.displacement.has_value();
+  if (impl_->displaced) {
+    const DisplacementSettings settings{*options.displacement, options.tessellation, options.displacement_level};
+    const auto& held = impl_->tessellation_settings;
+    if (!held || held->method != settings.method || held->tessellation != settings.tessellation || held->level != settings.level) {
+      impl_->tessellation.load(pack_displacement(*impl_->scene, settings));
+      impl_->tessellation_settings = settings;
+    }
+  }
   RenderResult result;
   result.width = options.width;
   result.height = options.height;
   for (result.attempts = 1;; ++result.attempts) {
-    const FrameParams params = make_frame_params(*impl_->scene, camera, options, impl_->bin_capacity);
+    FrameParams params = make_frame_params(*impl_->scene, camera, options, impl_->bin_capacity);
+    if (impl_->displaced) params.input_triangles = static_cast<cl_int>(impl_->tessellation.packed().triangle_count());
     impl_->ensure_frame_buffers(params);
     impl_->bin_capacity = params.bin_capacity;
     impl_->last_params = params;
@@ -327,6 +349,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     result.ms.raster = sum(ev.raster);
     result.ms.shade = sum(ev.shade);
     result.ms.readback = sum(ev.readback);
+    result.ms.tessellate = sum(ev.tessellate);
     const cl_ulong first = ev.setup.front().getProfilingInfo<CL_PROFILING_COMMAND_START>();
     const cl_ulong last = ev.readback.back().getProfilingInfo<CL_PROFILING_COMMAND_END>();
     result.ms.total = static_cast<double>(last - first) * 1e-6;

@@ -25,6 +25,7 @@ struct StageTimes {
   double shade = 0;     // shading and resolve
   double readback = 0;  // image to host
   double total = 0;     // first command's start to last command's end
+  double tessellate = 0;  // displacement renders: the tessellation kernel (its setup counts in setup)
 };
 
 struct RenderResult {

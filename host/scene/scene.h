@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +12,8 @@
 #include <glm/glm.hpp>
 
 namespace seamcl {
+
+struct Displacement;  // per-face displacement maps (scene/displacement_map.h)
 
 // One mip level, texels in linear RGBA, row-major, row 0 at v = 0.
 struct TextureLevel {
@@ -82,6 +85,9 @@ struct Scene {
   // albedo(f, the surface point of its centre). The analytic reference evaluates it at every
   // subsample instead of filtering texels. Empty for textures that came from elsewhere (files).
   std::function<glm::vec4(size_t face, glm::vec3 point)> albedo;
+  // Per-face displacement maps, read only by renders that ask for a displacement method
+  // (docs/displacement.md); null for scenes without them.
+  std::shared_ptr<const Displacement> displacement;
 
   size_t triangle_count() const { return faces.size() * 2; }
   std::array<glm::vec3, 4> corners(const Face& f) const;

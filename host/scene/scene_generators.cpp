@@ -13,6 +13,7 @@
 #include <thread>
 
 #include <seamcl/core/input_error.h>
+#include "scene/displaced_scene.h"
 
 namespace seamcl {
 namespace {
@@ -345,6 +346,10 @@ const std::vector<Generator>& generators() {
         "a closed mesh (a split pentagonal prism, 30 quads, vertices of valence 3, 4 and 5) with textures from 1x1 to "
         "256x256 side by side and neighbours rotated by every multiple of 90 degrees"},
        make_mixed},
+      {{"displaced",
+        "a closed cube-sphere of 24 quads with displacement maps (2x2 to 33x33 samples, neighbours rotated); "
+        "render it with displacement_method"},
+       make_displaced_scene},
   };
   return list;
 }

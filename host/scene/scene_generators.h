@@ -32,7 +32,7 @@ struct GeneratorInfo {
   TextureContent content = TextureContent::Surface;  // its content unless options say otherwise
 };
 
-// paper, quad2, plane, cube, closeup-seam, closeup-corner, mixed; the first is the default scene.
+// paper, quad2, plane, cube, closeup-seam, closeup-corner, mixed, displaced; the first is the default scene.
 const std::vector<GeneratorInfo>& scene_generators();
 
 // Throws InputError (field "scene") for an unknown name.

@@ -1,0 +1,230 @@
+#include <seamcl/eval/displacement_metrics.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <seamcl/core/input_error.h>
+#include <seamcl/pipeline/renderer.h>
+#include "pipeline/displacement_packing.h"
+#include "pipeline/tessellation_stage.h"
+#include "scene/displacement_map.h"
+
+namespace seamcl {
+namespace {
+
+// Index of vertex (i, j) of `patch` in the tessellator's output.
+size_t vertex_index(int patch, int i, int j, int t) {
+  return (static_cast<size_t>(patch) * (t + 1) + static_cast<size_t>(j)) * (t + 1) + static_cast<size_t>(i);
+}
+
+// Grid position of step k (0..T) along edge e from corner e.
+void edge_grid(int e, int k, int t, int* i, int* j) {
+  switch (e) {
+    case 0: *i = k; *j = 0; break;
+    case 1: *i = t; *j = k; break;
+    case 2: *i = t - k; *j = t; break;
+    default: *i = 0; *j = t - k; break;
+  }
+}
+
+void compare(const TessVertex& a, const TessVertex& b, DisplacementGap& gap) {
+  ++gap.compared_pairs;
+  bool differ = false;
+  for (int c = 0; c < 3; ++c) {
+    const double d = std::fabs(static_cast<double>(a.position[c]) - static_cast<double>(b.position[c]));
+    gap.max_gap = std::max(gap.max_gap, d);
+    differ = differ || a.position[c] != b.position[c];
+  }
+  gap.differing_pairs += differ;
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+}  // namespace
+
+DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<TessVertex>& vertices) {
+  DisplacementGap gap;
+  const int t = packed.params.tessellation;
+  if (vertices.size() != packed.vertex_count()) throw std::invalid_argument("measure_gap: vertex count does not match");
+  // Shared edges, each once (from the lower-numbered patch), all T+1 points including corners.
+  for (int p = 0; p < static_cast<int>(packed.patches.size()); ++p) {
+    const DisplacementPatch& patch = packed.patches[static_cast<size_t>(p)];
+    for (int e = 0; e < 4; ++e) {
+      const int q = patch.neighbor[e];
+      if (q < 0 || q < p) continue;
+      const int qe = patch.neighbor_edge[e];
+      for (int k = 0; k <= t; ++k) {
+        int i = 0, j = 0, qi = 0, qj = 0;
+        edge_grid(e, k, t, &i, &j);
+        edge_grid(qe, patch.neighbor_same_way[e] ? k : t - k, t, &qi, &qj);
+        compare(vertices[vertex_index(p, i, j, t)], vertices[vertex_index(q, qi, qj, t)], gap);
+      }
+    }
+  }
+  // Every patch corner at a mesh vertex against the first patch's there (diagonal patches too).
+  std::map<uint32_t, size_t> first_at_vertex;
+  for (int p = 0; p < static_cast<int>(packed.patches.size()); ++p) {
+    for (int c = 0; c < 4; ++c) {
+      const int i = (c == 1 || c == 2) ? t : 0, j = (c >= 2) ? t : 0;
+      const size_t index = vertex_index(p, i, j, t);
+      const auto [it, inserted] = first_at_vertex.emplace(packed.patches[static_cast<size_t>(p)].vertex[c], index);
+      if (!inserted) compare(vertices[it->second], vertices[index], gap);
+    }
+  }
+  return gap;
+}
+
+bool is_closed_mesh(const Scene& scene) {
+  std::map<std::pair<uint32_t, uint32_t>, int> uses;
+  for (const Face& f : scene.faces) {
+    for (int e = 0; e < 4; ++e) {
+      const uint32_t a = f.vertices[e], b = f.vertices[(e + 1) % 4];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  if (uses.empty()) return false;
+  for (const auto& [edge, count] : uses) {
+    if (count != 2) return false;
+  }
+  return true;
+}
+
+Scene with_flag_shell(const Scene& scene, float shrink) {
+  Scene out = scene;
+  glm::vec3 center(0.0f);
+  for (const glm::vec3& p : scene.positions) center += p;
+  if (!scene.positions.empty()) center /= static_cast<float>(scene.positions.size());
+  const auto base = static_cast<uint32_t>(out.positions.size());
+  for (const glm::vec3& p : scene.positions) out.positions.push_back(center + (p - center) * shrink);
+  TextureLevel flag;
+  flag.width = flag.height = 1;
+  flag.texels = {glm::vec4(kFlagColor, 1.0f)};
+  const MipChain flag_texture = build_mip_chain(flag);
+  for (const Face& f : scene.faces) {
+    const auto& v = f.vertices;
+    out.faces.push_back({{base + v[0], base + v[3], base + v[2], base + v[1]}, flag_texture});
+  }
+  if (scene.displacement) {
+    auto displacement = std::make_shared<Displacement>(*scene.displacement);
+    displacement->maps.resize(out.faces.size());  // the flag's maps are empty: not displaced
+    out.displacement = displacement;
+  }
+  if (scene.albedo) {
+    const size_t scene_faces = scene.faces.size();
+    out.albedo = [albedo = scene.albedo, scene_faces](size_t face, glm::vec3 p) {
+      return face < scene_faces ? albedo(face, p) : glm::vec4(kFlagColor, 1.0f);
+    };
+  }
+  return out;
+}
+
+size_t count_flag_pixels(const std::vector<uint32_t>& sample_triangles, int width, int height, int sample_count,
+                         int tessellation, size_t first_flag_patch) {
+  const size_t per_patch = 2 * static_cast<size_t>(tessellation) * tessellation;
+  size_t flagged = 0;
+  const size_t pixels = static_cast<size_t>(width) * height;
+  for (size_t pixel = 0; pixel < pixels && (pixel + 1) * sample_count <= sample_triangles.size(); ++pixel) {
+    for (int s = 0; s < sample_count; ++s) {
+      const uint32_t slot = sample_triangles[pixel * sample_count + s];
+      if (slot != SEAMCL_NO_TRIANGLE && slot / SEAMCL_CLIP_SLOTS / per_patch >= first_flag_patch) {
+        ++flagged;
+        break;
+      }
+    }
+  }
+  return flagged;
+}
+
+nlohmann::json DisplacementReport::to_json() const {
+  nlohmann::json out = {{"method", method},
+                        {"tessellation", tessellation},
+                        {"level", level},
+                        {"max_gap", gap.max_gap},
+                        {"compared_pairs", gap.compared_pairs},
+                        {"differing_pairs", gap.differing_pairs},
+                        {"crack_frames", crack_frames},
+                        {"samples", samples},
+                        {"vertices", vertices},
+                        {"triangles", triangles},
+                        {"extra_bytes", extra_bytes},
+                        {"matched_samples", matched_samples},
+                        {"unmatched_edges", unmatched_edges},
+                        {"tessellate_ms", tessellate_ms},
+                        {"frame_ms", frame_ms}};
+  out["crack_pixels"] = crack_pixels ? nlohmann::json(*crack_pixels) : nlohmann::json(nullptr);
+  return out;
+}
+
+DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, const Camera& camera,
+                                        const RenderOptions& options, int orbit_frames, int repeat) {
+  if (!options.displacement) throw InputError("displacement_method", "is needed to measure displacement");
+  const DisplacementSettings settings{*options.displacement, options.tessellation, options.displacement_level};
+  DisplacementReport report;
+  report.method = to_string(settings.method);
+  report.tessellation = settings.tessellation;
+  report.level = settings.level;
+
+  // 1. The gap, from the device's own tessellation.
+  PackedDisplacement packed = pack_displacement(scene, settings);
+  report.extra_bytes = packed.method_bytes();
+  report.matched_samples = packed.matched_samples;
+  report.unmatched_edges = packed.unmatched_edges;
+  report.triangles = packed.triangle_count();
+  TessellationStage stage(runtime);
+  stage.load(std::move(packed));
+  const std::vector<TessVertex> vertices =
+      stage.tessellate(program_options(options.texels, sampler_params(options), false));
+  report.gap = measure_gap(stage.packed(), vertices);
+  report.vertices = vertices.size();
+  for (const TessVertex& v : vertices) report.samples += v.samples;
+  stage.release();
+
+  auto cameras = [&] {
+    std::vector<Camera> list;
+    if (orbit_frames > 0) {
+      for (int f = 0; f < orbit_frames; ++f) list.push_back(orbit_camera(scene, f, orbit_frames));
+    } else {
+      list.push_back(camera);
+    }
+    return list;
+  }();
+
+  // 2. Time per frame, on the scene itself.
+  {
+    Renderer renderer(runtime);
+    renderer.load_scene(scene, options.texels);
+    renderer.render(cameras.front(), options);  // builds and warms the kernels
+    std::vector<double> frame, tessellate;
+    for (int r = 0; r < std::max(repeat, 1); ++r) {
+      const RenderResult result = renderer.render(cameras[static_cast<size_t>(r) % cameras.size()], options);
+      frame.push_back(result.ms.total);
+      tessellate.push_back(result.ms.tessellate);
+    }
+    report.frame_ms = median(frame);
+    report.tessellate_ms = median(tessellate);
+  }
+
+  // 3. Crack pixels, on a closed mesh with its flag inside.
+  if (is_closed_mesh(scene)) {
+    const Scene flagged = with_flag_shell(scene);
+    Renderer renderer(runtime);
+    renderer.load_scene(flagged, options.texels);
+    size_t cracks = 0;
+    for (const Camera& c : cameras) {
+      renderer.render(c, options);
+      cracks += count_flag_pixels(renderer.read_sample_triangles(), options.width, options.height, options.msaa,
+                                  options.tessellation, scene.faces.size());
+    }
+    report.crack_pixels = cracks;
+    report.crack_frames = static_cast<int>(cameras.size());
+  }
+  return report;
+}
+
+}  // namespace seamcl

@@ -1,0 +1,246 @@
+#include "pipeline/displacement_packing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <utility>
+
+#include <seamcl/core/input_error.h>
+
+namespace seamcl {
+namespace {
+
+constexpr std::array<std::array<float, 2>, 4> kCornerUv{{{0.0f, 0.0f}, {1.0f, 0.0f}, {1.0f, 1.0f}, {0.0f, 1.0f}}};
+
+struct EdgeSide {
+  uint32_t face;
+  int edge;
+};
+
+// Edges by their two vertices (smaller index first), each with the face sides that use it.
+std::map<std::pair<uint32_t, uint32_t>, std::vector<EdgeSide>> edge_sides(const Scene& scene) {
+  std::map<std::pair<uint32_t, uint32_t>, std::vector<EdgeSide>> out;
+  for (uint32_t f = 0; f < scene.faces.size(); ++f) {
+    const auto& v = scene.faces[f].vertices;
+    for (int e = 0; e < 4; ++e) {
+      const uint32_t a = v[e], b = v[(e + 1) % 4];
+      out[{std::min(a, b), std::max(a, b)}].push_back({f, e});
+    }
+  }
+  return out;
+}
+
+// The lowest-numbered face at each vertex (among those `eligible` says), or -1.
+template <typename Eligible>
+std::vector<int> lowest_face_at_vertex(const Scene& scene, Eligible eligible) {
+  std::vector<int> out(scene.positions.size(), -1);
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    if (!eligible(f)) continue;
+    for (uint32_t v : scene.faces[f].vertices) {
+      if (out[v] < 0) out[v] = static_cast<int>(f);
+    }
+  }
+  return out;
+}
+
+int corner_of(const Face& face, uint32_t vertex) {
+  for (int c = 0; c < 4; ++c) {
+    if (face.vertices[c] == vertex) return c;
+  }
+  return 0;
+}
+
+// Samples along edge e of a map, from corner e to corner e+1: their count and the k-th one.
+int edge_length(const DisplacementMap& m, int e) { return (e % 2 == 0) ? m.columns : m.rows; }
+uint16_t& edge_sample(DisplacementMap& m, int e, int k) {
+  switch (e) {
+    case 0: return m.at(k, 0);
+    case 1: return m.at(m.columns - 1, k);
+    case 2: return m.at(m.columns - 1 - k, m.rows - 1);
+    default: return m.at(0, m.rows - 1 - k);
+  }
+}
+uint16_t& corner_sample(DisplacementMap& m, int c) { return edge_sample(m, c, 0); }
+
+bool matchable(const DisplacementMap& m) { return m.columns >= 2 && m.rows >= 2; }
+
+uint16_t round_to_multiple(uint16_t value, int multiple) {
+  const long rounded = std::lround(static_cast<double>(value) / multiple) * multiple;
+  return static_cast<uint16_t>(std::min<long>(rounded, 65535L / multiple * multiple));
+}
+
+}  // namespace
+
+size_t match_edge_samples(const Scene& scene, std::vector<DisplacementMap>& maps, size_t* unmatched_edges) {
+  size_t changed = 0;
+  auto set = [&](uint16_t& sample, uint16_t value) {
+    changed += sample != value;
+    sample = value;
+  };
+  // 1. One value per vertex at every face's corner: a multiple of 64, so that any edge ratio up
+  //    to 64 interpolates it exactly.
+  const std::vector<int> owner = lowest_face_at_vertex(scene, [&](size_t f) { return matchable(maps[f]); });
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    if (!matchable(maps[f])) continue;
+    for (int c = 0; c < 4; ++c) {
+      const uint32_t v = scene.faces[f].vertices[c];
+      const auto o = static_cast<size_t>(owner[v]);
+      const uint16_t value = round_to_multiple(corner_sample(maps[o], corner_of(scene.faces[o], v)), 64);
+      set(corner_sample(maps[f], c), value);
+    }
+  }
+  // 2. Across each shared edge, the finer side's samples on the coarser side's lines.
+  size_t unmatched = 0;
+  for (const auto& [key, sides] : edge_sides(scene)) {
+    if (sides.size() != 2) continue;
+    EdgeSide a = sides[0], b = sides[1];
+    DisplacementMap* ma = &maps[a.face];
+    DisplacementMap* mb = &maps[b.face];
+    if (ma->empty() && mb->empty()) continue;
+    if (!matchable(*ma) || !matchable(*mb)) {
+      ++unmatched;
+      continue;
+    }
+    // Coarse side first (fewer samples; on a tie the lower-numbered face).
+    const int na = edge_length(*ma, a.edge) - 1, nb = edge_length(*mb, b.edge) - 1;
+    if (nb < na || (nb == na && b.face < a.face)) {
+      std::swap(a, b);
+      std::swap(ma, mb);
+    }
+    const int coarse = edge_length(*ma, a.edge) - 1, fine = edge_length(*mb, b.edge) - 1;
+    const int ratio = fine / coarse;
+    if (fine % coarse != 0 || ratio > 64 || (64 % ratio) != 0) {
+      ++unmatched;
+      continue;
+    }
+    // Both sides from a's corner a.edge: b runs the other way unless its edge starts there too.
+    const bool same_way = scene.faces[b.face].vertices[b.edge] == scene.faces[a.face].vertices[a.edge];
+    auto b_at = [&](int k) -> uint16_t& { return edge_sample(*mb, b.edge, same_way ? k : fine - k); };
+    for (int k = 1; k < coarse; ++k) set(edge_sample(*ma, a.edge, k), round_to_multiple(edge_sample(*ma, a.edge, k), ratio));
+    for (int k = 0; k < coarse; ++k) {
+      const long lo = edge_sample(*ma, a.edge, k), hi = edge_sample(*ma, a.edge, k + 1);
+      for (int m = (k == 0 ? 1 : 0); m < ratio; ++m) set(b_at(k * ratio + m), static_cast<uint16_t>(lo + (hi - lo) * m / ratio));
+    }
+  }
+  if (unmatched_edges) *unmatched_edges = unmatched;
+  return changed;
+}
+
+size_t PackedDisplacement::vertex_count() const {
+  const auto t = static_cast<size_t>(params.tessellation);
+  return patches.size() * (t + 1) * (t + 1);
+}
+
+size_t PackedDisplacement::triangle_count() const {
+  const auto t = static_cast<size_t>(params.tessellation);
+  return patches.size() * 2 * t * t;
+}
+
+size_t PackedDisplacement::method_bytes() const {
+  switch (params.method) {
+    case SEAMCL_DISPLACEMENT_ZIPPER:
+      return patches.size() * (sizeof(DisplacementPatch::neighbor) + sizeof(DisplacementPatch::neighbor_edge) +
+                               sizeof(DisplacementPatch::neighbor_same_way) + sizeof(DisplacementPatch::corner_value));
+    case SEAMCL_DISPLACEMENT_OWNERSHIP: return patches.size() * sizeof(DisplacementPatch::texcoord);
+    default: return 0;
+  }
+}
+
+PackedDisplacement pack_displacement(const Scene& scene, const DisplacementSettings& settings) {
+  if (settings.tessellation < 1 || settings.tessellation > SEAMCL_MAX_TESSELLATION) {
+    throw InputError("tessellation", "must be in 1.." + std::to_string(SEAMCL_MAX_TESSELLATION) + ", got " +
+                                         std::to_string(settings.tessellation));
+  }
+  if (settings.level < 0 || settings.level > 16) {
+    throw InputError("displacement_level", "must be in 0..16, got " + std::to_string(settings.level));
+  }
+  if (!scene.displacement) {
+    throw InputError("displacement", "scene '" + scene.name +
+                                         "' has no displacement maps (the built-in 'displaced' scene has; an .obj "
+                                         "takes them with --displacement FILE.ptx)");
+  }
+  const Displacement& source = *scene.displacement;
+  validate_displacement(source, scene.faces.size());
+  const auto t = static_cast<size_t>(settings.tessellation);
+  if (scene.faces.size() * 2 * t * t > kMaxTessellatedTriangles) {
+    throw InputError("tessellation", std::to_string(scene.faces.size()) + " patches at T = " + std::to_string(t) +
+                                         " make " + std::to_string(scene.faces.size() * 2 * t * t) +
+                                         " triangles, over the limit of " + std::to_string(kMaxTessellatedTriangles));
+  }
+
+  PackedDisplacement out;
+  out.params.tessellation = settings.tessellation;
+  out.params.method = displacement_method_code(settings.method);
+  out.params.patches = static_cast<cl_int>(scene.faces.size());
+  out.params.scale = source.scale;
+
+  std::vector<DisplacementMap> maps;
+  maps.reserve(source.maps.size());
+  for (const DisplacementMap& m : source.maps) maps.push_back(displacement_level(m, settings.level));
+  if (settings.method == DisplacementMethod::Fixed) out.matched_samples = match_edge_samples(scene, maps, &out.unmatched_edges);
+
+  for (const glm::vec3& p : scene.positions) out.positions.push_back({{p.x, p.y, p.z, 1.0f}});
+  // Vertex normals: the mean of the faces' normals around each vertex, in face order.
+  std::vector<glm::vec3> normal_sum(scene.positions.size(), glm::vec3(0.0f));
+  for (const Face& face : scene.faces) {
+    const glm::vec3 n = scene.face_normal(face);
+    for (uint32_t v : face.vertices) normal_sum[v] += n;
+  }
+  for (const glm::vec3& s : normal_sum) {
+    const float length = glm::length(s);
+    const glm::vec3 n = length > 0.0f && std::isfinite(length) ? s / length : glm::vec3(0.0f, 0.0f, 1.0f);
+    out.normals.push_back({{n.x, n.y, n.z, 0.0f}});
+  }
+
+  const auto sides = edge_sides(scene);
+  const std::vector<int> lowest = lowest_face_at_vertex(scene, [](size_t) { return true; });
+  const std::vector<int> lowest_mapped = lowest_face_at_vertex(scene, [&](size_t f) { return !maps[f].empty(); });
+  out.patches.resize(scene.faces.size());
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    const Face& face = scene.faces[f];
+    DisplacementPatch& p = out.patches[f];
+    p.map_offset = static_cast<cl_uint>(out.samples.size());
+    p.columns = maps[f].columns;
+    p.rows = maps[f].rows;
+    out.samples.insert(out.samples.end(), maps[f].samples.begin(), maps[f].samples.end());
+    for (int k = 0; k < 4; ++k) {
+      p.vertex[k] = face.vertices[k];
+      p.neighbor[k] = -1;
+      p.neighbor_edge[k] = 0;
+      p.neighbor_same_way[k] = 0;
+      const uint32_t a = face.vertices[k], b = face.vertices[(k + 1) % 4];
+      const auto& edge = sides.at({std::min(a, b), std::max(a, b)});
+      if (edge.size() == 2) {
+        const EdgeSide other = edge[0].face == f && edge[0].edge == k ? edge[1] : edge[0];
+        p.neighbor[k] = static_cast<cl_int>(other.face);
+        p.neighbor_edge[k] = other.edge;
+        p.neighbor_same_way[k] = scene.faces[other.face].vertices[other.edge] == a ? 1 : 0;
+      }
+    }
+    for (int k = 0; k < 4; ++k) {
+      const uint32_t v = face.vertices[k];
+      // Zipper: the corner's one value, the corner sample of the lowest-numbered mapped face there.
+      const int z = lowest_mapped[v];
+      p.corner_value[k] = z < 0 ? 0.0f
+                                : static_cast<float>(corner_sample(maps[static_cast<size_t>(z)],
+                                                                   corner_of(scene.faces[static_cast<size_t>(z)], v))) /
+                                      65535.0f;
+      // Ownership: this corner's uv in its own face, in the owners of its two edges, in the
+      // corner's owner (the lowest-numbered face of each).
+      auto texcoord = [&](int owner) {
+        const auto o = static_cast<size_t>(owner);
+        const int c = corner_of(scene.faces[o], v);
+        return DisplacementTexcoord{owner, kCornerUv[c][0], kCornerUv[c][1]};
+      };
+      const int edge_before = (k + 3) % 4;
+      const int own = static_cast<int>(f);
+      p.texcoord[k][0] = texcoord(own);
+      p.texcoord[k][1] = texcoord(p.neighbor[k] < 0 ? own : std::min(own, p.neighbor[k]));
+      p.texcoord[k][2] = texcoord(p.neighbor[edge_before] < 0 ? own : std::min(own, p.neighbor[edge_before]));
+      p.texcoord[k][3] = texcoord(lowest[v]);
+    }
+  }
+  return out;
+}
+
+}  // namespace seamcl

@@ -1,0 +1,98 @@
+#include "pipeline/tessellation_stage.h"
+
+#include <algorithm>
+
+namespace seamcl {
+namespace {
+
+constexpr size_t kGroup = 64;
+size_t round_up(size_t value, size_t multiple) { return (value + multiple - 1) / multiple * multiple; }
+
+template <typename T>
+cl::Buffer upload(ClRuntime& runtime, const std::vector<T>& data) {
+  // OpenCL refuses zero-sized buffers; one element of padding keeps empty arrays legal.
+  const size_t bytes = std::max<size_t>(data.size(), 1) * sizeof(T);
+  cl::Buffer buffer(runtime.context(), CL_MEM_READ_ONLY, bytes);
+  if (!data.empty()) runtime.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, data.size() * sizeof(T), data.data());
+  return buffer;
+}
+
+}  // namespace
+
+void TessellationStage::load(PackedDisplacement packed) {
+  release();
+  packed_ = std::move(packed);
+  params_ = upload(runtime_, std::vector<TessellationParams>{packed_.params});
+  patches_ = upload(runtime_, packed_.patches);
+  samples_ = upload(runtime_, packed_.samples);
+  positions_ = upload(runtime_, packed_.positions);
+  normals_ = upload(runtime_, packed_.normals);
+  vertices_ = cl::Buffer(runtime_.context(), CL_MEM_READ_WRITE, std::max<size_t>(packed_.vertex_count(), 1) * sizeof(TessVertex));
+  loaded_ = true;
+}
+
+void TessellationStage::release() {
+  loaded_ = false;
+  packed_ = PackedDisplacement{};
+  params_ = patches_ = samples_ = positions_ = normals_ = vertices_ = cl::Buffer();
+}
+
+TessellationStage::Kernels& TessellationStage::kernels(const std::string& program_options) {
+  auto it = kernels_.find(program_options);
+  if (it == kernels_.end()) {
+    const cl::Program& program = runtime_.program(program_options);
+    it = kernels_.emplace(program_options, Kernels{cl::Kernel(program, "tessellate"), cl::Kernel(program, "tessellated_setup")}).first;
+  }
+  return it->second;
+}
+
+void TessellationStage::enqueue_tessellate(Kernels& k, std::vector<cl::Event>* events) {
+  const size_t vertices = packed_.vertex_count();
+  if (vertices == 0) return;
+  k.tessellate.setArg(0, params_);
+  k.tessellate.setArg(1, patches_);
+  k.tessellate.setArg(2, samples_);
+  k.tessellate.setArg(3, positions_);
+  k.tessellate.setArg(4, normals_);
+  k.tessellate.setArg(5, vertices_);
+  cl::Event* event = nullptr;
+  if (events) event = &events->emplace_back();
+  runtime_.queue().enqueueNDRangeKernel(k.tessellate, cl::NullRange, cl::NDRange(round_up(vertices, kGroup)), cl::NDRange(kGroup),
+                                        nullptr, event);
+}
+
+void TessellationStage::enqueue(const std::string& program_options, const cl::Buffer& frame_params, const cl::Buffer& setups,
+                                const cl::Buffer& stats, int input_triangles, std::vector<cl::Event>& tessellate_events,
+                                std::vector<cl::Event>& setup_events) {
+  Kernels& k = kernels(program_options);
+  enqueue_tessellate(k, &tessellate_events);
+  if (input_triangles <= 0) return;
+  k.setup.setArg(0, frame_params);
+  k.setup.setArg(1, params_);
+  k.setup.setArg(2, vertices_);
+  k.setup.setArg(3, setups);
+  k.setup.setArg(4, stats);
+  runtime_.queue().enqueueNDRangeKernel(k.setup, cl::NullRange, cl::NDRange(round_up(static_cast<size_t>(input_triangles), kGroup)),
+                                        cl::NDRange(kGroup), nullptr, &setup_events.emplace_back());
+}
+
+std::vector<TessVertex> TessellationStage::tessellate(const std::string& program_options) {
+  enqueue_tessellate(kernels(program_options), nullptr);
+  return read_vertices();
+}
+
+std::vector<TessVertex> TessellationStage::read_vertices() {
+  std::vector<TessVertex> out(packed_.vertex_count());
+  if (!out.empty()) runtime_.queue().enqueueReadBuffer(vertices_, CL_TRUE, 0, out.size() * sizeof(TessVertex), out.data());
+  return out;
+}
+
+size_t TessellationStage::device_bytes() const {
+  size_t bytes = 0;
+  for (const cl::Buffer* b : {&params_, &patches_, &samples_, &positions_, &normals_, &vertices_}) {
+    if ((*b)() != nullptr) bytes += b->getInfo<CL_MEM_SIZE>();
+  }
+  return bytes;
+}
+
+}  // namespace seamcl

@@ -1,0 +1,247 @@
+/* Stage 0 (displacement renders only): tessellation. Two kernels.
+ *
+ * tessellate: one work-item per output vertex, patch p's vertex (i, j) at
+ * p * (T+1)^2 + j * (T+1) + i (T = params->tessellation, 1..SEAMCL_MAX_TESSELLATION).
+ *   1. Domain point (u, v). naive: i/T, j/T in float. The other methods: fixed point
+ *      (SEAMCL_DOMAIN_ONE = 1); a point on edge e is computed from the edge's end with the lower
+ *      mesh vertex index and mirrored at the other end, so both patches on the edge make the same
+ *      point (the D3D11 tessellator's rule). An edge's level is T on both sides.
+ *   2. Base surface: bilinear in the patch's corner positions and vertex normals.
+ *   3. Displacement h in [0, 1] by the method (SEAMCL_DISPLACEMENT_*): naive and fixed sample the
+ *      patch's own map (float bilinear / exact integer bilinear), zipper averages both sides'
+ *      samples on an edge and takes corner_value at a corner, ownership interpolates the owners'
+ *      texcoords with the post's index formulas and samples once.
+ *   4. position = base + unit normal * (scale * h); uv = the domain point (for colour textures).
+ * Host guarantees: patches, samples, positions, normals as packed by
+ * host/pipeline/displacement_packing.cpp; output holds patches * (T+1)^2 TessVertex.
+ *
+ * tessellated_setup: triangle setup (kernels/triangle_setup.cl's clipping, snapping, culling and
+ * planes, whose helpers it calls) of micro-triangle t: patch t / (2 T^2), cell c = (t / 2) % T^2
+ * at (c % T, c / T), split as the quads are: (00, 10, 11) for even t and (00, 11, 01) for odd t.
+ * Every record's face is the patch, so shading reads the patch's colour texture and seam method.
+ * Twin: host/twins/tessellate.cpp (tessellate); tessellated_setup at T = 1 without displacement
+ * equals triangle_setup exactly (tests/test_displacement.cpp). */
+
+SEAMCL_INLINE float disp_texel(__global const ushort* s, int columns, int i, int j) {
+  return (float)s[j * columns + i];
+}
+
+SEAMCL_INLINE float disp_sample_float(__global const ushort* s, int columns, int rows, float u, float v) {
+  if (columns == 0) return 0.0f;
+  const float x = u * (float)(columns - 1);
+  const float y = v * (float)(rows - 1);
+  int i0 = (int)x, j0 = (int)y;
+  i0 = i0 > columns - 2 ? columns - 2 : i0;
+  j0 = j0 > rows - 2 ? rows - 2 : j0;
+  i0 = i0 < 0 ? 0 : i0;
+  j0 = j0 < 0 ? 0 : j0;
+  const int i1 = columns > 1 ? i0 + 1 : 0, j1 = rows > 1 ? j0 + 1 : 0;
+  const float fx = columns > 1 ? x - (float)i0 : 0.0f;
+  const float fy = rows > 1 ? y - (float)j0 : 0.0f;
+  const float bottom = (1.0f - fx) * disp_texel(s, columns, i0, j0) + fx * disp_texel(s, columns, i1, j0);
+  const float top = (1.0f - fx) * disp_texel(s, columns, i0, j1) + fx * disp_texel(s, columns, i1, j1);
+  return ((1.0f - fy) * bottom + fy * top) * (1.0f / 65535.0f);
+}
+
+SEAMCL_INLINE float disp_sample_exact(__global const ushort* s, int columns, int rows, long u, long v) {
+  if (columns == 0) return 0.0f;
+  const long one = SEAMCL_DOMAIN_ONE;
+  const long xn = u * (long)(columns - 1), yn = v * (long)(rows - 1);
+  long i0 = xn >> 16, j0 = yn >> 16, fx = xn & (one - 1), fy = yn & (one - 1);
+  if (columns == 1) { i0 = 0; fx = 0; } else if (i0 >= columns - 1) { i0 = columns - 2; fx = one; }
+  if (rows == 1) { j0 = 0; fy = 0; } else if (j0 >= rows - 1) { j0 = rows - 2; fy = one; }
+  const long i1 = columns > 1 ? i0 + 1 : 0, j1 = rows > 1 ? j0 + 1 : 0;
+  const long bottom = (long)s[j0 * columns + i0] * (one - fx) + (long)s[j0 * columns + i1] * fx;
+  const long top = (long)s[j1 * columns + i0] * (one - fx) + (long)s[j1 * columns + i1] * fx;
+  const long numerator = bottom * (one - fy) + top * fy;
+  return (float)numerator * (1.0f / 4294967296.0f) * (1.0f / 65535.0f);
+}
+
+SEAMCL_INLINE void disp_edge_uv(int e, long s, long* u, long* v) {
+  const long one = SEAMCL_DOMAIN_ONE;
+  if (e == 0) { *u = s; *v = 0; }
+  else if (e == 1) { *u = one; *v = s; }
+  else if (e == 2) { *u = one - s; *v = one; }
+  else { *u = 0; *v = one - s; }
+}
+
+__kernel void tessellate(__constant TessellationParams* params, __global const DisplacementPatch* patches,
+                         __global const ushort* samples, __global const float4* positions,
+                         __global const float4* normals, __global TessVertex* out) {
+  const int t = params->tessellation;
+  const int side = t + 1;
+  const int id = (int)get_global_id(0);
+  if (id >= params->patches * side * side) return;
+  const int patch = id / (side * side);
+  const int i = (id % (side * side)) % side, j = (id % (side * side)) / side;
+  __global const DisplacementPatch* p = &patches[patch];
+  const long one = SEAMCL_DOMAIN_ONE;
+  const float inv_one = 1.0f / (float)SEAMCL_DOMAIN_ONE;
+  const int method = params->method;
+
+  /* 1. Domain point */
+  int edge = -1, step = 0;
+  const int corner = (i == 0 || i == t) && (j == 0 || j == t);
+  if (!corner) {
+    if (j == 0) { edge = 0; step = i; }
+    else if (i == t) { edge = 1; step = j; }
+    else if (j == t) { edge = 2; step = t - i; }
+    else if (i == 0) { edge = 3; step = t - j; }
+  }
+  long uf = (long)i * one / t, vf = (long)j * one / t;
+  long s = 0;
+  if (edge >= 0) {
+    s = p->vertex[edge] < p->vertex[(edge + 1) % 4] ? (long)step * one / t : one - (long)(t - step) * one / t;
+    disp_edge_uv(edge, s, &uf, &vf);
+  }
+  const int naive = method == SEAMCL_DISPLACEMENT_NAIVE;
+  const float u = naive ? (float)i / (float)t : (float)uf * inv_one;
+  const float v = naive ? (float)j / (float)t : (float)vf * inv_one;
+
+  /* 2. Base surface */
+  float w[4];
+  w[0] = (1.0f - u) * (1.0f - v);
+  w[1] = u * (1.0f - v);
+  w[2] = u * v;
+  w[3] = (1.0f - u) * v;
+  float px = 0.0f, py = 0.0f, pz = 0.0f, nx = 0.0f, ny = 0.0f, nz = 0.0f;
+  for (int k = 0; k < 4; ++k) {
+    const float4 P = positions[p->vertex[k]];
+    const float4 N = normals[p->vertex[k]];
+    px = px + w[k] * P.x;
+    py = py + w[k] * P.y;
+    pz = pz + w[k] * P.z;
+    nx = nx + w[k] * N.x;
+    ny = ny + w[k] * N.y;
+    nz = nz + w[k] * N.z;
+  }
+  const float length = sqrt(nx * nx + ny * ny + nz * nz);
+  const float inv_length = length > 0.0f ? 1.0f / length : 0.0f;
+
+  /* 3. Displacement */
+  __global const ushort* own = samples + p->map_offset;
+  const int columns = p->columns, rows = p->rows;
+  float h = 0.0f;
+  uint taken = 0;
+  if (method == SEAMCL_DISPLACEMENT_NAIVE) {
+    h = disp_sample_float(own, columns, rows, u, v);
+    taken = columns > 0;
+  } else if (method == SEAMCL_DISPLACEMENT_FIXED) {
+    h = disp_sample_exact(own, columns, rows, uf, vf);
+    taken = columns > 0;
+  } else if (method == SEAMCL_DISPLACEMENT_ZIPPER) {
+    if (corner) {
+      h = p->corner_value[i == 0 ? (j == 0 ? 0 : 3) : (j == 0 ? 1 : 2)];
+    } else if (edge >= 0 && p->neighbor[edge] >= 0) {
+      __global const DisplacementPatch* q = &patches[p->neighbor[edge]];
+      long ou = 0, ov = 0;
+      disp_edge_uv(p->neighbor_edge[edge], p->neighbor_same_way[edge] ? s : one - s, &ou, &ov);
+      const float mine = disp_sample_float(own, columns, rows, u, v);
+      const float theirs = disp_sample_float(samples + q->map_offset, q->columns, q->rows, (float)ou * inv_one, (float)ov * inv_one);
+      h = (mine + theirs) * 0.5f;
+      taken = (uint)(columns > 0) + (uint)(q->columns > 0);
+    } else {
+      h = disp_sample_float(own, columns, rows, u, v);
+      taken = columns > 0;
+    }
+  } else {
+    /* ownership: the post's index formulas over corners (0,0), (1,0), (1,1), (0,1) */
+    const int x0 = uf == 0, x1 = uf == one, y0 = vf == 0, y1 = vf == one;
+    int index[4];
+    index[0] = 2 * x0 + y0;
+    index[1] = 2 * y0 + x1;
+    index[2] = 2 * x1 + y1;
+    index[3] = 2 * y1 + x0;
+    float tu = 0.0f, tv = 0.0f, heaviest = 0.0f;
+    int face = -1;
+    for (int k = 0; k < 4; ++k) {
+      const DisplacementTexcoord tc = p->texcoord[k][index[k]];
+      tu = tu + w[k] * tc.u;
+      tv = tv + w[k] * tc.v;
+      if (w[k] > heaviest) {
+        heaviest = w[k];
+        face = tc.face;
+      }
+    }
+    if (face >= 0) {
+      __global const DisplacementPatch* q = &patches[face];
+      h = disp_sample_float(samples + q->map_offset, q->columns, q->rows, tu, tv);
+      taken = q->columns > 0;
+    }
+  }
+
+  /* 4. Displace along the unit normal */
+  const float offset = params->scale * h;
+  TessVertex r;
+  r.position[0] = px + (nx * inv_length) * offset;
+  r.position[1] = py + (ny * inv_length) * offset;
+  r.position[2] = pz + (nz * inv_length) * offset;
+  r.u = u;
+  r.v = v;
+  r.displacement = h;
+  r.samples = taken;
+  r.pad0 = 0;
+  out[id] = r;
+}
+
+__kernel void tessellated_setup(__constant FrameParams* frame, __constant TessellationParams* params,
+                                __global const TessVertex* vertices, __global TriangleSetup* out,
+                                __global FrameStats* stats) {
+  const int tri = (int)get_global_id(0);
+  if (tri >= frame->input_triangles) return;
+  const int t = params->tessellation;
+  const int side = t + 1;
+  const int patch = tri / (2 * t * t);
+  const int cell = (tri / 2) % (t * t);
+  const int ci = cell % t, cj = cell / t;
+  /* corners of the cell: 0 = (ci, cj), 1 = (ci+1, cj), 2 = (ci+1, cj+1), 3 = (ci, cj+1) */
+  const int base = patch * side * side;
+  int vid[4];
+  vid[0] = base + cj * side + ci;
+  vid[1] = vid[0] + 1;
+  vid[2] = vid[0] + side + 1;
+  vid[3] = vid[0] + side;
+  const int corner[3] = {0, (tri & 1) ? 2 : 1, (tri & 1) ? 3 : 2};
+
+  /* From here on as triangle_setup (kernels/triangle_setup.cl), per micro-triangle. */
+  ClipVertex polygon[3 + 5];
+  int count = 3;
+  for (int k = 0; k < 3; ++k) {
+    const TessVertex tv = vertices[vid[corner[k]]];
+    const __constant float* m = frame->view_proj;
+    polygon[k].x = m[0] * tv.position[0] + m[4] * tv.position[1] + m[8] * tv.position[2] + m[12];
+    polygon[k].y = m[1] * tv.position[0] + m[5] * tv.position[1] + m[9] * tv.position[2] + m[13];
+    polygon[k].w = m[3] * tv.position[0] + m[7] * tv.position[1] + m[11] * tv.position[2] + m[15];
+    polygon[k].u = tv.u;
+    polygon[k].v = tv.v;
+  }
+  for (int plane = 0; plane < 5 && count > 0; ++plane) {
+    float d[8];
+    int outside = 0;
+    for (int k = 0; k < count; ++k) {
+      d[k] = clip_distance(polygon[k], plane, frame);
+      outside += d[k] < 0.0f;
+    }
+    if (outside == 0) continue;
+    ClipVertex clipped[3 + 5];
+    int n = 0;
+    for (int k = 0; k < count; ++k) {
+      const int l = (k + 1) % count;
+      if (d[k] >= 0.0f) clipped[n++] = polygon[k];
+      if ((d[k] >= 0.0f) != (d[l] >= 0.0f)) {
+        clipped[n++] = d[k] >= 0.0f ? clip_lerp(polygon[k], polygon[l], d[k], d[l])
+                                    : clip_lerp(polygon[l], polygon[k], d[l], d[k]);
+      }
+    }
+    count = n;
+    for (int k = 0; k < count; ++k) polygon[k] = clipped[k];
+  }
+  uint visible = 0;
+  for (int k = 0; k < SEAMCL_CLIP_SLOTS; ++k) {
+    TriangleSetup s = empty_setup((uint)patch);
+    if (k + 2 < count) s = setup_screen_triangle(polygon[0], polygon[k + 1], polygon[k + 2], (uint)patch, frame);
+    visible += s.bbox_max_x >= s.bbox_min_x && s.bbox_max_y >= s.bbox_min_y;
+    out[tri * SEAMCL_CLIP_SLOTS + k] = s;
+  }
+  if (visible > 0) atomic_add(&stats->visible_triangles, visible);
+}
