@@ -11,9 +11,11 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <seamcl/assets/ptex_displacement.h>
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
@@ -29,6 +31,9 @@ using namespace seamcl;
 struct RenderArgs {
   std::optional<std::string> scene, texture, method, filter, zero_coverage, texels, size, shading;
   std::optional<int> msaa, aniso, guard_band, frame, frames;
+  std::optional<std::string> displacement_method;
+  std::optional<int> tessellation, displacement_level;
+  std::string displacement_map;  // a .ptx of displacement for an .obj scene (CLI only)
   bool centroid = false;
   bool tint = false;
   std::string output;
@@ -60,6 +65,9 @@ json render_request(const RenderArgs& a) {
   if (a.frame) request["frame"] = *a.frame;
   if (a.frames) request["frames"] = *a.frames;
   if (a.tint) request["tint"] = true;
+  if (a.displacement_method) request["displacement_method"] = *a.displacement_method;
+  if (a.tessellation) request["tessellation"] = *a.tessellation;
+  if (a.displacement_level) request["displacement_level"] = *a.displacement_level;
   return request;
 }
 
@@ -72,7 +80,8 @@ int run_render(const RenderArgs& args, const std::string& device) {
   const auto scene_start = std::chrono::steady_clock::now();
   SceneSourceOptions source;
   source.generator.tint = options.tint;
-  const Scene scene = load_scene_source(options.scene, options.texture, source);
+  Scene scene = load_scene_source(options.scene, options.texture, source);
+  if (!args.displacement_map.empty()) attach_ptex_displacement(scene, args.displacement_map);
   const Camera camera = options.frame ? orbit_camera(scene, *options.frame, options.frames) : scene.camera;
   const double scene_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - scene_start).count();
 
@@ -107,6 +116,14 @@ int run_render(const RenderArgs& args, const std::string& device) {
                 {"padding_bytes", renderer.packed_scene().padding_bytes()},
                 {"adjacency_bytes", reads_adjacency(options.method) ? renderer.packed_scene().adjacency_bytes() : 0},
                 {"bin_entries", result.stats.bin_entries}};
+    if (options.displacement) {
+      // The gap and crack pixels of this frame (docs/displacement.md), the times of the renders above.
+      DisplacementReport report = measure_displacement(runtime, scene, camera, options, 0, 0);
+      report.frame_ms = stage_median(&StageTimes::total);
+      report.tessellate_ms = stage_median(&StageTimes::tessellate);
+      out["displacement"] = report.to_json();
+      out["triangles"] = report.triangles;
+    }
     if (!args.output.empty()) out["output"] = args.output;
     std::cout << out.dump(2) << "\n";
   } else {
@@ -184,6 +201,12 @@ int main(int argc, char** argv) {
   render->add_option("--shading", render_args.shading, "Where to shade: pixel, centroid or sample [pixel]");
   render->add_flag("--centroid", render_args.centroid, "Shade at the centroid of the covered samples (same as --shading centroid)");
   render->add_flag("--tint", render_args.tint, "Built-in scenes: tint each face a different base colour");
+  render->add_option("--displacement-method", render_args.displacement_method,
+                     "Tessellate and displace with this seam method: " + listed(displacement_method_names()) + " [off]");
+  render->add_option("--tessellation", render_args.tessellation, "Displacement: each patch a (T+1)^2 grid, T 1..64 [8]");
+  render->add_option("--displacement-level", render_args.displacement_level, "Displacement: the maps' level sampled, 0..16 [0]");
+  render->add_option("--displacement-map", render_args.displacement_map,
+                     "Displacement: a 1-channel .ptx for an .obj scene, face i displacing face i");
   render->add_option("-o,--output", render_args.output, "Output image, .png or .exr (none: render and time only)");
   render->add_flag("--json", render_args.json_out, "Print one JSON object: device, options, ms per stage, triangles, fragments");
   render->add_option("--repeat", render_args.repeat, "Render N times and report the median time per stage [1]");

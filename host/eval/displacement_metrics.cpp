@@ -195,13 +195,13 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
     return list;
   }();
 
-  // 2. Time per frame, on the scene itself.
-  {
+  // 2. Time per frame, on the scene itself (repeat 0: the caller times its own renders).
+  if (repeat > 0) {
     Renderer renderer(runtime);
     renderer.load_scene(scene, options.texels);
     renderer.render(cameras.front(), options);  // builds and warms the kernels
     std::vector<double> frame, tessellate;
-    for (int r = 0; r < std::max(repeat, 1); ++r) {
+    for (int r = 0; r < repeat; ++r) {
       const RenderResult result = renderer.render(cameras[static_cast<size_t>(r) % cameras.size()], options);
       frame.push_back(result.ms.total);
       tessellate.push_back(result.ms.tessellate);

@@ -64,7 +64,8 @@ struct DisplacementReport {
 
 // Measures options.displacement (required) on `scene` at `camera`, or over `frames` frames of
 // its orbit when frames > 0: the gap from the device's tessellation, crack pixels from renders
-// of with_flag_shell(scene), time per frame from renders of the scene itself (median of repeat).
+// of with_flag_shell(scene) (closed meshes only), time per frame from `repeat` renders of the
+// scene itself (median; repeat 0 leaves the times 0 for a caller that times its own renders).
 DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, const Camera& camera,
                                         const RenderOptions& options, int orbit_frames = 0, int repeat = 1);
 

@@ -1,0 +1,219 @@
+// Displacement seen the honest way: crack pixels on a closed mesh whose inside is a flag, over an
+// orbit; the real Ptex displacement maps on plane.obj; the CLI, HTTP schema and error paths.
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <seamcl/assets/ptex_displacement.h>
+#include <seamcl/assets/scene_source.h>
+#include <seamcl/core/input_error.h>
+#include <seamcl/eval/displacement_metrics.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene_generators.h>
+#include "http_server.h"
+#include "pipeline/displacement_packing.h"
+#include "pipeline/tessellation_stage.h"
+#include "scene/displacement_map.h"
+#include "test_support.h"
+
+namespace {
+
+using namespace seamcl;
+using seamcl_tests::shared_runtime;
+namespace fs = std::filesystem;
+
+const std::string kAssets = std::string(SEAMCL_TEST_ASSETS_DIR) + "/ptex/";
+
+RenderOptions small_options(DisplacementMethod method, int t) {
+  RenderOptions o;
+  o.width = 96;
+  o.height = 96;
+  o.msaa = 1;
+  o.displacement = method;
+  o.tessellation = t;
+  return o;
+}
+
+TEST(DisplacementCracks, FlagShowsOnlyThroughCracksOverASixtyFrameOrbit) {
+  const Scene scene = generate_scene("displaced", {});
+  for (int t : {3, 8}) {
+    for (DisplacementMethod method : {DisplacementMethod::Zipper, DisplacementMethod::Ownership, DisplacementMethod::Fixed}) {
+      const DisplacementReport r = measure_displacement(shared_runtime(), scene, scene.camera, small_options(method, t), 60, 0);
+      ASSERT_TRUE(r.crack_pixels.has_value());
+      EXPECT_EQ(r.crack_frames, 60);
+      EXPECT_EQ(*r.crack_pixels, 0u) << to_string(method) << " T=" << t;
+    }
+    const DisplacementReport naive =
+        measure_displacement(shared_runtime(), scene, scene.camera, small_options(DisplacementMethod::Naive, t), 60, 0);
+    ASSERT_TRUE(naive.crack_pixels.has_value());
+    EXPECT_GT(*naive.crack_pixels, 0u) << "naive, T=" << t;
+  }
+}
+
+TEST(DisplacementCracks, TheFlagIsHiddenByTheUndisplacedMeshAndSeenWithoutIt) {
+  // The flag test can fail both ways: with the outer surface gone every covered pixel is flag;
+  // with it in place and no displacement at all nothing is.
+  const Scene scene = generate_scene("displaced", {});
+  Scene flagged = with_flag_shell(scene);
+  RenderOptions options = small_options(DisplacementMethod::Naive, 4);
+  Renderer renderer(shared_runtime());
+  Scene flat = flagged;
+  auto zero = std::make_shared<Displacement>(*scene.displacement);
+  zero->scale = 0.0f;
+  zero->maps.resize(flat.faces.size());
+  flat.displacement = zero;
+  renderer.load_scene(flat);
+  renderer.render(scene.camera, options);
+  EXPECT_EQ(count_flag_pixels(renderer.read_sample_triangles(), 96, 96, 1, 4, scene.faces.size()), 0u);
+  // Only the flag: shift its patch range to 0 so every covered pixel counts.
+  const size_t covered = count_flag_pixels(renderer.read_sample_triangles(), 96, 96, 1, 4, 0);
+  EXPECT_GT(covered, 1000u);
+  EXPECT_FALSE(is_closed_mesh(generate_scene("quad2", {})));
+  EXPECT_TRUE(is_closed_mesh(flagged));
+}
+
+TEST(DisplacementPtex, RealMapsOnPlaneObj) {
+  for (const char* file : {"rand_lo.ptx", "wave_lo.ptx"}) {
+    Scene scene = load_scene_source(kAssets + "plane.obj");
+    attach_ptex_displacement(scene, kAssets + file);
+    ASSERT_TRUE(scene.displacement);
+    ASSERT_EQ(scene.displacement->maps.size(), scene.faces.size());
+    std::set<int> sides;
+    for (const DisplacementMap& m : scene.displacement->maps) sides.insert(m.columns);
+    EXPECT_GE(sides.size(), 2u) << "mixed face sizes";
+    for (int t : {1, 4, 7, 16}) {
+      for (DisplacementMethod method : {DisplacementMethod::Naive, DisplacementMethod::Zipper,
+                                        DisplacementMethod::Ownership, DisplacementMethod::Fixed}) {
+        const DisplacementReport r = measure_displacement(shared_runtime(), scene, scene.camera, small_options(method, t), 0, 0);
+        EXPECT_FALSE(r.crack_pixels.has_value()) << "plane.obj is open";
+        if (method == DisplacementMethod::Naive) {
+          if (t > 1) EXPECT_GT(r.gap.max_gap, 0.0) << file << " T=" << t;
+        } else {
+          EXPECT_EQ(r.gap.max_gap, 0.0) << file << " " << to_string(method) << " T=" << t;
+          EXPECT_EQ(r.gap.differing_pairs, 0u);
+        }
+        if (method == DisplacementMethod::Fixed) EXPECT_EQ(r.unmatched_edges, 0u);
+      }
+    }
+  }
+}
+
+TEST(DisplacementPtex, RefusesFilesThatAreNotOneChannelMapsOfThisMesh) {
+  auto field_of = [](const std::function<void()>& f, std::string* message = nullptr) -> std::string {
+    try {
+      f();
+    } catch (const InputError& e) {
+      if (message) *message = e.what();
+      return e.field();
+    }
+    return "(none)";
+  };
+  Scene plane = load_scene_source(kAssets + "plane.obj");
+  std::string message;
+  EXPECT_EQ(field_of([&] { attach_ptex_displacement(plane, kAssets + "cellnoise.ptx"); }, &message), "displacement_map");
+  EXPECT_NE(message.find("cellnoise.ptx"), std::string::npos) << message;
+  Scene cube = load_scene_source(kAssets + "cube.obj");
+  EXPECT_EQ(field_of([&] { attach_ptex_displacement(cube, kAssets + "rand_lo.ptx"); }, &message), "displacement_map");
+  EXPECT_NE(message.find("faces"), std::string::npos) << message;
+  EXPECT_EQ(field_of([&] { attach_ptex_displacement(plane, kAssets + "no_such_file.ptx"); }), "displacement_map");
+  // A truncated file.
+  const fs::path cut = fs::temp_directory_path() / "seamcl_disp_truncated.ptx";
+  {
+    std::ifstream in(kAssets + "rand_lo.ptx", std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  }
+  EXPECT_EQ(field_of([&] { attach_ptex_displacement(plane, cut.string()); }), "displacement_map");
+  fs::remove(cut);
+  EXPECT_FALSE(plane.displacement) << "a refused file changes nothing";
+}
+
+TEST(DisplacementService, OpenApiListsTheMethodsTheParserTakes) {
+  const nlohmann::json doc = nlohmann::json::parse(server::openapi_json());
+  const auto& body = doc.at("components").at("schemas").at("RenderRequest").at("properties");
+  EXPECT_EQ(body.at("displacement_method").at("enum").get<std::vector<std::string>>(), displacement_method_names());
+  EXPECT_EQ(body.at("tessellation").at("maximum"), SEAMCL_MAX_TESSELLATION);
+  EXPECT_EQ(body.at("tessellation").at("default"), RenderOptions{}.tessellation);
+  bool in_query = false;
+  for (const auto& p : doc.at("paths").at("/v1/render").at("get").at("parameters")) {
+    if (p.at("name") == "displacement_method") {
+      in_query = true;
+      EXPECT_EQ(p.at("schema").at("enum").get<std::vector<std::string>>(), displacement_method_names());
+    }
+  }
+  EXPECT_TRUE(in_query);
+}
+
+struct CliRun {
+  int code = -1;
+  std::string out, err;
+};
+
+CliRun run_cli(const std::string& args) {
+  const fs::path dir = fs::temp_directory_path();
+  const std::string out = (dir / "seamcl_disp_out.txt").string(), err = (dir / "seamcl_disp_err.txt").string();
+  const int status = std::system((std::string(SEAMCL_BINARY) + " " + args + " >" + out + " 2>" + err + " </dev/null").c_str());
+  CliRun r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  auto slurp = [](const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+TEST(DisplacementCli, RenderJsonReportsTheGapAndCracks) {
+  const CliRun ok = run_cli("render --scene displaced --displacement-method zipper --tessellation 7 --size 64x64 --json");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  const nlohmann::json j = nlohmann::json::parse(ok.out);
+  const auto& d = j.at("displacement");
+  EXPECT_EQ(d.at("method"), "zipper");
+  EXPECT_EQ(d.at("tessellation"), 7);
+  EXPECT_EQ(d.at("max_gap"), 0.0);
+  EXPECT_EQ(d.at("crack_pixels"), 0);
+  EXPECT_GT(d.at("samples").get<size_t>(), d.at("vertices").get<size_t>()) << "zipper samples twice on edges";
+  EXPECT_GT(d.at("frame_ms").get<double>(), 0.0);
+  EXPECT_EQ(j.at("options").at("displacement_method"), "zipper");
+
+  const CliRun naive = run_cli("render --scene displaced --displacement-method naive --tessellation 7 --size 64x64 --json");
+  ASSERT_EQ(naive.code, 0) << naive.err;
+  EXPECT_GT(nlohmann::json::parse(naive.out).at("displacement").at("max_gap").get<double>(), 0.0);
+
+  const CliRun plain = run_cli("render --scene displaced --size 32x32 --json");
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  EXPECT_FALSE(nlohmann::json::parse(plain.out).contains("displacement"));
+}
+
+TEST(DisplacementCli, BadInputExitsTwoNamingTheField) {
+  struct Case {
+    std::string args, field;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"--scene displaced --displacement-method wobbly", "displacement_method"},
+           {"--scene displaced --displacement-method fixed --tessellation 0", "tessellation"},
+           {"--scene displaced --displacement-method fixed --tessellation 65", "tessellation"},
+           {"--scene displaced --displacement-method fixed --displacement-level 17", "displacement_level"},
+           {"--scene cube --displacement-method fixed", "displacement"},
+           {"--scene " + kAssets + "plane.obj --displacement-map " + kAssets + "cellnoise.ptx --displacement-method fixed",
+            "displacement_map"},
+       }) {
+    const CliRun r = run_cli("render " + c.args + " --size 16x16");
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    EXPECT_EQ(r.err.find(c.field + ":") != std::string::npos, true) << c.args << "\n" << r.err;
+  }
+}
+
+}  // namespace
