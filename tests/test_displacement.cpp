@@ -1,6 +1,9 @@
 // The tessellation stage and the displacement seam methods (docs/displacement.md): the kernel
 // against its twin, the exact gap between patches, and hostile displacement input.
+#include <algorithm>
 #include <cstring>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -194,6 +197,94 @@ TEST(Displacement, DefaultRendersAreUnchangedByTheScenesMaps) {
   b.load_scene(without);
   const RenderResult ra = a.render(with_maps.camera, options), rb = b.render(without.camera, options);
   EXPECT_EQ(std::memcmp(ra.pixels.data(), rb.pixels.data(), ra.pixels.size() * sizeof(glm::vec4)), 0);
+}
+
+// Face f's vertex list started one corner later, its map turned to match (the same surface,
+// the same samples): new (u, v) is old (1 - v, u).
+void rotate_face(Scene& scene, Displacement& d, size_t f) {
+  auto& v = scene.faces[f].vertices;
+  std::rotate(v.begin(), v.begin() + 1, v.end());
+  const DisplacementMap old = d.maps[f];
+  DisplacementMap turned;
+  turned.columns = old.rows;
+  turned.rows = old.columns;
+  turned.samples.resize(old.samples.size());
+  for (int j = 0; j < turned.rows; ++j)
+    for (int i = 0; i < turned.columns; ++i) turned.at(i, j) = old.at(old.columns - 1 - j, i);
+  d.maps[f] = turned;
+}
+
+TEST(Displacement, ZeroGapForEveryRotationOfANeighbour) {
+  // Turn two neighbouring faces through all 16 combinations of their rotations.
+  for (int ra = 0; ra < 4; ++ra) {
+    for (int rb = 0; rb < 4; ++rb) {
+      Scene scene = displaced();
+      auto d = std::make_shared<Displacement>(*scene.displacement);
+      const PackedDisplacement before = pack_displacement(scene, {DisplacementMethod::Naive, 1, 0});
+      const size_t a = 5, b = static_cast<size_t>(before.patches[a].neighbor[0]);
+      for (int k = 0; k < ra; ++k) rotate_face(scene, *d, a);
+      for (int k = 0; k < rb; ++k) rotate_face(scene, *d, b);
+      scene.displacement = d;
+      for (DisplacementMethod method : kWatertight) {
+        for (int t : {3, 8}) {
+          PackedDisplacement packed;
+          const std::vector<TessVertex> v = device_tessellation(scene, {method, t, 0}, &packed);
+          const DisplacementGap gap = measure_gap(packed, v);
+          EXPECT_EQ(gap.differing_pairs, 0u) << to_string(method) << " T=" << t << " rotations " << ra << ", " << rb;
+        }
+      }
+    }
+  }
+}
+
+TEST(Displacement, CoarserLevelsStayWatertight) {
+  for (int level : {1, 2, 5}) {
+    for (DisplacementMethod method : kWatertight) {
+      PackedDisplacement packed;
+      const std::vector<TessVertex> v = device_tessellation(displaced(), {method, 16, level}, &packed);
+      const DisplacementGap gap = measure_gap(packed, v);
+      EXPECT_EQ(gap.differing_pairs, 0u) << to_string(method) << " level " << level;
+    }
+  }
+  // Level 5 leaves every map at 2 samples a side: the maps shrink as asked.
+  const PackedDisplacement packed = pack_displacement(displaced(), {DisplacementMethod::Naive, 4, 5});
+  for (const DisplacementPatch& p : packed.patches) {
+    EXPECT_EQ(p.columns, 2);
+    EXPECT_EQ(p.rows, 2);
+  }
+}
+
+TEST(Displacement, FixedNeedsMatchedMapsAndSaysWhatMatchingChanged) {
+  // The post: fixed point alone is not enough; the maps' edge samples must match. Fixed reports
+  // how many samples its matching changed, and the same maps unmatched crack.
+  PackedDisplacement packed = pack_displacement(displaced(), {DisplacementMethod::Fixed, 16, 0});
+  EXPECT_GT(packed.matched_samples, 0u);
+  EXPECT_EQ(packed.unmatched_edges, 0u);
+  const PackedDisplacement raw = pack_displacement(displaced(), {DisplacementMethod::Naive, 16, 0});
+  packed.samples = raw.samples;  // the unmatched maps, same layout
+  const DisplacementGap gap = measure_gap(packed, tessellate_reference(packed));
+  EXPECT_GT(gap.differing_pairs, 0u);
+}
+
+TEST(Displacement, CostsFollowTheMethod) {
+  const int t = 8;
+  std::map<DisplacementMethod, size_t> samples, bytes;
+  for (DisplacementMethod method : kAllMethods) {
+    const PackedDisplacement packed = pack_displacement(displaced(), {method, t, 0});
+    size_t taken = 0;
+    for (const TessVertex& v : tessellate_reference(packed)) taken += v.samples;
+    samples[method] = taken;
+    bytes[method] = packed.method_bytes();
+  }
+  const size_t vertices = displaced().faces.size() * (t + 1) * (t + 1);
+  EXPECT_EQ(samples[DisplacementMethod::Naive], vertices);
+  EXPECT_EQ(samples[DisplacementMethod::Ownership], vertices) << "one sample per vertex";
+  EXPECT_EQ(samples[DisplacementMethod::Fixed], vertices);
+  // Zipper: two on each edge's T-1 inner vertices (both patches), none at corners.
+  const size_t patches = displaced().faces.size();
+  EXPECT_EQ(samples[DisplacementMethod::Zipper], vertices + patches * 4 * (t - 1) - patches * 4);
+  EXPECT_EQ(bytes[DisplacementMethod::Ownership], patches * 16 * sizeof(DisplacementTexcoord));
+  EXPECT_EQ(bytes[DisplacementMethod::Naive], 0u);
 }
 
 TEST(Displacement, RejectsHostileSettingsNamingTheField) {

@@ -20,6 +20,7 @@
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 #include "http_server.h"
+#include "server_support.h"
 #include "pipeline/displacement_packing.h"
 #include "pipeline/tessellation_stage.h"
 #include "scene/displacement_map.h"
@@ -151,6 +152,31 @@ TEST(DisplacementService, OpenApiListsTheMethodsTheParserTakes) {
     }
   }
   EXPECT_TRUE(in_query);
+}
+
+TEST(DisplacementService, RendersOverHttpAndRefusesBadFields) {
+  seamcl::server::ServerOptions server_options;
+  seamcl_tests::LiveServer server(server_options);
+  httplib::Client c("127.0.0.1", server.port());
+  c.set_read_timeout(120, 0);
+  const nlohmann::json body = {{"scene", "displaced"}, {"size", "48x48"}, {"displacement_method", "ownership"}, {"tessellation", 5}};
+  auto ok = c.Post("/v1/render", body.dump(), "application/json");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200) << ok->body;
+  EXPECT_EQ(ok->get_header_value("Content-Type"), "image/png");
+  auto get = c.Get("/v1/render?scene=displaced&size=48x48&displacement_method=ownership&tessellation=5");
+  ASSERT_TRUE(get);
+  EXPECT_EQ(get->status, 200);
+  EXPECT_EQ(get->body, ok->body);
+  for (const auto& [bad, field] : std::vector<std::pair<nlohmann::json, std::string>>{
+           {{{"scene", "displaced"}, {"displacement_method", "wobbly"}}, "displacement_method"},
+           {{{"scene", "displaced"}, {"displacement_method", "zipper"}, {"tessellation", 99}}, "tessellation"},
+           {{{"scene", "paper"}, {"displacement_method", "zipper"}}, "displacement"}}) {
+    auto res = c.Post("/v1/render", bad.dump(), "application/json");
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 400) << bad.dump();
+    EXPECT_EQ(nlohmann::json::parse(res->body).value("field", ""), field) << res->body;
+  }
 }
 
 struct CliRun {
