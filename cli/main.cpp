@@ -34,6 +34,7 @@ struct RenderArgs {
   std::optional<std::string> displacement_method;
   std::optional<int> tessellation, displacement_level;
   std::string displacement_map;  // a .ptx of displacement for an .obj scene (CLI only)
+  int crack_orbit = 0;           // count crack pixels over this many orbit frames (0: this frame)
   bool centroid = false;
   bool tint = false;
   std::string output;
@@ -76,6 +77,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
   const RenderOptions options = parse_render_options(render_request(args));
   if (!args.output.empty()) image_format_for_path(args.output, "output");
   if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
+  if (args.crack_orbit < 0 || args.crack_orbit > 3600) throw InputError("crack_orbit", "must be in 0..3600");
 
   const auto scene_start = std::chrono::steady_clock::now();
   SceneSourceOptions source;
@@ -118,7 +120,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
                 {"bin_entries", result.stats.bin_entries}};
     if (options.displacement) {
       // The gap and crack pixels of this frame (docs/displacement.md), the times of the renders above.
-      DisplacementReport report = measure_displacement(runtime, scene, camera, options, 0, 0);
+      DisplacementReport report = measure_displacement(runtime, scene, camera, options, args.crack_orbit, 0);
       report.frame_ms = stage_median(&StageTimes::total);
       report.tessellate_ms = stage_median(&StageTimes::tessellate);
       out["displacement"] = report.to_json();
@@ -207,6 +209,8 @@ int main(int argc, char** argv) {
   render->add_option("--displacement-level", render_args.displacement_level, "Displacement: the maps' level sampled, 0..16 [0]");
   render->add_option("--displacement-map", render_args.displacement_map,
                      "Displacement: a 1-channel .ptx for an .obj scene, face i displacing face i");
+  render->add_option("--crack-orbit", render_args.crack_orbit,
+                     "Displacement: count crack pixels over N frames of the scene's orbit instead of this frame [0]");
   render->add_option("-o,--output", render_args.output, "Output image, .png or .exr (none: render and time only)");
   render->add_flag("--json", render_args.json_out, "Print one JSON object: device, options, ms per stage, triangles, fragments");
   render->add_option("--repeat", render_args.repeat, "Render N times and report the median time per stage [1]");

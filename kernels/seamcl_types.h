@@ -157,6 +157,7 @@ typedef struct {
 #define SEAMCL_DISPLACEMENT_ZIPPER 1    /* edges: mean of both sides' samples; corners: one snapped value */
 #define SEAMCL_DISPLACEMENT_OWNERSHIP 2 /* one sample through the owner's texcoord (4 per corner) */
 #define SEAMCL_DISPLACEMENT_FIXED 3     /* fixed-point domain points, own map, exact integer filtering */
+#define SEAMCL_DISPLACEMENT_PTEX_FILTER 4 /* a 3x3 tent of one own-texel spacing, taps past an edge read the neighbour */
 #define SEAMCL_DOMAIN_ONE 65536         /* fixed-point domain coordinates: 16 fraction bits */
 #define SEAMCL_MAX_TESSELLATION 64
 

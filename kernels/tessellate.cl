@@ -10,7 +10,8 @@
  *   3. Displacement h in [0, 1] by the method (SEAMCL_DISPLACEMENT_*): naive and fixed sample the
  *      patch's own map (float bilinear / exact integer bilinear), zipper averages both sides'
  *      samples on an edge and takes corner_value at a corner, ownership interpolates the owners'
- *      texcoords with the post's index formulas and samples once.
+ *      texcoords with the post's index formulas and samples once, ptex-filter filters across
+ *      edges into the neighbours' maps (disp_sample_across_edges).
  *   4. position = base + unit normal * (scale * h); uv = the domain point (for colour textures).
  * Host guarantees: patches, samples, positions, normals as packed by
  * host/pipeline/displacement_packing.cpp; output holds patches * (T+1)^2 TessVertex.
@@ -63,6 +64,50 @@ SEAMCL_INLINE void disp_edge_uv(int e, long s, long* u, long* v) {
   else if (e == 1) { *u = one; *v = s; }
   else if (e == 2) { *u = one - s; *v = one; }
   else { *u = 0; *v = one - s; }
+}
+
+/* ptex-filter: a 3x3 tent (1/4, 1/2, 1/4 per axis) of taps one own sample spacing apart; a tap
+ * past edge e reads the neighbour at the same depth past its side; taps past a corner or a
+ * boundary are dropped; the sum is renormalised. */
+SEAMCL_INLINE float disp_sample_across_edges(__global const DisplacementPatch* patches, __global const ushort* samples,
+                                             int face, float u, float v, uint* taken) {
+  __global const DisplacementPatch* p = &patches[face];
+  const int columns = p->columns, rows = p->rows;
+  if (columns == 0) return 0.0f;
+  __global const ushort* own = samples + p->map_offset;
+  const float rx = columns > 1 ? 1.0f / (float)(columns - 1) : 0.0f;
+  const float ry = rows > 1 ? 1.0f / (float)(rows - 1) : 0.0f;
+  const float tent[3] = {0.25f, 0.5f, 0.25f};
+  float sum = 0.0f, weight = 0.0f;
+  for (int b = 0; b < 3; ++b) {
+    for (int a = 0; a < 3; ++a) {
+      const float w = tent[a] * tent[b];
+      const float tu = u + (float)(a - 1) * rx, tv = v + (float)(b - 1) * ry;
+      const int out_u = tu < 0.0f ? 3 : tu > 1.0f ? 1 : -1, out_v = tv < 0.0f ? 0 : tv > 1.0f ? 2 : -1;
+      if (out_u < 0 && out_v < 0) {
+        sum = sum + w * disp_sample_float(own, columns, rows, tu, tv);
+        weight = weight + w;
+        *taken += 1;
+        continue;
+      }
+      if (out_u >= 0 && out_v >= 0) continue;
+      const int e = out_u >= 0 ? out_u : out_v;
+      const int n = p->neighbor[e];
+      if (n < 0) continue;
+      const float s = e == 0 ? tu : e == 1 ? tv : e == 2 ? 1.0f - tu : 1.0f - tv;
+      const float depth = e == 0 ? -tv : e == 1 ? tu - 1.0f : e == 2 ? tv - 1.0f : -tu;
+      const float sn = p->neighbor_same_way[e] ? s : 1.0f - s;
+      const int m = p->neighbor_edge[e];
+      const float nu = m == 0 ? sn : m == 1 ? 1.0f - depth : m == 2 ? 1.0f - sn : depth;
+      const float nv = m == 0 ? depth : m == 1 ? sn : m == 2 ? 1.0f - depth : 1.0f - sn;
+      __global const DisplacementPatch* q = &patches[n];
+      if (q->columns == 0) continue;
+      sum = sum + w * disp_sample_float(samples + q->map_offset, q->columns, q->rows, nu, nv);
+      weight = weight + w;
+      *taken += 1;
+    }
+  }
+  return weight > 0.0f ? sum / weight : 0.0f;
 }
 
 __kernel void tessellate(__constant TessellationParams* params, __global const DisplacementPatch* patches,
@@ -129,6 +174,8 @@ __kernel void tessellate(__constant TessellationParams* params, __global const D
   } else if (method == SEAMCL_DISPLACEMENT_FIXED) {
     h = disp_sample_exact(own, columns, rows, uf, vf);
     taken = columns > 0;
+  } else if (method == SEAMCL_DISPLACEMENT_PTEX_FILTER) {
+    h = disp_sample_across_edges(patches, samples, patch, u, v, &taken);
   } else if (method == SEAMCL_DISPLACEMENT_ZIPPER) {
     if (corner) {
       h = p->corner_value[i == 0 ? (j == 0 ? 0 : 3) : (j == 0 ? 1 : 2)];

@@ -28,15 +28,18 @@ void edge_grid(int e, int k, int t, int* i, int* j) {
   }
 }
 
-void compare(const TessVertex& a, const TessVertex& b, DisplacementGap& gap) {
+// Adds the pair to the totals and returns its largest coordinate difference.
+double compare(const TessVertex& a, const TessVertex& b, DisplacementGap& gap) {
   ++gap.compared_pairs;
   bool differ = false;
+  double largest = 0.0;
   for (int c = 0; c < 3; ++c) {
-    const double d = std::fabs(static_cast<double>(a.position[c]) - static_cast<double>(b.position[c]));
-    gap.max_gap = std::max(gap.max_gap, d);
+    largest = std::max(largest, std::fabs(static_cast<double>(a.position[c]) - static_cast<double>(b.position[c])));
     differ = differ || a.position[c] != b.position[c];
   }
+  gap.max_gap = std::max(gap.max_gap, largest);
   gap.differing_pairs += differ;
+  return largest;
 }
 
 double median(std::vector<double> values) {
@@ -63,7 +66,8 @@ DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<
         int i = 0, j = 0, qi = 0, qj = 0;
         edge_grid(e, k, t, &i, &j);
         edge_grid(qe, patch.neighbor_same_way[e] ? k : t - k, t, &qi, &qj);
-        compare(vertices[vertex_index(p, i, j, t)], vertices[vertex_index(q, qi, qj, t)], gap);
+        const double d = compare(vertices[vertex_index(p, i, j, t)], vertices[vertex_index(q, qi, qj, t)], gap);
+        if (k > 0 && k < t) gap.max_edge_gap = std::max(gap.max_edge_gap, d);
       }
     }
   }
@@ -74,7 +78,7 @@ DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<
       const int i = (c == 1 || c == 2) ? t : 0, j = (c >= 2) ? t : 0;
       const size_t index = vertex_index(p, i, j, t);
       const auto [it, inserted] = first_at_vertex.emplace(packed.patches[static_cast<size_t>(p)].vertex[c], index);
-      if (!inserted) compare(vertices[it->second], vertices[index], gap);
+      if (!inserted) gap.max_corner_gap = std::max(gap.max_corner_gap, compare(vertices[it->second], vertices[index], gap));
     }
   }
   return gap;
@@ -146,6 +150,8 @@ nlohmann::json DisplacementReport::to_json() const {
                         {"tessellation", tessellation},
                         {"level", level},
                         {"max_gap", gap.max_gap},
+                        {"max_edge_gap", gap.max_edge_gap},
+                        {"max_corner_gap", gap.max_corner_gap},
                         {"compared_pairs", gap.compared_pairs},
                         {"differing_pairs", gap.differing_pairs},
                         {"crack_frames", crack_frames},

@@ -25,6 +25,8 @@ struct DisplacementGap {
   double max_gap = 0.0;        // largest |a - b| over coordinates of such pairs (exact: float differences held in double)
   size_t compared_pairs = 0;   // pairs compared
   size_t differing_pairs = 0;  // pairs whose positions are not equal coordinate by coordinate
+  double max_edge_gap = 0.0;   // max_gap over the pairs inside shared edges (not at their ends)
+  double max_corner_gap = 0.0; // max_gap over the pairs at mesh vertices
 };
 DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<TessVertex>& vertices);
 

@@ -8,10 +8,11 @@
 namespace seamcl {
 namespace {
 
-constexpr std::array<std::pair<DisplacementMethod, const char*>, 4> kNames{{{DisplacementMethod::Naive, "naive"},
+constexpr std::array<std::pair<DisplacementMethod, const char*>, 5> kNames{{{DisplacementMethod::Naive, "naive"},
                                                                            {DisplacementMethod::Zipper, "zipper"},
                                                                            {DisplacementMethod::Ownership, "ownership"},
-                                                                           {DisplacementMethod::Fixed, "fixed"}}};
+                                                                           {DisplacementMethod::Fixed, "fixed"},
+                                                                           {DisplacementMethod::PtexFilter, "ptex-filter"}}};
 
 }  // namespace
 
@@ -41,6 +42,7 @@ int displacement_method_code(DisplacementMethod method) {
     case DisplacementMethod::Zipper: return SEAMCL_DISPLACEMENT_ZIPPER;
     case DisplacementMethod::Ownership: return SEAMCL_DISPLACEMENT_OWNERSHIP;
     case DisplacementMethod::Fixed: return SEAMCL_DISPLACEMENT_FIXED;
+    case DisplacementMethod::PtexFilter: return SEAMCL_DISPLACEMENT_PTEX_FILTER;
   }
   return SEAMCL_DISPLACEMENT_NAIVE;
 }

@@ -16,8 +16,12 @@ namespace seamcl {
 //               post's index formulas pick the owner's, one sample;
 //   fixed     - domain points in fixed point, an edge's computed from one end and mirrored, the
 //               patch's own map filtered in exact integer arithmetic, on maps whose edge samples
-//               are made to match (the post: fixed point alone is not enough).
-enum class DisplacementMethod { Naive, Zipper, Ownership, Fixed };
+//               are made to match (the post: fixed point alone is not enough);
+//   ptex-filter - each patch filters its own map with a 3x3 tent one of its own sample spacings
+//               wide, taps past an edge read the neighbour's map (the traverse idea), taps past
+//               a corner or a boundary are dropped and the rest renormalised: both sides agree
+//               only where they would use the same filter width.
+enum class DisplacementMethod { Naive, Zipper, Ownership, Fixed, PtexFilter };
 
 std::optional<DisplacementMethod> parse_displacement_method(std::string_view name);
 std::string to_string(DisplacementMethod method);

@@ -142,6 +142,9 @@ size_t PackedDisplacement::method_bytes() const {
       return patches.size() * (sizeof(DisplacementPatch::neighbor) + sizeof(DisplacementPatch::neighbor_edge) +
                                sizeof(DisplacementPatch::neighbor_same_way) + sizeof(DisplacementPatch::corner_value));
     case SEAMCL_DISPLACEMENT_OWNERSHIP: return patches.size() * sizeof(DisplacementPatch::texcoord);
+    case SEAMCL_DISPLACEMENT_PTEX_FILTER:
+      return patches.size() * (sizeof(DisplacementPatch::neighbor) + sizeof(DisplacementPatch::neighbor_edge) +
+                               sizeof(DisplacementPatch::neighbor_same_way));
     default: return 0;
   }
 }

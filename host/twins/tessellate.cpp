@@ -65,6 +65,49 @@ void edge_uv(int e, int64_t s, int64_t* u, int64_t* v) {
   }
 }
 
+// ptex-filter: a 3x3 tent (weights 1/4, 1/2, 1/4 per axis) of taps one own sample spacing apart;
+// a tap past edge e reads the neighbour at the same distance past its side of the edge; taps past
+// a corner or a boundary are dropped; the sum is renormalised.
+float sample_across_edges(const PackedDisplacement& d, int face, float u, float v, cl_uint* taken) {
+  const DisplacementPatch& p = d.patches[static_cast<size_t>(face)];
+  const Map own = map_of(d, face);
+  if (own.columns == 0) return 0.0f;
+  const float rx = own.columns > 1 ? 1.0f / static_cast<float>(own.columns - 1) : 0.0f;
+  const float ry = own.rows > 1 ? 1.0f / static_cast<float>(own.rows - 1) : 0.0f;
+  const float tent[3] = {0.25f, 0.5f, 0.25f};
+  float sum = 0.0f, weight = 0.0f;
+  for (int b = 0; b < 3; ++b) {
+    for (int a = 0; a < 3; ++a) {
+      const float w = tent[a] * tent[b];
+      const float tu = u + static_cast<float>(a - 1) * rx, tv = v + static_cast<float>(b - 1) * ry;
+      const int out_u = tu < 0.0f ? 3 : tu > 1.0f ? 1 : -1, out_v = tv < 0.0f ? 0 : tv > 1.0f ? 2 : -1;
+      if (out_u < 0 && out_v < 0) {
+        sum = sum + w * sample_float(own, tu, tv);
+        weight = weight + w;
+        *taken += 1;
+        continue;
+      }
+      if (out_u >= 0 && out_v >= 0) continue;  // past a corner
+      const int e = out_u >= 0 ? out_u : out_v;
+      const int n = p.neighbor[e];
+      if (n < 0) continue;  // a boundary
+      const float s = e == 0 ? tu : e == 1 ? tv : e == 2 ? 1.0f - tu : 1.0f - tv;
+      const float depth = e == 0 ? -tv : e == 1 ? tu - 1.0f : e == 2 ? tv - 1.0f : -tu;
+      const float sn = p.neighbor_same_way[e] ? s : 1.0f - s;
+      const int m = p.neighbor_edge[e];
+      // The neighbour's edge point, moved inwards by depth.
+      const float nu = m == 0 ? sn : m == 1 ? 1.0f - depth : m == 2 ? 1.0f - sn : depth;
+      const float nv = m == 0 ? depth : m == 1 ? sn : m == 2 ? 1.0f - depth : 1.0f - sn;
+      const Map theirs = map_of(d, n);
+      if (theirs.columns == 0) continue;
+      sum = sum + w * sample_float(theirs, nu, nv);
+      weight = weight + w;
+      *taken += 1;
+    }
+  }
+  return weight > 0.0f ? sum / weight : 0.0f;
+}
+
 }  // namespace
 
 TessVertex tessellate_vertex_reference(const PackedDisplacement& d, int patch, int i, int j) {
@@ -116,6 +159,8 @@ TessVertex tessellate_vertex_reference(const PackedDisplacement& d, int patch, i
   } else if (params.method == SEAMCL_DISPLACEMENT_FIXED) {
     h = sample_exact(own, uf, vf);
     samples = own.columns > 0;
+  } else if (params.method == SEAMCL_DISPLACEMENT_PTEX_FILTER) {
+    h = sample_across_edges(d, patch, u, v, &samples);
   } else if (params.method == SEAMCL_DISPLACEMENT_ZIPPER) {
     if (corner) {
       h = p.corner_value[(i == 0 ? (j == 0 ? 0 : 3) : (j == 0 ? 1 : 2))];
