@@ -113,6 +113,9 @@ struct Renderer::Impl {
     setups = tile_counts = tile_offsets = tile_cursors = tile_lists = sample_triangle = image = seam_mask = cl::Buffer();
     setups_capacity = tiles_capacity = samples_capacity = pixels_capacity = mask_capacity = 0;
     tile_lists_capacity = 0;
+    // The tessellated vertices are sized by the request too (packed again on the next render).
+    tessellation.release();
+    tessellation_settings.reset();
     // What a scene needed once is not kept either: the lists start again at the initial size
     // (render_memory's estimate) and grow if this scene needs it.
     bin_capacity = scene ? initial_tile_list_entries(scene->triangle_count()) : 0;
