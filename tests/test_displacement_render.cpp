@@ -80,6 +80,19 @@ TEST(DisplacementCracks, TheFlagIsHiddenByTheUndisplacedMeshAndSeenWithoutIt) {
   EXPECT_GT(covered, 1000u);
   EXPECT_FALSE(is_closed_mesh(generate_scene("quad2", {})));
   EXPECT_TRUE(is_closed_mesh(flagged));
+  // An orbit to count over is needed.
+  Scene still = scene;
+  still.orbit.reset();
+  EXPECT_THROW(
+      {
+        try {
+          measure_displacement(shared_runtime(), still, still.camera, options, 3, 0);
+        } catch (const InputError& e) {
+          EXPECT_EQ(e.field(), "crack_orbit");
+          throw;
+        }
+      },
+      InputError);
 }
 
 TEST(DisplacementPtex, RealMapsOnPlaneObj) {
@@ -232,6 +245,7 @@ TEST(DisplacementCli, BadInputExitsTwoNamingTheField) {
            {"--scene displaced --displacement-method fixed --tessellation 0", "tessellation"},
            {"--scene displaced --displacement-method fixed --tessellation 65", "tessellation"},
            {"--scene displaced --displacement-method fixed --displacement-level 17", "displacement_level"},
+           {"--scene displaced --displacement-method fixed --crack-orbit -1", "crack_orbit"},
            {"--scene cube --displacement-method fixed", "displacement"},
            {"--scene " + kAssets + "plane.obj --displacement-map " + kAssets + "cellnoise.ptx --displacement-method fixed",
             "displacement_map"},

@@ -170,6 +170,9 @@ nlohmann::json DisplacementReport::to_json() const {
 DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, const Camera& camera,
                                         const RenderOptions& options, int orbit_frames, int repeat) {
   if (!options.displacement) throw InputError("displacement_method", "is needed to measure displacement");
+  if (orbit_frames > 0 && !scene.orbit) {
+    throw InputError("crack_orbit", "scene '" + scene.name + "' has no orbit to count crack pixels over");
+  }
   const DisplacementSettings settings{*options.displacement, options.tessellation, options.displacement_level};
   DisplacementReport report;
   report.method = to_string(settings.method);
