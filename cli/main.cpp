@@ -198,6 +198,7 @@ int main(int argc, char** argv) {
   extra_commands.push_back(seamcl::cli::add_serve_command(app));
   extra_commands.push_back(seamcl::cli::add_compare_command(app));
   extra_commands.push_back(seamcl::cli::add_bench_command(app));
+  extra_commands.push_back(seamcl::cli::add_merge_command(app));
 
   try {
     app.parse(argc, argv);
