@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
-#include <set>
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
