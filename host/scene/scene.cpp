@@ -226,6 +226,29 @@ Camera orbit_camera(const Scene& scene, int frame, int frames) {
   return camera;
 }
 
+namespace {
+
+// A reflective face needs an environment to reflect and a unit shading normal at each corner.
+void check_reflective_face(const Scene& scene, const Face& face, const std::string& face_field) {
+  if (face.roughness < 0.0f) return;
+  if (!(face.roughness <= 4.0f)) throw InputError(face_field + ".roughness", "must be in 0..4 (or < 0: diffuse)");
+  if (!scene.environment) throw InputError(face_field + ".roughness", "a reflective face needs an environment");
+  if (scene.normals.size() != scene.positions.size()) {
+    throw InputError("normals", "reflective faces need one normal per position (" +
+                                    std::to_string(scene.positions.size()) + "), got " +
+                                    std::to_string(scene.normals.size()));
+  }
+  for (uint32_t v : face.vertices) {
+    const glm::vec3 n = scene.normals[v];
+    const float length = glm::length(n);
+    if (!(std::fabs(length - 1.0f) < 1e-3f)) {
+      throw InputError("normals[" + std::to_string(v) + "]", "must be a unit vector");
+    }
+  }
+}
+
+}  // namespace
+
 void validate_scene(const Scene& scene) {
   if (scene.faces.empty()) throw InputError("faces", "the scene has no faces");
   for (size_t i = 0; i < scene.positions.size(); ++i)
@@ -247,7 +270,9 @@ void validate_scene(const Scene& scene) {
     if (!(area_measure > 0.0f) || !std::isfinite(area_measure))
       throw InputError(face_field + ".vertices", "the quad is degenerate (zero area)");
     check_texture(face.texture, face_field + ".texture");
+    check_reflective_face(scene, face, face_field);
   }
+  if (scene.environment) validate_environment(*scene.environment);
 
   const Camera& camera = scene.camera;
   check_vec3(camera.eye, "camera.eye");

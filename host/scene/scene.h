@@ -10,6 +10,8 @@
 
 #include <glm/glm.hpp>
 
+#include <seamcl/scene/environment.h>
+
 namespace seamcl {
 
 // One mip level, texels in linear RGBA, row-major, row 0 at v = 0.
@@ -37,6 +39,9 @@ MipChain build_mip_chain(TextureLevel level0);
 struct Face {
   std::array<uint32_t, 4> vertices{};
   MipChain texture;
+  // < 0: a diffuse face showing its texture. >= 0: the face reflects the scene's environment
+  // (0 a mirror; more widens the lookup, glossy), shaded with Scene::normals.
+  float roughness = -1.0f;
 };
 
 // The point of the face at (u, v), piecewise linear over its two triangles exactly as rendered,
@@ -78,6 +83,8 @@ struct Scene {
   std::optional<Orbit> orbit;  // needed for --frame
   Light light;
   glm::vec3 background{0.02f, 0.02f, 0.03f};  // linear RGB
+  std::optional<Environment> environment;      // what reflective faces (and the skybox) show
+  std::vector<glm::vec3> normals;              // per vertex: shading normals of reflective faces
 
   size_t triangle_count() const { return faces.size() * 2; }
   std::array<glm::vec3, 4> corners(const Face& f) const;

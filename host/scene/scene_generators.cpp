@@ -11,6 +11,7 @@
 #include <thread>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/scene/envmap_scene.h>
 
 namespace seamcl {
 namespace {
@@ -199,6 +200,9 @@ const std::vector<Generator>& generators() {
       {{"plane", "a 128x128 ground plane of 64x64 quads (32x32 textures) at a grazing angle"},
        make_plane},
       {{"cube", "a closed cube of six 64x64-textured faces, seen obliquely"}, make_cube},
+      {{"envmap", "mirror and glossy spheres and a mirror torus in an analytic environment (skybox), "
+                  "for the cube-map methods (cube_method)"},
+       [](const GeneratorOptions& options) { return make_envmap_scene(options); }},
   };
   return list;
 }
@@ -253,6 +257,7 @@ glm::vec3 face_tint(size_t face_index) {
 void apply_generator_options(Scene& scene, const GeneratorOptions& options) {
   if (options.constant_color)
     set_constant_textures(scene, glm::vec4(*options.constant_color, 1.0f));
+  if (options.constant_color && scene.environment) scene.environment->constant = *options.constant_color;
   if (!options.tint) return;
   // The box filter is linear, so scaling every level equals re-filtering a scaled level 0.
   for (size_t f = 0; f < scene.faces.size(); ++f) {

@@ -4,6 +4,7 @@
 
 #include "twins/raster.h"
 #include "twins/sample_pattern.h"
+#include "twins/shade_reflection.h"
 #include "twins/texture_sample.h"
 
 namespace seamcl {
@@ -26,8 +27,11 @@ SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y) {
   return r;
 }
 
-glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& f, const TriangleSetup& t, float x, float y) {
+glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& f, const TriangleSetup& t, float x, float y,
+                                   const std::vector<float>* cube_texels) {
   const SurfaceUv s = interpolate_uv(t, x, y);
+  const int reflective = scene.faces.at(t.face).reflective;
+  if (reflective >= 0) return shade_reflection_reference(f, scene.reflective_faces.at(reflective), *cube_texels, s);
   const glm::vec4 albedo =
       sample_texture_reference(scene.textures(), t.face, f.sampler, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
   const FaceGpu& face = scene.faces.at(t.face);
@@ -77,7 +81,8 @@ bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& f
 
 ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& f,
                                          const std::vector<TriangleSetup>& setups,
-                                         const std::vector<uint32_t>& sample_triangle) {
+                                         const std::vector<uint32_t>& sample_triangle,
+                                         const std::vector<float>* cube_texels) {
   const int samples = f.sample_count;
   const std::vector<SampleOffset>& pattern = sample_pattern(samples);
   constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
@@ -99,16 +104,21 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
         }
         const TriangleSetup& t = setups.at(slot);
         if (f.shading_mode == SEAMCL_SHADE_SAMPLE) {
-          sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s));
+          sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s), cube_texels);
           ++out.fragments;
           continue;
         }
         if (std::find(ids, ids + s, slot) != ids + s) continue;  // shaded at its first sample
         const PixelFragment fragment = pixel_fragment(f, t, ids, slot, x, y);
-        sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y) * static_cast<float>(fragment.covered);
+        sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y, cube_texels) * static_cast<float>(fragment.covered);
         ++out.fragments;
       }
-      sum += background * static_cast<float>(uncovered);  // once: an empty pixel is exactly the background
+      if (uncovered > 0 && f.environment.skybox) {
+        sum += shade_sky_reference(f, *cube_texels, static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f) *
+               static_cast<float>(uncovered);
+      } else {
+        sum += background * static_cast<float>(uncovered);  // once: an empty pixel is exactly the background
+      }
       out.pixels[static_cast<size_t>(y) * f.width + x] = glm::vec4(sum / static_cast<float>(samples), 1.0f);
     }
   }
