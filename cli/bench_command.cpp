@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <seamcl/assets/scene_source.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
@@ -26,7 +27,6 @@
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
-#include <seamcl/scene/scene_json.h>
 #include "commands.h"
 #include "measure_args.h"
 
@@ -169,7 +169,9 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
 
   GeneratorOptions generator_options;
   generator_options.tint = frame.tint;
-  const Scene scene = load_scene(frame.scene, generator_options);
+  SceneSourceOptions source;
+  source.generator = generator_options;
+  const Scene scene = load_scene_source(frame.scene, frame.texture, source);
   const auto wall_start = std::chrono::steady_clock::now();
 
   ClRuntime runtime(global.device);

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <seamcl/assets/scene_source.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
@@ -22,7 +23,6 @@
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
-#include <seamcl/scene/scene_json.h>
 #include "commands.h"
 #include "measure_args.h"
 
@@ -80,7 +80,9 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   generator_options.tint = frame.tint;
   if (!args.constant_color.empty()) generator_options.constant_color = parse_color(args.constant_color);
 
-  const Scene scene = load_scene(frame.scene, generator_options);
+  SceneSourceOptions source;
+  source.generator = generator_options;
+  const Scene scene = load_scene_source(frame.scene, frame.texture, source);
   const Camera camera = frame.frame ? orbit_camera(scene, *frame.frame, frame.frames) : scene.camera;
   if (!args.images_dir.empty()) fs::create_directories(args.images_dir);
 

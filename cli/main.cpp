@@ -11,13 +11,13 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <seamcl/assets/scene_source.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
-#include <seamcl/scene/scene_json.h>
 #include <seamcl/version.h>
 #include "commands.h"
 
@@ -27,7 +27,7 @@ using nlohmann::json;
 using namespace seamcl;
 
 struct RenderArgs {
-  std::optional<std::string> scene, method, filter, zero_coverage, texels, size, shading, cube_method;
+  std::optional<std::string> scene, texture, method, filter, zero_coverage, texels, size, shading, cube_method;
   std::optional<int> msaa, aniso, guard_band, frame, frames;
   bool centroid = false;
   bool tint = false;
@@ -46,6 +46,7 @@ double median(std::vector<double> values) {
 json render_request(const RenderArgs& a) {
   json request = json::object();
   if (a.scene) request["scene"] = *a.scene;
+  if (a.texture) request["texture"] = *a.texture;
   if (a.method) request["method"] = *a.method;
   if (a.filter) request["filter"] = *a.filter;
   if (a.zero_coverage) request["zero_coverage"] = *a.zero_coverage;
@@ -70,9 +71,9 @@ int run_render(const RenderArgs& args, const std::string& device) {
   if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
 
   const auto scene_start = std::chrono::steady_clock::now();
-  GeneratorOptions generator_options;
-  generator_options.tint = options.tint;
-  const Scene scene = load_scene(options.scene, generator_options);
+  SceneSourceOptions source;
+  source.generator.tint = options.tint;
+  const Scene scene = load_scene_source(options.scene, options.texture, source);
   const Camera camera = options.frame ? orbit_camera(scene, *options.frame, options.frames) : scene.camera;
   const double scene_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - scene_start).count();
 
@@ -105,7 +106,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
                 {"fragments", result.stats.fragments},
                 {"texture_bytes", renderer.packed_scene().texture_bytes()},
                 {"padding_bytes", renderer.packed_scene().padding_bytes()},
-                {"adjacency_bytes", options.method == Method::Traverse ? renderer.packed_scene().adjacency_bytes() : 0},
+                {"adjacency_bytes", reads_adjacency(options.method) ? renderer.packed_scene().adjacency_bytes() : 0},
                 {"bin_entries", result.stats.bin_entries}};
     if (!args.output.empty()) out["output"] = args.output;
     std::cout << out.dump(2) << "\n";
@@ -161,7 +162,10 @@ int main(int argc, char** argv) {
 
   RenderArgs render_args;
   CLI::App* render = app.add_subcommand("render", "Render one frame of a scene to PNG (sRGB 8-bit) or EXR (linear)");
-  render->add_option("--scene", render_args.scene, "Built-in scene name (see 'seamcl scenes') or a scene JSON file [paper]");
+  render->add_option("--scene", render_args.scene,
+                     "Built-in scene name (see 'seamcl scenes'), a scene JSON file, an .obj mesh or a .ptx that holds its mesh [paper]");
+  render->add_option("--texture", render_args.texture,
+                     "A .ptx file of per-face textures for an .obj --scene (face i of the mesh takes face i of the file)");
   auto listed = [](const std::vector<std::string>& names) {
     std::string s;
     for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;

@@ -6,7 +6,8 @@ namespace seamcl::cli {
 
 void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& default_methods) {
   a.methods = default_methods;
-  command->add_option("--scene", a.scene, "Built-in scene name or a scene JSON file [paper]");
+  command->add_option("--scene", a.scene, "Built-in scene name, a scene JSON file, an .obj mesh or a .ptx that holds its mesh [paper]");
+  command->add_option("--texture", a.texture, "A .ptx file of per-face textures for an .obj --scene (face i of the mesh takes face i of the file)");
   command->add_option("--methods", a.methods, "Comma list of seam methods [" + default_methods + "]");
   command->add_option("--msaa", a.msaa, "Comma list of MSAA rates (1, 2, 4, 8, 16) [1,2,4,8]");
   command->add_option("--aniso", a.aniso, "Maximum anisotropy, 1..16 [16]");
@@ -33,6 +34,7 @@ void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& d
 nlohmann::json measure_request(const MeasureArgs& a) {
   nlohmann::json request = nlohmann::json::object();
   if (a.scene) request["scene"] = *a.scene;
+  if (a.texture) request["texture"] = *a.texture;
   if (a.filter) request["filter"] = *a.filter;
   if (a.zero_coverage) request["zero_coverage"] = *a.zero_coverage;
   if (a.texels) request["texels"] = *a.texels;

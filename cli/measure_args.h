@@ -12,7 +12,7 @@
 namespace seamcl::cli {
 
 struct MeasureArgs {
-  std::optional<std::string> scene, filter, zero_coverage, texels, size, shading;
+  std::optional<std::string> scene, texture, filter, zero_coverage, texels, size, shading;
   std::optional<int> aniso;
   std::string methods;
   std::string msaa = "1,2,4,8";

@@ -31,6 +31,8 @@ struct ServeArgs {
   double deadline_s = 60;
   std::string cache_dir;
   long long cache_max_mib = 256;
+  std::string assets_dir;
+  long long assets_cache_mib = 512;
   long long request_memory_mib = 1024;
 };
 
@@ -42,6 +44,7 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   if (!(args.read_timeout_s >= 0.1 && args.read_timeout_s <= 600)) throw InputError("read-timeout", "must be in 0.1..600 seconds");
   if (!(args.deadline_s >= 0 && args.deadline_s <= 3600)) throw InputError("deadline", "must be in 0..3600 seconds (0: none)");
   if (args.cache_max_mib < 0) throw InputError("cache-max-mib", "must be at least 0 (0: no bound)");
+  if (args.assets_cache_mib < 0) throw InputError("assets-cache-mib", "must be at least 0 (0: cache nothing)");
   if (args.request_memory_mib < 1 || args.request_memory_mib > (1LL << 20)) {
     throw InputError("request-memory-mib", "must be in 1..1048576");
   }
@@ -68,6 +71,8 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   options.deadline_ms = static_cast<int>(args.deadline_s * 1000);
   options.cache_dir = args.cache_dir;
   options.cache_max_bytes = static_cast<std::uintmax_t>(args.cache_max_mib) << 20;
+  options.assets_dir = args.assets_dir;
+  options.asset_cache.max_bytes = static_cast<size_t>(args.assets_cache_mib) << 20;
   options.max_request_device_bytes = static_cast<size_t>(args.request_memory_mib) << 20;
   options.max_request_host_bytes = static_cast<size_t>(args.request_memory_mib) << 20;
   server::HttpServer http(runtime, options);
@@ -117,6 +122,10 @@ Command add_serve_command(CLI::App& app) {
   serve->add_option("--cache-dir", args->cache_dir,
                     "Reference cache of POST /v1/compare [$SEAMCL_CACHE_DIR, else <temp>/seamcl-serve-cache]");
   serve->add_option("--cache-max-mib", args->cache_max_mib, "Reference cache bound, least recently used go first; 0: none [256]");
+  serve->add_option("--assets", args->assets_dir,
+                    "Directory of assets (.obj, .ptx, scene .json) that requests may name, relative to it; nothing else on disk is reachable [none]");
+  serve->add_option("--assets-cache-mib", args->assets_cache_mib,
+                    "Bound of the loaded assets kept between requests (least recently used go first); 0: keep none [512]");
   serve->add_option("--request-memory-mib", args->request_memory_mib,
                     "Device and host memory one request may need, estimated before anything is allocated; more: 413 [1024]");
   serve->add_option("--deadline", args->deadline_s,

@@ -14,6 +14,11 @@
  * Only texels of the cube are read, whatever the direction (NaN and zero included).
  * Twin: host/twins/cube_sample.cpp. */
 
+/* The cube path is compiled as calls, not inlined: a fold can run at three taps of four in two
+ * levels of up to 16 probes, and inlining every copy into shade_resolve made PoCL's compile take
+ * minutes. It does not vectorise in any case (its probe loop has a per-item trip count). */
+#define CUBE_CALL __attribute__((noinline))
+
 /* A direction on its face. */
 typedef struct {
   int face;
@@ -100,7 +105,7 @@ SEAMCL_INLINE void cube_add_texel(FilterSum* sum, __global const float* texels, 
  * adjacent face (the out-of-range component becomes +-1 and the major one shrinks by as much as
  * it went past), where it is a texel centre again: the same texel grid, continued round the edge.
  * Taps at most m texels outside (the caller clamps), so the fold lands inside that face. */
-SEAMCL_INLINE uint cube_fold_texel(int size, int face, int level, int m, int i, int j) {
+CUBE_CALL uint cube_fold_texel(int size, int face, int level, int m, int i, int j) {
   const float sc = ((float)i + 0.5f) * 2.0f / (float)m - 1.0f;
   const float tc = ((float)j + 0.5f) * 2.0f / (float)m - 1.0f;
   float x, y, z;
@@ -129,7 +134,7 @@ SEAMCL_INLINE uint cube_fold_texel(int size, int face, int level, int m, int i, 
 }
 
 /* One bilinear tap (i, j) of an m x m level with weight w, as the method reads it. */
-SEAMCL_INLINE void cube_tap(FilterSum* sum, __global const float* texels, int size, int face, int level, int m, int i,
+CUBE_CALL void cube_tap(FilterSum* sum, __global const float* texels, int size, int face, int level, int m, int i,
                             int j, float w, int method) {
   const int out_i = i < 0 || i >= m;
   const int out_j = j < 0 || j >= m;
@@ -152,7 +157,7 @@ SEAMCL_INLINE void cube_tap(FilterSum* sum, __global const float* texels, int si
   }
 }
 
-SEAMCL_INLINE void cube_bilinear(FilterSum* sum, __global const float* texels, int size, int face, int level, float s,
+CUBE_CALL void cube_bilinear(FilterSum* sum, __global const float* texels, int size, int face, int level, float s,
                                  float t, float weight, int method) {
   const int m = max(size >> level, 1);
   /* Seamless taps may reach one face width round an edge; for the others two texels out is as
@@ -196,9 +201,11 @@ SEAMCL_INLINE void cube_trilinear(FilterSum* sum, __global const float* texels, 
 }
 
 /* The filtered sum on the selected face, before discard's renormalisation. explicit_lod >= 0:
- * one trilinear lookup at that lod (tests and seam measurements), whatever the filter. */
-SEAMCL_INLINE FilterSum cube_filter(__global const float* texels, CubeSampler cube, CubeUv c, float roughness,
-                                    float explicit_lod, int method) {
+ * one trilinear lookup at that lod (tests and seam measurements), whatever the filter. Every
+ * filter is N probes along the footprint's longer axis, trilinear at one lod: one probe at the
+ * centre except for aniso. */
+CUBE_CALL FilterSum cube_filter(__global const float* texels, CubeSampler cube, CubeUv c, float roughness,
+                                float explicit_lod, int method) {
   FilterSum sum = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
   const float n = (float)cube.size;
   float ax_u = c.dsdx, ax_v = c.dtdx, ay_u = c.dsdy, ay_v = c.dtdy;
@@ -229,32 +236,34 @@ SEAMCL_INLINE FilterSum cube_filter(__global const float* texels, CubeSampler cu
     len2_y += blur2;
   }
   const int finite = c.valid && len2_x < INFINITY && len2_y < INFINITY;
-  const float coarsest = (float)(cube.level_count - 1);
+  int probes = 1;
+  float lod = (float)(cube.level_count - 1);
+  float step_u = 0.0f, step_v = 0.0f;
   if (explicit_lod >= 0.0f) {
-    cube_trilinear(&sum, texels, cube, c.face, c.s, c.t, explicit_lod, 1.0f, method);
+    lod = explicit_lod;
   } else if (!finite) {
-    cube_trilinear(&sum, texels, cube, c.face, c.s, c.t, coarsest, 1.0f, method);
+    /* the coarsest level */
   } else if (cube.filter == SEAMCL_FILTER_BILINEAR) {
-    cube_trilinear(&sum, texels, cube, c.face, c.s, c.t, 0.0f, 1.0f, method);
+    lod = 0.0f;
   } else if (cube.filter == SEAMCL_FILTER_TRILINEAR) {
-    cube_trilinear(&sum, texels, cube, c.face, c.s, c.t, lod_of(fmax(len2_x, len2_y)), 1.0f, method);
+    lod = lod_of(fmax(len2_x, len2_y));
   } else {
     const int x_major = len2_x >= len2_y;
     const float major2 = x_major ? len2_x : len2_y;
     const float minor2 = x_major ? len2_y : len2_x;
     const float ratio = minor2 > 0.0f ? sqrt(major2 / minor2) : major2 > 0.0f ? (float)cube.max_aniso : 1.0f;
-    const int probes = clamp((int)__builtin_ceilf(fmin(ratio, 16.0f)), 1, cube.max_aniso);
-    const float inv_probes = 1.0f / (float)probes;
-    const float lod = lod_of(major2) - approx_log2((float)probes);
-    const float step_u = (x_major ? ax_u : ay_u) * inv_probes;
-    const float step_v = (x_major ? ax_v : ay_v) * inv_probes;
-    float pu = c.s + step_u * (0.5f - 0.5f * (float)probes);
-    float pv = c.t + step_v * (0.5f - 0.5f * (float)probes);
-    for (int i = 0; i < probes; ++i) {
-      cube_trilinear(&sum, texels, cube, c.face, pu, pv, lod, inv_probes, method);
-      pu += step_u;
-      pv += step_v;
-    }
+    probes = clamp((int)__builtin_ceilf(fmin(ratio, 16.0f)), 1, cube.max_aniso);
+    lod = lod_of(major2) - approx_log2((float)probes);
+    step_u = (x_major ? ax_u : ay_u) / (float)probes;
+    step_v = (x_major ? ax_v : ay_v) / (float)probes;
+  }
+  const float inv_probes = 1.0f / (float)probes;
+  float pu = c.s + step_u * (0.5f - 0.5f * (float)probes);
+  float pv = c.t + step_v * (0.5f - 0.5f * (float)probes);
+  for (int i = 0; i < probes; ++i) {
+    cube_trilinear(&sum, texels, cube, c.face, pu, pv, lod, inv_probes, method);
+    pu += step_u;
+    pv += step_v;
   }
   return sum;
 }

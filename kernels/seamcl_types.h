@@ -28,7 +28,7 @@ typedef float cl_float;
 
 /* shading_mode */
 #define SEAMCL_SHADE_PIXEL 0    /* once per pixel and triangle, at the pixel centre */
-#define SEAMCL_SHADE_CENTROID 1 /* once per pixel and triangle, at the mean of its covered samples */
+#define SEAMCL_SHADE_CENTROID 1 /* as PIXEL, but a partly covered pixel at the mean of its covered samples */
 #define SEAMCL_SHADE_SAMPLE 2   /* every sample (supersampling) */
 
 /* SamplerParams.filter */
@@ -44,31 +44,44 @@ typedef float cl_float;
 #define SEAMCL_ZERO_COVERAGE_CLAMP 0 /* clamped trilinear lookup at the centre clamped to the face */
 #define SEAMCL_ZERO_COVERAGE_NAN 1   /* the raw division 0/0 (the paper's failure case) */
 
+/* SamplerParams.traverse: which neighbouring faces a lookup also reads */
+#define SEAMCL_TRAVERSE_NONE 0    /* the face alone */
+#define SEAMCL_TRAVERSE_EDGES 1   /* and its four edge neighbours (McDonald 2013, the paper's) */
+#define SEAMCL_TRAVERSE_CORNERS 2 /* and, past a valence-4 corner, the diagonal face (Ptex) */
+
 /* How one texture lookup filters. The seam methods are settings of it: clamp = address clamp;
- * black = address border; discard = address border + renormalize; traverse = discard + the same
- * lookup on each edge neighbour through its uv transform, all summed before renormalising;
- * guardband = address clamp on textures stored with a band filled from the neighbours. */
+ * black = address border; discard = address border + renormalize; traverse-edges = discard + the
+ * same lookup on each edge neighbour through its uv transform, all summed before renormalising;
+ * traverse = traverse-edges + the diagonal faces at valence-4 corners; guardband = address clamp
+ * on textures stored with a band filled from the neighbours. */
 typedef struct {
   cl_int filter;         /* SEAMCL_FILTER_* */
   cl_int address;        /* SEAMCL_ADDRESS_* */
   cl_int renormalize;    /* 1: divide by the summed weight of the taps inside */
   cl_int max_aniso;      /* 1..16, for aniso and ewa */
   cl_int zero_coverage;  /* SEAMCL_ZERO_COVERAGE_*, when renormalize and no tap is inside */
-  cl_int traverse;       /* 1: also filter the edge neighbours (FaceNeighbors) */
+  cl_int traverse;       /* SEAMCL_TRAVERSE_*: also filter the neighbours (FaceNeighbors) */
   cl_int guard_band;     /* band texels stored around every level (guardband); the kernels take it
                             from the build option SEAMCL_SAMPLER_GUARD_BAND, this is the host's copy */
   cl_int pad0;
 } SamplerParams;
 
-/* A face's edge neighbours, for traverse. Edge k runs from corner k to corner k+1 (uv (0,0),
+/* A face's neighbours, for traverse. Edge k runs from corner k to corner k+1 (uv (0,0),
  * (1,0), (1,1), (0,1)): edge 0 is v = 0, 1 is u = 1, 2 is v = 1, 3 is u = 0. neighbor[k] is the
  * face across it (-1 at a boundary or a non-manifold edge); transform[k] maps this face's uv to
  * the neighbour's: (u', v') = (t0 u + t1 v + t2, t3 u + t4 v + t5), derivatives by the linear part.
  * Both uv spaces are unit squares, so the map is a rotation by a multiple of 90 degrees (or, for
- * a neighbour of opposite orientation, a reflection) and a translation. */
+ * a neighbour of opposite orientation, a reflection) and a translation.
+ * corner[k] is the diagonal face past corner k when that corner's vertex has valence 4 (four
+ * faces around it, a closed ring), else -1: at any other valence, or at a mesh boundary, there is
+ * no one face past the corner, and the part of a footprint there is dropped (renormalised away).
+ * corner_transform[k] maps this face's uv to the diagonal face's, as the two edge maps composed
+ * (host/pipeline/adjacency.h). */
 typedef struct {
   cl_int neighbor[4];
   cl_float transform[4][6];
+  cl_int corner[4];
+  cl_float corner_transform[4][6];
 } FaceNeighbors;
 
 /* CubeSampler.method: how a cube-map lookup treats its filter taps at the faces' edges. */

@@ -1,7 +1,8 @@
 /* Stage 4: shade and resolve. One work-item per pixel, work-groups of one tile.
  *
  * SEAMCL_SHADE_PIXEL / _CENTROID: each distinct triangle among the pixel's samples is shaded once,
- * at the pixel centre (or the mean of the positions of the samples it covers), and its colour
+ * at the pixel centre (or, when it covers some but not all of them, the mean of the positions of
+ * the samples it covers), and its colour
  * counts for the samples it covers; samples no triangle covers count the background. A centre
  * where the triangle's plane has 1/w <= 0 (extrapolated past the horizon) falls back to the
  * centroid, whose samples lie inside the triangle. SEAMCL_SHADE_SAMPLE shades every sample at its
@@ -52,7 +53,7 @@ SEAMCL_INLINE float3 load3(__global const float* p) { return (float3)(p[0], p[1]
 
 /* The environment along direction d (its screen derivatives dx, dy), or, for the analytic
  * reference (SEAMCL_CUBE_DIRECTION), the unit direction scaled by 1 + roughness. */
-SEAMCL_INLINE float3 environment_lookup(__constant FrameParams* frame, __global const float* cube_texels, float3 d,
+__attribute__((noinline)) float3 environment_lookup(__constant FrameParams* frame, __global const float* cube_texels, float3 d,
                                         float3 dx, float3 dy, float roughness) {
   if (frame->environment.sampler.method == SEAMCL_CUBE_DIRECTION) {
     return d * ((1.0f + roughness) / sqrt(dot3(d, d)));
@@ -65,7 +66,7 @@ SEAMCL_INLINE float3 environment_lookup(__constant FrameParams* frame, __global 
 /* A reflective face at uv: the point (piecewise linear over the two triangles, as rasterised),
  * the normal (bilinear over the corners' normals, normalised), the view ray I from the eye and
  * R = I - 2 (N.I) N, with screen derivatives by the chain rule through d(uv)/d(pixel). */
-SEAMCL_INLINE float3 shade_reflection(__constant FrameParams* frame, __global const ReflectiveFace* rf,
+__attribute__((noinline)) float3 shade_reflection(__constant FrameParams* frame, __global const ReflectiveFace* rf,
                                       __global const float* cube_texels, SurfaceUv s) {
   const float u = s.u, v = s.v;
   const float3 p0 = load3(rf->position[0]), p1 = load3(rf->position[1]);
@@ -175,7 +176,11 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
       centroid_y /= (float)covered;
       float shade_x = (float)x + 0.5f;
       float shade_y = (float)y + 0.5f;
-      if (frame->shading_mode == SEAMCL_SHADE_CENTROID || !(plane_inv_w(setups + slot, shade_x, shade_y) > 0.0f)) {
+      /* Centroid shading keeps the centre when every sample is covered (as D3D and GL do): the
+       * centroid of a full pattern is not the centre (16x: (-1/32, -1/32)). */
+      const int partly_covered = covered < samples;
+      if ((frame->shading_mode == SEAMCL_SHADE_CENTROID && partly_covered) ||
+          !(plane_inv_w(setups + slot, shade_x, shade_y) > 0.0f)) {
         shade_x = centroid_x;
         shade_y = centroid_y;
       }

@@ -11,7 +11,7 @@
  * Host guarantees: full chains down to 1x1, power-of-two sizes, offsets in range. Only texels of
  * the face's own levels are ever read, whatever the coordinates (NaN and infinities included).
  * Written for PoCL's vectoriser: scalar channels, no floor/log2 builtins, no float4 arithmetic.
- * Twin: host/texture_sample.cpp. */
+ * Twin: host/twins/texture_sample.cpp. */
 
 #ifndef SEAMCL_TEXELS_F32
 #define SEAMCL_TEXELS_F32 0
@@ -361,31 +361,73 @@ SEAMCL_INLINE FilterSum filter_texture(const FaceGpu* face, __global const uint*
   return sum;
 }
 
+/* Whether any tap of face `other` can weigh anything in a lookup (derivatives in this face's uv)
+ * whose point lies at least `distance` (uv) outside the other face's square. Conservative: a
+ * neighbour it rules out would add exactly nothing, so skipping it changes no bit of the result;
+ * it spares interior lookups the neighbours' filters. The bound, term by term, is argued in the
+ * twin (host/twins/texture_sample.cpp, neighbor_may_contribute). */
+SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, float distance, float dudx, float dvdx,
+                                          float dudy, float dvdy) {
+  const float axis_x = fabs(dudx) + fabs(dvdx);
+  const float axis_y = fabs(dudy) + fabs(dvdy);
+  const float axes = axis_x + axis_y;
+  if (!(axes < INFINITY)) return 1;
+  const float longest = fmax(axis_x, axis_y);
+  const float min_side = (float)min(other->width, other->height);
+  const float aspect = (float)max(other->width, other->height) / min_side;
+  const float texel = filter == SEAMCL_FILTER_BILINEAR ? 1.0f / min_side
+                                                       : fmin(1.0f, fmax(1.0f / min_side, 2.01f * aspect * longest));
+  const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f * longest
+                       : filter == SEAMCL_FILTER_EWA ? (1.0f + aspect) * axes
+                                                     : 0.0f;
+  const float reach = spread + texel;
+  const float counted = distance > 2.0f ? 2.0f : distance;
+  return !(counted >= reach);
+}
+
+/* The same filter, border-addressed, on face `other` at this lookup's point and footprint carried
+ * into its uv by the map t, added to `sum`: the taps that fall inside `other`. */
+SEAMCL_INLINE void accumulate_across(FilterSum* sum, __global const FaceGpu* faces, int other,
+                                     __global const float* t, float distance, __global const uint* level_offsets,
+                                     TEXEL_BUFFER texels, __global const float* srgb_to_linear, int filter,
+                                     int max_aniso, float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
+  if (other < 0) return;
+  const FaceGpu g = faces[other];
+  if (!neighbor_may_contribute(&g, filter, distance, dudx, dvdx, dudy, dvdy)) return;
+  const FilterSum s = filter_texture(&g, level_offsets, texels, srgb_to_linear, filter, SEAMCL_ADDRESS_BORDER,
+                                     max_aniso, t[0] * u + t[1] * v + t[2], t[3] * u + t[4] * v + t[5],
+                                     t[0] * dudx + t[1] * dvdx, t[3] * dudx + t[4] * dvdx,
+                                     t[0] * dudy + t[1] * dvdy, t[3] * dudy + t[4] * dvdy);
+  sum->r += s.r;
+  sum->g += s.g;
+  sum->b += s.b;
+  sum->a += s.a;
+  sum->weight += s.weight;
+}
+
 /* Traverse (McDonald 2013, the paper's Listing 1): the same filter, border-addressed, on each
  * edge neighbour at this lookup's point and footprint carried into the neighbour's uv, summed
- * into `sum`. Corners: the diagonal faces are not edge neighbours, so taps that fall past a
- * corner (outside this face and its edge neighbours) are not read and weigh zero; the final
- * renormalisation spreads their weight over the rest, as Discard does everywhere. */
+ * into `sum`. With `corners` (traverse; traverse-edges leaves them out), also on the diagonal
+ * face past each valence-4 corner, as Ptex's filter does, so the 3x3 faces around are read.
+ * Taps past a corner of any other valence, or past a mesh boundary, are not read and weigh zero:
+ * the final renormalisation spreads their weight over the rest, as Discard does everywhere. */
 SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* faces,
                                         __global const FaceNeighbors* neighbors, uint face_index,
                                         __global const uint* level_offsets, TEXEL_BUFFER texels,
-                                        __global const float* srgb_to_linear, int filter, int max_aniso, float u,
-                                        float v, float dudx, float dvdx, float dudy, float dvdy) {
+                                        __global const float* srgb_to_linear, int filter, int max_aniso, int corners,
+                                        float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   __global const FaceNeighbors* n = neighbors + face_index;
+  /* How far the point lies inside each edge: the least distance to the face across it. */
+  const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
   for (int k = 0; k < 4; ++k) {
-    const int other = n->neighbor[k];
-    if (other < 0) continue;
-    __global const float* t = n->transform[k];
-    const FaceGpu g = faces[other];
-    const FilterSum s = filter_texture(&g, level_offsets, texels, srgb_to_linear, filter, SEAMCL_ADDRESS_BORDER,
-                                       max_aniso, t[0] * u + t[1] * v + t[2], t[3] * u + t[4] * v + t[5],
-                                       t[0] * dudx + t[1] * dvdx, t[3] * dudx + t[4] * dvdx,
-                                       t[0] * dudy + t[1] * dvdy, t[3] * dudy + t[4] * dvdy);
-    sum->r += s.r;
-    sum->g += s.g;
-    sum->b += s.b;
-    sum->a += s.a;
-    sum->weight += s.weight;
+    accumulate_across(sum, faces, n->neighbor[k], n->transform[k], inside[k], level_offsets, texels,
+                      srgb_to_linear, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy);
+  }
+  if (!corners) return;
+  /* Corner k lies between edges k-1 and k. */
+  for (int k = 0; k < 4; ++k) {
+    accumulate_across(sum, faces, n->corner[k], n->corner_transform[k], fmax(inside[(k + 3) & 3], inside[k]),
+                      level_offsets, texels, srgb_to_linear, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy);
   }
 }
 
@@ -400,9 +442,10 @@ SEAMCL_INLINE float4 sample_texture(__global const FaceGpu* faces, __global cons
   const FaceGpu face = faces[face_index];
   FilterSum sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),
                                  SAMPLER_ADDRESS(sampler), sampler.max_aniso, u, v, dudx, dvdx, dudy, dvdy);
-  if (SAMPLER_TRAVERSE(sampler)) {
+  if (SAMPLER_TRAVERSE(sampler) != SEAMCL_TRAVERSE_NONE) {
     accumulate_neighbors(&sum, faces, neighbors, face_index, level_offsets, texels, srgb_to_linear,
-                         SAMPLER_FILTER(sampler), sampler.max_aniso, u, v, dudx, dvdx, dudy, dvdy);
+                         SAMPLER_FILTER(sampler), sampler.max_aniso,
+                         SAMPLER_TRAVERSE(sampler) == SEAMCL_TRAVERSE_CORNERS, u, v, dudx, dvdx, dudy, dvdy);
   }
   if (!SAMPLER_RENORMALIZE(sampler)) return (float4)(sum.r, sum.g, sum.b, sum.a);
   const int clamp_when_uncovered = SAMPLER_ZERO_COVERAGE(sampler) == SEAMCL_ZERO_COVERAGE_CLAMP;
@@ -447,9 +490,10 @@ __kernel void texture_filter_batch(__global const FaceGpu* faces, __global const
   const FaceGpu face = faces[face_index];
   FilterSum sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),
                                  SAMPLER_ADDRESS(sampler), sampler.max_aniso, q[1], q[2], q[3], q[4], q[5], q[6]);
-  if (SAMPLER_TRAVERSE(sampler)) {
+  if (SAMPLER_TRAVERSE(sampler) != SEAMCL_TRAVERSE_NONE) {
     accumulate_neighbors(&sum, faces, neighbors, face_index, level_offsets, texels, srgb_to_linear,
-                         SAMPLER_FILTER(sampler), sampler.max_aniso, q[1], q[2], q[3], q[4], q[5], q[6]);
+                         SAMPLER_FILTER(sampler), sampler.max_aniso,
+                         SAMPLER_TRAVERSE(sampler) == SEAMCL_TRAVERSE_CORNERS, q[1], q[2], q[3], q[4], q[5], q[6]);
   }
   out[i] = (float4)(sum.r, sum.g, sum.b, sum.a);
   weights[i] = sum.weight;

@@ -207,7 +207,7 @@ std::string scene_key(const std::string& name, bool tint) { return tint ? name +
 // The paths the server answers and the methods each allows (others: 405).
 const std::map<std::string, std::vector<std::string>>& known_paths() {
   static const std::map<std::string, std::vector<std::string>> paths = {
-      {"/", {"GET"}},           {"/health", {"GET"}},          {"/v1/scenes", {"GET"}},
+      {"/", {"GET"}},           {"/health", {"GET"}},          {"/v1/scenes", {"GET"}}, {"/v1/assets", {"GET"}},
       {"/v1/methods", {"GET"}}, {"/v1/render", {"GET", "POST"}}, {"/v1/compare", {"POST"}}, {"/v1/reference", {"POST"}},
       {"/openapi.json", {"GET"}}};
   return paths;
@@ -226,7 +226,11 @@ std::string method_description(const std::string& name) {
   if (name == "clamp") return "taps outside the face read the nearest edge texel (seams show)";
   if (name == "black") return "taps outside the face weigh zero, no renormalisation (edges darken)";
   if (name == "discard") return "taps outside the face weigh zero, the rest are renormalised (Toth 2013)";
-  if (name == "traverse") return "taps outside the face are fetched from the edge-adjacent faces (McDonald 2013)";
+  if (name == "traverse") {
+    return "taps outside the face are fetched from the edge-adjacent faces and, past valence-4 corners, the diagonal "
+           "face (McDonald 2013, with Ptex's corners)";
+  }
+  if (name == "traverse-edges") return "taps outside the face are fetched from the edge-adjacent faces only (McDonald 2013, as the paper compares)";
   if (name == "guardband") return "each mip level carries a band of texels from its neighbours (McDonald and Burley 2011)";
   return "";
 }
@@ -373,6 +377,7 @@ HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
   if (options_.request_read_timeout_ms < 1) throw InputError("request_read_timeout_ms", "must be at least 1");
   if (options_.deadline_ms < 0) throw InputError("deadline", "must be at least 0 (0: none)");
   options_.cache_dir = server_cache_dir(options_.cache_dir);
+  if (!options_.assets_dir.empty()) assets_ = std::make_unique<AssetDirectory>(options_.assets_dir, options_.asset_cache);
 
   // The built-in scenes are generated on first use (builtin_scene), the default one by the
   // warm-up, so the port is bound without waiting for them. One slot per thread: their Renderers
@@ -548,6 +553,15 @@ json HttpServer::health_json() const {
           {"queue", options_.queue}};
 }
 
+json HttpServer::assets_json() const {
+  json list = json::array();
+  if (assets_) {
+    for (const AssetEntry& entry : assets_->list())
+      list.push_back({{"name", entry.name}, {"kind", to_string(entry.kind)}, {"bytes", entry.bytes}});
+  }
+  return {{"enabled", assets_ != nullptr}, {"assets", list}};
+}
+
 json HttpServer::scenes_json() const {
   json list = json::array();
   const std::string default_scene = RenderOptions{}.scene;
@@ -585,7 +599,7 @@ json HttpServer::make_methods_json() const {
                        {"description", method_description(name)},
                        {"texture_bytes", {{"rgba8", packed.texture_bytes()}, {"rgba32f", packed.texel_count() * float_texel_bytes}}},
                        {"padding_bytes", {{"rgba8", packed.padding_bytes()}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
-                       {"adjacency_bytes", method == Method::Traverse ? packed.adjacency_bytes() : 0}});
+                       {"adjacency_bytes", reads_adjacency(method) ? packed.adjacency_bytes() : 0}});
   }
   json scene_names = json::array();
   for (const GeneratorInfo& g : scene_generators()) scene_names.push_back(g.name);
@@ -643,18 +657,37 @@ std::shared_ptr<const Scene> HttpServer::builtin_scene(const std::string& name, 
   return scene;
 }
 
-// The scene: a built-in one (never a file path: clients name no server files) or inline.
+std::shared_ptr<const Scene> HttpServer::asset_scene(const RenderOptions& options) const {
+  SceneSourceOptions source;
+  source.generator.tint = options.tint;
+  // A file's decoded texels (float RGBA) beyond the host budget are refused by the reader, before
+  // they are allocated; a smaller asset is measured against the budgets like any scene.
+  source.ptex_limits.max_texels = std::min<uint64_t>(source.ptex_limits.max_texels, options_.max_request_host_bytes / sizeof(glm::vec4));
+  return assets_->load(options.scene, options.texture, source);
+}
+
+// The scene: a built-in one, an asset of the --assets directory (names inside it only), or inline.
 std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene, RenderOptions& options,
                                                        std::string& key) const {
   std::shared_ptr<const Scene> scene;
   key.clear();
+  const bool builtin = inline_scene.is_null() && is_builtin_scene(options.scene);
+  if (!options.texture.empty() && (builtin || !inline_scene.is_null()))
+    throw HttpError{400, "texture", "goes with an .obj scene of the asset directory"};
+  if (inline_scene.is_null() && !builtin && assets_) {
+    scene = asset_scene(options);
+    options.scene = scene->name;
+    return scene;
+  }
+  if (!options.texture.empty()) throw HttpError{400, "texture", "this server has no asset directory (seamcl serve --assets DIR)"};
   if (inline_scene.is_null()) {
     const std::shared_ptr<const Scene> found =
         options.scene.find('+') == std::string::npos ? builtin_scene(options.scene, options.tint) : nullptr;
     if (!found) {
       std::string known;
       for (const GeneratorInfo& g : scene_generators()) known += (known.empty() ? "" : ", ") + g.name;
-      throw HttpError{400, "scene", "unknown scene '" + options.scene + "' (built-in: " + known + "; or an inline scene object)"};
+      throw HttpError{400, "scene", "unknown scene '" + options.scene + "' (built-in: " + known + "; or an inline scene object" +
+                                        (assets_ ? "; or an asset (GET /v1/assets))" : ")")};
     }
     scene = found;
     key = scene_key(options.scene, options.tint);
@@ -731,8 +764,8 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   const json inline_scene = take_inline_scene(rest);
   RenderOptions options = parse_render_options(rest);
   std::string key;
-  const bool inline_request = !inline_scene.is_null();
   const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, options, key);
+  const bool inline_request = key.empty();  // an inline scene or an asset: held for this request only
   const Camera camera = options.frame ? orbit_camera(*scene, *options.frame, options.frames) : scene->camera;
   // Limits after every syntax check (a malformed request is a 400 whatever its size) and before
   // anything is packed or put on the device (an inline scene's own size is bounded by the face
@@ -1119,6 +1152,9 @@ void HttpServer::install_routes() {
            }));
   http.Get("/v1/scenes", guarded([this](const httplib::Request&, httplib::Response& res) {
              res.set_content(json_text(scenes_json()), "application/json");
+           }));
+  http.Get("/v1/assets", guarded([this](const httplib::Request&, httplib::Response& res) {
+             res.set_content(json_text(assets_json()), "application/json");
            }));
   http.Get("/v1/methods", guarded([this](const httplib::Request&, httplib::Response& res) {
              res.set_content(json_text(methods_json()), "application/json");

@@ -31,6 +31,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <seamcl/assets/asset_directory.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/pipeline/render_options.h>
@@ -85,6 +86,10 @@ struct ServerOptions {
   // ("deadline") instead; 0: no deadline. Long work also stops when the client has gone.
   int deadline_ms = 60'000;
   std::function<void(const std::string&)> log;          // one line per request; empty: stderr
+  // Assets (`--assets DIR`): scenes named relative to this directory and nothing else on disk;
+  // empty: built-in and inline scenes only. Loaded assets are cached within these bounds.
+  std::string assets_dir;
+  AssetCacheLimits asset_cache;
 };
 
 // The built-in assets, embedded at build time (server/embed_assets.cmake).
@@ -138,6 +143,9 @@ class HttpServer {
                                              std::string& key) const;
   void refuse_over_budget(size_t device_bytes, size_t host_bytes, const std::string& field, const std::string& what) const;
   nlohmann::json scenes_json() const;
+  nlohmann::json assets_json() const;
+  // An asset of the asset directory by options.scene and options.texture (400 without one).
+  std::shared_ptr<const Scene> asset_scene(const RenderOptions& options) const;
   nlohmann::json make_methods_json() const;
   // A built-in scene ("paper", tinted or not), generated on first use; null for an unknown name.
   std::shared_ptr<const Scene> builtin_scene(const std::string& name, bool tint) const;
@@ -151,6 +159,7 @@ class HttpServer {
   ClRuntime& runtime_;
   ServerOptions options_;
   std::unique_ptr<GuardedHttpServer> http_;
+  std::unique_ptr<AssetDirectory> assets_;  // null without --assets
   int port_ = -1;
   std::chrono::steady_clock::time_point started_;
 

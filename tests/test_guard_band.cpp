@@ -1,11 +1,15 @@
-// Guard bands (McDonald and Burley 2011): the bands hold the neighbours' texels, the kernels
-// read them as their twin does, and they cost the memory reported.
+// Guard bands (McDonald and Burley 2011): the bands hold the neighbours' texels at the band's own
+// texel density (box-filtered from a finer neighbour, interpolated from a coarser one), corners
+// at every valence and at boundaries hold what guard_band.h says, the kernels read them as their
+// twin does, and they cost the memory reported.
+#include "test_meshes.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
+#include <set>
 
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/render_options.h>
@@ -137,4 +141,128 @@ TEST(KernelVsTwin, GuardBandEveryFilterAndStorage) {
       }
     }
   }
+}
+
+namespace {
+
+// Two unit quads side by side (face 0 left, face 1 right, sharing the edge x = 1), level 0 of
+// face 0 `left` texels square and of face 1 `right`, every texel distinct.
+Scene two_quads(int left, int right) {
+  Scene scene;
+  scene.name = "two_quads";
+  for (int j = 0; j <= 1; ++j) {
+    for (int i = 0; i <= 2; ++i) scene.positions.emplace_back(static_cast<float>(i), static_cast<float>(j), 0.0f);
+  }
+  for (int f = 0; f < 2; ++f) {
+    Face face;
+    const uint32_t i = static_cast<uint32_t>(f);
+    face.vertices = {i, i + 1, i + 4, i + 3};
+    scene.faces.push_back(std::move(face));
+  }
+  seamcl_tests::set_textures(scene, {{left, left}, {right, right}}, seamcl_tests::distinct_texel);
+  scene.camera.eye = {1, 0.5f, 3};
+  scene.camera.target = {1, 0.5f, 0};
+  return scene;
+}
+
+void expect_near(glm::vec4 got, glm::vec4 expected, const std::string& where) {
+  EXPECT_LT(glm::length(got - expected), 1e-6f) << where << ": got " << got.r << "," << got.g << " expected "
+                                                << expected.r << "," << expected.g;
+}
+
+// Every face one colour of its own.
+glm::vec4 face_colour(size_t face, int, int) {
+  return {static_cast<float>(face % 7) / 7.0f, static_cast<float>(face / 7) / 7.0f, 0.5f, 1.0f};
+}
+
+}  // namespace
+
+TEST(GuardBand, FinerNeighboursAreBoxFilteredToTheBandsTexelDensity) {
+  constexpr int band = 2;
+  // A 1x1 face beside a 256x256 one: its band texel (one face wide) is that face's mean, the
+  // 1x1 level of its chain, not one of its texels.
+  {
+    const Scene scene = two_quads(1, 256);
+    const TextureLevel padded = guard_banded_level(scene, build_adjacency(scene), 0, 0, band);
+    expect_near(padded.at(band + 1, band), scene.faces[1].texture.levels.back().at(0, 0), "1x1 beside 256x256");
+  }
+  // 4x4 beside 16x16: each band texel is the 4x4 block of the neighbour's texels it covers,
+  // which is its level 2; and at level 1 (2x2 beside it) the neighbour's level 3.
+  {
+    const Scene scene = two_quads(4, 16);
+    const std::vector<FaceNeighbors> adjacency = build_adjacency(scene);
+    const TextureLevel level0 = guard_banded_level(scene, adjacency, 0, 0, band);
+    const TextureLevel level1 = guard_banded_level(scene, adjacency, 0, 1, band);
+    for (int k = 0; k < band; ++k) {
+      for (int j = 0; j < 4; ++j) {
+        expect_near(level0.at(band + 4 + k, band + j), scene.faces[1].texture.levels[2].at(k, j), "4x4 beside 16x16");
+      }
+      for (int j = 0; j < 2; ++j) {
+        expect_near(level1.at(band + 2 + k, band + j), scene.faces[1].texture.levels[3].at(k, j), "level 1");
+      }
+    }
+  }
+}
+
+TEST(GuardBand, CoarserNeighboursAreInterpolatedAtTheBandTexelsCentre) {
+  // 16x16 beside 4x4: band texel (16, j) stands for the neighbour's uv (1/32, (j + .5) / 16):
+  // its level 0 interpolated there (clamped to its first column), as a lookup of it would be.
+  constexpr int band = 1;
+  const Scene scene = two_quads(16, 4);
+  const TextureLevel padded = guard_banded_level(scene, build_adjacency(scene), 0, 0, band);
+  const TextureLevel& neighbour = scene.faces[1].texture.levels[0];
+  for (int j = 0; j < 16; ++j) {
+    const float y = std::clamp((static_cast<float>(j) + 0.5f) / 16.0f * 4.0f - 0.5f, 0.0f, 3.0f);
+    const int row = static_cast<int>(y);
+    const float t = y - static_cast<float>(row);
+    const glm::vec4 expected = neighbour.at(0, row) * (1.0f - t) + neighbour.at(0, std::min(row + 1, 3)) * t;
+    expect_near(padded.at(band + 16, band + j), expected, "row " + std::to_string(j));
+  }
+}
+
+TEST(GuardBand, CornerBandsAtEveryValenceAndAtBoundaries) {
+  // Faces of one colour each, so a corner band texel shows which faces filled it: the diagonal
+  // face at valence 4; at valence 5 the mean of the faces that share only the vertex; at valence
+  // 3 and at boundary vertices the mean of the two edges' continuations (the face across each
+  // edge, or this face where there is none).
+  Scene prism = seamcl_tests::split_pentagonal_prism();
+  Scene box = seamcl_tests::subdivided_cube(2);
+  box.faces.erase(box.faces.begin() + 4, box.faces.begin() + 8);
+  std::set<int> valences_seen;
+  size_t boundary_corners = 0;
+  for (Scene* scene : {&prism, &box}) {
+    seamcl_tests::set_textures(*scene, {{4, 4}, {2, 8}, {1, 1}, {16, 16}}, face_colour);
+    const std::vector<FaceNeighbors> adjacency = build_adjacency(*scene);
+    auto colour = [&](int face) { return scene->faces[static_cast<size_t>(face)].texture.levels[0].at(0, 0); };
+    for (uint32_t f = 0; f < scene->faces.size(); ++f) {
+      constexpr int band = 2;
+      const TextureLevel padded = guard_banded_level(*scene, adjacency, f, 0, band);
+      const int w = scene->faces[f].texture.width(), h = scene->faces[f].texture.height();
+      // The band texel next to each corner, outside both edges.
+      const int corner_i[4] = {band - 1, band + w, band + w, band - 1};
+      const int corner_j[4] = {band - 1, band - 1, band + h, band + h};
+      for (int k = 0; k < 4; ++k) {
+        const VertexRing ring = corner_ring(*scene, adjacency, f, k);
+        glm::vec4 expected(0.0f);
+        if (ring.valence() == 4) {
+          expected = colour(static_cast<int>(ring.faces[1].face));
+        } else if (ring.valence() >= 5) {
+          for (int i = 1; i + 2 < ring.valence(); ++i) expected += colour(static_cast<int>(ring.faces[static_cast<size_t>(i)].face));
+          expected /= static_cast<float>(ring.valence() - 3);
+        } else {
+          boundary_corners += !ring.closed;
+          for (int e : {(k + 3) % 4, k}) {
+            const int other = adjacency[f].neighbor[e];
+            expected += colour(other >= 0 ? other : static_cast<int>(f)) * 0.5f;
+          }
+        }
+        valences_seen.insert(ring.valence());
+        expect_near(padded.at(corner_i[k], corner_j[k]), expected,
+                    scene->name + " face " + std::to_string(f) + " corner " + std::to_string(k) + " valence " +
+                        std::to_string(ring.valence()));
+      }
+    }
+  }
+  EXPECT_EQ(valences_seen, (std::set<int>{0, 3, 4, 5}));
+  EXPECT_GT(boundary_corners, 0u);
 }

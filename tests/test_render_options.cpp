@@ -50,7 +50,8 @@ TEST(RenderOptions, EnumNamesRoundTrip) {
   for (const std::string& name : filter_names()) EXPECT_EQ(to_string(*parse_filter(name)), name);
   for (const std::string& name : zero_coverage_names()) EXPECT_EQ(to_string(*parse_zero_coverage(name)), name);
   for (const std::string& name : texel_format_names()) EXPECT_EQ(to_string(*parse_texel_format(name)), name);
-  EXPECT_EQ(method_names(), (std::vector<std::string>{"clamp", "black", "discard", "traverse", "guardband"}));
+  EXPECT_EQ(method_names(),
+            (std::vector<std::string>{"clamp", "black", "discard", "traverse", "traverse-edges", "guardband"}));
   EXPECT_EQ(filter_names(), (std::vector<std::string>{"bilinear", "trilinear", "aniso", "ewa"}));
   EXPECT_FALSE(parse_method("Clamp").has_value());
   EXPECT_FALSE(parse_shading_mode("").has_value());
@@ -80,8 +81,14 @@ TEST(RenderOptions, MethodsAreSamplerSettings) {
   const SamplerParams traverse = sampler_params(Method::Traverse, Filter::Aniso, 16, ZeroCoverage::Clamp);
   EXPECT_EQ(traverse.address, SEAMCL_ADDRESS_BORDER);
   EXPECT_EQ(traverse.renormalize, 1);
-  EXPECT_EQ(traverse.traverse, 1);
+  EXPECT_EQ(traverse.traverse, SEAMCL_TRAVERSE_CORNERS);
   EXPECT_EQ(traverse.guard_band, 0);
+  const SamplerParams edges = sampler_params(Method::TraverseEdges, Filter::Aniso, 16, ZeroCoverage::Clamp);
+  EXPECT_EQ(edges.address, SEAMCL_ADDRESS_BORDER);
+  EXPECT_EQ(edges.renormalize, 1);
+  EXPECT_EQ(edges.traverse, SEAMCL_TRAVERSE_EDGES);
+  EXPECT_TRUE(reads_adjacency(Method::Traverse) && reads_adjacency(Method::TraverseEdges));
+  EXPECT_FALSE(reads_adjacency(Method::Discard) || reads_adjacency(Method::Guardband));
   const SamplerParams guardband = sampler_params(Method::Guardband, Filter::Aniso, 16, ZeroCoverage::Clamp, 3);
   EXPECT_EQ(guardband.address, SEAMCL_ADDRESS_CLAMP);
   EXPECT_EQ(guardband.renormalize, 0);

@@ -1,12 +1,17 @@
-// Traverse (McDonald 2013): the adjacency and uv transforms it reads, the kernel against its
-// twin on connected faces of different sizes and orientations, and seamlessness on constant
-// scenes.
+// Traverse (McDonald 2013, with Ptex's corners) and traverse-edges (without them): the adjacency,
+// corner rings and uv transforms they read, the kernel against its twin on connected faces of
+// different sizes and orientations, the diagonal face's share past a corner, and the bound that
+// lets interior lookups skip the neighbours.
+#include "test_meshes.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
+#include <set>
+#include <string>
+#include <utility>
 
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/render_options.h>
@@ -90,9 +95,12 @@ TEST(Adjacency, ClosedMeshesLinkEveryEdge) {
 }
 
 TEST(KernelVsTwin, TraverseOnConnectedFacesOfMixedSizesAndOrientations) {
-  // The cube's faces meet at rotated uv frames; paper's at mixed, non-square sizes.
-  for (const char* name : {"cube", "paper"}) {
-    const Scene scene = generate_scene(name, {});
+  // The cube's faces meet at rotated uv frames; paper's at mixed, non-square sizes, valence 4
+  // everywhere; the prism's at sizes from 1x1 to 256x256 and valence 3, 4 and 5.
+  Scene prism = seamcl_tests::split_pentagonal_prism();
+  seamcl_tests::set_textures(prism, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+  for (const char* name : {"cube", "paper", "prism"}) {
+    const Scene scene = std::string(name) == "prism" ? prism : generate_scene(name, {});
     std::mt19937 rng(77);
     std::vector<Lookup> lookups;
     for (int i = 0; i < 3000; ++i) {
@@ -108,12 +116,17 @@ TEST(KernelVsTwin, TraverseOnConnectedFacesOfMixedSizesAndOrientations) {
       lookups.push_back(l);
     }
     for (TexelFormat format : {TexelFormat::Rgba8, TexelFormat::Rgba32f}) {
+      if (std::string(name) == "prism" && format == TexelFormat::Rgba8) continue;  // its sizes, once is enough
       const PackedScene packed = pack_scene(scene, format);
       TextureLookups device(shared_runtime(), packed);
       device.set_lookups(lookups);
-      for (Filter filter : {Filter::Bilinear, Filter::Trilinear, Filter::Aniso, Filter::Ewa}) {
-        SCOPED_TRACE(testing::Message() << name << " " << to_string(format) << " " << to_string(filter));
-        const SamplerParams sampler = sampler_params(Method::Traverse, filter, 8, ZeroCoverage::Clamp);
+      for (const auto& [method, filter] : std::vector<std::pair<Method, Filter>>{
+               {Method::Traverse, Filter::Bilinear}, {Method::Traverse, Filter::Trilinear},
+               {Method::Traverse, Filter::Aniso}, {Method::Traverse, Filter::Ewa},
+               {Method::TraverseEdges, Filter::Trilinear}, {Method::TraverseEdges, Filter::Ewa}}) {
+        SCOPED_TRACE(testing::Message() << name << " " << to_string(format) << " " << to_string(method) << " "
+                                        << to_string(filter));
+        const SamplerParams sampler = sampler_params(method, filter, 8, ZeroCoverage::Clamp);
         const std::vector<glm::vec4> gpu = device.sample(sampler);
         const std::vector<FilterSum> sums = device.filter(sampler);
         size_t bad = 0, beyond_own_face = 0;
@@ -155,4 +168,197 @@ TEST(Traverse, ContinuesAcrossTheEdgeWhereDiscardStops) {
                                                   1.0f, 0.5f, d, 0, 0, d);
   EXPECT_NEAR(discard.weight, 0.5f, 0.05f);
   EXPECT_NEAR(traverse.weight, 1.0f, 0.05f);
+}
+
+namespace {
+
+// How many faces hold each vertex.
+std::vector<int> faces_per_vertex(const Scene& scene) {
+  std::vector<int> count(scene.positions.size(), 0);
+  for (const Face& face : scene.faces) {
+    for (uint32_t v : face.vertices) ++count[v];
+  }
+  return count;
+}
+
+// The cube with one side left out: its rim is a mesh boundary.
+Scene open_box() {
+  Scene scene = seamcl_tests::subdivided_cube(2);
+  scene.faces.erase(scene.faces.begin() + 4, scene.faces.begin() + 8);
+  return scene;
+}
+
+bool same_map(const UvMap& a, const UvMap& b) {
+  return glm::all(glm::equal(a.linear[0], b.linear[0])) && glm::all(glm::equal(a.linear[1], b.linear[1])) &&
+         glm::all(glm::equal(a.offset, b.offset));
+}
+
+}  // namespace
+
+TEST(Adjacency, CornerRingsFindEveryVertexsValence) {
+  // Closed meshes: every ring closes, around as many faces as hold the vertex; the diagonal face
+  // is linked exactly at valence 4.
+  for (const Scene& scene : {seamcl_tests::subdivided_cube(2), seamcl_tests::split_pentagonal_prism(),
+                             generate_scene("cube", {})}) {
+    SCOPED_TRACE(scene.name);
+    const std::vector<FaceNeighbors> adjacency = build_adjacency(scene);
+    const std::vector<int> holding = faces_per_vertex(scene);
+    std::set<int> valences;
+    for (uint32_t f = 0; f < scene.faces.size(); ++f) {
+      for (int k = 0; k < 4; ++k) {
+        const VertexRing ring = corner_ring(scene, adjacency, f, k);
+        const uint32_t vertex = scene.faces[f].vertices[k];
+        EXPECT_TRUE(ring.closed) << "face " << f << " corner " << k;
+        EXPECT_EQ(ring.valence(), holding[vertex]) << "face " << f << " corner " << k;
+        valences.insert(ring.valence());
+        // Every face of the ring holds the vertex, at the corner recorded.
+        for (const RingFace& r : ring.faces) EXPECT_EQ(scene.faces[r.face].vertices[r.corner], vertex);
+        EXPECT_EQ(adjacency[f].corner[k] >= 0, ring.valence() == 4) << "face " << f << " corner " << k;
+      }
+    }
+    if (scene.name == "split_pentagonal_prism") EXPECT_EQ(valences, (std::set<int>{3, 4, 5}));
+    if (scene.name == "subdivided_cube") EXPECT_EQ(valences, (std::set<int>{3, 4}));
+  }
+  // At a boundary the ring is open and nothing is linked past the corner.
+  const Scene box = open_box();
+  const std::vector<FaceNeighbors> adjacency = build_adjacency(box);
+  size_t open = 0;
+  for (uint32_t f = 0; f < box.faces.size(); ++f) {
+    for (int k = 0; k < 4; ++k) {
+      const VertexRing ring = corner_ring(box, adjacency, f, k);
+      if (ring.closed) continue;
+      ++open;
+      EXPECT_EQ(ring.valence(), 0);
+      EXPECT_EQ(adjacency[f].corner[k], -1);
+    }
+  }
+  EXPECT_GT(open, 8u);
+}
+
+TEST(Adjacency, DiagonalMapIsTheEdgeMapsComposedEitherWayRound) {
+  // At a valence-4 vertex the diagonal face is reached across edge k and then across the
+  // neighbour's other edge at the vertex, or across edge k-1 and on: both give the same map, the
+  // one corner_map builds from the corners alone, and it follows the surface where it is flat.
+  for (const Scene& scene : {seamcl_tests::subdivided_cube(2), generate_scene("paper", {})}) {
+    SCOPED_TRACE(scene.name);
+    const std::vector<FaceNeighbors> adjacency = build_adjacency(scene);
+    size_t checked = 0, flat = 0;
+    for (uint32_t f = 0; f < scene.faces.size(); ++f) {
+      for (int k = 0; k < 4; ++k) {
+        const int diagonal = adjacency[f].corner[k];
+        if (diagonal < 0) continue;
+        ++checked;
+        const UvMap stored = uv_map(adjacency[f].corner_transform[k]);
+        const VertexRing ring = corner_ring(scene, adjacency, f, k);
+        ASSERT_EQ(ring.valence(), 4);
+        EXPECT_TRUE(same_map(stored, corner_map(k, ring.faces[1].corner, corner_swap(scene, ring.faces[1]))))
+            << "face " << f << " corner " << k;
+        // The other way round: across edge k-1, then across that neighbour's edge into the diagonal.
+        const int before = (k + 3) % 4;
+        const uint32_t side = static_cast<uint32_t>(adjacency[f].neighbor[before]);
+        bool found = false;
+        for (int e = 0; e < 4 && !found; ++e) {
+          if (adjacency[side].neighbor[e] != diagonal) continue;
+          const UvMap other_way = compose(uv_map(adjacency[side].transform[e]), uv_map(adjacency[f].transform[before]));
+          found = same_map(other_way, stored);
+        }
+        EXPECT_TRUE(found) << "face " << f << " corner " << k;
+        // Where the four faces are coplanar squares, a point past the corner lands on the same
+        // 3D point of the diagonal face as the face's own plane continued gives.
+        const auto corners = scene.corners(scene.faces[f]);
+        const auto diagonal_corners = scene.corners(scene.faces[static_cast<size_t>(diagonal)]);
+        constexpr float cu[4] = {0, 1, 1, 0}, cv[4] = {0, 0, 1, 1};
+        const glm::vec2 past(cu[k] + (cu[k] > 0 ? 0.3f : -0.3f), cv[k] + (cv[k] > 0 ? 0.2f : -0.2f));
+        const glm::vec3 continued = corners[0] + past.x * (corners[1] - corners[0]) + past.y * (corners[3] - corners[0]);
+        const glm::vec2 mapped = stored.point(past);
+        EXPECT_TRUE(mapped.x > 0 && mapped.x < 1 && mapped.y > 0 && mapped.y < 1) << mapped.x << "," << mapped.y;
+        if (scene.name == "subdivided_cube" && std::fabs(glm::dot(scene.face_normal(scene.faces[f]),
+                                                                  scene.face_normal(scene.faces[static_cast<size_t>(diagonal)]))) > 0.999f) {
+          ++flat;
+          EXPECT_LT(glm::length(face_point(diagonal_corners, mapped.x, mapped.y) - continued), 1e-5f);
+        }
+      }
+    }
+    EXPECT_GT(checked, 0u);
+    // The four faces around each side's centre (the others fold over the cube's edges).
+    if (scene.name == "subdivided_cube") EXPECT_EQ(flat, 24u);
+  }
+}
+
+TEST(Traverse, DiagonalFaceTakesThePartOfTheFootprintPastTheCorner) {
+  // A footprint centred on the vertex where four coplanar squares of the subdivided cube meet:
+  // traverse-edges reads three of the four quadrants, traverse all four, as one texture would.
+  Scene scene = seamcl_tests::subdivided_cube(2);
+  seamcl_tests::set_textures(scene, {{64, 64}}, seamcl_tests::distinct_texel);
+  const PackedScene packed = pack_scene(scene, TexelFormat::Rgba32f);
+  const std::vector<FaceNeighbors>& adjacency = packed.neighbors;
+  // A face and a valence-4 corner of it.
+  uint32_t face = 0;
+  int corner = -1;
+  for (uint32_t f = 0; f < scene.faces.size() && corner < 0; ++f) {
+    for (int k = 0; k < 4 && corner < 0; ++k) {
+      if (adjacency[f].corner[k] >= 0) {
+        face = f;
+        corner = k;
+      }
+    }
+  }
+  ASSERT_GE(corner, 0);
+  constexpr float cu[4] = {0, 1, 1, 0}, cv[4] = {0, 0, 1, 1};
+  const float d = 4.0f / 64.0f;  // four texels
+  for (Filter filter : {Filter::Trilinear, Filter::Aniso, Filter::Ewa}) {
+    SCOPED_TRACE(to_string(filter));
+    auto weight = [&](Method method) {
+      return method_sum_reference(packed.textures(), face, sampler_params(method, filter, 8, ZeroCoverage::Clamp),
+                                  cu[corner], cv[corner], d, 0, 0, d)
+          .weight;
+    };
+    EXPECT_NEAR(weight(Method::Discard), 0.25f, 0.03f);
+    EXPECT_NEAR(weight(Method::TraverseEdges), 0.75f, 0.05f);
+    EXPECT_NEAR(weight(Method::Traverse), 1.0f, 0.05f);
+  }
+}
+
+TEST(Traverse, SkipsOnlyNeighboursThatWouldAddNothing) {
+  // neighbor_may_contribute is what lets an interior lookup skip the neighbours' filters; it must
+  // never rule out a neighbour that holds a tap of any weight. Checked on every neighbour of
+  // random lookups (sizes 1x1 to 256x256, non-square ones too), every filter, and on purpose
+  // near the bound: footprints from a hundredth of a texel to a whole face.
+  Scene scene = seamcl_tests::subdivided_cube(2);
+  seamcl_tests::set_textures(scene, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+  const PackedScene packed = pack_scene(scene, TexelFormat::Rgba32f);
+  const TextureView view = packed.textures();
+  std::mt19937 rng(5);
+  size_t skipped = 0, kept = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const uint32_t face = static_cast<uint32_t>(rng() % scene.faces.size());
+    const float u = uniform(rng, -0.1f, 1.1f), v = uniform(rng, -0.1f, 1.1f);
+    const float scale = std::pow(10.0f, uniform(rng, -4.0f, 0.0f));
+    const float dudx = scale * uniform(rng, -1, 1), dvdx = scale * uniform(rng, -1, 1);
+    const float dudy = scale * uniform(rng, -1, 1), dvdy = scale * uniform(rng, -1, 1);
+    const Filter filter = static_cast<Filter>(rng() % 4);
+    const SamplerParams sampler = sampler_params(Method::Traverse, filter, 1 + static_cast<int>(rng() % 16), ZeroCoverage::Clamp);
+    const FaceNeighbors& n = packed.neighbors[face];
+    const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
+    for (int j = 0; j < 8; ++j) {
+      const int k = j % 4;
+      const int other = j < 4 ? n.neighbor[k] : n.corner[k];
+      if (other < 0) continue;
+      const float distance = j < 4 ? inside[k] : std::fmax(inside[(k + 3) % 4], inside[k]);
+      if (neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], sampler.filter, distance, dudx, dvdx, dudy,
+                                  dvdy)) {
+        ++kept;
+        continue;
+      }
+      ++skipped;
+      const UvMap map = uv_map(j < 4 ? n.transform[k] : n.corner_transform[k]);
+      const glm::vec2 p = map.point({u, v}), dx = map.direction({dudx, dvdx}), dy = map.direction({dudy, dvdy});
+      const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER,
+                                                   p.x, p.y, dx.x, dx.y, dy.x, dy.y);
+      ASSERT_EQ(s.weight, 0.0f) << "face " << face << " neighbour " << other << " (" << (j < 4 ? "edge " : "corner ") << k
+                                << ") at " << u << "," << v << " scale " << scale << " " << to_string(filter);
+    }
+  }
+  // The bound is not vacuous: interior lookups do skip.
+  EXPECT_GT(skipped, kept / 4);
 }

@@ -1,6 +1,6 @@
-// Ptex (.ptx) files: per-face textures of a quad mesh, as written by the Ptex library. The format's
-// facts are in docs/ptex-format.md; every size, offset and count is checked against the file
-// before it is used, so a truncated or hostile file is an InputError, never a crash or an
+// Ptex (.ptx) files: per-face textures of a quad mesh, as written by the Ptex library. What is read
+// and what is refused is in docs/ptex-format.md; every size, offset and count is checked against
+// the file before it is used, so a truncated or hostile file is an InputError, never a crash or an
 // allocation the file cannot justify.
 #pragma once
 #include <array>
@@ -25,7 +25,8 @@ enum class PtexDataType { Uint8 = 0, Uint16 = 1, Float16 = 2, Float32 = 3 };
 struct PtexFaceInfo {
   int ulog2 = 0;
   int vlog2 = 0;
-  bool constant = false;
+  bool constant = false;  // one value over the whole face (its chain is still full-size)
+  bool subface = false;   // a quad of a split non-quad face (Ptex's flag; kept for display)
   std::array<int32_t, 4> adjacent_faces{-1, -1, -1, -1};
   std::array<uint8_t, 4> adjacent_edges{};
 };
@@ -43,26 +44,41 @@ struct PtexFile {
   int alpha_channel = -1; // -1: none
   std::vector<PtexFaceInfo> faces;
   // Per face, the full chain down to 1x1 in linear RGBA float: integer types divided by their
-  // maximum, grey copied to RGB, alpha 1 when the file has none. Stored reductions are used as
-  // they are; missing ones are 2x2 (2x1, 1x2) box filters of the level above.
+  // maximum, grey copied to RGB, alpha 1 when the file has none (straight, not premultiplied, at
+  // every level). Stored reductions are used as they are; missing ones are 2x2 (2x1, 1x2) box
+  // filters of the level above; the 1x1 level is the file's constant data (Ptex's own 1x1 level).
+  // Every chain passes validate_scene's checks.
   std::vector<MipChain> textures;
   std::map<std::string, std::string> metadata;  // values rendered as text, for display
+                                                // (long arrays shortened)
   std::optional<PtexMesh> mesh;
 };
 
-// Limits that bound what a file may make the reader allocate, beyond what the file's own size
-// justifies.
+// Limits on what a file may make the reader allocate. Every block of the file must inflate to
+// exactly the size its headers give, so decoded data is bounded by the file's size (zlib's best
+// ratio is about 1000:1); a constant face, though, becomes a full-size chain from one texel, and
+// these bound that too. Checked before anything is allocated.
 struct PtexLimits {
-  uint64_t max_texels = uint64_t(1) << 28;  // all levels of all faces, after decoding
+  uint64_t max_texels = uint64_t(1) << 26;  // all levels of all faces: 64 Mi texels, 1 GiB as float RGBA
   int max_faces = 1 << 20;
+  int max_side_log2 = 12;                   // faces up to 4096 texels a side, as validate_scene accepts
+  uint64_t max_metadata_bytes = uint64_t(1) << 28;  // all metadata values, inflated
+  uint64_t max_file_bytes = uint64_t(1) << 31;      // read_ptex_file only
+  float max_texel_magnitude = 1e9f;  // |value| of a float texel; larger, inf or nan is refused,
+                                     // so that no filter sum overflows to inf in a render
 };
 
-// Parses a whole file held in memory. Throws InputError(field, message) with field naming the
-// part at fault ("ptex.header.nchannels", "ptex.faces[12].level 1", ...), for every malformed,
-// truncated or unsupported input (triangle meshes, edits).
+// Parses a whole file held in memory. Throws InputError with field "texture" and a message that
+// names the part at fault ("header: nchannels 1000 is not 1 to 4", "face 12, level 1: block of
+// 4000 bytes runs past the 300 bytes left in the level"), for every malformed, truncated or
+// unsupported input (triangle meshes, edits, more than 4 channels).
 PtexFile parse_ptex(std::span<const uint8_t> bytes, const PtexLimits& limits = {});
 
-// Reads and parses a file; an unreadable file is InputError("texture", ...) naming the path.
+// Reads and parses a file; every error is InputError("texture", ...) whose message starts with
+// the path.
 PtexFile read_ptex_file(const std::string& path, const PtexLimits& limits = {});
+
+// Texels of all levels of all faces of a file's textures (16 bytes each as float RGBA).
+uint64_t ptex_texel_count(const PtexFile& file);
 
 }  // namespace seamcl

@@ -79,7 +79,7 @@ EntryResult measure_entry(Renderer& renderer, const Camera& camera, const Method
   const PackedScene& packed = renderer.packed_scene();
   out.texture_bytes = packed.texture_bytes();
   out.padding_bytes = packed.padding_bytes();
-  out.adjacency_bytes = entry.options.method == Method::Traverse ? packed.adjacency_bytes() : 0;
+  out.adjacency_bytes = reads_adjacency(entry.options.method) ? packed.adjacency_bytes() : 0;
   return out;
 }
 

@@ -41,6 +41,9 @@ glm::vec3 edge_point(const Edge& e, float along, bool face_a, float inside) {
   return d;
 }
 
+// Samples of one cube-edge pixel lie within 0.25 radians of each other.
+constexpr float kContinuousCos = 0.9689124f;  // cos(0.25)
+
 double rgb_norm(glm::vec4 v) { return glm::length(glm::dvec3(v.r, v.g, v.b)); }
 
 // Directions over a disk of half-angle `angle` around unit d (Vogel's spiral, 16 points).
@@ -152,6 +155,11 @@ CubeReference cube_reference(Renderer& renderer, const Camera& camera, const Ren
       glm::vec4 sum(0.0f);
       int first_face = -1;
       bool crosses = false;
+      // A pixel whose samples' directions spread wide (a silhouette: reflection against sky, or
+      // a grazing fold) or that shows background is not a cube-edge pixel, whatever faces its
+      // samples select: its error is the silhouette's.
+      bool continuous = true;
+      glm::vec3 first_direction(0.0f);
       for (int sy = 0; sy < scale; ++sy) {
         for (int sx = 0; sx < scale; ++sx) {
           const glm::vec4 p = directions.pixels[static_cast<size_t>(y * scale + sy) * big.width + (x * scale + sx)];
@@ -159,9 +167,12 @@ CubeReference cube_reference(Renderer& renderer, const Camera& camera, const Ren
           const float length = glm::length(d);
           if (!(length > 0.5f)) {  // not an environment lookup: the background (skybox off)
             sum += background;
+            continuous = false;
             continue;
           }
           const glm::vec3 unit = d / length;
+          if (first_face < 0) first_direction = unit;
+          continuous = continuous && glm::dot(unit, first_direction) > kContinuousCos;
           const float roughness = length - 1.0f;
           if (roughness > 1e-4f) {
             glm::vec4 disk(0.0f);
@@ -178,8 +189,9 @@ CubeReference cube_reference(Renderer& renderer, const Camera& camera, const Ren
       }
       const size_t i = static_cast<size_t>(y) * out.width + x;
       out.pixels[i] = glm::vec4(glm::vec3(sum * inv), 1.0f);
-      out.cube_edge[i] = crosses ? 1 : 0;
-      out.edge_pixels += crosses ? 1 : 0;
+      const bool edge = crosses && continuous;
+      out.cube_edge[i] = edge ? 1 : 0;
+      out.edge_pixels += edge ? 1 : 0;
     }
   }
   return out;

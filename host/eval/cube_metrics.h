@@ -32,7 +32,8 @@ EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environme
 // the width and height with 1 sample per pixel, each sample the environment along its lookup
 // direction (a mirror's exactly; a glossy one's averaged over a disk of half-angle roughness / 2,
 // the footprint the lookup widens by), then box-averaged over scale x scale. `cube_edge` marks the
-// pixels whose samples select more than one cube face: their footprint crosses a cube edge.
+// pixels whose samples select more than one cube face (their footprint crosses a cube edge) and
+// lie within 0.25 radians of each other (not a silhouette, whose error is not the seam's).
 struct CubeReference {
   int width = 0, height = 0;
   std::vector<glm::vec4> pixels;

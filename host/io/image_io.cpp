@@ -111,9 +111,21 @@ std::vector<glm::vec4> read_image(const std::string& path, int& width, int& heig
   linear.get_pixels(OIIO::ROI(0, width, 0, height, 0, 1, 0, channels), OIIO::TypeDesc::FLOAT, values.data());
   std::vector<glm::vec4> pixels(static_cast<size_t>(width) * height, glm::vec4(0, 0, 0, 1));
   for (size_t i = 0; i < pixels.size(); ++i) {
+    if (channels <= 2) {
+      pixels[i] = glm::vec4(glm::vec3(values[i * channels]), channels == 2 ? values[i * channels + 1] : 1.0f);
+      continue;
+    }
     for (int c = 0; c < std::min(channels, 4); ++c) pixels[i][c] = values[i * channels + c];
   }
   return pixels;
+}
+
+void read_image_size(const std::string& path, int& width, int& height) {
+  auto input = OIIO::ImageInput::open(path);
+  if (!input) throw std::runtime_error("cannot read " + path + ": " + OIIO::geterror());
+  width = input->spec().width;
+  height = input->spec().height;
+  input->close();
 }
 
 }  // namespace seamcl

@@ -19,7 +19,12 @@ void write_image(const std::string& path, int width, int height, const std::vect
 // The same encoding in memory (for the HTTP service).
 std::string encode_image(ImageFormat format, int width, int height, const std::vector<glm::vec4>& pixels);
 
-// Reads any image OpenImageIO can, as linear RGBA float (PNG/JPEG decoded from sRGB).
+// Reads any image OpenImageIO can, as linear RGBA float (PNG/JPEG decoded from sRGB). Grey images
+// (one channel, or grey and alpha) become grey RGB; a missing alpha is 1.
 std::vector<glm::vec4> read_image(const std::string& path, int& width, int& height);
+
+// The size of an image file from its header alone, so that a caller can refuse a huge one before
+// reading its pixels. Throws std::runtime_error when the file is not an image OpenImageIO reads.
+void read_image_size(const std::string& path, int& width, int& height);
 
 }  // namespace seamcl

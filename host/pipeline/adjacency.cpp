@@ -1,5 +1,6 @@
 #include "pipeline/adjacency.h"
 
+#include <cassert>
 #include <map>
 #include <utility>
 
@@ -24,11 +25,122 @@ struct EdgeRef {
   int edge;
 };
 
+// The map across edge k of face f onto edge j of face g, where g runs the edge backwards when
+// `reversed` (consistently oriented neighbours do).
+UvMap edge_map(int k, int j, bool reversed) {
+  // Where f's corner k and corner k+1 sit in g's uv.
+  const glm::vec2 ga = reversed ? corner_uv(j + 1) : corner_uv(j);
+  const glm::vec2 gb = reversed ? corner_uv(j) : corner_uv(j + 1);
+  // A point p = a + s e + t n_f (s along the edge, t into f) lands at a' + s e' - t n_g: the
+  // same distance past the edge, out of g. Linear part L = [e', -n_g] [e, n_f]^T (both bases
+  // orthonormal), offset o = a' - L a.
+  const glm::vec2 e = corner_uv(k + 1) - corner_uv(k);
+  const glm::vec2 nf = inward_normal(k);
+  const glm::mat2 to_local = glm::transpose(glm::mat2(e, nf));  // rows e, n_f
+  UvMap map;
+  map.linear = glm::mat2(gb - ga, -inward_normal(j)) * to_local;
+  map.offset = ga - map.linear * corner_uv(k);
+  return map;
+}
+
+// The corner of `face` that holds vertex v, or -1 unless exactly one does.
+int corner_of(const Face& face, uint32_t v) {
+  int found = -1;
+  for (int k = 0; k < 4; ++k) {
+    if (face.vertices[k] != v) continue;
+    if (found >= 0) return -1;
+    found = k;
+  }
+  return found;
+}
+
 }  // namespace
+
+UvMap compose(const UvMap& second, const UvMap& first) {
+  return {second.linear * first.linear, second.linear * first.offset + second.offset};
+}
+
+UvMap uv_map(const float t[6]) {
+  UvMap map;
+  // glm is column-major: linear[c][r].
+  map.linear[0][0] = t[0];
+  map.linear[1][0] = t[1];
+  map.offset.x = t[2];
+  map.linear[0][1] = t[3];
+  map.linear[1][1] = t[4];
+  map.offset.y = t[5];
+  return map;
+}
+
+void store(const UvMap& map, float t[6]) {
+  t[0] = map.linear[0][0];
+  t[1] = map.linear[1][0];
+  t[2] = map.offset.x;
+  t[3] = map.linear[0][1];
+  t[4] = map.linear[1][1];
+  t[5] = map.offset.y;
+}
+
+UvMap corner_map(int k, int j, bool swap) {
+  // Outward axes at corner k: edge k-1 and edge k continued past the corner.
+  const glm::vec2 p = corner_uv(k) - corner_uv(k + 3);
+  const glm::vec2 q = corner_uv(k) - corner_uv(k + 1);
+  // Inward axes at corner j of the other face: along its edges j and j-1.
+  const glm::vec2 e1 = corner_uv(j + 1) - corner_uv(j);
+  const glm::vec2 e2 = corner_uv(j + 3) - corner_uv(j);
+  UvMap map;
+  map.linear = (swap ? glm::mat2(e2, e1) : glm::mat2(e1, e2)) * glm::transpose(glm::mat2(p, q));
+  map.offset = corner_uv(j) - map.linear * corner_uv(k);
+  return map;
+}
+
+bool corner_swap(const Scene& scene, const RingFace& diagonal) {
+  // The distance past the corner along edge k-1's line runs along the edge the walk entered the
+  // diagonal face by (shared with the neighbour across edge k).
+  const Face& face = scene.faces[diagonal.face];
+  return face.vertices[(diagonal.corner + 1) % 4] != diagonal.entered_from;
+}
+
+VertexRing corner_ring(const Scene& scene, const std::vector<FaceNeighbors>& adjacency, uint32_t start, int corner) {
+  VertexRing ring;
+  const Face& first = scene.faces[start];
+  const uint32_t vertex = first.vertices[corner];
+  if (corner_of(first, vertex) != corner) return ring;
+  uint32_t current = start;
+  int exit_edge = corner;
+  for (int step = 0; step < kMaxRingValence; ++step) {
+    const Face& here = scene.faces[current];
+    const int next = adjacency[current].neighbor[exit_edge];
+    if (next < 0) return ring;  // a boundary: open
+    // The far end of the edge crossed.
+    const uint32_t a = here.vertices[exit_edge], b = here.vertices[(exit_edge + 1) % 4];
+    assert(a == vertex || b == vertex);
+    const uint32_t entered_from = a == vertex ? b : a;
+    if (static_cast<uint32_t>(next) == start) {
+      ring.closed = entered_from == first.vertices[(corner + 3) % 4];
+      if (!ring.closed) ring.faces.clear();
+      return ring;
+    }
+    const Face& face = scene.faces[static_cast<size_t>(next)];
+    const int j = corner_of(face, vertex);
+    if (j < 0) return ring;
+    // Leave by the other edge at the vertex.
+    if (face.vertices[(j + 1) % 4] == entered_from) {
+      exit_edge = (j + 3) % 4;
+    } else if (face.vertices[(j + 3) % 4] == entered_from) {
+      exit_edge = j;
+    } else {
+      return ring;
+    }
+    ring.faces.push_back({static_cast<uint32_t>(next), j, entered_from});
+    current = static_cast<uint32_t>(next);
+  }
+  return ring;  // more faces than kMaxRingValence: open
+}
 
 std::vector<FaceNeighbors> build_adjacency(const Scene& scene) {
   std::vector<FaceNeighbors> out(scene.faces.size());
-  // Every directed edge (from, to) with the face and edge index that own it.
+  // Every undirected edge with the faces and edge indices that own it.
   std::map<std::pair<uint32_t, uint32_t>, std::vector<EdgeRef>> edges;
   for (size_t f = 0; f < scene.faces.size(); ++f) {
     for (int k = 0; k < 4; ++k) {
@@ -40,45 +152,57 @@ std::vector<FaceNeighbors> build_adjacency(const Scene& scene) {
     FaceNeighbors& n = out[f];
     for (int k = 0; k < 4; ++k) {
       n.neighbor[k] = -1;
-      for (int i = 0; i < 6; ++i) n.transform[k][i] = 0.0f;
+      n.corner[k] = -1;
+      for (int i = 0; i < 6; ++i) n.transform[k][i] = n.corner_transform[k][i] = 0.0f;
       const uint32_t a = scene.faces[f].vertices[k], b = scene.faces[f].vertices[(k + 1) % 4];
       const auto& sharing = edges.at({std::min(a, b), std::max(a, b)});
       if (sharing.size() != 2) continue;
       const EdgeRef other = sharing[0].face == static_cast<int>(f) && sharing[0].edge == k ? sharing[1] : sharing[0];
       if (other.face == static_cast<int>(f)) continue;  // a quad folded onto itself
       const Face& g = scene.faces[static_cast<size_t>(other.face)];
-      const int j = other.edge;
-      // Where vertex a (corner k of f) and vertex b (corner k+1) sit in g's uv.
-      const bool reversed = g.vertices[j] == b;  // consistently oriented neighbours run the edge backwards
-      const glm::vec2 ga = reversed ? corner_uv(j + 1) : corner_uv(j);
-      const glm::vec2 gb = reversed ? corner_uv(j) : corner_uv(j + 1);
-      // A point p = a + s e + t n_f (s along the edge, t into f) lands at a' + s e' - t n_g: the
-      // same distance past the edge, out of g. Linear part L = [e', -n_g] [e, n_f]^T (both bases
-      // orthonormal), offset o = a' - L a.
-      const glm::vec2 e = corner_uv(k + 1) - corner_uv(k);
-      const glm::vec2 nf = inward_normal(k);
-      const glm::vec2 e_g = gb - ga;
-      const glm::vec2 ng = inward_normal(j);
-      const glm::mat2 to_local = glm::transpose(glm::mat2(e, nf));  // rows e, n_f
-      const glm::mat2 linear = glm::mat2(e_g, -ng) * to_local;
-      const glm::vec2 offset = ga - linear * corner_uv(k);
+      const bool reversed = g.vertices[other.edge] == b;  // consistently oriented neighbours run the edge backwards
       n.neighbor[k] = other.face;
-      // glm is column-major: linear[c][r].
-      n.transform[k][0] = linear[0][0];
-      n.transform[k][1] = linear[1][0];
-      n.transform[k][2] = offset.x;
-      n.transform[k][3] = linear[0][1];
-      n.transform[k][4] = linear[1][1];
-      n.transform[k][5] = offset.y;
+      store(edge_map(k, other.edge, reversed), n.transform[k]);
+    }
+  }
+  // Corners, once every edge is linked: the diagonal face of a valence-4 vertex, reached across
+  // edge k and then across the neighbour's other edge at the vertex.
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    for (int k = 0; k < 4; ++k) {
+      const VertexRing ring = corner_ring(scene, out, static_cast<uint32_t>(f), k);
+      if (ring.valence() != 4) continue;
+      const RingFace& beside = ring.faces[0];
+      const RingFace& diagonal = ring.faces[1];
+      // The edge of `beside` into the diagonal face: the one from the vertex to where the walk
+      // entered it (two faces may share two edges, as on a torus two faces around).
+      int across = -1;
+      const uint32_t vertex = scene.faces[f].vertices[k];
+      const Face& b = scene.faces[beside.face];
+      for (int e = 0; e < 4; ++e) {
+        const bool at_vertex = b.vertices[e] == vertex || b.vertices[(e + 1) % 4] == vertex;
+        const bool to_entry = b.vertices[e] == diagonal.entered_from || b.vertices[(e + 1) % 4] == diagonal.entered_from;
+        if (at_vertex && to_entry && out[beside.face].neighbor[e] == static_cast<int>(diagonal.face)) across = e;
+      }
+      assert(across >= 0);
+      const UvMap map = compose(uv_map(out[beside.face].transform[across]), uv_map(out[f].transform[k]));
+      out[f].corner[k] = static_cast<int>(diagonal.face);
+      store(map, out[f].corner_transform[k]);
     }
   }
   return out;
 }
 
+bool has_adjacency(const std::vector<FaceNeighbors>& adjacency) {
+  if (adjacency.size() < 2) return true;
+  for (const FaceNeighbors& n : adjacency)
+    for (int k = 0; k < 4; ++k)
+      if (n.neighbor[k] >= 0) return true;
+  return false;
+}
+
 glm::vec2 transform_uv(const FaceNeighbors& n, int edge, glm::vec2 uv, bool translate) {
-  const float* t = n.transform[edge];
-  const float w = translate ? 1.0f : 0.0f;
-  return {t[0] * uv.x + t[1] * uv.y + t[2] * w, t[3] * uv.x + t[4] * uv.y + t[5] * w};
+  const UvMap map = uv_map(n.transform[edge]);
+  return translate ? map.point(uv) : map.direction(uv);
 }
 
 }  // namespace seamcl

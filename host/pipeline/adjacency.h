@@ -1,6 +1,8 @@
-// Edge adjacency of a scene's quads and the uv transform across each shared edge: what the
-// traverse method (McDonald 2013) reads. Built once per scene from the shared vertex indices.
+// Adjacency of a scene's quads and the uv maps between neighbouring faces: what traverse
+// (McDonald 2013, with Ptex's corners) and the guard bands read. Built once per scene from the
+// shared vertex indices: the edge neighbours, and the ring of faces around each corner's vertex.
 #pragma once
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -10,11 +12,62 @@
 
 namespace seamcl {
 
+// uv' = linear uv + offset, from one face's unit square to another's: a rotation by a multiple of
+// 90 degrees or a reflection, and a translation by whole units.
+struct UvMap {
+  glm::mat2 linear{1.0f};
+  glm::vec2 offset{0.0f};
+  glm::vec2 point(glm::vec2 uv) const { return linear * uv + offset; }
+  glm::vec2 direction(glm::vec2 d) const { return linear * d; }
+};
+UvMap compose(const UvMap& second, const UvMap& first);  // first, then second
+UvMap uv_map(const float stored[6]);                     // as FaceNeighbors stores it
+void store(const UvMap& map, float stored[6]);
+
 // Per face, as the kernels read it (FaceNeighbors in kernels/seamcl_types.h). An edge shared by
-// exactly two faces links them; an edge of one face, or of three or more, has no neighbour.
+// exactly two faces links them; an edge of one face, or of three or more, has no neighbour. A
+// corner whose vertex has valence 4 links the diagonal face, through the edge maps composed.
 std::vector<FaceNeighbors> build_adjacency(const Scene& scene);
+
+// What the methods that read neighbours (traverse, guardband) need: true unless there are two or
+// more faces and no edge links two of them. A single face has nothing to read across; many faces
+// that share no vertex index (an OBJ written with split vertices, say) would quietly render as
+// discard or clamp.
+bool has_adjacency(const std::vector<FaceNeighbors>& adjacency);
 
 // Applies transform k of `n` to a uv point (or, with translate = false, to a derivative).
 glm::vec2 transform_uv(const FaceNeighbors& n, int edge, glm::vec2 uv, bool translate = true);
+
+// A face of the ring around a vertex: which of its corners is the vertex, and the vertex at the
+// other end of the edge the walk entered it through.
+struct RingFace {
+  uint32_t face;
+  int corner;
+  uint32_t entered_from;
+};
+
+// Rings are walked up to this many faces; a vertex with more is treated as open (a mesh
+// boundary): past its corners nothing is read.
+inline constexpr int kMaxRingValence = 32;
+
+// The faces around corner `corner` of `face`: the walk starts across edge `corner` and goes on,
+// each time across the edge at the vertex that it did not come in by. closed: it came back to
+// `face` across edge corner - 1, and `faces` holds the valence - 1 other faces, the diagonal ones
+// (sharing no edge with `face`) from faces[1] to faces[valence - 3]. Open: a mesh boundary or
+// non-manifold edge on the way, a face holding the vertex twice, or more than kMaxRingValence.
+struct VertexRing {
+  std::vector<RingFace> faces;
+  bool closed = false;
+  int valence() const { return closed ? static_cast<int>(faces.size()) + 1 : 0; }
+};
+VertexRing corner_ring(const Scene& scene, const std::vector<FaceNeighbors>& adjacency, uint32_t face, int corner);
+
+// The map of the quadrant past corner k of a face (its two edges at that corner continued) onto
+// the corner of another face at its corner j: distances past the two edges become distances in
+// from that face's two edges at j. Which edge takes which is `swap`; at a valence-4 vertex the
+// mesh decides it (corner_swap), at others a symmetric use takes both.
+UvMap corner_map(int k, int j, bool swap);
+// The swap that carries a ring's diagonal face (ring.faces[1] at valence 4) into place.
+bool corner_swap(const Scene& scene, const RingFace& diagonal);
 
 }  // namespace seamcl

@@ -32,10 +32,11 @@ std::vector<std::string> enum_names(const std::array<std::pair<Enum, const char*
   return out;
 }
 
-constexpr std::array<std::pair<Method, const char*>, 5> kMethods{{{Method::Clamp, "clamp"},
+constexpr std::array<std::pair<Method, const char*>, 6> kMethods{{{Method::Clamp, "clamp"},
                                                                   {Method::Black, "black"},
                                                                   {Method::Discard, "discard"},
                                                                   {Method::Traverse, "traverse"},
+                                                                  {Method::TraverseEdges, "traverse-edges"},
                                                                   {Method::Guardband, "guardband"}}};
 constexpr std::array<std::pair<Filter, const char*>, 4> kFilters{
     {{Filter::Bilinear, "bilinear"}, {Filter::Trilinear, "trilinear"}, {Filter::Aniso, "aniso"}, {Filter::Ewa, "ewa"}}};
@@ -120,6 +121,8 @@ std::optional<CubeMethod> parse_cube_method(std::string_view name) { return pars
 std::string to_string(CubeMethod method) { return enum_name(method, kCubeMethods); }
 std::vector<std::string> cube_method_names() { return enum_names(kCubeMethods); }
 
+bool reads_adjacency(Method method) { return method == Method::Traverse || method == Method::TraverseEdges; }
+
 SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCoverage zero_coverage, int guard_band) {
   SamplerParams p{};
   p.filter = filter == Filter::Bilinear    ? SEAMCL_FILTER_BILINEAR
@@ -128,8 +131,10 @@ SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCo
                                            : SEAMCL_FILTER_EWA;
   p.address = method == Method::Clamp || method == Method::Guardband ? SEAMCL_ADDRESS_CLAMP : SEAMCL_ADDRESS_BORDER;
   p.guard_band = method == Method::Guardband ? guard_band : 0;
-  p.renormalize = method == Method::Discard || method == Method::Traverse ? 1 : 0;
-  p.traverse = method == Method::Traverse ? 1 : 0;
+  p.renormalize = method == Method::Discard || reads_adjacency(method) ? 1 : 0;
+  p.traverse = method == Method::Traverse        ? SEAMCL_TRAVERSE_CORNERS
+               : method == Method::TraverseEdges ? SEAMCL_TRAVERSE_EDGES
+                                                 : SEAMCL_TRAVERSE_NONE;
   p.max_aniso = max_aniso;
   p.zero_coverage = zero_coverage == ZeroCoverage::Clamp ? SEAMCL_ZERO_COVERAGE_CLAMP : SEAMCL_ZERO_COVERAGE_NAN;
   return p;
@@ -159,6 +164,9 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
     if (key == "scene") {
       options.scene = string_field(value, key);
       if (options.scene.empty()) throw InputError(key, "must not be empty");
+    } else if (key == "texture") {
+      options.texture = string_field(value, key);
+      if (options.texture.empty()) throw InputError(key, "must not be empty");
     } else if (key == "method") {
       options.method = enum_field(value, key, "method", kMethods);
     } else if (key == "filter") {
@@ -221,6 +229,7 @@ nlohmann::json to_json(const RenderOptions& options) {
                         {"shading", to_string(options.shading)},
                         {"tint", options.tint},
                         {"cube_method", to_string(options.cube_method)}};
+  if (!options.texture.empty()) out["texture"] = options.texture;
   if (options.frame) {
     out["frame"] = *options.frame;
     out["frames"] = options.frames;

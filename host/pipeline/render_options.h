@@ -17,11 +17,14 @@ namespace seamcl {
 //   clamp   - taps read the nearest edge texel (seams show);
 //   black   - taps outside weigh zero, no renormalisation (Ptex's black border: edges darken);
 //   discard - taps outside weigh zero and the rest are renormalised (Toth 2013);
-//   traverse - discard, plus the same lookup on the four edge neighbours through their uv
-//              transforms, all summed and then renormalised (McDonald 2013);
+//   traverse - discard, plus the same lookup on the four edge neighbours and, past a valence-4
+//              corner, on the diagonal face, through their uv transforms, all summed and then
+//              renormalised (McDonald 2013, with the corners of Ptex's filter);
+//   traverse-edges - traverse without the corners: the edge neighbours only (the paper's
+//              McDonald 2013, as Toth compares against);
 //   guardband - clamp, on textures whose every level carries a band of guard_band texels
 //               filled from the neighbours at build time (McDonald and Burley 2011).
-enum class Method { Clamp, Black, Discard, Traverse, Guardband };
+enum class Method { Clamp, Black, Discard, Traverse, TraverseEdges, Guardband };
 // The filter of one lookup: bilinear (level 0), trilinear, aniso (hardware-style probes), ewa.
 enum class Filter { Bilinear, Trilinear, Aniso, Ewa };
 // Discard with every tap outside: a clamped lookup (the paper's fix) or the raw 0/0 (NaN).
@@ -45,6 +48,8 @@ enum class CubeMethod { Clamp, Seamless, Stretch, Warp, Fixup, Discard };
 std::optional<Method> parse_method(std::string_view name);
 std::string to_string(Method method);
 std::vector<std::string> method_names();
+// Whether the method reads neighbouring faces through the adjacency (traverse, traverse-edges).
+bool reads_adjacency(Method method);
 std::optional<ShadingMode> parse_shading_mode(std::string_view name);
 std::string to_string(ShadingMode mode);
 std::vector<std::string> shading_mode_names();
@@ -67,7 +72,8 @@ inline constexpr int kMaxImageSide = 16384;
 inline constexpr long long kMaxSamplesPerImage = 1LL << 28;  // width * height * msaa
 
 struct RenderOptions {
-  std::string scene = "paper";  // built-in name or scene file
+  std::string scene = "paper";  // built-in name or scene file (.json, .obj mesh, .ptx with its mesh)
+  std::string texture;          // a .ptx for an .obj scene; empty: none
   Method method = Method::Discard;
   Filter filter = Filter::Aniso;
   ZeroCoverage zero_coverage = ZeroCoverage::Clamp;
@@ -85,7 +91,7 @@ struct RenderOptions {
 };
 
 // Reads the keys present in `request` over the defaults. Throws InputError naming the key on a
-// wrong type, an out-of-range value or an unknown key. Keys: scene, method, filter, msaa, aniso,
+// wrong type, an out-of-range value or an unknown key. Keys: scene, texture, method, filter, msaa, aniso,
 // size ("WxH"), shading, centroid (bool, same as shading=centroid), zero_coverage, texels,
 // guard_band, frame, frames, tint, cube_method.
 RenderOptions parse_render_options(const nlohmann::json& request);

@@ -8,6 +8,7 @@
 #include <seamcl/pipeline/render_memory.h>
 #include <seamcl/core/over_budget.h>
 #include "core/srgb.h"
+#include "pipeline/adjacency.h"
 #include "pipeline/frame_params.h"
 #include <seamcl/pipeline/packed_cube.h>
 
@@ -294,6 +295,11 @@ const std::vector<float>& Renderer::cube_texels() const { return impl_->cube_hos
 
 RenderResult Renderer::render(const Camera& camera, const RenderOptions& options) {
   if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
+  if ((options.method == Method::Traverse || options.method == Method::Guardband) && !has_adjacency(impl_->packed.neighbors)) {
+    throw InputError("method", to_string(options.method) + " reads each face's edge neighbours, and no two of the " +
+                                   std::to_string(impl_->scene->faces.size()) + " faces of scene '" + impl_->scene->name +
+                                   "' share an edge (faces are neighbours through shared vertex indices)");
+  }
   const SamplerParams sampler = sampler_params(options);
   if (!impl_->uploaded || options.texels != impl_->packed.format || sampler.guard_band != impl_->packed.guard_band) {
     impl_->pack_and_upload(options.texels, sampler.guard_band);

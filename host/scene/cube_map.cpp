@@ -93,16 +93,22 @@ CubeMap bake_cube_map(const DirectionFunction& radiance, int size, CubeBake bake
       level.texels.reserve(static_cast<size_t>(m) * m);
       for (int j = 0; j < m; ++j) {
         for (int i = 0; i < m; ++i) {
+          // Stretch and warp edge texels stand for the cube edge itself, shared by both faces:
+          // a spread of samples would reach past the edge on each face's own plane and the two
+          // copies would differ, so they take their one direction.
+          const bool edge = bake != CubeBake::Centres && (i == 0 || j == 0 || i == m - 1 || j == m - 1);
+          const int k = edge ? 1 : samples;
+          const float step = edge ? 1.0f : inv_samples;
           glm::vec4 sum(0.0f);
-          for (int b = 0; b < samples; ++b) {
-            const float y = static_cast<float>(j) + (static_cast<float>(b) + 0.5f) * inv_samples - 0.5f;
+          for (int b = 0; b < k; ++b) {
+            const float y = static_cast<float>(j) + (static_cast<float>(b) + 0.5f) * step - 0.5f;
             const float tc = cube_bake_coordinate(bake, y, m);
-            for (int a = 0; a < samples; ++a) {
-              const float x = static_cast<float>(i) + (static_cast<float>(a) + 0.5f) * inv_samples - 0.5f;
+            for (int a = 0; a < k; ++a) {
+              const float x = static_cast<float>(i) + (static_cast<float>(a) + 0.5f) * step - 0.5f;
               sum += radiance(glm::normalize(cube_direction(f, cube_bake_coordinate(bake, x, m), tc)));
             }
           }
-          level.texels.push_back(sum * (inv_samples * inv_samples));
+          level.texels.push_back(sum * (step * step));
         }
       }
       cube.faces[f].levels.push_back(std::move(level));

@@ -64,9 +64,11 @@ struct CubeMap {
 // Bakes every level of every face: texel (i, j) of an m x m level is the mean of `radiance` over
 // samples x samples points spread evenly over the texel in index space (i + (k + .5) / samples
 // - .5), each taken through the bake's map; samples = 1 evaluates the texel's own direction.
+// Stretch and warp edge texels always take their own direction (the edge's), so that both
+// faces hold the same value there.
 // Directions passed to `radiance` are unit vectors. Throws InputError("cube_size") unless n is a
 // power of two in 1..kMaxCubeSize.
-inline constexpr int kMaxCubeSize = 2048;
+inline constexpr int kMaxCubeSize = 512;  // 6 (4 n^2 - 1) / 3 texels: 2^21 for 512
 CubeMap bake_cube_map(const DirectionFunction& radiance, int size, CubeBake bake, int samples = 1);
 
 }  // namespace seamcl

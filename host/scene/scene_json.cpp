@@ -212,11 +212,21 @@ struct TexturePlan {
   int height = 0;
   bool constant = false;
   glm::vec3 color{1.0f};
+  std::string image;  // a file whose pixels are level 0 (its size is the texture's)
 };
 
 TexturePlan read_texture(const json& value, const std::string& path) {
-  const ObjectFields fields(value, path, {"width", "height", "content", "color"});
+  const ObjectFields fields(value, path, {"width", "height", "content", "color", "image"});
   TexturePlan plan;
+  if (const json* image = fields.optional("image")) {
+    const std::string image_path = fields.path_of("image");
+    plan.image = read_string(*image, image_path);
+    if (plan.image.empty()) throw InputError(image_path, "must not be empty");
+    for (std::string_view other : {"width", "height", "content", "color"})
+      if (fields.optional(other))
+        throw InputError(fields.path_of(other), "must not be given with image (the image gives the texture)");
+    return plan;
+  }
   auto read_side = [&fields](std::string_view side) {
     const std::string side_path = fields.path_of(side);
     const int size = read_int(fields.required(side), side_path, 1, kMaxTextureSide);
@@ -278,7 +288,7 @@ Light read_light(const json& value) {
   return light;
 }
 
-Scene read_explicit_scene(const json& doc, const std::string& default_name) {
+Scene read_explicit_scene(const json& doc, const std::string& default_name, const FaceImageLoader& load_image) {
   const ObjectFields fields(
       doc, "", {"name", "positions", "faces", "camera", "orbit", "light", "background", "environment", "normals"});
   Scene scene;
@@ -318,7 +328,9 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name) {
     const std::string texture_path = face_fields.path_of("texture");
     // A reflective face never reads its texture: it may leave it out (then 1 x 1).
     const json* texture = face.roughness >= 0.0f ? face_fields.optional("texture") : &face_fields.required("texture");
-    plans.push_back(texture ? read_texture(*texture, texture_path) : TexturePlan{1, 1, true, glm::vec3(0.5f)});
+    plans.push_back(texture ? read_texture(*texture, texture_path) : TexturePlan{1, 1, true, glm::vec3(0.5f), {}});
+    if (!plans.back().image.empty() && !load_image)
+      throw InputError(texture_path + ".image", "image files cannot be read here (an inline scene names no files)");
     total_texels += static_cast<size_t>(plans.back().width) * plans.back().height;
     if (total_texels > kMaxSceneTexels)
       throw InputError(texture_path, "the scene's textures exceed " +
@@ -345,6 +357,15 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name) {
   // Textures last: baking is the expensive part, so a document is checked in full first.
   for (size_t f = 0; f < scene.faces.size(); ++f) {
     const TexturePlan& plan = plans[f];
+    if (!plan.image.empty()) {
+      const std::string image_path = element_path("faces", f) + ".texture.image";
+      TextureLevel level0 = load_image(plan.image, image_path);
+      total_texels += level0.texels.size();
+      if (total_texels > kMaxSceneTexels)
+        throw InputError(image_path, "the scene's textures exceed " + std::to_string(kMaxSceneTexels) + " texels in all");
+      scene.faces[f].texture = build_mip_chain(std::move(level0));
+      continue;
+    }
     const glm::vec4 color(plan.color, 1.0f);
     TextureLevel level0 =
         plan.constant
@@ -361,9 +382,9 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name) {
 
 using SceneSource = std::variant<GeneratorRequest, Scene>;
 
-SceneSource read_document(const json& doc, const std::string& default_name) {
+SceneSource read_document(const json& doc, const std::string& default_name, const FaceImageLoader& load_image) {
   if (doc.is_object() && doc.contains("generator")) return read_generator_request(doc);
-  return read_explicit_scene(doc, default_name);
+  return read_explicit_scene(doc, default_name, load_image);
 }
 
 Scene realize(SceneSource source, const GeneratorOptions& extra) {
@@ -383,7 +404,7 @@ std::string message_of(const InputError& error) {
   return std::string(error.what()).substr(error.field().size() + 2);
 }
 
-SceneSource read_scene_file(const std::string& path) {
+SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load_image) {
   std::error_code error_code;
   if (!std::filesystem::exists(path, error_code))
     throw InputError("scene", "cannot read scene file '" + path + "': no such file");
@@ -398,7 +419,7 @@ SceneSource read_scene_file(const std::string& path) {
     throw InputError("scene", "scene file '" + path + "' is not valid JSON: " + error.what());
   }
   try {
-    return read_document(doc, std::filesystem::path(path).stem().string());
+    return read_document(doc, std::filesystem::path(path).stem().string(), load_image);
   } catch (const InputError& error) {
     throw InputError(error.field(), message_of(error) + " (in '" + path + "')");
   }
@@ -406,19 +427,34 @@ SceneSource read_scene_file(const std::string& path) {
 
 }  // namespace
 
-Scene parse_scene_json(const nlohmann::json& doc) {
-  return realize(read_document(doc, "scene"), {});
+Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_image) {
+  return realize(read_document(doc, "scene", load_image), {});
 }
 
-Scene load_scene_file(const std::string& path) { return realize(read_scene_file(path), {}); }
+Scene load_scene_file(const std::string& path, const FaceImageLoader& load_image) {
+  return realize(read_scene_file(path, load_image), {});
+}
 
-Scene load_scene(const std::string& name_or_path, const GeneratorOptions& options) {
+Scene load_scene(const std::string& name_or_path, const GeneratorOptions& options, const FaceImageLoader& load_image) {
   if (is_generator_name(name_or_path)) return generate_scene(name_or_path, options);
   std::error_code ignored;
   if (name_or_path.ends_with(".json") || std::filesystem::exists(name_or_path, ignored))
-    return realize(read_scene_file(name_or_path), options);
+    return realize(read_scene_file(name_or_path, load_image), options);
   throw InputError("scene", "unknown scene '" + name_or_path + "' (known: " +
                                 known_generator_names() + "; or the path of a .json scene file)");
+}
+
+bool is_builtin_scene(const std::string& name) { return is_generator_name(name); }
+
+SceneViewFields parse_scene_view_fields(const nlohmann::json& doc) {
+  SceneViewFields view;
+  if (!doc.is_object()) return view;
+  if (const auto camera = doc.find("camera"); camera != doc.end()) view.camera = read_camera(*camera);
+  if (const auto orbit = doc.find("orbit"); orbit != doc.end()) view.orbit = read_orbit(*orbit);
+  if (const auto light = doc.find("light"); light != doc.end()) view.light = read_light(*light);
+  if (const auto background = doc.find("background"); background != doc.end())
+    view.background = read_color(*background, "background");
+  return view;
 }
 
 }  // namespace seamcl

@@ -1,7 +1,9 @@
 // Scenes from JSON files; the format is documented in docs/scene-format.md. Every error is an
 // InputError whose field is the JSON path of the value at fault (e.g. "faces[2].texture.width").
 #pragma once
+#include <functional>
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <string>
 
 #include <seamcl/scene/scene.h>
@@ -9,18 +11,39 @@
 
 namespace seamcl {
 
+// Reads the image a face names ("texture": {"image": NAME}) as level 0 of its texture. `field` is
+// the JSON path to name in errors (faces[3].texture.image). host/scene reads no image files
+// itself: host/assets supplies this (seamcl::load_scene_source), and without one an image face is
+// an InputError, so an inline scene (the HTTP service) can name no file.
+using FaceImageLoader = std::function<TextureLevel(const std::string& name, const std::string& field)>;
+
 // Either a generator reference ({"generator": ..., "options": ...}) or an explicit scene.
 // The result has passed validate_scene.
-Scene parse_scene_json(const nlohmann::json& doc);
+Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_image = {});
 
 // Reads and parses a scene file. An unreadable file or bad JSON syntax is InputError("scene", ...)
 // naming the path and the parse error; errors in the content keep their JSON path as the field.
 // An explicit scene without "name" is named after the file.
-Scene load_scene_file(const std::string& path);
+Scene load_scene_file(const std::string& path, const FaceImageLoader& load_image = {});
 
 // A built-in scene name, else a scene file (a path that ends in .json or exists). `options`
 // apply on top of the scene's own: for a generator file, tint if either asks and the caller's
 // constant colour over the file's; for an explicit scene, as apply_generator_options.
-Scene load_scene(const std::string& name_or_path, const GeneratorOptions& options);
+Scene load_scene(const std::string& name_or_path, const GeneratorOptions& options,
+                 const FaceImageLoader& load_image = {});
+
+// True for a built-in scene name (scene_generators()).
+bool is_builtin_scene(const std::string& name);
+
+// The members of a scene document that are not geometry, read exactly as an explicit scene reads
+// them (same defaults, same errors); absent members stay empty. Other members are not looked at:
+// for documents of other forms (host/assets' mesh scenes) that share these members.
+struct SceneViewFields {
+  std::optional<Camera> camera;
+  std::optional<Orbit> orbit;
+  std::optional<Light> light;
+  std::optional<glm::vec3> background;
+};
+SceneViewFields parse_scene_view_fields(const nlohmann::json& doc);
 
 }  // namespace seamcl

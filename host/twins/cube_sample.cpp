@@ -193,15 +193,18 @@ FilterSum cube_filter_reference(const std::vector<float>& texels, const CubeSamp
     len2_y += blur2;
   }
   const bool finite = c.valid && len2_x < INFINITY && len2_y < INFINITY;
-  const float coarsest = static_cast<float>(cube.level_count - 1);
+  // Every filter is N probes along the longer axis, trilinear at one lod: one at the centre
+  // except for aniso.
+  int probes = 1;
+  float lod = static_cast<float>(cube.level_count - 1);  // non-finite: the coarsest level
+  float step_u = 0.0f, step_v = 0.0f;
   if (explicit_lod >= 0.0f) {
-    trilinear(sum, texels, cube, c.face, c.s, c.t, explicit_lod, 1.0f, method);
+    lod = explicit_lod;
   } else if (!finite) {
-    trilinear(sum, texels, cube, c.face, c.s, c.t, coarsest, 1.0f, method);
   } else if (cube.filter == SEAMCL_FILTER_BILINEAR) {
-    trilinear(sum, texels, cube, c.face, c.s, c.t, 0.0f, 1.0f, method);
+    lod = 0.0f;
   } else if (cube.filter == SEAMCL_FILTER_TRILINEAR) {
-    trilinear(sum, texels, cube, c.face, c.s, c.t, lod_of(std::fmax(len2_x, len2_y)), 1.0f, method);
+    lod = lod_of(std::fmax(len2_x, len2_y));
   } else {
     const bool x_major = len2_x >= len2_y;
     const float major2 = x_major ? len2_x : len2_y;
@@ -209,18 +212,18 @@ FilterSum cube_filter_reference(const std::vector<float>& texels, const CubeSamp
     const float ratio = minor2 > 0.0f   ? std::sqrt(major2 / minor2)
                         : major2 > 0.0f ? static_cast<float>(cube.max_aniso)
                                         : 1.0f;
-    const int probes = std::clamp(static_cast<int>(std::ceil(std::fmin(ratio, 16.0f))), 1, cube.max_aniso);
-    const float inv_probes = 1.0f / static_cast<float>(probes);
-    const float lod = lod_of(major2) - approx_log2(static_cast<float>(probes));
-    const float step_u = (x_major ? ax_u : ay_u) * inv_probes;
-    const float step_v = (x_major ? ax_v : ay_v) * inv_probes;
-    float pu = c.s + step_u * (0.5f - 0.5f * static_cast<float>(probes));
-    float pv = c.t + step_v * (0.5f - 0.5f * static_cast<float>(probes));
-    for (int i = 0; i < probes; ++i) {
-      trilinear(sum, texels, cube, c.face, pu, pv, lod, inv_probes, method);
-      pu += step_u;
-      pv += step_v;
-    }
+    probes = std::clamp(static_cast<int>(std::ceil(std::fmin(ratio, 16.0f))), 1, cube.max_aniso);
+    lod = lod_of(major2) - approx_log2(static_cast<float>(probes));
+    step_u = (x_major ? ax_u : ay_u) / static_cast<float>(probes);
+    step_v = (x_major ? ax_v : ay_v) / static_cast<float>(probes);
+  }
+  const float inv_probes = 1.0f / static_cast<float>(probes);
+  float pu = c.s + step_u * (0.5f - 0.5f * static_cast<float>(probes));
+  float pv = c.t + step_v * (0.5f - 0.5f * static_cast<float>(probes));
+  for (int i = 0; i < probes; ++i) {
+    trilinear(sum, texels, cube, c.face, pu, pv, lod, inv_probes, method);
+    pu += step_u;
+    pv += step_v;
   }
   return sum;
 }

@@ -57,8 +57,11 @@ PixelFragment pixel_fragment(const FrameParams& f, const TriangleSetup& t, const
   centroid_y /= static_cast<float>(out.covered);
   out.x = static_cast<float>(x) + 0.5f;
   out.y = static_cast<float>(y) + 0.5f;
-  // The centroid also stands in for a centre beyond the plane's horizon (1/w <= 0).
-  if (f.shading_mode == SEAMCL_SHADE_CENTROID || !(plane_inv_w(t, out.x, out.y) > 0.0f)) {
+  // Centroid shading keeps the centre of a fully covered pixel (as D3D and GL do: a full
+  // pattern's centroid is off centre, at 16x by (-1/32, -1/32)). The centroid also stands in for
+  // a centre beyond the plane's horizon (1/w <= 0).
+  const bool partly_covered = out.covered < f.sample_count;
+  if ((f.shading_mode == SEAMCL_SHADE_CENTROID && partly_covered) || !(plane_inv_w(t, out.x, out.y) > 0.0f)) {
     out.x = centroid_x;
     out.y = centroid_y;
   }

@@ -247,23 +247,65 @@ FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, 
   return sum;
 }
 
+bool neighbor_may_contribute(const FaceGpu& other, int filter, float distance, float dudx, float dvdx, float dudy,
+                             float dvdy) {
+  // Footprint axes by their 1-norms in uv: no shorter than their lengths, and kept by the maps
+  // between faces (which only permute and negate u and v).
+  const float axis_x = std::fabs(dudx) + std::fabs(dvdx);
+  const float axis_y = std::fabs(dudy) + std::fabs(dvdy);
+  const float axes = axis_x + axis_y;
+  // A non-finite footprint sends every filter to the coarsest level: it may reach anything.
+  if (!(axes < INFINITY)) return true;
+  const float longest = std::fmax(axis_x, axis_y);
+  const float min_side = static_cast<float>(std::min(other.width, other.height));
+  const float aspect = static_cast<float>(std::max(other.width, other.height)) / min_side;
+  // A tap weighs something only within one texel of its probe. The coarsest texel the other
+  // face's filter can weigh (uv): bilinear reads level 0; the others a trilinear pair at lod <=
+  // log2 of the longer axis in its level-0 texels (at most max side x `longest`), whose second
+  // level's texels are up to twice that long (2.01: approx_log2's error); none is longer than
+  // the face.
+  const float texel = filter == SEAMCL_FILTER_BILINEAR
+                          ? 1.0f / min_side
+                          : std::fmin(1.0f, std::fmax(1.0f / min_side, 2.01f * aspect * longest));
+  // How far the probes spread from the point: aniso's over half the major axis; EWA's ellipse
+  // over both axes, its minor one grown up to `aspect` times in uv by the eccentricity clamp.
+  const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f * longest
+                       : filter == SEAMCL_FILTER_EWA ? (1.0f + aspect) * axes
+                                                     : 0.0f;
+  const float reach = spread + texel;
+  // EWA pulls a centre more than two face widths out back to two widths: count no distance
+  // beyond 2. A NaN distance is never skipped.
+  const float counted = distance > 2.0f ? 2.0f : distance;
+  return !(counted >= reach);
+}
+
 FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const SamplerParams& sampler, float u, float v,
                                float dudx, float dvdx, float dudy, float dvdy) {
   FilterSum sum = filter_texture_reference(tex, face, sampler, sampler.address, u, v, dudx, dvdx, dudy, dvdy);
-  if (!sampler.traverse) return sum;
-  // Traverse: each edge neighbour at this point and footprint carried into its uv, border-
-  // addressed. Diagonal faces are not edge neighbours: taps past a corner are not read.
-  const FaceNeighbors& n = tex.neighbors->at(face);
-  for (int k = 0; k < 4; ++k) {
-    if (n.neighbor[k] < 0) continue;
-    const float* t = n.transform[k];
-    const FilterSum s = filter_texture_reference(tex, static_cast<uint32_t>(n.neighbor[k]), sampler, SEAMCL_ADDRESS_BORDER,
+  if (sampler.traverse == SEAMCL_TRAVERSE_NONE) return sum;
+  // Traverse: each neighbour at this point and footprint carried into its uv, border-addressed,
+  // so it weighs only the taps that fall inside it. A neighbour whose taps cannot reach the
+  // point is skipped: it would add nothing.
+  auto add_across = [&](int other, const float* t, float distance) {
+    if (other < 0) return;
+    if (!neighbor_may_contribute(tex.faces->at(static_cast<size_t>(other)), sampler.filter, distance, dudx, dvdx, dudy,
+                                 dvdy)) {
+      return;
+    }
+    const FilterSum s = filter_texture_reference(tex, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER,
                                                  t[0] * u + t[1] * v + t[2], t[3] * u + t[4] * v + t[5],
                                                  t[0] * dudx + t[1] * dvdx, t[3] * dudx + t[4] * dvdx,
                                                  t[0] * dudy + t[1] * dvdy, t[3] * dudy + t[4] * dvdy);
     sum.color += s.color;
     sum.weight += s.weight;
-  }
+  };
+  // How far the point lies inside each edge: the least distance to the face across it.
+  const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
+  const FaceNeighbors& n = tex.neighbors->at(face);
+  for (int k = 0; k < 4; ++k) add_across(n.neighbor[k], n.transform[k], inside[k]);
+  if (sampler.traverse != SEAMCL_TRAVERSE_CORNERS) return sum;
+  // Past a valence-4 corner, the diagonal face (corner k lies between edges k-1 and k).
+  for (int k = 0; k < 4; ++k) add_across(n.corner[k], n.corner_transform[k], std::fmax(inside[(k + 3) % 4], inside[k]));
   return sum;
 }
 

@@ -17,9 +17,15 @@ float approx_log2(float x);
 
 FilterSum filter_texture_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler,
                                    int address, float u, float v, float dudx, float dvdx, float dudy, float dvdy);
+// Whether any tap of face `other` can weigh anything in a lookup with `filter` (SEAMCL_FILTER_*;
+// derivatives in this face's uv)
+// whose point lies at least `distance` (uv) outside the other face's square: a conservative
+// bound, so a neighbour it rules out would have added exactly nothing. Traverse skips those.
+bool neighbor_may_contribute(const FaceGpu& other, int filter, float distance, float dudx, float dvdx, float dudy,
+                             float dvdy);
 // What a method sums before renormalising: filter_texture_reference on the face with the
 // sampler's address mode and, for traverse, on each edge neighbour (border) through its uv
-// transform.
+// transform, and with corners, on the diagonal face past each valence-4 corner.
 FilterSum method_sum_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler, float u, float v,
                                float dudx, float dvdx, float dudy, float dvdy);
 // The lookup as a seam method asks for it (renormalisation and zero-coverage rule included).

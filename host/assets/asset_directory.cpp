@@ -1,0 +1,139 @@
+#include <seamcl/assets/asset_directory.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <sstream>
+
+#include <seamcl/core/input_error.h>
+#include <seamcl/pipeline/render_memory.h>
+
+namespace seamcl {
+namespace {
+
+namespace fs = std::filesystem;
+
+// `path` (canonical) is `root` (canonical) or below it.
+bool is_within(const fs::path& path, const fs::path& root) {
+  auto p = path.begin();
+  for (auto r = root.begin(); r != root.end(); ++r, ++p) {
+    if (r->empty()) continue;  // a trailing separator
+    if (p == path.end() || *p != *r) return false;
+  }
+  return true;
+}
+
+// Size and modification time: a changed file is a different cache entry.
+std::string file_stamp(const std::string& path) {
+  std::error_code error;
+  const auto size = fs::file_size(path, error);
+  const auto time = fs::last_write_time(path, error);
+  std::ostringstream out;
+  out << size << "@" << time.time_since_epoch().count();
+  return out.str();
+}
+
+}  // namespace
+
+AssetDirectory::AssetDirectory(const std::string& root, AssetCacheLimits limits) : limits_(limits) {
+  std::error_code error;
+  if (!fs::is_directory(root, error)) throw InputError("assets", "'" + root + "' is not a directory");
+  root_ = fs::canonical(root, error).string();
+  if (error) throw InputError("assets", "cannot open '" + root + "': " + error.message());
+}
+
+std::vector<AssetEntry> AssetDirectory::list() const {
+  std::vector<AssetEntry> out;
+  std::error_code error;
+  fs::recursive_directory_iterator it(root_, fs::directory_options::skip_permission_denied, error), end;
+  for (; !error && it != end && out.size() < kMaxListed; it.increment(error)) {
+    const fs::path& path = it->path();
+    if (path.filename().string().starts_with(".")) {
+      if (it->is_directory(error)) it.disable_recursion_pending();
+      continue;
+    }
+    if (it->is_symlink(error) && it->is_directory(error)) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    const std::optional<AssetKind> kind = asset_kind_of_path(path.string());
+    if (!kind || !it->is_regular_file(error)) continue;
+    const fs::path target = fs::canonical(path, error);
+    if (error || !is_within(target, root_)) {
+      error.clear();
+      continue;
+    }
+    out.push_back({fs::relative(path, root_).generic_string(), *kind, fs::file_size(target, error)});
+  }
+  std::sort(out.begin(), out.end(), [](const AssetEntry& a, const AssetEntry& b) { return a.name < b.name; });
+  return out;
+}
+
+std::string AssetDirectory::resolve(const std::string& name, const std::string& relative_to, const std::string& field) const {
+  if (name.empty()) throw InputError(field, "must not be empty");
+  const fs::path given(name);
+  if (given.is_absolute() || name.front() == '/' || name.front() == '\\')
+    throw InputError(field, "must be a name inside the asset directory, not an absolute path");
+  for (const fs::path& part : given)
+    if (part == "..") throw InputError(field, "must be a name inside the asset directory ('..' is not allowed)");
+  if (name.find('\0') != std::string::npos) throw InputError(field, "must not hold a NUL character");
+  const fs::path base = relative_to.empty() ? fs::path(root_) : fs::path(relative_to);
+  std::error_code error;
+  const fs::path resolved = fs::canonical(base / given, error);
+  if (error) throw InputError(field, "no asset '" + name + "' in the asset directory");
+  if (!is_within(resolved, root_)) throw InputError(field, "'" + name + "' leads out of the asset directory");
+  if (!fs::is_regular_file(resolved, error)) throw InputError(field, "'" + name + "' is not a file");
+  return resolved.string();
+}
+
+std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, const std::string& texture,
+                                                  SceneSourceOptions options) {
+  options.resolve = [this](const std::string& name, const std::string& relative_to, const std::string& field) {
+    return resolve(name, relative_to, field);
+  };
+  std::ostringstream key;
+  key << resolve(scene, "", "scene") << "|" << file_stamp(resolve(scene, "", "scene")) << "|";
+  if (!texture.empty()) key << resolve(texture, "", "texture") << "|" << file_stamp(resolve(texture, "", "texture"));
+  key << "|" << options.generator.tint << "|" << options.mesh_texture_size << "|" << options.ptex_limits.max_texels;
+  if (options.generator.constant_color) {
+    const glm::vec3 c = *options.generator.constant_color;
+    key << "|" << c.r << "," << c.g << "," << c.b;
+  }
+  {
+    std::lock_guard lock(mutex_);
+    const auto found = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.key == key.str(); });
+    if (found != entries_.end()) {
+      entries_.splice(entries_.begin(), entries_, found);
+      return found->scene;
+    }
+    ++loads_;
+  }
+  // Read outside the lock: a large file does not hold up requests for cached ones.
+  auto loaded = std::make_shared<const Scene>(load_scene_source(scene, texture, options));
+  const size_t bytes = scene_host_bytes(scene_sizes(*loaded));
+  std::lock_guard lock(mutex_);
+  if (bytes > limits_.max_bytes || limits_.max_entries == 0) return loaded;
+  entries_.push_front({key.str(), loaded, bytes});
+  bytes_ += bytes;
+  while (entries_.size() > limits_.max_entries || bytes_ > limits_.max_bytes) {
+    bytes_ -= entries_.back().bytes;
+    entries_.pop_back();
+  }
+  return loaded;
+}
+
+size_t AssetDirectory::cached_entries() const {
+  std::lock_guard lock(mutex_);
+  return entries_.size();
+}
+
+size_t AssetDirectory::cached_bytes() const {
+  std::lock_guard lock(mutex_);
+  return bytes_;
+}
+
+long long AssetDirectory::file_loads() const {
+  std::lock_guard lock(mutex_);
+  return loads_;
+}
+
+}  // namespace seamcl

@@ -1,0 +1,74 @@
+// A directory of assets that a service renders from (`seamcl serve --assets DIR`): names relative
+// to it, and nothing else on disk. Every name a client gives, and every name a scene file in it
+// gives, resolves here: an absolute path, a `..` component or a symlink that leads out of the
+// directory is refused, naming the field. Loaded scenes are cached, bounded in bytes and entries,
+// so repeated requests do not read the files again.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <seamcl/assets/scene_source.h>
+#include <seamcl/scene/scene.h>
+
+namespace seamcl {
+
+struct AssetEntry {
+  std::string name;  // relative to the directory, '/'-separated
+  AssetKind kind;
+  std::uintmax_t bytes = 0;
+};
+
+struct AssetCacheLimits {
+  size_t max_bytes = size_t{512} << 20;  // host bytes of the cached scenes (scene_host_bytes); 0: cache nothing
+  size_t max_entries = 8;
+};
+
+class AssetDirectory {
+ public:
+  // `root` must be an existing directory: InputError("assets") otherwise.
+  explicit AssetDirectory(const std::string& root, AssetCacheLimits limits = {});
+
+  const std::string& root() const { return root_; }
+
+  // Every .json, .obj and .ptx file under the directory, sorted by name: at most kMaxListed, no
+  // hidden files or directories, symlinked directories not entered, symlinked files only when they
+  // resolve inside the directory.
+  static constexpr size_t kMaxListed = 1000;
+  std::vector<AssetEntry> list() const;
+
+  // The path of `name` inside the directory (`relative_to`: a directory inside it, empty for the
+  // directory itself). InputError(field) for an empty or absolute name, a `..` component, a name
+  // that resolves outside the directory (symlinks followed) and a name that is not a file here.
+  std::string resolve(const std::string& name, const std::string& relative_to, const std::string& field) const;
+
+  // load_scene_source with every name resolved here; from the cache when the same names with the
+  // same options were loaded before and the scene and texture files have the same size and
+  // modification time (files named inside a scene file are not checked: they are seen again once
+  // the entry leaves the cache).
+  std::shared_ptr<const Scene> load(const std::string& scene, const std::string& texture, SceneSourceOptions options);
+
+  size_t cached_entries() const;
+  size_t cached_bytes() const;
+  long long file_loads() const;  // cache misses so far
+
+ private:
+  struct Entry {
+    std::string key;
+    std::shared_ptr<const Scene> scene;
+    size_t bytes = 0;
+  };
+
+  std::string root_;  // canonical
+  AssetCacheLimits limits_;
+  mutable std::mutex mutex_;
+  std::list<Entry> entries_;  // most recently used first
+  size_t bytes_ = 0;
+  long long loads_ = 0;
+};
+
+}  // namespace seamcl

@@ -1,0 +1,469 @@
+// Users' assets: the OBJ reader on the Ptex samples and on crafted files, scenes of a mesh and its
+// .ptx (face counts, the file's adjacency against the mesh's), the camera framed from the bounds,
+// per-face image textures, the asset directory's containment and cache, and whole renders of
+// every sample: constant colours exact under discard, traverse and guardband, traverse seamless
+// across cube_text's rotated neighbours, no NaN with any method at 1x and 8x.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+#include <seamcl/assets/asset_directory.h>
+#include <seamcl/assets/asset_scene.h>
+#include <seamcl/assets/obj_mesh.h>
+#include <seamcl/assets/scene_source.h>
+#include <seamcl/core/input_error.h>
+#include <seamcl/io/image_io.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/pipeline/texture_lookups.h>
+#include <seamcl/scene/scene_generators.h>
+#include <seamcl/scene/scene_json.h>
+#include "core/srgb.h"
+#include "lit_constant.h"
+#include "pipeline/adjacency.h"
+#include "test_support.h"
+
+using namespace seamcl;
+using seamcl_tests::shared_runtime;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string sample(const std::string& name) { return std::string(SEAMCL_TEST_ASSETS_DIR) + "/ptex/" + name; }
+
+// The message of an InputError thrown by `run`, with its field checked.
+template <typename Run>
+std::string input_error(Run run, const std::string& field) {
+  try {
+    run();
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.field(), field) << error.what();
+    return error.what();
+  }
+  ADD_FAILURE() << "no InputError";
+  return {};
+}
+
+// A fresh directory per test, removed after it.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "seamcl_assets_XXXXXX").string();
+    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  const fs::path& path() const { return path_; }
+  std::string write(const std::string& name, const std::string& text) const {
+    const fs::path file = path_ / name;
+    fs::create_directories(file.parent_path());
+    std::ofstream(file, std::ios::binary) << text;
+    return file.string();
+  }
+
+ private:
+  fs::path path_;
+};
+
+// The sample pairs: mesh, texture (the textures share meshes).
+struct SamplePair {
+  const char* mesh;
+  const char* texture;
+};
+constexpr SamplePair kPairs[] = {{"cube.obj", "cube_text.ptx"},
+                                 {"plane.obj", "rand_lo.ptx"},
+                                 {"plane.obj", "wave_lo.ptx"},
+                                 {"ptex_test_object.obj", "cellnoise.ptx"}};
+
+// Loaded once per test process: cube_text alone is 72 faces of 512x512.
+const Scene& sample_scene(const std::string& mesh, const std::string& texture) {
+  static std::map<std::string, std::unique_ptr<Scene>> scenes;
+  std::unique_ptr<Scene>& scene = scenes[mesh + "+" + texture];
+  if (!scene) scene = std::make_unique<Scene>(load_scene_source(sample(mesh), sample(texture)));
+  return *scene;
+}
+
+// black.ptx holds one face and no mesh: it goes on a unit quad.
+std::string unit_quad_obj(const TempDir& dir) {
+  return dir.write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+}
+
+bool all_finite(const std::vector<glm::vec4>& pixels) {
+  for (const glm::vec4& p : pixels)
+    if (!std::isfinite(p.r) || !std::isfinite(p.g) || !std::isfinite(p.b) || !std::isfinite(p.a)) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST(Assets, ObjSamplesHaveTheirFaceAndVertexCountsInFileOrder) {
+  struct Expected {
+    const char* name;
+    size_t faces, vertices;
+  };
+  for (const Expected& e : {Expected{"cube.obj", 72, 64}, Expected{"plane.obj", 9, 16}, Expected{"ptex_test_object.obj", 306, 308}}) {
+    SCOPED_TRACE(e.name);
+    const ObjMesh mesh = read_obj_file(sample(e.name));
+    EXPECT_EQ(mesh.faces.size(), e.faces);
+    EXPECT_EQ(mesh.positions.size(), e.vertices);
+    // The first and last face lines, read here without tinyobjloader: 1-based "v/vt/vn" indices.
+    std::ifstream in(sample(e.name));
+    std::vector<std::array<uint32_t, 4>> lines;
+    std::vector<glm::vec3> first_vertex;
+    for (std::string line; std::getline(in, line);) {
+      std::istringstream words(line);
+      std::string word;
+      words >> word;
+      if (word == "v" && first_vertex.empty()) {
+        glm::vec3 p;
+        words >> p.x >> p.y >> p.z;
+        first_vertex.push_back(p);
+      }
+      if (word != "f") continue;
+      std::array<uint32_t, 4> face{};
+      for (uint32_t& index : face) {
+        words >> word;
+        index = static_cast<uint32_t>(std::stoul(word.substr(0, word.find('/')))) - 1;
+      }
+      lines.push_back(face);
+    }
+    ASSERT_EQ(lines.size(), e.faces);
+    EXPECT_EQ(mesh.faces.front(), lines.front());
+    EXPECT_EQ(mesh.faces.back(), lines.back());
+    EXPECT_EQ(mesh.positions.front(), first_vertex.front());
+  }
+}
+
+TEST(Assets, ObjRefusesAFaceThatIsNotAQuadNamingItsIndexAndLine) {
+  const std::string text = "version 1\nsurface subd per-face cage crafted\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\n"
+                           "f 1 2 3 4\nf 2 5 3 4\n# a triangle next\nf 1 2 3\n";
+  const std::string message = input_error([&] { parse_obj(text, "crafted.obj"); }, "scene");
+  EXPECT_NE(message.find("'crafted.obj': face 2 (0-based; line 11) has 3 vertices; only quads are supported"), std::string::npos)
+      << message;
+  const std::string missing = input_error([] { parse_obj("v 0 0 0\nf 1 2 3 4\n", "m.obj", "mesh"); }, "mesh");
+  EXPECT_NE(missing.find("face 0 (0-based; line 2) names a vertex that does not exist"), std::string::npos) << missing;
+  EXPECT_NE(input_error([] { parse_obj("v 0 0 0\n", "empty.obj"); }, "scene").find("has no faces"), std::string::npos);
+  EXPECT_NE(input_error([] { read_obj_file("/nonexistent/x.obj"); }, "scene").find("no such file"), std::string::npos);
+}
+
+TEST(Assets, SamplePairsLoadWithTheFilesAdjacencyAgreeingWithTheMesh) {
+  for (const SamplePair& pair : kPairs) {
+    SCOPED_TRACE(pair.texture);
+    const Scene& scene = sample_scene(pair.mesh, pair.texture);
+    const ObjMesh mesh = read_obj_file(sample(pair.mesh));
+    ASSERT_EQ(scene.faces.size(), mesh.faces.size());
+    EXPECT_EQ(scene.positions, mesh.positions);  // units unchanged
+    EXPECT_TRUE(scene.orbit.has_value());
+    EXPECT_TRUE(has_adjacency(build_adjacency(scene)));
+  }
+  // cube.obj's neighbours include rotated ones: some shared edge is not the opposite edge.
+  const Scene& cube = sample_scene("cube.obj", "cube_text.ptx");
+  int rotated = 0;
+  for (const FaceNeighbors& n : build_adjacency(cube))
+    for (int k = 0; k < 4; ++k) rotated += n.neighbor[k] >= 0 && !(n.transform[k][0] == 1 && n.transform[k][4] == 1);
+  EXPECT_GT(rotated, 0);
+}
+
+TEST(Assets, FaceCountsMustMatchAndADisagreeingAdjacencyNamesBothFaces) {
+  const std::string counts = input_error([] { load_scene_source(sample("plane.obj"), sample("cube_text.ptx")); }, "texture");
+  EXPECT_NE(counts.find("has 72 faces but the mesh"), std::string::npos) << counts;
+  EXPECT_NE(counts.find("has 9"), std::string::npos) << counts;
+
+  // rand_lo on plane.obj, with face 4's right neighbour moved in the file only.
+  PtexFile file = read_ptex_file(sample("rand_lo.ptx"));
+  const int old_neighbor = file.faces[4].adjacent_faces[1];
+  ASSERT_GE(old_neighbor, 0);
+  file.faces[4].adjacent_faces[1] = 0;
+  const std::string message = input_error(
+      [&] { scene_from_ptex(read_obj_file(sample("plane.obj")), file, "plane.obj", "rand_lo.ptx"); }, "texture");
+  EXPECT_NE(message.find("face 4 edge 1 (right) meets face 0 edge"), std::string::npos) << message;
+  EXPECT_NE(message.find("but face " + std::to_string(old_neighbor) + " edge"), std::string::npos) << message;
+}
+
+TEST(Assets, TraverseAndGuardbandRefuseAMeshWithoutSharedEdgesSingleQuadsStillRender) {
+  TempDir dir;
+  // Two quads side by side, each with vertices of its own: no edge is shared by index.
+  const std::string split = dir.write("split.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 1 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\n"
+                                                   "f 1 2 3 4\nf 5 6 7 8\n");
+  const Scene scene = load_scene_source(split);
+  Renderer renderer(shared_runtime());
+  renderer.load_scene(scene);
+  RenderOptions options;
+  options.width = 32;
+  options.height = 32;
+  for (Method method : {Method::Traverse, Method::Guardband}) {
+    options.method = method;
+    const std::string message = input_error([&] { renderer.render(scene.camera, options); }, "method");
+    EXPECT_NE(message.find("no two of the 2 faces of scene 'split' share an edge"), std::string::npos) << message;
+  }
+  options.method = Method::Discard;
+  EXPECT_TRUE(all_finite(renderer.render(scene.camera, options).pixels));
+  const Scene quad = load_scene_source(unit_quad_obj(dir));
+  renderer.load_scene(quad);
+  options.method = Method::Traverse;
+  EXPECT_TRUE(all_finite(renderer.render(quad.camera, options).pixels));
+}
+
+TEST(Assets, TheFramedCameraSeesTheWholeMeshOnEveryOrbitFrame) {
+  for (const char* mesh : {"cube.obj", "plane.obj", "ptex_test_object.obj"}) {
+    SCOPED_TRACE(mesh);
+    const Scene scene = load_scene_source(sample(mesh));
+    for (int frame = 0; frame < 8; ++frame) {
+      const Camera camera = orbit_camera(scene, frame, 8);
+      if (frame == 0) EXPECT_EQ(camera.eye, scene.camera.eye);
+      for (float aspect : {0.75f, 480.0f / 540.0f, 4.0f / 3.0f}) {
+        const glm::mat4 view_projection = glm::perspective(glm::radians(camera.fov_y_degrees), aspect, 0.01f, 1000.0f) *
+                                          glm::lookAt(camera.eye, camera.target, camera.up);
+        for (const glm::vec3& p : scene.positions) {
+          const glm::vec4 clip = view_projection * glm::vec4(p, 1.0f);
+          ASSERT_GT(clip.w, 0.0f);
+          EXPECT_LE(std::abs(clip.x / clip.w), 1.0f);
+          EXPECT_LE(std::abs(clip.y / clip.w), 1.0f);
+        }
+      }
+    }
+  }
+}
+
+TEST(Assets, ConstantColourSamplesRenderExactlyUnderDiscardTraverseAndGuardband) {
+  const glm::vec3 color(0.8f, 0.5f, 0.2f);
+  const glm::vec3 stored(decode_srgb8(encode_srgb8(glm::vec4(color, 1.0f))));
+  TempDir dir;
+  for (const char* mesh : {"cube.obj", "plane.obj", "ptex_test_object.obj"}) {
+    SCOPED_TRACE(mesh);
+    // The meshes' own texture sizes, painted one colour (set_constant_textures keeps sizes).
+    Scene scene = std::string(mesh) == "cube.obj"            ? sample_scene(mesh, "cube_text.ptx")
+                  : std::string(mesh) == "plane.obj"         ? sample_scene(mesh, "wave_lo.ptx")
+                                                             : sample_scene(mesh, "cellnoise.ptx");
+    set_constant_textures(scene, glm::vec4(color, 1.0f));
+    Renderer renderer(shared_runtime());
+    renderer.load_scene(scene);
+    for (int msaa : {1, 4}) {
+      for (Method method : {Method::Discard, Method::Traverse, Method::Guardband}) {
+        RenderOptions options;
+        options.width = 96;
+        options.height = 72;
+        options.msaa = msaa;
+        options.method = method;
+        const seamcl_tests::SeamCheck check =
+            seamcl_tests::compare_with_lit_constant(renderer, renderer.render(scene.camera, options), stored);
+        EXPECT_GT(check.checked, 300u);
+        EXPECT_EQ(check.off, 0u) << to_string(method) << " msaa " << msaa << " worst " << check.worst;
+      }
+    }
+  }
+}
+
+// Lookups placed just inside a face, at the middle of an edge whose neighbour is rotated in uv,
+// with a footprint that reaches over it. Each such pair of faces gets a texture that is linear in
+// the first face's uv, continued over the second by unfolding it about the shared edge in 3D
+// (from the mesh's positions, not from the adjacency transform under test); every filter
+// reproduces linear content exactly where its taps read the right texels. Traverse must match
+// it; clamp, which repeats the edge texels, must not (so the lookups do reach over the seam).
+TEST(Assets, TraverseIsSeamlessAcrossCubeTextsRotatedNeighbours) {
+  Scene scene = sample_scene("cube.obj", "cube_text.ptx");
+  constexpr int kSide = 64;
+  auto linear = [](glm::vec2 uv) { return glm::vec4(0.3f + 0.2f * uv.x, 0.4f + 0.15f * uv.y, 0.5f + 0.1f * (uv.x - uv.y), 1.0f); };
+  for (Face& face : scene.faces) face.texture = build_mip_chain(TextureLevel{kSide, kSide, std::vector<glm::vec4>(kSide * kSide, glm::vec4(0.5f))});
+  const std::vector<FaceNeighbors> adjacency = build_adjacency(scene);
+  std::vector<bool> used(scene.faces.size(), false);
+  std::vector<Lookup> lookups;
+  std::vector<glm::vec4> expected;
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    for (int k = 0; k < 4 && !used[f]; ++k) {
+      const FaceNeighbors& n = adjacency[f];
+      const int g = n.neighbor[k];
+      if (g < 0 || used[static_cast<size_t>(g)] || (n.transform[k][0] == 1 && n.transform[k][4] == 1)) continue;
+      used[f] = used[static_cast<size_t>(g)] = true;
+      // f's uv frame in 3D (the cube's faces are squares): origin corner 0, axes to corners 1 and 3.
+      const std::array<glm::vec3, 4> fc = scene.corners(scene.faces[f]);
+      const glm::vec3 eu = fc[1] - fc[0], ev = fc[3] - fc[0];
+      auto uv_in_f = [&](glm::vec3 p) { return glm::vec2(glm::dot(p - fc[0], eu) / glm::dot(eu, eu), glm::dot(p - fc[0], ev) / glm::dot(ev, ev)); };
+      // g's corners unfolded into f's plane about the shared edge a-b.
+      const glm::vec3 a = fc[static_cast<size_t>(k)], b = fc[static_cast<size_t>((k + 1) % 4)];
+      const glm::vec3 edge = glm::normalize(b - a);
+      const glm::vec3 centre = 0.25f * (fc[0] + fc[1] + fc[2] + fc[3]);
+      const glm::vec3 outward = -glm::normalize((centre - a) - glm::dot(centre - a, edge) * edge);
+      std::array<glm::vec2, 4> g_uv_in_f;
+      const std::array<glm::vec3, 4> gc = scene.corners(scene.faces[static_cast<size_t>(g)]);
+      for (size_t c = 0; c < 4; ++c) {
+        const glm::vec3 d = gc[c] - a;
+        const glm::vec3 perpendicular = d - glm::dot(d, edge) * edge;
+        g_uv_in_f[c] = uv_in_f(a + glm::dot(d, edge) * edge + glm::length(perpendicular) * outward);
+      }
+      TextureLevel fl{kSide, kSide, {}}, gl{kSide, kSide, {}};
+      for (int j = 0; j < kSide; ++j) {
+        for (int i = 0; i < kSide; ++i) {
+          const float u = (i + 0.5f) / kSide, v = (j + 0.5f) / kSide;
+          fl.texels.push_back(linear({u, v}));
+          const glm::vec2 in_f = (1 - u) * (1 - v) * g_uv_in_f[0] + u * (1 - v) * g_uv_in_f[1] + u * v * g_uv_in_f[2] + (1 - u) * v * g_uv_in_f[3];
+          gl.texels.push_back(linear(in_f));
+        }
+      }
+      scene.faces[f].texture = build_mip_chain(std::move(fl));
+      scene.faces[static_cast<size_t>(g)].texture = build_mip_chain(std::move(gl));
+      // Mid-edge, 1.5 texels inside, with a 4-texel footprint.
+      const glm::vec2 uv = 0.5f * (uv_in_f(a) + uv_in_f(b)) + (1.5f / kSide) * glm::normalize(0.5f - 0.5f * (uv_in_f(a) + uv_in_f(b)));
+      lookups.push_back({static_cast<uint32_t>(f), uv.x, uv.y, 4.0f / kSide, 0, 0, 4.0f / kSide});
+      expected.push_back(linear(uv));
+    }
+  }
+  ASSERT_GT(lookups.size(), 4u) << "cube.obj should have rotated neighbours";
+  const PackedScene packed = pack_scene(scene, TexelFormat::Rgba32f, 0);
+  TextureLookups batch(shared_runtime(), packed);
+  batch.set_lookups(lookups);
+  auto worst_error = [&](Method method) {
+    const std::vector<glm::vec4> got = batch.sample(sampler_params(method, Filter::Trilinear, 16, ZeroCoverage::Clamp));
+    float worst = 0;
+    for (size_t i = 0; i < got.size(); ++i) worst = std::max(worst, glm::length(glm::vec3(got[i] - expected[i])));
+    return worst;
+  };
+  const float traverse = worst_error(Method::Traverse);
+  const float clamp = worst_error(Method::Clamp);
+  RecordProperty("rotated_pairs", static_cast<int>(lookups.size()));
+  EXPECT_LT(traverse, 1e-4f);
+  EXPECT_GT(clamp, 100 * traverse + 1e-3f);
+}
+
+TEST(Assets, EverySampleRendersWithEveryMethodAt1xAnd8xWithoutNaN) {
+  TempDir dir;
+  std::vector<std::pair<std::string, std::string>> samples;
+  for (const SamplePair& pair : kPairs) samples.emplace_back(pair.mesh, pair.texture);
+  for (const auto& [mesh, texture] : samples) {
+    SCOPED_TRACE(texture);
+    const Scene& scene = sample_scene(mesh, texture);
+    Renderer renderer(shared_runtime());
+    renderer.load_scene(scene);
+    for (const std::string& method : method_names()) {
+      for (int msaa : {1, 8}) {
+        const RenderOptions options = parse_render_options({{"method", method}, {"msaa", msaa}, {"size", "64x48"}});
+        const RenderResult result = renderer.render(scene.camera, options);
+        EXPECT_TRUE(all_finite(result.pixels)) << method << " " << msaa;
+        EXPECT_GT(result.stats.fragments, 0u);
+      }
+    }
+  }
+  // black.ptx: one face, no mesh in the file, so on a unit quad.
+  const Scene black = load_scene_source(unit_quad_obj(dir), sample("black.ptx"));
+  Renderer renderer(shared_runtime());
+  renderer.load_scene(black);
+  for (const std::string& method : method_names())
+    for (int msaa : {1, 8})
+      EXPECT_TRUE(all_finite(renderer.render(black.camera, parse_render_options({{"method", method}, {"msaa", msaa}, {"size", "32x24"}})).pixels));
+}
+
+TEST(Assets, MeshSceneFilesNamePathsRelativeToTheFile) {
+  TempDir dir;
+  const std::string mesh = fs::relative(sample("plane.obj"), dir.path() / "scenes").string();
+  const std::string texture = fs::relative(sample("wave_lo.ptx"), dir.path() / "scenes").string();
+  const std::string file = dir.write("scenes/plane_wave.json", nlohmann::json{{"mesh", mesh}, {"texture", texture},
+      {"light", {{"ambient", 0.5}}}}.dump());
+  const Scene scene = load_scene_source(file);
+  EXPECT_EQ(scene.name, "plane_wave");
+  EXPECT_EQ(scene.faces.size(), 9u);
+  EXPECT_EQ(scene.light.ambient, 0.5f);
+  EXPECT_EQ(scene.faces[0].texture.width(), sample_scene("plane.obj", "wave_lo.ptx").faces[0].texture.width());
+  // A camera given wins over the framed one; the framed orbit stays for --frame.
+  const std::string with_camera = dir.write("scenes/camera.json", nlohmann::json{{"mesh", mesh},
+      {"camera", {{"eye", {0, 0, 3}}, {"target", {0, 0, 0}}}}}.dump());
+  const Scene framed = load_scene_source(with_camera);
+  EXPECT_EQ(framed.camera.eye, glm::vec3(0, 0, 3));
+  EXPECT_TRUE(framed.orbit.has_value());
+  const std::string unknown = dir.write("scenes/bad.json", R"({"mesh": "x.obj", "lights": 1})");
+  EXPECT_NE(input_error([&] { load_scene_source(unknown); }, "lights").find("unknown field"), std::string::npos);
+  const std::string missing = dir.write("scenes/missing.json", R"({"mesh": "nowhere.obj"})");
+  EXPECT_NE(input_error([&] { load_scene_source(missing); }, "mesh").find("(in '"), std::string::npos);
+  EXPECT_NE(input_error([&] { load_scene_source("paper", sample("wave_lo.ptx")); }, "texture").find("goes with an .obj scene"),
+            std::string::npos);
+}
+
+TEST(Assets, ImageFacesAreReadUprightRelativeToTheSceneFile) {
+  TempDir dir;
+  // 4x2 linear values, written as EXR so they come back exactly (half floats of these values).
+  std::vector<glm::vec4> pixels;
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) pixels.push_back(glm::vec4(0.125f * x, 0.5f * y, 0.25f, 1.0f));
+  fs::create_directories(dir.path() / "tiles");
+  write_image((dir.path() / "tiles" / "tile.exr").string(), 4, 2, pixels);
+  write_image((dir.path() / "tiles" / "odd.exr").string(), 3, 2, std::vector<glm::vec4>(6, glm::vec4(1)));
+  auto scene_with = [&](const std::string& image) {
+    return nlohmann::json{{"positions", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}},
+                          {"faces", {{{"vertices", {0, 1, 2, 3}}, {"texture", {{"image", image}}}}}},
+                          {"camera", {{"eye", {0.5, 0.5, 2}}, {"target", {0.5, 0.5, 0}}}}};
+  };
+  const Scene scene = load_scene_source(dir.write("tiled.json", scene_with("tiles/tile.exr").dump()));
+  const TextureLevel& level0 = scene.faces[0].texture.levels[0];
+  ASSERT_EQ(level0.width, 4);
+  ASSERT_EQ(level0.height, 2);
+  // Texture row 0 (v = 0) is the image's bottom row.
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 4; ++i) EXPECT_EQ(level0.at(i, j), pixels[static_cast<size_t>(1 - j) * 4 + i]) << i << "," << j;
+  EXPECT_EQ(scene.faces[0].texture.levels.size(), 3u);
+
+  const std::string odd = input_error([&] { load_scene_source(dir.write("odd.json", scene_with("tiles/odd.exr").dump())); },
+                                      "faces[0].texture.image");
+  EXPECT_NE(odd.find("3 texels wide; each side must be a power of two"), std::string::npos) << odd;
+  input_error([&] { load_scene_source(dir.write("gone.json", scene_with("tiles/gone.png").dump())); }, "faces[0].texture.image");
+  // host/scene alone reads no file: an inline scene cannot name one.
+  const std::string inline_message = input_error([&] { parse_scene_json(scene_with("tiles/tile.exr")); }, "faces[0].texture.image");
+  EXPECT_NE(inline_message.find("cannot be read here"), std::string::npos);
+  nlohmann::json both = scene_with("tiles/tile.exr");
+  both["faces"][0]["texture"]["width"] = 4;
+  input_error([&] { parse_scene_json(both); }, "faces[0].texture.width");
+}
+
+TEST(Assets, TheAssetDirectoryRefusesNamesThatLeaveItAndCachesWhatItLoads) {
+  TempDir outside;
+  const std::string secret = outside.write("secret.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+  TempDir root;
+  fs::copy_file(sample("plane.obj"), root.path() / "plane.obj");
+  fs::create_directories(root.path() / "maps");
+  fs::copy_file(sample("wave_lo.ptx"), root.path() / "maps" / "wave_lo.ptx");
+  root.write(".hidden/x.obj", "");
+  root.write("notes.txt", "");
+  fs::create_symlink(secret, root.path() / "escape.obj");
+  fs::create_symlink(outside.path(), root.path() / "linked_dir");
+  root.write("scenes/out.json", R"({"mesh": "../../)" + outside.path().filename().string() + R"(/secret.obj"})");
+
+  AssetDirectory assets(root.path().string(), {size_t{64} << 20, 4});
+  std::vector<std::string> listed;
+  for (const AssetEntry& entry : assets.list()) listed.push_back(entry.name + ":" + to_string(entry.kind));
+  EXPECT_EQ(listed, (std::vector<std::string>{"maps/wave_lo.ptx:ptex", "plane.obj:mesh", "scenes/out.json:scene"}));
+
+  EXPECT_NE(input_error([&] { assets.resolve("../" + outside.path().filename().string() + "/secret.obj", "", "scene"); }, "scene")
+                .find("'..' is not allowed"), std::string::npos);
+  EXPECT_NE(input_error([&] { assets.resolve(secret, "", "scene"); }, "scene").find("not an absolute path"), std::string::npos);
+  EXPECT_NE(input_error([&] { assets.resolve("escape.obj", "", "scene"); }, "scene").find("leads out of the asset directory"),
+            std::string::npos);
+  EXPECT_NE(input_error([&] { assets.resolve("linked_dir/secret.obj", "", "texture"); }, "texture").find("leads out"),
+            std::string::npos);
+  EXPECT_NE(input_error([&] { assets.resolve("nothing.obj", "", "scene"); }, "scene").find("no asset"), std::string::npos);
+  // A scene file inside cannot reach out either.
+  input_error([&] { assets.load("scenes/out.json", "", {}); }, "mesh");
+
+  const auto first = assets.load("plane.obj", "maps/wave_lo.ptx", {});
+  const auto again = assets.load("plane.obj", "maps/wave_lo.ptx", {});
+  EXPECT_EQ(first, again);
+  EXPECT_EQ(assets.file_loads(), 2);  // the refused scene file, then the pair once
+  EXPECT_EQ(assets.cached_entries(), 1u);
+  SceneSourceOptions tinted;
+  tinted.generator.tint = true;
+  EXPECT_NE(assets.load("plane.obj", "maps/wave_lo.ptx", tinted), first);
+  EXPECT_EQ(assets.cached_entries(), 2u);
+  // Bounded: with room for nothing, nothing stays.
+  AssetDirectory uncached(root.path().string(), {0, 4});
+  uncached.load("plane.obj", "", {});
+  EXPECT_EQ(uncached.cached_entries(), 0u);
+}

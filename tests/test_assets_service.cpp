@@ -1,0 +1,192 @@
+// Assets through the front ends: the real seamcl binary on bad .obj and .ptx files (exit 2, one
+// line naming the field, nothing written) and on a good pair, and `seamcl serve --assets DIR`:
+// the listing, renders of assets, and every way out of DIR refused with 400 naming the field.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include <seamcl/assets/scene_source.h>
+#include <seamcl/io/image_io.h>
+#include "server_support.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using seamcl_tests::LiveServer;
+
+namespace {
+
+std::string sample(const std::string& name) { return std::string(SEAMCL_TEST_ASSETS_DIR) + "/ptex/" + name; }
+
+class Workspace {
+ public:
+  Workspace() {
+    std::string pattern = (fs::temp_directory_path() / "seamcl_assets_service_XXXXXX").string();
+    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp");
+    root_ = pattern;
+    fs::create_directories(root_ / "assets" / "maps");
+    fs::create_directories(root_ / "outside");
+  }
+  ~Workspace() {
+    std::error_code ignored;
+    fs::remove_all(root_, ignored);
+  }
+  fs::path path(const std::string& relative) const { return root_ / relative; }
+  std::string write(const std::string& relative, const std::string& text) const {
+    std::ofstream(root_ / relative, std::ios::binary) << text;
+    return (root_ / relative).string();
+  }
+
+  struct Result {
+    int exit_code;
+    std::string err;
+  };
+  Result run(const std::string& args) const {
+    const std::string err = (root_ / "stderr.txt").string();
+    const std::string command = "cd '" + root_.string() + "' && '" + SEAMCL_BINARY + "' " + args + " >/dev/null 2>'" + err + "' </dev/null";
+    const int status = std::system(command.c_str());
+    std::ifstream in(err);
+    std::stringstream text;
+    text << in.rdbuf();
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, text.str()};
+  }
+
+ private:
+  fs::path root_;
+};
+
+}  // namespace
+
+TEST(AssetsCli, BadMeshesAndPtexFilesExit2WithOneLineNamingTheField) {
+  Workspace w;
+  w.write("triangle.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n");
+  w.write("broken.ptx", "Ptex but not really");
+  struct Case {
+    std::string args, field, text;
+  };
+  for (const Case& c : {Case{"render --scene triangle.obj -o out.png", "scene:", "face 0 (0-based; line 4) has 3 vertices"},
+                        Case{"render --scene " + sample("plane.obj") + " --texture broken.ptx -o out.png", "texture:", "broken.ptx"},
+                        Case{"render --scene broken.ptx -o out.png", "scene:", "broken.ptx"},
+                        Case{"render --scene " + sample("plane.obj") + " --texture " + sample("cube_text.ptx") + " -o out.png",
+                             "texture:", "has 72 faces"},
+                        Case{"compare --scene paper --texture " + sample("wave_lo.ptx") + " --methods discard --msaa 1", "texture:",
+                             "goes with an .obj scene"},
+                        Case{"bench --scene missing.obj --methods discard --msaa 1 --frames 1 --no-errors", "scene:", "no such file"}}) {
+    SCOPED_TRACE(c.args);
+    const Workspace::Result r = w.run(c.args);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(c.field), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(c.text), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(w.path("out.png")));
+  }
+}
+
+TEST(AssetsCli, RendersAMeshWithItsPtexAtTheAskedSize) {
+  Workspace w;
+  const Workspace::Result r =
+      w.run("render --scene " + sample("plane.obj") + " --texture " + sample("wave_lo.ptx") + " --frame 3 --frames 8 --size 40x30 -o plane.png");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int width = 0, height = 0;
+  seamcl::read_image(w.path("plane.png").string(), width, height);
+  EXPECT_EQ(width, 40);
+  EXPECT_EQ(height, 30);
+}
+
+TEST(AssetsService, ListsRendersAndRefusesEveryWayOutOfTheDirectory) {
+  Workspace w;
+  fs::copy_file(sample("plane.obj"), w.path("assets/plane.obj"));
+  fs::copy_file(sample("wave_lo.ptx"), w.path("assets/maps/wave_lo.ptx"));
+  w.write("outside/secret.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+  fs::create_symlink(w.path("outside/secret.obj"), w.path("assets/escape.obj"));
+
+  seamcl::server::ServerOptions options;
+  options.threads = 1;
+  options.assets_dir = w.path("assets").string();
+  LiveServer server(options);
+  httplib::Client client("127.0.0.1", server.port());
+  client.set_read_timeout(120, 0);
+
+  const auto listing = client.Get("/v1/assets");
+  ASSERT_TRUE(listing);
+  ASSERT_EQ(listing->status, 200);
+  const json assets = json::parse(listing->body);
+  EXPECT_EQ(assets.at("enabled"), true);
+  ASSERT_EQ(assets.at("assets").size(), 2u) << assets.dump();  // the symlink out is not listed
+  EXPECT_EQ(assets.at("assets")[0].at("name"), "maps/wave_lo.ptx");
+  EXPECT_EQ(assets.at("assets")[0].at("kind"), "ptex");
+  EXPECT_EQ(assets.at("assets")[1].at("name"), "plane.obj");
+  EXPECT_EQ(assets.at("assets")[1].at("bytes"), fs::file_size(sample("plane.obj")));
+
+  const json render = {{"scene", "plane.obj"}, {"texture", "maps/wave_lo.ptx"}, {"size", "32x24"}, {"method", "traverse"}};
+  for (int i = 0; i < 2; ++i) {
+    const auto image = client.Post("/v1/render", render.dump(), "application/json");
+    ASSERT_TRUE(image);
+    EXPECT_EQ(image->status, 200) << image->body;
+    EXPECT_EQ(image->get_header_value("Content-Type"), "image/png");
+  }
+  const auto get = client.Get("/v1/render?scene=plane.obj&texture=maps/wave_lo.ptx&size=16x16");
+  ASSERT_TRUE(get);
+  EXPECT_EQ(get->status, 200) << get->body;
+
+  struct Refusal {
+    json body;
+    std::string field, text;
+  };
+  for (const Refusal& r : {Refusal{{{"scene", "../outside/secret.obj"}}, "scene", "'..' is not allowed"},
+                           Refusal{{{"scene", w.path("outside/secret.obj").string()}}, "scene", "not an absolute path"},
+                           Refusal{{{"scene", "escape.obj"}}, "scene", "leads out of the asset directory"},
+                           Refusal{{{"scene", "plane.obj"}, {"texture", "maps/../../outside/x.ptx"}}, "texture", "'..'"},
+                           Refusal{{{"scene", "plane.obj"}, {"texture", "nothing.ptx"}}, "texture", "no asset"},
+                           Refusal{{{"scene", "paper"}, {"texture", "maps/wave_lo.ptx"}}, "texture", "goes with an .obj"}}) {
+    SCOPED_TRACE(r.body.dump());
+    const auto answer = client.Post("/v1/render", r.body.dump(), "application/json");
+    ASSERT_TRUE(answer);
+    EXPECT_EQ(answer->status, 400) << answer->body;
+    const json error = json::parse(answer->body);
+    EXPECT_EQ(error.at("field"), r.field);
+    EXPECT_NE(error.at("error").get<std::string>().find(r.text), std::string::npos) << answer->body;
+  }
+  // The kinds the document lists are the library's names.
+  EXPECT_EQ(json::parse(seamcl::server::openapi_json())
+                .at("components").at("schemas").at("Assets").at("properties").at("assets").at("items").at("properties")
+                .at("kind").at("enum"),
+            json(seamcl::asset_kind_names()));
+}
+
+TEST(AssetsService, WithoutAssetsNoFileIsReachableAndAHugeAssetIsRefusedNotLoaded) {
+  Workspace w;
+  fs::copy_file(sample("plane.obj"), w.path("assets/plane.obj"));
+  fs::copy_file(sample("wave_lo.ptx"), w.path("assets/wave_lo.ptx"));
+  {
+    seamcl::server::ServerOptions options;
+    options.threads = 1;
+    LiveServer server(options);
+    httplib::Client client("127.0.0.1", server.port());
+    const auto listing = client.Get("/v1/assets");
+    ASSERT_TRUE(listing);
+    EXPECT_EQ(json::parse(listing->body).at("enabled"), false);
+    const auto answer = client.Post("/v1/render", json{{"scene", sample("plane.obj")}}.dump(), "application/json");
+    ASSERT_TRUE(answer);
+    EXPECT_EQ(answer->status, 400);
+    EXPECT_EQ(json::parse(answer->body).at("field"), "scene");
+  }
+  // A host budget below what the texture decodes to: refused by the reader's limit, as a 4xx.
+  seamcl::server::ServerOptions options;
+  options.threads = 1;
+  options.assets_dir = w.path("assets").string();
+  options.max_request_host_bytes = 4096;
+  LiveServer server(options);
+  httplib::Client client("127.0.0.1", server.port());
+  client.set_read_timeout(60, 0);
+  const auto answer = client.Post("/v1/render", json{{"scene", "plane.obj"}, {"texture", "wave_lo.ptx"}}.dump(), "application/json");
+  ASSERT_TRUE(answer);
+  EXPECT_TRUE(answer->status == 400 || answer->status == 413) << answer->status << " " << answer->body;
+  EXPECT_EQ(json::parse(answer->body).at("field"), "texture");
+}
