@@ -73,6 +73,7 @@ bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& f
   for (int s = 0; s < f.sample_count; ++s) {
     if (ids[s] == SEAMCL_NO_TRIANGLE || std::find(ids, ids + s, ids[s]) != ids + s) continue;
     const TriangleSetup& t = setups.at(ids[s]);
+    if (scene.faces.at(t.face).reflective >= 0) continue;  // a cube-map lookup: no patch taps
     const PixelFragment fragment = pixel_fragment(f, t, ids, ids[s], x, y);
     const SurfaceUv uv = interpolate_uv(t, fragment.x, fragment.y);
     const FilterSum sum =

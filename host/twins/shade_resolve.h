@@ -34,6 +34,7 @@ PixelFragment pixel_fragment(const FrameParams& frame, const TriangleSetup& t, c
 
 // Whether some fragment of pixel (x, y) (pixel or centroid shading) has no filter tap inside its
 // face (nor, for traverse, its neighbours): the fragments zero_coverage=nan turns into NaN.
+// Reflective faces (cube-map lookups) have no patch taps and never count.
 bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& frame,
                                   const std::vector<TriangleSetup>& setups, const uint32_t* ids, int x, int y);
 
