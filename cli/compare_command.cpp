@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -37,6 +38,8 @@ struct CompareArgs : MeasureArgs {
   std::string constant_color;  // "r,g,b" linear: paint every face this colour
   std::string images_dir;
   int repeat = 3;
+  std::vector<std::string> references;  // --reference, repeatable, each a name or a comma list
+  bool no_progress = false;
 };
 
 glm::vec3 parse_color(const std::string& text) {
@@ -66,6 +69,15 @@ json base_request(const CompareArgs& a) {
   return request;
 }
 
+// The names of --reference (repeatable, each a name or a comma list); paper when none is given.
+std::vector<ReferenceKind> reference_kinds(const std::vector<std::string>& given) {
+  std::vector<std::string> names;
+  for (const std::string& text : given)
+    for (const std::string& name : split_list(text, "reference")) names.push_back(name);
+  if (names.empty()) names.push_back("paper");
+  return parse_reference_kinds(names);
+}
+
 int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   // Validate everything before any work.
   const json base = base_request(args);
@@ -74,6 +86,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   const std::vector<int> rates = parse_int_list(args.msaa, "msaa");
   const std::vector<MethodEntry> entries = method_entries(base, methods, rates);
   if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
+  const std::vector<ReferenceKind> kinds = reference_kinds(args.references);
   const ReferenceSettings ref_settings = reference_settings(args);
   (void)reference_render_options(frame, ref_settings);  // size and reference settings checked now
   GeneratorOptions generator_options;
@@ -85,25 +98,41 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   const Scene scene = load_scene_source(frame.scene, frame.texture, source);
   const Camera camera = frame.frame ? orbit_camera(scene, *frame.frame, frame.frames) : scene.camera;
   if (!args.images_dir.empty()) fs::create_directories(args.images_dir);
+  auto progress = [&](const std::string& line) {
+    if (!args.no_progress) std::fprintf(stderr, "compare: %s\n", line.c_str());
+  };
 
   ClRuntime runtime(global.device);
   Renderer renderer(runtime);
   renderer.load_scene(scene, frame.texels);
-
-  // The seam mask of this frame at its own size, from a 1-sample render.
-  const FaceMap faces = render_face_map(renderer, camera, frame);
-  const std::vector<uint8_t> mask = seam_mask(faces);
-  const size_t seam_pixels = static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{1}));
-
-  const ReferenceImage reference = reference_image(renderer, camera, frame, ref_settings);
+  const ComparisonTargets targets =
+      prepare_targets(runtime, renderer, camera, frame, entries, ref_settings, kinds, progress);
   if (!args.images_dir.empty()) {
-    write_image((fs::path(args.images_dir) / "reference.png").string(), reference.width, reference.height,
-                reference.pixels);
+    for (const ReferenceImage& reference : targets.high_res) {
+      const std::string name = reference.kind == ReferenceKind::Paper ? "reference" : "reference_" + to_string(reference.kind);
+      write_image((fs::path(args.images_dir) / (name + ".png")).string(), reference.width, reference.height,
+                  reference.pixels);
+    }
+    for (const auto& [msaa, reference] : targets.seamless_by_rate) {
+      write_image((fs::path(args.images_dir) / ("reference_seamless_msaa" + std::to_string(msaa) + ".png")).string(),
+                  reference.width, reference.height, reference.pixels);
+    }
+    for (const auto& [msaa, mask] : targets.masks) {
+      std::vector<glm::vec4> mask_image(mask.size());
+      // Seams white, mesh boundary rims grey, the rest black.
+      for (size_t i = 0; i < mask.size(); ++i)
+        mask_image[i] = mask[i] == SEAMCL_MASK_SEAM       ? glm::vec4(1)
+                        : mask[i] == SEAMCL_MASK_BOUNDARY ? glm::vec4(0.2f, 0.2f, 0.2f, 1.0f)
+                                                          : glm::vec4(0, 0, 0, 1);
+      write_image((fs::path(args.images_dir) / ("seam_mask_msaa" + std::to_string(msaa) + ".png")).string(), frame.width,
+                  frame.height, mask_image);
+    }
   }
 
   json results = json::array();
+  const TargetsFor targets_for = [&](const MethodEntry& entry) { return targets.for_entry(entry); };
   for (const EntryResult& measured :
-       compare_methods(renderer, scene, camera, entries, &reference.pixels, &mask, args.repeat)) {
+       compare_methods(renderer, scene, camera, entries, targets_for, args.repeat, {}, progress)) {
     json item = compare_result_json(measured);
     if (!args.images_dir.empty()) {
       const RenderResult& result = measured.last;
@@ -117,23 +146,13 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
     results.push_back(item);
   }
 
-  if (!args.images_dir.empty()) {
-    std::vector<glm::vec4> mask_image(mask.size());
-    for (size_t i = 0; i < mask.size(); ++i) mask_image[i] = mask[i] ? glm::vec4(1) : glm::vec4(0, 0, 0, 1);
-    write_image((fs::path(args.images_dir) / "seam_mask.png").string(), frame.width, frame.height, mask_image);
-  }
-
+  const json summary = targets.summary_json(entries.front().options.msaa, true);
   const std::string size = std::to_string(frame.width) + "x" + std::to_string(frame.height);
   if (args.json_out) {
-    json out = {{"scene", scene.name},
-                {"size", size},
-                {"device", runtime.device_description()},
-                {"reference_method", reference.method},
-                {"reference", reference_json(reference, true)},
-                {"seam_pixels", seam_pixels},
-                {"seam_radius", kSeamRadius},
-                {"options", to_json(frame)},
-                {"results", results}};
+    json out = {{"scene", scene.name}, {"size", size}, {"device", runtime.device_description()}};
+    out.update(summary);
+    out["options"] = to_json(frame);
+    out["results"] = results;
     if (frame.frame) {
       out["frame"] = *frame.frame;
       out["frames"] = frame.frames;
@@ -141,17 +160,21 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
     if (!args.images_dir.empty()) out["images"] = args.images_dir;
     std::cout << out.dump(2) << "\n";
   } else {
-    std::printf("%s %s, reference: %s at %dx, %d spp, Mitchell B=C=1/3 (%s); %zu seam pixels\n", scene.name.c_str(),
-                size.c_str(), reference.method.c_str(), kReferenceScale, reference.msaa,
-                reference.from_cache ? "cached" : "rendered", seam_pixels);
-    std::printf("%-10s %4s %9s %10s %10s %10s %10s %10s %6s\n", "method", "msaa", "ms", "mean", "p99", "max",
-                "seam_mean", "seam_p99", "nan");
+    std::printf("%s %s; seam mask: pixels whose texture footprint crosses a face edge\n", scene.name.c_str(), size.c_str());
+    for (const auto& [msaa, mask] : summary["seam_mask"]["by_msaa"].items()) {
+      std::printf("  msaa %s: %zu seam pixels (%.1f%%)\n", msaa.c_str(), mask["pixels"].get<size_t>(),
+                  100.0 * mask["coverage"].get<double>());
+    }
+    std::printf("%-9s %-10s %4s %9s %10s %10s %10s %10s %10s %6s\n", "reference", "method", "msaa", "ms", "mean",
+                "seam_mean", "seam_p99", "off_mean", "off_p99", "nan");
     for (const json& r : results) {
-      const json& e = r["error"];
-      std::printf("%-10s %4d %9.2f %10.3e %10.3e %10.3e %10.3e %10.3e %6zu\n", r["method"].get<std::string>().c_str(),
-                  r["msaa"].get<int>(), r["ms"]["median"].get<double>(), e["mean"].get<double>(),
-                  e["p99"].get<double>(), e["max"].get<double>(), e["seam_mean"].get<double>(),
-                  e["seam_p99"].get<double>(), e["nan_pixels"].get<size_t>());
+      json by_reference = r.contains("errors") ? r["errors"] : json{{to_string(kinds.front()), r["error"]}};
+      for (const auto& [name, e] : by_reference.items()) {
+        std::printf("%-9s %-10s %4d %9.2f %10.3e %10.3e %10.3e %10.3e %10.3e %6zu\n", name.c_str(),
+                    r["method"].get<std::string>().c_str(), r["msaa"].get<int>(), r["ms"]["median"].get<double>(),
+                    e["mean"].get<double>(), e["seam_mean"].get<double>(), e["seam_p99"].get<double>(),
+                    e["off_seam_mean"].get<double>(), e["off_seam_p99"].get<double>(), e["nan_pixels"].get<size_t>());
+      }
     }
   }
   return 0;
@@ -171,6 +194,12 @@ Command add_compare_command(CLI::App& app) {
   cmd->add_option("--images", args->images_dir,
                   "Write each image, an error heat map (log scale 1e-4..1), the reference and the seam mask (PNG) here");
   cmd->add_option("--repeat", args->repeat, "Timed renders per method and rate; ms reports median, min, max [3]");
+  cmd->add_option("--reference", args->references,
+                  "Reference(s) to measure against, repeatable or a comma list: paper (traverse at 8x, Mitchell), box "
+                  "(the same, box downsample), analytic (the texture function at every 8x subsample, Mitchell), "
+                  "seamless (a planar grid of equal faces as one texture, at the measured rate); the first is `error`'s "
+                  "[paper]");
+  cmd->add_flag("--no-progress", args->no_progress, "Do not print progress lines on stderr");
   return Command{cmd, [args](const GlobalOptions& global) { return run_compare(*args, global); }};
 }
 

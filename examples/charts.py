@@ -7,8 +7,9 @@
 
 writes into --out:
   pareto.png    time per frame (median over the orbit) against seam error (mean over the seam
-                mask of the reference frames), one point per method and MSAA rate, the Pareto
-                front (no other point both faster and more accurate) marked;
+                mask of the reference frames), one point per method (colour) and MSAA rate
+                (marker), the Pareto front (no other point both faster and more accurate)
+                circled and labelled (labels placed so that none overlaps another);
   figure5.png   the paper's Figure 5: left, the fraction of pixels where ||discard - traverse||
                 >= x per MSAA rate (bench's "differences"); right, the fraction of pixels that
                 deviate from the reference by >= x, discard and traverse per MSAA rate; log x;
@@ -28,7 +29,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 COLOURS = {"discard": "tab:blue", "traverse": "tab:orange", "clamp": "tab:green", "guardband": "tab:red",
-           "black": "tab:gray"}
+           "black": "tab:gray", "traverse-edges": "tab:brown"}
 MARKERS = {1: "o", 2: "s", 4: "^", 8: "D", 16: "P"}
 
 
@@ -51,6 +52,52 @@ def pareto_front(points):
     return sorted(front, key=lambda i: points[i][0])
 
 
+def _overlap(a, b):
+    """Area shared by two display-space boxes (x0, y0, x1, y1)."""
+    w = min(a[2], b[2]) - max(a[0], b[0])
+    h = min(a[3], b[3]) - max(a[1], b[1])
+    return w * h if w > 0 and h > 0 else 0.0
+
+
+# Offsets (points) tried for a label, nearest first: right, above, below, left, then farther out.
+LABEL_OFFSETS = [(6, 4), (6, -12), (-6, 4), (-6, -12), (0, 10), (0, -16), (12, 12), (12, -20), (-12, 12),
+                 (-12, -20), (18, 0), (-18, 0), (0, 22), (0, -28), (24, 18), (24, -26), (-24, 18), (-24, -26)]
+
+
+def place_labels(ax, points, labels, avoid=(), fontsize=7):
+    """Labels the data points without overlaps, deterministically: each label takes the first offset
+    (LABEL_OFFSETS) whose box meets no label placed before it, no marker (points and `avoid`) and stays
+    inside the axes; where none is free, the offset with the least overlap, joined by a thin line.
+    Call after the axes' limits and scales are final."""
+    fig = ax.figure
+    renderer = fig.canvas.get_renderer()
+    ax_box = ax.get_window_extent(renderer)
+    to_px = fig.dpi / 72.0
+    marker = 5 * to_px
+    blocked = [(x - marker, y - marker, x + marker, y + marker)
+               for x, y in (ax.transData.transform(p) for p in list(points) + list(avoid))]
+    placed = []
+    for (x, y), text in zip(points, labels):
+        best = None
+        for dx, dy in LABEL_OFFSETS:
+            t = ax.annotate(text, (x, y), textcoords="offset points", xytext=(dx, dy), fontsize=fontsize,
+                            ha="left" if dx >= 0 else "right", va="bottom" if dy >= 0 else "top")
+            bb = t.get_window_extent(renderer)
+            box = (bb.x0, bb.y0, bb.x1, bb.y1)
+            t.remove()
+            outside = (box[0] < ax_box.x0 or box[2] > ax_box.x1 or box[1] < ax_box.y0 or box[3] > ax_box.y1)
+            cost = sum(_overlap(box, o) for o in blocked + placed) + (1e6 if outside else 0.0)
+            if best is None or cost < best[0]:
+                best = (cost, dx, dy, box)
+            if cost == 0:
+                break
+        cost, dx, dy, box = best
+        ax.annotate(text, (x, y), textcoords="offset points", xytext=(dx, dy), fontsize=fontsize,
+                    ha="left" if dx >= 0 else "right", va="bottom" if dy >= 0 else "top",
+                    arrowprops=dict(arrowstyle="-", lw=0.5, color="0.4") if abs(dx) + abs(dy) > 14 else None)
+        placed.append(box)
+
+
 def chart_pareto(bench, out, error_key="seam_mean"):
     rs = [r for r in bench["results"] if "error" in r]
     if not rs:
@@ -58,10 +105,9 @@ def chart_pareto(bench, out, error_key="seam_mean"):
         return None
     pts = [(r["ms"]["median"], r["error"][error_key]) for r in rs]
     front = pareto_front(pts)
-    fig, ax = plt.subplots(figsize=(7, 5))
+    fig, ax = plt.subplots(figsize=(8.5, 5))
     for r, (x, y) in zip(rs, pts):
         ax.scatter(x, y, color=COLOURS.get(r["method"], "k"), marker=MARKERS.get(r["msaa"], "x"), s=50, zorder=3)
-        ax.annotate(f'{r["method"]} {r["msaa"]}x', (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
         # min..max over the orbit's frames
         ax.plot([r["ms"]["min"], r["ms"]["max"]], [y, y], color=COLOURS.get(r["method"], "k"), alpha=0.25, lw=1)
     fx = [pts[i][0] for i in front]
@@ -73,13 +119,17 @@ def chart_pareto(bench, out, error_key="seam_mean"):
             ax.scatter([], [], color=c, label=m)
     ax.set_xscale("log")
     ax.set_yscale("log")
+    for r in sorted({r["msaa"] for r in rs}):
+        ax.scatter([], [], color="k", marker=MARKERS.get(r, "x"), facecolors="none", label=f"{r}x MSAA")
     ax.set_xlabel("time per frame, ms (median over the orbit; bar: min..max)")
     ax.set_ylabel(f"error vs reference: {error_key} (2-norm, linear RGB)")
     ax.set_title(f'{bench["scene"]} {bench["size"]}, {bench["frames"]} frames, '
                  f'errors on {len(bench.get("error_frames", []))}')
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1), title="colour: method, marker: rate",
+              title_fontsize=7)
     fig.tight_layout()
+    place_labels(ax, [pts[i] for i in front], [f'{rs[i]["method"]} {rs[i]["msaa"]}x' for i in front], avoid=pts)
     path = os.path.join(out, "pareto.png")
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -25,6 +25,14 @@ typedef float cl_float;
 #define SEAMCL_MAX_SAMPLES 16
 #define SEAMCL_CLIP_SLOTS 6          /* a triangle clipped by 5 planes is a fan of at most 6 */
 #define SEAMCL_NO_TRIANGLE 0xffffffffu
+/* Seam mask (shade_resolve built with -DSEAMCL_SEAM_MASK=1): a footprint crosses an edge when a
+ * filter puts more than this weight beyond it. Float rounding of weights that sum to 1 stays
+ * below 1e-6; a tap weighing less than this changes a colour by less than it too. */
+#define SEAMCL_SEAM_WEIGHT_TOLERANCE 1e-5f
+/* Seam mask values, per pixel */
+#define SEAMCL_MASK_NONE 0     /* no footprint crosses a face edge: every seam method agrees */
+#define SEAMCL_MASK_SEAM 1     /* a footprint crosses an edge shared by two faces */
+#define SEAMCL_MASK_BOUNDARY 2 /* footprints cross mesh boundary edges only (silhouette rims) */
 
 /* shading_mode */
 #define SEAMCL_SHADE_PIXEL 0    /* once per pixel and triangle, at the pixel centre */

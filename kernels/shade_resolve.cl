@@ -12,11 +12,28 @@
  * Reflective faces (FaceGpu.reflective >= 0, scenes with an environment, built with
  * -DSEAMCL_CUBE=1 only) look the reflected view ray up in the cube map instead (shade_reflection),
  * and uncovered samples show the environment when frame->environment.skybox is set.
- * Host guarantees: sample_triangle from raster of this frame. Twin: host/shade_resolve.cpp
+ * Seam mask (only in programs built with -DSEAMCL_SEAM_MASK=1, so that renders without it pay
+ * nothing): per pixel, over its fragments (each sample's with SEAMCL_SHADE_SAMPLE), whether a
+ * texture footprint crosses a face edge. A fragment's own filter (same point, footprint, filter
+ * and anisotropy, border-addressed) crosses edge k when the same filter at the point mirrored
+ * across edge k weighs more than SEAMCL_SEAM_WEIGHT_TOLERANCE inside the face (the filters are
+ * symmetric, so this is the weight it puts beyond edge k); the same filter carried onto an edge
+ * neighbour as traverse reads it (at the neighbour's own resolution, so a coarser neighbour's
+ * taps reach further back) crosses when it weighs more than the tolerance inside the neighbour.
+ * SEAMCL_MASK_SEAM: some footprint crosses an edge shared with a neighbour (or leaves the face
+ * past a corner only); else SEAMCL_MASK_BOUNDARY: some footprint crosses a mesh boundary edge
+ * only; else SEAMCL_MASK_NONE, and there every seam method returns the same colour.
+ * Without guard bands only (GUARD 0): a band would count as inside.
+ * Host guarantees: sample_triangle from raster of this frame; seam_mask holds width * height
+ * bytes when SEAMCL_SEAM_MASK is 1 (unused otherwise). Twin: host/twins/shade_resolve.cpp
  * (reflections: host/twins/shade_reflection.cpp). */
 
 #ifndef SEAMCL_CUBE
 #define SEAMCL_CUBE 0
+#endif
+
+#ifndef SEAMCL_SEAM_MASK
+#define SEAMCL_SEAM_MASK 0
 #endif
 
 typedef struct {
@@ -127,12 +144,71 @@ SEAMCL_INLINE float3 shade_fragment(__constant FrameParams* frame, __global cons
                   albedo.z * frame->light_color[2]) * lighting;
 }
 
+#if SEAMCL_SEAM_MASK
+/* A pixel's class over its fragments: seam over boundary over none. */
+SEAMCL_INLINE uchar merge_mask(uchar a, uchar b) {
+  return a == SEAMCL_MASK_SEAM || b == SEAMCL_MASK_SEAM ? (uchar)SEAMCL_MASK_SEAM
+         : a == SEAMCL_MASK_BOUNDARY || b == SEAMCL_MASK_BOUNDARY ? (uchar)SEAMCL_MASK_BOUNDARY
+                                                                  : (uchar)SEAMCL_MASK_NONE;
+}
+
+/* The weight the filter of `face` at (u, v) puts inside the face, border-addressed. */
+SEAMCL_INLINE float weight_inside(__constant FrameParams* frame, const FaceGpu* face, __global const uint* level_offsets,
+                                  TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
+                                  float dudx, float dvdx, float dudy, float dvdy) {
+  return filter_texture(face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(frame->sampler),
+                        SEAMCL_ADDRESS_BORDER, frame->sampler.max_aniso, u, v, dudx, dvdx, dudy, dvdy)
+      .weight;
+}
+
+SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global const TriangleSetup* t,
+                                    __global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
+                                    __global const uint* level_offsets, TEXEL_BUFFER texels,
+                                    __global const float* srgb_to_linear, float x, float y) {
+  const SurfaceUv s = interpolate_uv(t, x, y);
+  const FaceGpu face = faces[t->face];
+  __global const FaceNeighbors* n = neighbors + t->face;
+  const float tolerance = SEAMCL_SEAM_WEIGHT_TOLERANCE;
+  /* NaN weights (a non-finite footprint) count as crossing: nothing shows they stay inside. */
+  const float own = weight_inside(frame, &face, level_offsets, texels, srgb_to_linear, s.u, s.v, s.dudx, s.dvdx,
+                                  s.dudy, s.dvdy);
+  int seam = 0, boundary = 0, any_edge = 0;
+  for (int k = 0; k < 4; ++k) {
+    /* Mirrored across edge k: v = 0, u = 1, v = 1, u = 0. */
+    const int across_v = (k & 1) == 0;
+    const float offset = k == 1 || k == 2 ? 2.0f : 0.0f;
+    const float mu = across_v ? s.u : offset - s.u, mv = across_v ? offset - s.v : s.v;
+    const float mdudx = across_v ? s.dudx : -s.dudx, mdudy = across_v ? s.dudy : -s.dudy;
+    const float mdvdx = across_v ? -s.dvdx : s.dvdx, mdvdy = across_v ? -s.dvdy : s.dvdy;
+    const float beyond = weight_inside(frame, &face, level_offsets, texels, srgb_to_linear, mu, mv, mdudx, mdvdx,
+                                       mdudy, mdvdy);
+    const int crosses = !(beyond <= tolerance);
+    any_edge |= crosses;
+    const int other = n->neighbor[k];
+    if (other < 0) {
+      boundary |= crosses;
+      continue;
+    }
+    __global const float* m = n->transform[k];
+    const FaceGpu g = faces[other];
+    const float reach = weight_inside(frame, &g, level_offsets, texels, srgb_to_linear, m[0] * s.u + m[1] * s.v + m[2],
+                                      m[3] * s.u + m[4] * s.v + m[5], m[0] * s.dudx + m[1] * s.dvdx,
+                                      m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
+                                      m[3] * s.dudy + m[4] * s.dvdy);
+    seam |= crosses | !(reach <= tolerance);
+  }
+  /* Taps outside past a corner only (no edge's mirror saw them): a seam, to be safe. */
+  seam |= !any_edge && !(own >= 1.0f - tolerance);
+  return seam ? (uchar)SEAMCL_MASK_SEAM : boundary ? (uchar)SEAMCL_MASK_BOUNDARY : (uchar)SEAMCL_MASK_NONE;
+}
+#endif
+
 __kernel void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* setups,
                             __global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
                             __global const uint* level_offsets, TEXEL_BUFFER texels,
                             __global const float* srgb_to_linear, __global const uint* sample_triangle, __global float4* image,
-                            __global FrameStats* stats, __global const ReflectiveFace* reflective_faces,
-                            __global const float* cube_texels) {
+                            __global FrameStats* stats, __global uchar* seam_mask,
+                            __global const ReflectiveFace* reflective_faces, __global const float* cube_texels) {
   __local uint group_fragments;
   if (get_local_id(0) == 0 && get_local_id(1) == 0) group_fragments = 0;
   barrier(CLK_LOCAL_MEM_FENCE);
@@ -147,6 +223,7 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
     const float3 background = (float3)(frame->background[0], frame->background[1], frame->background[2]);
     float3 sum = (float3)(0.0f);
     int uncovered = 0;
+    uchar crosses = SEAMCL_MASK_NONE;
     for (int s = 0; s < samples; ++s) {
       const uint slot = ids[s];
       if (slot == SEAMCL_NO_TRIANGLE) {
@@ -157,6 +234,10 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
       const float sample_y = (float)sample_fixed_y(y, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
       if (frame->shading_mode == SEAMCL_SHADE_SAMPLE) {
         sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, sample_x, sample_y);
+#if SEAMCL_SEAM_MASK
+        crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,
+                                                      srgb_to_linear, sample_x, sample_y));
+#endif
         ++fragments;
         continue;
       }
@@ -186,6 +267,10 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
       }
       sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, shade_x, shade_y) *
              (float)covered;
+#if SEAMCL_SEAM_MASK
+      crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,
+                                                    srgb_to_linear, shade_x, shade_y));
+#endif
       ++fragments;
     }
     /* Added once, so that an empty pixel is exactly the background (n*b/n is exact for n a power
@@ -201,6 +286,11 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
 #endif
     const float3 color = sum / (float)samples;
     image[(size_t)y * (size_t)frame->width + (size_t)x] = (float4)(color, 1.0f);
+#if SEAMCL_SEAM_MASK
+    seam_mask[(size_t)y * (size_t)frame->width + (size_t)x] = crosses;
+#else
+    (void)crosses;
+#endif
   }
   atomic_add(&group_fragments, fragments);
   barrier(CLK_LOCAL_MEM_FENCE);

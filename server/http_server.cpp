@@ -882,6 +882,11 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
     repeat = value.get<int>();
     rest.erase("repeat");
   }
+  std::vector<ReferenceKind> reference_kinds = {ReferenceKind::Paper};
+  if (rest.contains("reference")) {
+    reference_kinds = parse_reference_kinds(split_list(compare_list_text(rest.at("reference"), "reference", false), "reference"));
+    rest.erase("reference");
+  }
   bool explicit_reference_msaa = false;
   const ReferenceSettings reference_settings = take_reference_settings(rest, explicit_reference_msaa);
   const json inline_scene = take_inline_scene(rest);
@@ -925,8 +930,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   // buffers are freed with it, and the slot's warm Renderers keep their scenes.
   const Clock::time_point queued = Clock::now();
   double queue_ms = 0;
-  size_t seam_pixels = 0;
-  ReferenceImage reference;
+  std::optional<ComparisonTargets> targets;
   std::vector<EntryResult> measured;
   {
     const std::unique_ptr<SlotLease> lease = acquire_slot(start);
@@ -935,16 +939,15 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
     Renderer renderer(runtime_);
     renderer.set_device_byte_limit(options_.max_request_device_bytes);
     renderer.load_scene(*scene, frame.texels);
-    const std::vector<uint8_t> mask = seam_mask(render_face_map(renderer, camera, frame));
-    seam_pixels = static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{1}));
     {
       const std::string cache_key = reference_cache_key(*scene, camera, frame, reference_settings);
       std::lock_guard lock(reference_locks_[std::hash<std::string>{}(cache_key) % reference_locks_.size()]);
-      reference = reference_image(renderer, camera, frame, reference_settings);
+      targets = prepare_targets(runtime_, renderer, camera, frame, entries, reference_settings, reference_kinds);
     }
     try {
       throw_if_stopped(should_stop, "before the entries");
-      measured = compare_methods(renderer, *scene, camera, entries, &reference.pixels, &mask, repeat, should_stop);
+      const TargetsFor targets_for = [&](const MethodEntry& entry) { return targets->for_entry(entry); };
+      measured = compare_methods(renderer, *scene, camera, entries, targets_for, repeat, should_stop, {});
     } catch (const Cancelled&) {
       if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
       throw HttpError{503, "deadline", "the compare ran past this server's deadline of " + std::to_string(options_.deadline_ms) + " ms", 1};
@@ -957,13 +960,10 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
               {"size", std::to_string(frame.width) + "x" + std::to_string(frame.height)},
               {"size_from", size_given ? "request" : "default"},
               {"device", runtime_.device_description()},
-              {"reference_method", reference.method},
-              {"reference", reference_json(reference, false)},
-              {"seam_pixels", seam_pixels},
-              {"seam_radius", kSeamRadius},
               {"repeat", repeat},
               {"options", to_json(frame)},
               {"results", results}};
+  out.update(targets->summary_json(entries.front().options.msaa, false));
   if (frame.frame) {
     out["frame"] = *frame.frame;
     out["frames"] = frame.frames;

@@ -533,7 +533,7 @@ TEST_F(Compare, Quad2JsonShape) {
   }
   EXPECT_EQ(seen, expected);
   // The images were written.
-  for (const char* f : {"reference.png", "seam_mask.png", "discard_msaa4.png", "discard_msaa4_error.png",
+  for (const char* f : {"reference.png", "seam_mask_msaa1.png", "seam_mask_msaa4.png", "discard_msaa4.png", "discard_msaa4_error.png",
                         "clamp_msaa1.png", "clamp_msaa1_error.png"}) {
     EXPECT_TRUE(fs::is_regular_file(*dir_ / "imgs" / f)) << f;
   }
@@ -550,8 +550,7 @@ TEST_F(Compare, Quad2OrderingAsMeasured) {
   // Black (Ptex's border mode, no renormalisation) darkens every seam: by far the largest seam error.
   EXPECT_GT(err("black", 4, "seam_mean"), 2.0 * err("discard", 4, "seam_mean"));
   EXPECT_GT(err("black", 4, "seam_mean"), 2.0 * err("clamp", 4, "seam_mean"));
-  // Discard vs clamp, measured (64x64, traverse reference at 8x, 1 spp): seam_mean 5.89e-3 for
-  // discard and 5.74e-3 for clamp at 4x MSAA, i.e. discard is *not* lower here, by ~2.5%. Why:
+  // Discard vs clamp (64x64, traverse reference at 8x, 1 spp): discard is *not* lower here. Why:
   // quad2's textures are baked from one smooth, continuous pattern, so a face's edge texel is
   // almost the colour just across the edge and clamp's repeated edge texel is a good guess, while
   // discard renormalises over the taps inside the face, whose centre of mass moves inward (a
@@ -559,9 +558,10 @@ TEST_F(Compare, Quad2OrderingAsMeasured) {
   // texture filtering (the 8x reference reads finer mip levels), so the two stay within 10%.
   EXPECT_NEAR(err("discard", 4, "seam_mean"), err("clamp", 4, "seam_mean"), 0.1 * err("clamp", 4, "seam_mean"));
   if (have_traverse()) {
-    // The reference method itself, at 1x, is closest at the seams (measured 5.53e-3).
-    EXPECT_LT(err("traverse", 4, "seam_mean"), err("discard", 4, "seam_mean"));
-    EXPECT_LT(err("traverse", 4, "seam_mean"), err("clamp", 4, "seam_mean"));
+    // Over the footprint seam mask, with quad2's smooth content, the reference method itself is
+    // no better than clamp at 4x (measured 7.12e-3 vs 6.87e-3): a neighbour's texels are about the
+    // edge texel's colour. The regimes where traverse wins are tests/test_references.cpp's.
+    EXPECT_NEAR(err("traverse", 4, "seam_mean"), err("clamp", 4, "seam_mean"), 0.15 * err("clamp", 4, "seam_mean"));
   }
 }
 

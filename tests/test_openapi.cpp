@@ -278,6 +278,8 @@ void expect_documented_type(const json& node, const std::string& type, const std
     EXPECT_EQ(t, "array") << path;
   } else if (type.find("[x, y, z]") != std::string::npos || type.find("[r, g, b]") != std::string::npos) {
     EXPECT_TRUE(is_triple("number")) << path << ": " << node.dump();
+  } else if (type.find("\"detail\"") != std::string::npos) {
+    EXPECT_EQ(node.value("enum", json()), json(texture_content_names())) << path;
   } else if (type.find("\"surface\"") != std::string::npos) {
     EXPECT_EQ(node.value("enum", json()), json({"surface", "constant"})) << path;
   } else {

@@ -326,9 +326,10 @@ TEST(Generators, ListsTheScenesWithPaperFirst) {
     names.push_back(info.name);
     EXPECT_FALSE(info.description.empty()) << info.name;
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"paper", "quad2", "plane", "cube", "envmap"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"paper", "quad2", "plane", "cube", "closeup-seam", "closeup-corner",
+                                             "mixed", "envmap"}));
   const std::string message = expect_input_error([] { generate_scene("teapot", {}); }, "scene");
-  EXPECT_NE(message.find("unknown scene 'teapot' (known: paper, quad2, plane, cube, envmap)"),
+  EXPECT_NE(message.find("unknown scene 'teapot' (known: paper, quad2, plane, cube, closeup-seam, closeup-corner, mixed, envmap)"),
             std::string::npos)
       << message;
 }

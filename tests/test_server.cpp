@@ -428,7 +428,7 @@ TEST(ServerSchema, OpenApiDocumentsEveryEndpoint) {
   // The compare request: the render options of the frame (no method, no format) and compare's own keys.
   const json compare = doc.at("components").at("schemas").at("CompareRequest").at("properties");
   for (const auto& [key, value] : compare.items()) {
-    EXPECT_TRUE(properties.contains(key) || key == "methods" || key == "repeat" || key.starts_with("reference_")) << key;
+    EXPECT_TRUE(properties.contains(key) || key == "methods" || key == "repeat" || key == "reference" || key.starts_with("reference_")) << key;
   }
   EXPECT_FALSE(compare.contains("method"));
   EXPECT_FALSE(compare.contains("format"));
@@ -583,13 +583,14 @@ json library_compare(const json& base, const std::string& methods, const std::st
   const Camera camera = frame.frame ? orbit_camera(scene, *frame.frame, frame.frames) : scene.camera;
   Renderer renderer(seamcl_tests::shared_runtime());
   renderer.load_scene(scene, frame.texels);
-  const std::vector<uint8_t> mask = seam_mask(render_face_map(renderer, camera, frame));
-  seam_pixels = static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{1}));
   ReferenceSettings settings;
   settings.use_cache = false;
-  const ReferenceImage reference = reference_image(renderer, camera, frame, settings);
+  const ComparisonTargets targets = prepare_targets(seamcl_tests::shared_runtime(), renderer, camera, frame, entries,
+                                                    settings, {ReferenceKind::Paper});
+  seam_pixels = targets.summary_json(entries.front().options.msaa, false).at("seam_pixels").get<size_t>();
   json results = json::array();
-  for (const EntryResult& r : compare_methods(renderer, scene, camera, entries, &reference.pixels, &mask, 1))
+  const TargetsFor targets_for = [&](const MethodEntry& entry) { return targets.for_entry(entry); };
+  for (const EntryResult& r : compare_methods(renderer, scene, camera, entries, targets_for, 1, {}, {}))
     results.push_back(compare_result_json(r));
   return results;
 }

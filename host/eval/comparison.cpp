@@ -68,6 +68,14 @@ std::vector<double> EntryResult::total_ms() const {
 EntryResult measure_entry(Renderer& renderer, const Camera& camera, const MethodEntry& entry, int repeat,
                           const std::vector<glm::vec4>* reference, const std::vector<uint8_t>* seam_mask,
                           const ShouldStop& should_stop) {
+  EntryTargets targets;
+  if (reference) targets.references.emplace_back("paper", reference);
+  targets.seam_mask = seam_mask;
+  return measure_entry(renderer, camera, entry, repeat, targets, should_stop);
+}
+
+EntryResult measure_entry(Renderer& renderer, const Camera& camera, const MethodEntry& entry, int repeat,
+                          const EntryTargets& targets, const ShouldStop& should_stop) {
   EntryResult out;
   out.entry = entry;
   for (int i = 0; i < repeat; ++i) {
@@ -75,7 +83,10 @@ EntryResult measure_entry(Renderer& renderer, const Camera& camera, const Method
     out.last = renderer.render(camera, entry.options);
     out.runs.push_back(out.last.ms);
   }
-  if (reference) out.errors = compare_images(out.last.pixels, *reference, seam_mask);
+  for (const auto& [name, reference] : targets.references) {
+    out.errors_by_reference.emplace_back(name, compare_images(out.last.pixels, *reference, targets.seam_mask));
+  }
+  if (!out.errors_by_reference.empty()) out.errors = out.errors_by_reference.front().second;
   const PackedScene& packed = renderer.packed_scene();
   out.texture_bytes = packed.texture_bytes();
   out.padding_bytes = packed.padding_bytes();
@@ -88,14 +99,116 @@ std::vector<EntryResult> compare_methods(Renderer& renderer, const Scene& scene,
                                          const std::vector<glm::vec4>* reference,
                                          const std::vector<uint8_t>* seam_mask, int repeat,
                                          const ShouldStop& should_stop) {
+  EntryTargets targets;
+  if (reference) targets.references.emplace_back("paper", reference);
+  targets.seam_mask = seam_mask;
+  return compare_methods(renderer, scene, camera, entries, [&](const MethodEntry&) { return targets; }, repeat,
+                         should_stop, {});
+}
+
+std::vector<EntryResult> compare_methods(Renderer& renderer, const Scene& scene, const Camera& camera,
+                                         const std::vector<MethodEntry>& entries, const TargetsFor& targets,
+                                         int repeat, const ShouldStop& should_stop, const Progress& progress) {
   std::vector<EntryResult> results;
-  for (const MethodEntry& entry : entries) {
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const MethodEntry& entry = entries[i];
     throw_if_stopped(should_stop, "before " + entry.method_name + " at msaa " + std::to_string(entry.options.msaa));
+    if (progress) {
+      progress("entry " + std::to_string(i + 1) + "/" + std::to_string(entries.size()) + ": " + entry.method_name +
+               " at msaa " + std::to_string(entry.options.msaa));
+    }
     renderer.load_scene(scene, entry.options.texels);
     renderer.warm_up(entry.options);
-    results.push_back(measure_entry(renderer, camera, entry, repeat, reference, seam_mask, should_stop));
+    results.push_back(measure_entry(renderer, camera, entry, repeat, targets(entry), should_stop));
   }
   return results;
+}
+
+EntryTargets ComparisonTargets::for_entry(const MethodEntry& entry) const {
+  EntryTargets t;
+  size_t next_high_res = 0;
+  for (ReferenceKind kind : kinds) {
+    const ReferenceImage& reference =
+        kind == ReferenceKind::Seamless ? seamless_by_rate.at(entry.options.msaa) : high_res.at(next_high_res++);
+    t.references.emplace_back(to_string(kind), &reference.pixels);
+  }
+  t.seam_mask = &masks.at(entry.options.msaa);
+  return t;
+}
+
+const ReferenceImage& ComparisonTargets::first() const {
+  return kinds.front() == ReferenceKind::Seamless ? seamless_by_rate.begin()->second : high_res.front();
+}
+
+json ComparisonTargets::summary_json(int first_rate, bool with_cache_path) const {
+  json references = json::array();
+  size_t next_high_res = 0;
+  for (ReferenceKind kind : kinds) {
+    references.push_back(kind == ReferenceKind::Seamless ? reference_json(seamless_by_rate.begin()->second, with_cache_path)
+                                                         : reference_json(high_res.at(next_high_res++), with_cache_path));
+  }
+  json by_msaa = json::object();
+  for (const auto& [msaa, mask] : masks) {
+    const size_t pixels = static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{SEAMCL_MASK_SEAM}));
+    const size_t boundary = static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{SEAMCL_MASK_BOUNDARY}));
+    by_msaa[std::to_string(msaa)] = {
+        {"pixels", pixels},
+        {"coverage", mask.empty() ? 0.0 : static_cast<double>(pixels) / static_cast<double>(mask.size())},
+        {"boundary_pixels", boundary}};
+  }
+  const std::vector<uint8_t>& mask = masks.at(first_rate);
+  return {{"reference_method", first().method},
+          {"reference", reference_json(first(), with_cache_path)},
+          {"references", references},
+          {"seam_pixels", static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{SEAMCL_MASK_SEAM}))},
+          {"seam_mask", {{"definition", "footprint"}, {"by_msaa", by_msaa}}}};
+}
+
+ComparisonTargets prepare_targets(ClRuntime& runtime, Renderer& renderer, const Camera& camera,
+                                  const RenderOptions& frame, const std::vector<MethodEntry>& entries,
+                                  const ReferenceSettings& settings, const std::vector<ReferenceKind>& kinds,
+                                  const Progress& progress) {
+  ComparisonTargets targets;
+  targets.kinds = kinds;
+  if (kinds.empty()) throw InputError("reference", "name at least one reference");
+  const Scene& scene = renderer.scene();
+  std::vector<ReferenceKind> high_res_kinds;
+  for (ReferenceKind kind : kinds)
+    if (kind != ReferenceKind::Seamless) high_res_kinds.push_back(kind);
+  const bool analytic = std::find(kinds.begin(), kinds.end(), ReferenceKind::Analytic) != kinds.end();
+  if (analytic && !scene.albedo) {
+    throw InputError("reference", "the analytic reference needs the function the textures were baked from; scene '" +
+                                      scene.name + "' has none (its textures came from files)");
+  }
+  std::optional<Scene> seamless;
+  if (high_res_kinds.size() != kinds.size()) seamless = seamless_scene(scene);
+  auto say = [&](const std::string& line) {
+    if (progress) progress(line);
+  };
+
+  for (const MethodEntry& entry : entries) {
+    if (targets.masks.count(entry.options.msaa)) continue;
+    say("seam mask at msaa " + std::to_string(entry.options.msaa));
+    targets.masks[entry.options.msaa] = footprint_seam_mask(renderer, camera, entry.options);
+  }
+  if (!high_res_kinds.empty()) {
+    const RenderOptions high = reference_render_options(frame, settings);
+    std::string names;
+    for (ReferenceKind kind : high_res_kinds) names += (names.empty() ? "" : ", ") + to_string(kind);
+    say("references " + names + " from one " + std::to_string(high.width) + "x" + std::to_string(high.height) +
+        " render (or the cache)");
+    targets.high_res = reference_images(renderer, camera, frame, settings, high_res_kinds);
+  }
+  if (seamless) {
+    Renderer seamless_renderer(runtime);
+    seamless_renderer.load_scene(*seamless, frame.texels);
+    for (const MethodEntry& entry : entries) {
+      if (targets.seamless_by_rate.count(entry.options.msaa)) continue;
+      say("seamless reference at msaa " + std::to_string(entry.options.msaa));
+      targets.seamless_by_rate[entry.options.msaa] = seamless_reference(seamless_renderer, camera, entry.options);
+    }
+  }
+  return targets;
 }
 
 double median_of(std::vector<double> v) {
@@ -121,10 +234,15 @@ json errors_json(const ImageErrors& errors) {
           {"seam_mean", finite_or_zero(errors.seam.mean)},
           {"seam_p99", finite_or_zero(errors.seam.p99)},
           {"seam_max", finite_or_zero(errors.seam.max)},
+          {"off_seam_mean", finite_or_zero(errors.off_seam.mean)},
+          {"off_seam_p99", finite_or_zero(errors.off_seam.p99)},
+          {"off_seam_max", finite_or_zero(errors.off_seam.max)},
           {"nan_pixels", errors.nan_pixels},
           {"seam_nan_pixels", errors.seam_nan_pixels},
           {"pixels", errors.all.pixels},
-          {"seam_pixels", errors.seam.pixels}};
+          {"seam_pixels", errors.seam.pixels},
+          {"off_seam_pixels", errors.off_seam.pixels},
+          {"seam_coverage", finite_or_zero(errors.seam_coverage)}};
 }
 
 json compare_result_json(const EntryResult& result) {
@@ -144,6 +262,11 @@ json compare_result_json(const EntryResult& result) {
     item["error"] = errors_json(*result.errors);
     item["curve"] = curve_json(result.errors->all);
     item["seam_curve"] = curve_json(result.errors->seam);
+  }
+  if (result.errors_by_reference.size() > 1) {
+    json by_reference = json::object();
+    for (const auto& [name, errors] : result.errors_by_reference) by_reference[name] = errors_json(errors);
+    item["errors"] = by_reference;
   }
   return item;
 }

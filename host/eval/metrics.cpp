@@ -111,6 +111,11 @@ std::vector<uint8_t> seam_mask(const FaceMap& faces, int radius) {
   return mask;
 }
 
+std::vector<uint8_t> footprint_seam_mask(Renderer& renderer, const Camera& camera, RenderOptions options) {
+  options.method = Method::Black;
+  return renderer.render(camera, options, true).seam_mask;
+}
+
 std::vector<float> pixel_distances(const std::vector<glm::vec4>& test, const std::vector<glm::vec4>& reference) {
   if (test.size() != reference.size()) {
     throw std::invalid_argument("pixel_distances: " + std::to_string(test.size()) + " test pixels vs " +
@@ -170,13 +175,23 @@ ImageErrors compare_images(const std::vector<glm::vec4>& test, const std::vector
   for (size_t i = 0; i < e.distance.size(); ++i) {
     if (std::isfinite(e.distance[i])) continue;
     ++e.nan_pixels;
-    if (mask && (*mask)[i]) ++e.seam_nan_pixels;
+    if (mask && (*mask)[i] == SEAMCL_MASK_SEAM) ++e.seam_nan_pixels;
   }
   e.all = error_stats(e.distance);
   if (mask) {
-    e.seam = error_stats(e.distance, mask);
+    // Seam: value 1; off the seams: value 0; a footprint mask's boundary pixels (2) are neither.
+    std::vector<uint8_t> seam(mask->size()), off(mask->size());
+    for (size_t i = 0; i < mask->size(); ++i) {
+      seam[i] = (*mask)[i] == SEAMCL_MASK_SEAM ? 1 : 0;
+      off[i] = (*mask)[i] == SEAMCL_MASK_NONE ? 1 : 0;
+    }
+    e.seam = error_stats(e.distance, &seam);
+    e.off_seam = error_stats(e.distance, &off);
+    const size_t covered = static_cast<size_t>(std::count(seam.begin(), seam.end(), uint8_t{1}));
+    e.seam_coverage = mask->empty() ? 0.0 : static_cast<double>(covered) / static_cast<double>(mask->size());
   } else {
     e.seam.curve.assign(static_cast<size_t>(kCurveSteps), 0.0);
+    e.off_seam = e.all;
   }
   return e;
 }

@@ -10,10 +10,18 @@
 // - p99: the nearest-rank 99th percentile, the ceil(0.99 n)-th smallest distance (1-based);
 // - curve: for x_i = 10^(-4 + i/10), i = 0..40 (1e-4 .. 1, 41 steps, 10 per decade), the fraction
 //   of the finite pixels with distance >= x_i;
-// - seam mask: pixels within Chebyshev distance kSeamRadius (2, i.e. a 5x5 square) of a seam
-//   pixel. A seam pixel is a covered pixel with a 4-neighbour covered by a *different face*, or a
-//   pixel whose samples mix faces (FaceMap::mixed). Face-to-background edges (silhouettes) are not
-//   seams: they are geometry, the same for every seam method.
+// - seam mask (the default, footprint_seam_mask), from the shade stage itself
+//   (kernels/shade_resolve.cl), per pixel: SEAMCL_MASK_SEAM (1) where some fragment's texture
+//   footprint, at the rate, shading, filter and anisotropy rendered, crosses an edge shared by two
+//   faces; SEAMCL_MASK_BOUNDARY (2) where footprints cross mesh boundary edges only (silhouette
+//   rims, whose error is mostly geometry); SEAMCL_MASK_NONE (0) elsewhere, and there every seam
+//   method returns the same colour. `seam` statistics are over the value 1, `off_seam` over 0:
+//   errors over the seams are the methods' own, errors off them what all methods share
+//   (silhouettes, filtering, the reference). A 0/1 mask (the boundary band) works the same way.
+// - boundary band (seam_mask(FaceMap), the earlier mask, kept for bench's temporal measure):
+//   pixels within Chebyshev distance kSeamRadius (2, i.e. a 5x5 square) of a pixel that has a
+//   4-neighbour covered by a *different face*, or whose samples mix faces (FaceMap::mixed).
+//   Face-to-background edges (silhouettes) are not seams there.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -53,8 +61,14 @@ FaceMap face_map_from_winners(const std::vector<uint32_t>& winners, const std::v
 // face id map of that frame at its own size.
 FaceMap render_face_map(Renderer& renderer, const Camera& camera, RenderOptions options);
 
-// 1 for the pixels near a seam (see above), 0 elsewhere.
+// The boundary band (see above): 1 for the pixels near a face boundary, 0 elsewhere.
 std::vector<uint8_t> seam_mask(const FaceMap& faces, int radius = kSeamRadius);
+
+// The footprint seam mask of a frame (see above): `options` rendered with the seam mask output.
+// The mask does not depend on the seam method, so it is rendered with black (border-addressed,
+// without guard bands) whatever options.method says; the rate, shading, filter and anisotropy are
+// the options'.
+std::vector<uint8_t> footprint_seam_mask(Renderer& renderer, const Camera& camera, RenderOptions options);
 
 struct ErrorStats {
   size_t pixels = 0;  // finite pixels counted (inside the mask, if any)
@@ -66,7 +80,9 @@ struct ErrorStats {
 
 struct ImageErrors {
   ErrorStats all;
-  ErrorStats seam;            // over the seam mask (all zero and pixels = 0 without one)
+  ErrorStats seam;            // over the seam pixels (mask 1; all zero and pixels = 0 without a mask)
+  ErrorStats off_seam;        // over the pixels off every edge (mask 0; equal to `all` without a mask)
+  double seam_coverage = 0;   // seam pixels / all pixels (0 without a mask)
   size_t nan_pixels = 0;      // non-finite pixels, whole frame
   size_t seam_nan_pixels = 0; // non-finite pixels inside the seam mask
   std::vector<float> distance;  // per pixel; NaN where non-finite

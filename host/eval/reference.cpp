@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <functional>
+#include <map>
+#include <optional>
+#include <set>
 #include <thread>
 
 #include <chrono>
@@ -186,6 +189,59 @@ CacheTrim trim_reference_cache(const std::string& dir, std::uintmax_t max_bytes,
   return trim;
 }
 
+std::optional<ReferenceKind> parse_reference_kind(std::string_view name) {
+  if (name == "paper") return ReferenceKind::Paper;
+  if (name == "box") return ReferenceKind::Box;
+  if (name == "analytic") return ReferenceKind::Analytic;
+  if (name == "seamless") return ReferenceKind::Seamless;
+  return std::nullopt;
+}
+
+std::string to_string(ReferenceKind kind) {
+  switch (kind) {
+    case ReferenceKind::Paper: return "paper";
+    case ReferenceKind::Box: return "box";
+    case ReferenceKind::Analytic: return "analytic";
+    case ReferenceKind::Seamless: return "seamless";
+  }
+  return "paper";
+}
+
+std::vector<std::string> reference_kind_names() { return {"paper", "box", "analytic", "seamless"}; }
+
+std::vector<ReferenceKind> parse_reference_kinds(const std::vector<std::string>& names) {
+  std::vector<ReferenceKind> kinds;
+  for (const std::string& name : names) {
+    const std::optional<ReferenceKind> kind = parse_reference_kind(name);
+    if (!kind) throw InputError("reference", "unknown reference '" + name + "' (one of paper, box, analytic, seamless)");
+    if (std::find(kinds.begin(), kinds.end(), *kind) == kinds.end()) kinds.push_back(*kind);
+  }
+  if (kinds.empty()) throw InputError("reference", "name at least one reference");
+  return kinds;
+}
+
+std::vector<glm::vec4> downsample_box(const std::vector<glm::vec4>& pixels, int width, int height, int factor) {
+  if (factor < 1 || width < factor || height < factor || width % factor != 0 || height % factor != 0 ||
+      pixels.size() != static_cast<size_t>(width) * static_cast<size_t>(height)) {
+    throw std::invalid_argument("downsample_box: " + std::to_string(width) + "x" + std::to_string(height) +
+                                " is not a multiple of " + std::to_string(factor));
+  }
+  const int out_w = width / factor, out_h = height / factor;
+  std::vector<glm::vec4> out(static_cast<size_t>(out_w) * static_cast<size_t>(out_h));
+  for (int y = 0; y < out_h; ++y) {
+    for (int x = 0; x < out_w; ++x) {
+      glm::dvec4 sum(0.0);  // in double: 64 terms, no order dependence worth the name
+      for (int j = 0; j < factor; ++j)
+        for (int i = 0; i < factor; ++i)
+          sum += glm::dvec4(pixels[static_cast<size_t>(y * factor + j) * static_cast<size_t>(width) +
+                                   static_cast<size_t>(x * factor + i)]);
+      out[static_cast<size_t>(y) * static_cast<size_t>(out_w) + static_cast<size_t>(x)] =
+          glm::vec4(sum / static_cast<double>(factor * factor));
+    }
+  }
+  return out;
+}
+
 double mitchell_netravali(double x, double b, double c) {
   x = std::fabs(x);
   if (x < 1.0) return ((12 - 9 * b - 6 * c) * x * x * x + (-18 + 12 * b + 6 * c) * x * x + (6 - 2 * b)) / 6.0;
@@ -257,7 +313,8 @@ RenderOptions reference_render_options(const RenderOptions& frame, const Referen
 std::string reference_cache_key(const Scene& scene, const Camera& camera, const RenderOptions& frame,
                                 const ReferenceSettings& settings) {
   const RenderOptions high = reference_render_options(frame, settings);
-  const nlohmann::json key = {
+  using nlohmann::json;
+  const json key = {
       {"version", SEAMCL_VERSION},
       {"kernels", text_hash(program_source())},
       {"scene", scene_content_hash(scene)},
@@ -266,15 +323,22 @@ std::string reference_cache_key(const Scene& scene, const Camera& camera, const 
         camera.up.y, camera.up.z, camera.fov_y_degrees}},
       {"render", to_json(high)},
       {"scale", kReferenceScale},
-      {"filter", {{"name", "mitchell"}, {"width", kMitchellWidth}, {"B", kMitchellB}, {"C", kMitchellC}}},
+      {"filter", settings.kind == ReferenceKind::Box
+                     ? json{{"name", "box"}}
+                     : json{{"name", "mitchell"}, {"width", kMitchellWidth}, {"B", kMitchellB}, {"C", kMitchellC}}},
   };
   return key.dump();
 }
 
 ReferenceImage reference_image(const Scene& scene, const Camera& camera, const RenderOptions& frame,
                                const ReferenceSettings& settings, const HighResRender& render) {
+  if (settings.kind != ReferenceKind::Paper && settings.kind != ReferenceKind::Box) {
+    throw InputError("reference", "the " + to_string(settings.kind) + " reference is not a downsampled render "
+                                  "(reference_images and seamless_reference make it)");
+  }
   const RenderOptions high = reference_render_options(frame, settings);
   ReferenceImage ref;
+  ref.kind = settings.kind;
   ref.width = frame.width;
   ref.height = frame.height;
   ref.method = to_string(high.method);
@@ -300,7 +364,8 @@ ReferenceImage reference_image(const Scene& scene, const Camera& camera, const R
                                std::to_string(big.height) + ", asked for " + std::to_string(high.width) + "x" +
                                std::to_string(high.height));
     }
-    ref.pixels = downsample_mitchell(big.pixels, big.width, big.height, kReferenceScale);
+    ref.pixels = settings.kind == ReferenceKind::Box ? downsample_box(big.pixels, big.width, big.height, kReferenceScale)
+                                                     : downsample_mitchell(big.pixels, big.width, big.height, kReferenceScale);
   }
   ref.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   if (settings.use_cache) {
@@ -324,11 +389,281 @@ ReferenceImage reference_image(Renderer& renderer, const Camera& camera, const R
   });
 }
 
+namespace {
+
+// uv of a triangle's planes at a pixel-space point, perspective-correct: the interpolation the
+// shade stage does (kernels/shade_resolve.cl, interpolate_uv), without the derivatives.
+glm::vec2 plane_uv(const TriangleSetup& t, float x, float y) {
+  const float dx = x - t.ref_x, dy = y - t.ref_y;
+  const float inv_w = t.inv_w[0] + t.inv_w[1] * dx + t.inv_w[2] * dy;
+  const float w = 1.0f / inv_w;
+  return {(t.u_over_w[0] + t.u_over_w[1] * dx + t.u_over_w[2] * dy) * w,
+          (t.v_over_w[0] + t.v_over_w[1] * dx + t.v_over_w[2] * dy) * w};
+}
+
+}  // namespace
+
+std::vector<glm::vec4> analytic_image(Renderer& renderer, const Scene& scene) {
+  if (!scene.albedo) {
+    throw InputError("reference", "the analytic reference needs the function the textures were baked from; scene '" +
+                                      scene.name + "' has none (its textures came from files)");
+  }
+  const FrameParams f = renderer.last_frame_params();
+  if (f.sample_count != 1) throw std::logic_error("analytic_image: the frame must have 1 sample per pixel");
+  const std::vector<uint32_t> winners = renderer.read_sample_triangles();
+  const std::vector<TriangleSetup> setups = renderer.read_setups();
+  const PackedScene& packed = renderer.packed_scene();
+  const glm::vec3 background(f.background[0], f.background[1], f.background[2]);
+  std::vector<glm::vec4> image(static_cast<size_t>(f.width) * static_cast<size_t>(f.height));
+  // Rows in parallel: the 8x frame of a 480x540 image is 16.6 million albedo evaluations.
+  auto shade_rows = [&](int first, int step) {
+    for (int y = first; y < f.height; y += step) {
+      for (int x = 0; x < f.width; ++x) {
+        const size_t pixel = static_cast<size_t>(y) * static_cast<size_t>(f.width) + static_cast<size_t>(x);
+        glm::vec3 sum(0.0f);
+        {
+          const uint32_t slot = winners[pixel];
+          if (slot == SEAMCL_NO_TRIANGLE) {
+            image[pixel] = glm::vec4(background, 1.0f);
+            continue;
+          }
+          const TriangleSetup& t = setups[slot];
+          const glm::vec2 uv = plane_uv(t, static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+          // The pixel centre lies inside its triangle, so uv is inside the face up to rounding.
+          const glm::vec3 point = face_point(scene.corners(scene.faces[t.face]), std::clamp(uv.x, 0.0f, 1.0f),
+                                             std::clamp(uv.y, 0.0f, 1.0f));
+          const glm::vec4 albedo = scene.albedo(t.face, point);
+          const FaceGpu& face = packed.faces[t.face];
+          const float n_dot_l =
+              face.normal[0] * f.light_dir[0] + face.normal[1] * f.light_dir[1] + face.normal[2] * f.light_dir[2];
+          const float lighting = f.ambient + (1.0f - f.ambient) * std::fmax(n_dot_l, 0.0f);
+          sum += glm::vec3(albedo.x * f.light_color[0], albedo.y * f.light_color[1], albedo.z * f.light_color[2]) *
+                 lighting;
+        }
+        image[pixel] = glm::vec4(sum, 1.0f);
+      }
+    }
+  };
+  const int threads = static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+  std::vector<std::thread> helpers;
+  for (int t = 1; t < threads; ++t) helpers.emplace_back(shade_rows, t, threads);
+  shade_rows(0, threads);
+  for (std::thread& helper : helpers) helper.join();
+  return image;
+}
+
+std::vector<ReferenceImage> reference_images(Renderer& renderer, const Camera& camera, const RenderOptions& frame,
+                                             const ReferenceSettings& settings, const std::vector<ReferenceKind>& kinds) {
+  // One 8x render, made when the first reference needs it and kept until the last is done.
+  std::optional<RenderResult> high_res;
+  auto render_once = [&](const RenderOptions& high) {
+    if (!high_res) high_res = renderer.render(camera, high);
+    return *high_res;
+  };
+  std::vector<ReferenceImage> images;
+  for (ReferenceKind kind : kinds) {
+    ReferenceSettings kind_settings = settings;
+    kind_settings.kind = kind;
+    if (kind == ReferenceKind::Seamless) {
+      throw InputError("reference", "the seamless reference is rendered per measured rate (seamless_reference)");
+    }
+    if (kind != ReferenceKind::Analytic) {
+      images.push_back(reference_image(renderer.scene(), camera, frame, kind_settings, render_once));
+      continue;
+    }
+    const Scene& scene = renderer.scene();
+    if (!scene.albedo) {
+      throw InputError("reference", "the analytic reference needs the function the textures were baked from; scene '" +
+                                        scene.name + "' has none (its textures came from files)");
+    }
+    const auto start = std::chrono::steady_clock::now();
+    // The subsamples are the 8x frame's pixel centres: one sample per pixel whatever the other
+    // references use.
+    kind_settings.msaa = 1;
+    const RenderOptions high = reference_render_options(frame, kind_settings);
+    // The analytic image reads the winners of the Renderer's last frame: render it now unless that
+    // is this frame (the other references may have come from the cache).
+    const FrameParams last = renderer.last_frame_params();
+    if (!high_res || last.width != high.width || last.height != high.height || last.sample_count != 1) {
+      high_res = renderer.render(camera, high);
+    }
+    const std::vector<glm::vec4> fine = analytic_image(renderer, scene);
+    ReferenceImage ref;
+    ref.kind = kind;
+    ref.width = frame.width;
+    ref.height = frame.height;
+    ref.method = "albedo";
+    ref.msaa = high.msaa;
+    ref.pixels = downsample_mitchell(fine, high.width, high.height, kReferenceScale);
+    ref.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    images.push_back(std::move(ref));
+  }
+  // The 8x frame's buffers are 64x a frame's: not kept for the renders that follow.
+  renderer.release_frame_buffers();
+  return images;
+}
+
+namespace {
+
+// The grid position of every face of a seamless grid, or why there is none.
+struct GridLayout {
+  int columns = 0, rows = 0;
+  std::vector<size_t> faces;  // row-major, row 0 at v = 0
+  std::string why_not;
+};
+
+GridLayout grid_layout(const Scene& scene) {
+  GridLayout grid;
+  const size_t n = scene.faces.size();
+  // Right neighbour: its corners 0 and 3 are this face's 1 and 2; upper: its 0 and 1 are 3 and 2.
+  std::map<std::pair<uint32_t, uint32_t>, size_t> by_left_edge, by_bottom_edge;
+  for (size_t f = 0; f < n; ++f) {
+    const auto& v = scene.faces[f].vertices;
+    by_left_edge[{v[0], v[3]}] = f;
+    by_bottom_edge[{v[0], v[1]}] = f;
+  }
+  auto right_of = [&](size_t f) -> std::optional<size_t> {
+    const auto& v = scene.faces[f].vertices;
+    const auto it = by_left_edge.find({v[1], v[2]});
+    return it == by_left_edge.end() ? std::nullopt : std::optional<size_t>(it->second);
+  };
+  auto above = [&](size_t f) -> std::optional<size_t> {
+    const auto& v = scene.faces[f].vertices;
+    const auto it = by_bottom_edge.find({v[3], v[2]});
+    return it == by_bottom_edge.end() ? std::nullopt : std::optional<size_t>(it->second);
+  };
+  std::vector<bool> has_left(n, false), has_below(n, false);
+  for (size_t f = 0; f < n; ++f) {
+    if (auto r = right_of(f)) has_left[*r] = true;
+    if (auto a = above(f)) has_below[*a] = true;
+  }
+  std::vector<size_t> origins;
+  for (size_t f = 0; f < n; ++f)
+    if (!has_left[f] && !has_below[f]) origins.push_back(f);
+  if (origins.size() != 1) {
+    grid.why_not = "its faces do not form one grid of consistently oriented quads";
+    return grid;
+  }
+  // Walks stop after n faces: on a closed surface they would go round for ever.
+  std::vector<size_t> row_start{origins[0]};
+  while (row_start.size() <= n) {
+    const auto a = above(row_start.back());
+    if (!a) break;
+    row_start.push_back(*a);
+  }
+  grid.rows = static_cast<int>(row_start.size());
+  for (size_t r = 0; r < row_start.size(); ++r) {
+    std::vector<size_t> row{row_start[r]};
+    while (row.size() <= n) {
+      const auto next = right_of(row.back());
+      if (!next) break;
+      row.push_back(*next);
+    }
+    if (r == 0) grid.columns = static_cast<int>(row.size());
+    if (static_cast<int>(row.size()) != grid.columns) {
+      grid.why_not = "its faces do not form a rectangular grid";
+      return grid;
+    }
+    for (size_t c = 0; c < row.size(); ++c) {
+      if (r > 0 && above(grid.faces[(r - 1) * row.size() + c]) != row[c]) {
+        grid.why_not = "its faces do not form a rectangular grid";
+        return grid;
+      }
+      grid.faces.push_back(row[c]);
+    }
+  }
+  if (grid.faces.size() != n || std::set<size_t>(grid.faces.begin(), grid.faces.end()).size() != n) {
+    grid.why_not = "not every face belongs to the grid once";
+  }
+  return grid;
+}
+
+}  // namespace
+
+Scene seamless_scene(const Scene& scene) {
+  auto refuse = [&](const std::string& why) {
+    return InputError("reference", "the seamless reference needs a planar grid of equal-resolution faces; scene '" +
+                                       scene.name + "': " + why);
+  };
+  const GridLayout grid = grid_layout(scene);
+  if (!grid.why_not.empty()) throw refuse(grid.why_not);
+  const int w = scene.faces[grid.faces[0]].texture.width(), h = scene.faces[grid.faces[0]].texture.height();
+  for (size_t f : grid.faces) {
+    if (scene.faces[f].texture.width() != w || scene.faces[f].texture.height() != h) {
+      throw refuse("its faces' textures differ in size");
+    }
+  }
+  const int W = w * grid.columns, H = h * grid.rows;
+  if ((W & (W - 1)) != 0 || (H & (H - 1)) != 0) {
+    throw refuse("the combined texture (" + std::to_string(W) + "x" + std::to_string(H) + ") is not a power of two");
+  }
+  // The grid's vertices on a parallelogram lattice: corner (i, j) at p00 + i a + j b.
+  auto corner = [&](int i, int j) {
+    const int c = std::min(i, grid.columns - 1), r = std::min(j, grid.rows - 1);
+    const Face& face = scene.faces[grid.faces[static_cast<size_t>(r * grid.columns + c)]];
+    const int k = (i > c ? 1 : 0) + (j > r ? 2 : 0);  // 0: corner 0, 1: corner 1, 2: corner 3, 3: corner 2
+    const int index[4] = {0, 1, 3, 2};
+    return scene.positions[face.vertices[static_cast<size_t>(index[k])]];
+  };
+  const glm::vec3 p00 = corner(0, 0);
+  const glm::vec3 a = corner(1, 0) - p00, b = corner(0, 1) - p00;
+  const float tolerance = 1e-5f * (glm::length(a) * static_cast<float>(grid.columns) + glm::length(b) * static_cast<float>(grid.rows));
+  for (int j = 0; j <= grid.rows; ++j)
+    for (int i = 0; i <= grid.columns; ++i)
+      if (glm::length(corner(i, j) - (p00 + static_cast<float>(i) * a + static_cast<float>(j) * b)) > tolerance)
+        throw refuse("its corners are not a planar, evenly spaced grid");
+  TextureLevel combined{W, H, std::vector<glm::vec4>(static_cast<size_t>(W) * static_cast<size_t>(H))};
+  for (int r = 0; r < grid.rows; ++r)
+    for (int c = 0; c < grid.columns; ++c) {
+      const TextureLevel& level = scene.faces[grid.faces[static_cast<size_t>(r * grid.columns + c)]].texture.levels.front();
+      for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i)
+          combined.texels[static_cast<size_t>(r * h + j) * static_cast<size_t>(W) + static_cast<size_t>(c * w + i)] =
+              level.at(i, j);
+    }
+  Scene out;
+  out.name = scene.name + "-seamless";
+  out.positions = {corner(0, 0), corner(grid.columns, 0), corner(grid.columns, grid.rows), corner(0, grid.rows)};
+  out.faces.push_back({{0, 1, 2, 3}, build_mip_chain(std::move(combined))});
+  out.camera = scene.camera;
+  out.orbit = scene.orbit;
+  out.light = scene.light;
+  out.background = scene.background;
+  validate_scene(out);
+  return out;
+}
+
+ReferenceImage seamless_reference(Renderer& seamless, const Camera& camera, const RenderOptions& frame) {
+  const auto start = std::chrono::steady_clock::now();
+  RenderOptions options = frame;
+  options.method = Method::Discard;
+  ReferenceImage ref;
+  ref.kind = ReferenceKind::Seamless;
+  ref.width = frame.width;
+  ref.height = frame.height;
+  ref.method = to_string(options.method);
+  ref.msaa = frame.msaa;
+  ref.pixels = seamless.render(camera, options).pixels;
+  ref.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return ref;
+}
+
 nlohmann::json reference_json(const ReferenceImage& reference, bool with_cache_path) {
-  nlohmann::json out = {{"method", reference.method},     {"msaa", reference.msaa},      {"scale", kReferenceScale},
-                        {"filter", "mitchell"},           {"filter_width", kMitchellWidth}, {"B", kMitchellB},
-                        {"C", kMitchellC},                {"from_cache", reference.from_cache},
+  if (reference.kind == ReferenceKind::Seamless) {
+    return {{"name", "seamless"}, {"method", reference.method}, {"msaa", reference.msaa}, {"scale", 1},
+            {"filter", "the measured frame's"}, {"from_cache", false}, {"ms", reference.render_ms}};
+  }
+  nlohmann::json out = {{"name", to_string(reference.kind)}, {"method", reference.method}, {"msaa", reference.msaa},
+                        {"scale", kReferenceScale},          {"from_cache", reference.from_cache},
                         {"ms", reference.render_ms}};
+  if (reference.kind == ReferenceKind::Box) {
+    out["filter"] = "box";
+  } else {
+    out["filter"] = "mitchell";
+    out["filter_width"] = kMitchellWidth;
+    out["B"] = kMitchellB;
+    out["C"] = kMitchellC;
+  }
   if (with_cache_path) out["cache_path"] = reference.cache_path;
   return out;
 }

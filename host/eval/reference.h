@@ -16,7 +16,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -28,6 +30,27 @@
 
 namespace seamcl {
 
+// The references an image can be measured against, each named in the results:
+//   paper    - the reference method (traverse) at 8x width and height, 1 sample per pixel, then a
+//              Mitchell-Netravali downsample (B = C = 1/3): the paper's;
+//   box      - the same 8x render with a box downsample (the mean of each 8x8 block), as an MSAA
+//              resolve filters (Mitchell rings at silhouettes);
+//   analytic - the same 8x frame at 1 sample per pixel (its geometry and lighting), each of its
+//              pixel centres (the subsamples) coloured by the function the textures were baked
+//              from (Scene::albedo) at its surface point instead of any texture lookup, then the
+//              Mitchell downsample: no seam method is favoured. Scenes without such a function
+//              are refused;
+//   seamless - for a planar grid of equal-resolution faces, which is one continuous texture:
+//              the grid rendered as one face carrying the combined texture, at the measured
+//              frame's own rate, filter and anisotropy. What a perfect seam method returns, so
+//              any difference is the seam method's alone. Other scenes are refused.
+enum class ReferenceKind { Paper, Box, Analytic, Seamless };
+std::optional<ReferenceKind> parse_reference_kind(std::string_view name);
+std::string to_string(ReferenceKind kind);
+std::vector<std::string> reference_kind_names();
+// "paper,box" -> kinds, in order, without repeats; InputError("reference") for an unknown name.
+std::vector<ReferenceKind> parse_reference_kinds(const std::vector<std::string>& names);
+
 inline constexpr int kReferenceScale = 8;             // 8x width and 8x height
 inline constexpr float kMitchellWidth = 4.0f;         // full width in output pixels (radius 2)
 inline constexpr double kMitchellB = 1.0 / 3.0;
@@ -36,6 +59,10 @@ inline constexpr long long kMaxReferencePixels = 1LL << 26;  // 8W x 8H; 64 Mpix
 
 // The Mitchell-Netravali (1988) cubic, support |x| < 2, integral 1.
 double mitchell_netravali(double x, double b = kMitchellB, double c = kMitchellC);
+
+// The mean of each factor x factor block (width and height multiples of `factor`;
+// std::invalid_argument otherwise).
+std::vector<glm::vec4> downsample_box(const std::vector<glm::vec4>& pixels, int width, int height, int factor);
 
 // Downsamples linear RGBA (width and height multiples of `factor`) by `factor` with OIIO's
 // "mitchell" resize at kMitchellWidth output pixels. Throws std::invalid_argument on bad sizes and
@@ -50,6 +77,7 @@ int default_reference_msaa(const std::string& method);
 inline constexpr std::uintmax_t kDefaultReferenceCacheBytes = std::uintmax_t{256} << 20;  // 256 MiB
 
 struct ReferenceSettings {
+  ReferenceKind kind = ReferenceKind::Paper;  // paper or box here; analytic and seamless below
   std::string method;      // empty: default_reference_method()
   int msaa = 0;            // 0: default_reference_msaa(method)
   std::string cache_dir;   // empty: default_cache_dir()
@@ -79,6 +107,7 @@ struct ReferenceImage {
   int width = 0;
   int height = 0;
   std::vector<glm::vec4> pixels;  // linear RGBA at the frame's size
+  ReferenceKind kind = ReferenceKind::Paper;
   std::string method;             // the reference method used
   int msaa = 1;                   // its samples per pixel at 8x
   bool from_cache = false;
@@ -117,6 +146,32 @@ CacheTrim trim_reference_cache(const std::string& dir, std::uintmax_t max_bytes,
 // frame buffers (Renderer::release_frame_buffers): the 8x frame's are not kept.
 ReferenceImage reference_image(Renderer& renderer, const Camera& camera, const RenderOptions& frame,
                                const ReferenceSettings& settings);
+
+// The paper, box and analytic references of one frame from one 8x render (the analytic one
+// evaluates Scene::albedo over that render's own fragments, so the three share their geometry
+// exactly). Paper and box go through the cache as reference_image does; analytic is never
+// cached. Throws InputError("reference") for seamless (see seamless_reference) and for analytic
+// on a scene without an albedo function. The results come in the order of `kinds`.
+std::vector<ReferenceImage> reference_images(Renderer& renderer, const Camera& camera, const RenderOptions& frame,
+                                             const ReferenceSettings& settings, const std::vector<ReferenceKind>& kinds);
+
+// The analytic image of a frame already rendered by `renderer` (its last render, 1 sample per
+// pixel): per pixel, background where nothing is covered, else albedo(face, the surface point at
+// the pixel centre) times the face's lighting. Exposed for the tests.
+std::vector<glm::vec4> analytic_image(Renderer& renderer, const Scene& scene);
+
+// The seamless reference's scene: `scene` when its faces form a planar grid (each face's right
+// and upper neighbours share its edge's two vertices in the same orientation, the corners lie
+// on a regular parallelogram lattice) of equal texture sizes whose combined size is a power of
+// two per side; then one face over the grid's outline whose texture is the faces' level 0 side
+// by side (its mip chain rebuilt: each level is the faces' same level side by side). Same
+// camera, orbit, light and background. InputError("reference", why) for any other scene.
+Scene seamless_scene(const Scene& scene);
+
+// The seamless reference of one measured frame: `seamless` (a Renderer with seamless_scene
+// loaded) renders `frame`'s options (rate, filter, anisotropy, shading, texels) with discard: on
+// a single face, at the grid's outline, the same as traverse.
+ReferenceImage seamless_reference(Renderer& seamless, const Camera& camera, const RenderOptions& frame);
 
 // How a reference was made, as compare, bench and the HTTP service report it: method, msaa,
 // scale, filter and its width, B, C, whether it came from the cache, ms; with_cache_path adds

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include <seamcl/pipeline/render_memory.h>
+#include <seamcl/core/input_error.h>
 #include <seamcl/core/over_budget.h>
 #include "core/srgb.h"
 #include "pipeline/adjacency.h"
@@ -50,7 +51,8 @@ struct Renderer::Impl {
 
   // Frame buffers, grown on demand.
   cl::Buffer frame_params, stats, setups, tile_counts, tile_offsets, tile_cursors, tile_lists, sample_triangle, image;
-  size_t setups_capacity = 0, tiles_capacity = 0, samples_capacity = 0, pixels_capacity = 0;
+  cl::Buffer seam_mask;  // only once a render asks for the mask
+  size_t setups_capacity = 0, tiles_capacity = 0, samples_capacity = 0, pixels_capacity = 0, mask_capacity = 0;
   uint32_t bin_capacity = 0;         // tile-list entries the next frame asks for
   uint32_t tile_lists_capacity = 0;  // entries allocated
   FrameParams last_params{};
@@ -66,8 +68,8 @@ struct Renderer::Impl {
   }
 
   // Makes the kernels of the program variant for this texel format and sampler current.
-  void use_kernels(TexelFormat format, const SamplerParams& sampler) {
-    const std::string options = program_options(format, sampler, scene->environment.has_value());
+  void use_kernels(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask) {
+    const std::string options = program_options(format, sampler, with_seam_mask, scene->environment.has_value());
     auto it = kernel_sets.find(options);
     if (it == kernel_sets.end()) {
       const cl::Program& program = runtime.program(options);
@@ -122,8 +124,8 @@ struct Renderer::Impl {
   }
 
   void release_frame_buffers() {
-    setups = tile_counts = tile_offsets = tile_cursors = tile_lists = sample_triangle = image = cl::Buffer();
-    setups_capacity = tiles_capacity = samples_capacity = pixels_capacity = 0;
+    setups = tile_counts = tile_offsets = tile_cursors = tile_lists = sample_triangle = image = seam_mask = cl::Buffer();
+    setups_capacity = tiles_capacity = samples_capacity = pixels_capacity = mask_capacity = 0;
     tile_lists_capacity = 0;
     // What a scene needed once is not kept either: the lists start again at the initial size
     // (render_memory's estimate) and grow if this scene needs it.
@@ -169,7 +171,7 @@ struct Renderer::Impl {
     std::vector<cl::Event> setup, binning, raster, shade, readback;
   };
 
-  StageEvents enqueue_frame(const FrameParams& p, std::vector<glm::vec4>& pixels) {
+  StageEvents enqueue_frame(const FrameParams& p, std::vector<glm::vec4>& pixels, std::vector<uint8_t>* mask) {
     cl::CommandQueue& queue = runtime.queue();
     StageEvents ev;
     auto next = [](std::vector<cl::Event>& list) -> cl::Event* {
@@ -235,12 +237,22 @@ struct Renderer::Impl {
     shade_kernel.setArg(7, sample_triangle);
     shade_kernel.setArg(8, image);
     shade_kernel.setArg(9, stats);
-    shade_kernel.setArg(10, reflective_faces);
-    shade_kernel.setArg(11, cube_texels);
+    if (mask) {
+      grow(seam_mask, mask_capacity, static_cast<size_t>(p.width) * p.height, sizeof(cl_uchar), runtime.context());
+      shade_kernel.setArg(10, seam_mask);
+    } else {
+      shade_kernel.setArg(10, sizeof(cl_mem), nullptr);  // a null buffer: the variant never touches it
+    }
+    shade_kernel.setArg(11, reflective_faces);
+    shade_kernel.setArg(12, cube_texels);
     queue.enqueueNDRangeKernel(shade_kernel, cl::NullRange, tile_grid, tile_group, nullptr, next(ev.shade));
 
     pixels.resize(static_cast<size_t>(p.width) * p.height);
     queue.enqueueReadBuffer(image, CL_FALSE, 0, pixels.size() * sizeof(cl_float4), pixels.data(), nullptr, next(ev.readback));
+    if (mask) {
+      mask->resize(pixels.size());
+      queue.enqueueReadBuffer(seam_mask, CL_FALSE, 0, mask->size(), mask->data(), nullptr, next(ev.readback));
+    }
     queue.finish();
     return ev;
   }
@@ -278,7 +290,8 @@ size_t Renderer::device_bytes() const {
   for (const cl::Buffer* buffer :
        {&i.positions, &i.faces, &i.neighbors, &i.level_offsets, &i.texels, &i.reflective_faces, &i.cube_texels,
         &i.srgb_table, &i.frame_params, &i.stats,
-        &i.setups, &i.tile_counts, &i.tile_offsets, &i.tile_cursors, &i.tile_lists, &i.sample_triangle, &i.image}) {
+        &i.setups, &i.tile_counts, &i.tile_offsets, &i.tile_cursors, &i.tile_lists, &i.sample_triangle, &i.image,
+        &i.seam_mask}) {
     if ((*buffer)() != nullptr) bytes += buffer->getInfo<CL_MEM_SIZE>();
   }
   return bytes;
@@ -293,19 +306,23 @@ const PackedScene& Renderer::packed_scene() const { return impl_->packed; }
 
 const std::vector<float>& Renderer::cube_texels() const { return impl_->cube_host; }
 
-RenderResult Renderer::render(const Camera& camera, const RenderOptions& options) {
+RenderResult Renderer::render(const Camera& camera, const RenderOptions& options, bool with_seam_mask) {
   if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
-  if ((options.method == Method::Traverse || options.method == Method::Guardband) && !has_adjacency(impl_->packed.neighbors)) {
+  if ((reads_adjacency(options.method) || options.method == Method::Guardband) && !has_adjacency(impl_->packed.neighbors)) {
     throw InputError("method", to_string(options.method) + " reads each face's edge neighbours, and no two of the " +
                                    std::to_string(impl_->scene->faces.size()) + " faces of scene '" + impl_->scene->name +
                                    "' share an edge (faces are neighbours through shared vertex indices)");
+  }
+  if (with_seam_mask && options.method == Method::Guardband) {
+    throw InputError("method", "the seam mask is measured on the faces' own texels; guardband's bands would count as "
+                               "inside (any other method gives the same mask)");
   }
   const SamplerParams sampler = sampler_params(options);
   if (!impl_->uploaded || options.texels != impl_->packed.format || sampler.guard_band != impl_->packed.guard_band) {
     impl_->pack_and_upload(options.texels, sampler.guard_band);
   }
   impl_->upload_cube(impl_->scene->environment ? std::optional(cube_bake(options.cube_method)) : std::nullopt);
-  impl_->use_kernels(options.texels, sampler);
+  impl_->use_kernels(options.texels, sampler, with_seam_mask);
   RenderResult result;
   result.width = options.width;
   result.height = options.height;
@@ -315,7 +332,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     impl_->ensure_frame_buffers(params);
     impl_->bin_capacity = params.bin_capacity;
     impl_->last_params = params;
-    const Impl::StageEvents ev = impl_->enqueue_frame(params, result.pixels);
+    const Impl::StageEvents ev = impl_->enqueue_frame(params, result.pixels, with_seam_mask ? &result.seam_mask : nullptr);
     impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &result.stats);
     if (result.stats.bin_entries > params.bin_capacity) {
       // The lists overflowed (the kernels stayed in bounds): grow with headroom and render again.
@@ -348,7 +365,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   }
 }
 
-std::string program_options(TexelFormat format, const SamplerParams& sampler, bool environment) {
+std::string program_options(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask, bool environment) {
   return std::string(format == TexelFormat::Rgba32f ? "-DSEAMCL_TEXELS_F32=1" : "-DSEAMCL_TEXELS_F32=0") +
          " -DSEAMCL_SAMPLER_FILTER=" + std::to_string(sampler.filter) +
          " -DSEAMCL_SAMPLER_ADDRESS=" + std::to_string(sampler.address) +
@@ -356,7 +373,7 @@ std::string program_options(TexelFormat format, const SamplerParams& sampler, bo
          " -DSEAMCL_SAMPLER_ZERO_COVERAGE=" + std::to_string(sampler.zero_coverage) +
          " -DSEAMCL_SAMPLER_TRAVERSE=" + std::to_string(sampler.traverse) +
          " -DSEAMCL_SAMPLER_GUARD_BAND=" + std::to_string(sampler.guard_band) +
-         (environment ? " -DSEAMCL_CUBE=1" : "");
+         (with_seam_mask ? " -DSEAMCL_SEAM_MASK=1" : "") + (environment ? " -DSEAMCL_CUBE=1" : "");
 }
 
 RenderResult Renderer::render_directions(const Camera& camera, const RenderOptions& options) {

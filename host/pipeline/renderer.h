@@ -34,13 +34,20 @@ struct RenderResult {
   StageTimes ms;
   FrameStats stats{};
   int attempts = 1;               // > 1 when the tile lists had to grow
+  // With render(..., with_seam_mask): per pixel, SEAMCL_MASK_SEAM (1) where some fragment's texture
+  // footprint crosses an edge shared by two faces, SEAMCL_MASK_BOUNDARY (2) where footprints
+  // cross mesh boundary edges only, SEAMCL_MASK_NONE (0) elsewhere (see kernels/shade_resolve.cl);
+  // empty otherwise.
+  std::vector<uint8_t> seam_mask;
 };
 
 // The build options of the program variant that reads `format` texels with `sampler`'s filter,
 // address mode, renormalisation and zero-coverage rule fixed at build time (max_aniso stays a
 // run-time parameter). See the specialisation note in kernels/texture_sample.cl.
-// With `environment`, the shade stage's environment branch is compiled in (-DSEAMCL_CUBE=1).
-std::string program_options(TexelFormat format, const SamplerParams& sampler, bool environment = false);
+// with_seam_mask builds the shade stage that also writes the seam mask; with `environment`, the
+// shade stage's environment branch is compiled in (-DSEAMCL_CUBE=1).
+std::string program_options(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask = false,
+                            bool environment = false);
 
 class Renderer {
  public:
@@ -79,7 +86,10 @@ class Renderer {
   // caller's to check beforehand with render_memory().
   void set_device_byte_limit(size_t bytes);
 
-  RenderResult render(const Camera& camera, const RenderOptions& options);
+  // with_seam_mask also reads back RenderResult::seam_mask (a program variant of its own, so the
+  // renders without it pay nothing). The mask reads the faces' own texels without guard bands:
+  // with Method::Guardband it throws InputError("method"); any other method gives the same mask.
+  RenderResult render(const Camera& camera, const RenderOptions& options, bool with_seam_mask = false);
 
   // For the analytic reference of scenes with an environment (host/eval/cube_metrics.h): every
   // environment lookup (reflective fragments, skybox) writes its unit direction times

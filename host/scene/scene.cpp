@@ -144,35 +144,60 @@ TextureLevel bake_face_texture(const std::array<glm::vec3, 4>& corners, int widt
 
 glm::vec4 surface_pattern(glm::vec3 p) {
   // Each channel sums two waves with different directions and wavelengths (0.5 to 0.75 units,
-  // so features of 0.25 to 0.4), and the colour changes along every direction of every surface;
-  // two stripe families (period about 0.9 units, lines about 0.17 wide) add sharp-but-smooth
-  // features in which a shifted or mismatched seam shows at once. Waves 0-2 and 4-6 are the
-  // channels' (r, g, b), 3 and 7 the stripes'.
-  constexpr int kWaves = 8;
-  constexpr float kWaveX[kWaves] = {7.1f, -4.4f, 3.6f, -3.2f, -2.7f, 10.8f, 2.4f, 5.3f};
-  constexpr float kWaveY[kWaves] = {2.3f, 6.2f, -7.7f, 5.8f, 9.4f, -3.1f, 4.9f, 1.9f};
-  constexpr float kWaveZ[kWaves] = {-3.9f, 8.3f, 5.1f, 2.6f, 4.6f, 2.2f, -11.2f, 4.1f};
-  constexpr float kPhase[kWaves] = {0.3f, 2.9f, 4.1f, 1.0f, 1.7f, 0.8f, 5.3f, 0.0f};
+  // so features of 0.25 to 0.4), and the colour changes along every direction of every surface.
+  // Light round spots (about 0.15 units, where three wave families peak together) add small
+  // features in which a shifted or mismatched seam shows at once. Stripes would read as seams
+  // (dark lines are what black's edges look like), so there are none. Waves 0-2 and 3-5 are the
+  // channels' (r, g, b), 6-8 the spots'.
+  constexpr int kWaves = 9;
+  constexpr float kWaveX[kWaves] = {7.1f, -4.4f, 3.6f, -2.7f, 10.8f, 2.4f, 6.3f, -3.1f, 1.2f};
+  constexpr float kWaveY[kWaves] = {2.3f, 6.2f, -7.7f, 9.4f, -3.1f, 4.9f, 1.1f, 6.0f, -6.6f};
+  constexpr float kWaveZ[kWaves] = {-3.9f, 8.3f, 5.1f, 4.6f, 2.2f, -11.2f, 3.7f, -3.5f, 5.2f};
+  constexpr float kPhase[kWaves] = {0.3f, 2.9f, 4.1f, 1.7f, 0.8f, 5.3f, 0.0f, 1.3f, 2.2f};
   float sine[kWaves];
   for (int k = 0; k < kWaves; ++k)
     sine[k] = smooth_sine(kWaveX[k] * p.x + kWaveY[k] * p.y + kWaveZ[k] * p.z + kPhase[k]);
 
-  glm::vec3 color(0.5f + 0.22f * sine[0] + 0.16f * sine[4],
-                  0.5f + 0.22f * sine[1] + 0.16f * sine[5],
-                  0.5f + 0.22f * sine[2] + 0.16f * sine[6]);
-  auto thin_stripe = [](float wave) {
-    // (0.5 + 0.5 sin)^8: smooth peaks about a fifth of the period wide.
-    const float s = 0.5f + 0.5f * wave;
-    const float s2 = s * s;
-    const float s4 = s2 * s2;
-    return s4 * s4;
-  };
-  color = glm::mix(color, glm::vec3(0.95f, 0.93f, 0.85f), 0.75f * thin_stripe(sine[3]));
-  color = glm::mix(color, glm::vec3(0.05f), 0.85f * thin_stripe(sine[7]));
+  glm::vec3 color(0.5f + 0.22f * sine[0] + 0.16f * sine[3],
+                  0.5f + 0.22f * sine[1] + 0.16f * sine[4],
+                  0.5f + 0.22f * sine[2] + 0.16f * sine[5]);
+  // Each factor (0.5 + 0.5 sin)^2 peaks once per period; their product is near 1 only where all
+  // three peak at once: round spots, not lines.
+  float spot = 1.0f;
+  for (int k = 6; k < 9; ++k) {
+    const float s = 0.5f + 0.5f * sine[k];
+    spot *= s * s;
+  }
+  color = glm::mix(color, glm::vec3(0.95f, 0.93f, 0.85f), 0.8f * std::sqrt(spot));
   return glm::vec4(glm::clamp(color, glm::vec3(0.05f), glm::vec3(0.95f)), 1.0f);
 }
 
+glm::vec4 detail_pattern(glm::vec3 p, float texel_spacing) {
+  // Per channel three waves of wavelengths 5, 6.3 and 7.7 texels (features of 2.5 to 3.9), in
+  // directions spread over the sphere so that every surface sees them at full frequency or
+  // close to it.
+  constexpr float kTwoPi = 6.2831853f;
+  constexpr float kWavelengths[3] = {5.0f, 6.3f, 7.7f};
+  constexpr float kDirections[9][3] = {{0.80f, 0.36f, -0.48f}, {-0.31f, 0.62f, 0.72f}, {0.45f, -0.85f, 0.27f},
+                                       {-0.66f, -0.21f, 0.72f}, {0.12f, 0.95f, -0.29f}, {0.93f, 0.05f, 0.36f},
+                                       {0.27f, -0.49f, -0.83f}, {-0.77f, 0.59f, -0.24f}, {0.52f, 0.52f, 0.68f}};
+  constexpr float kPhase[9] = {0.4f, 2.1f, 4.4f, 1.3f, 3.7f, 5.9f, 0.9f, 2.8f, 5.1f};
+  const float spacing = std::max(texel_spacing, 1e-6f);
+  float channel[3];
+  for (int c = 0; c < 3; ++c) {
+    float sum = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+      const float* d = kDirections[3 * c + k];
+      const float frequency = kTwoPi / (kWavelengths[k] * spacing);
+      sum += smooth_sine(frequency * (d[0] * p.x + d[1] * p.y + d[2] * p.z) + kPhase[3 * c + k]);
+    }
+    channel[c] = 0.5f + 0.15f * sum;  // three sines in [-1, 1]: [0.05, 0.95]
+  }
+  return glm::vec4(glm::clamp(glm::vec3(channel[0], channel[1], channel[2]), glm::vec3(0.05f), glm::vec3(0.95f)), 1.0f);
+}
+
 void set_constant_textures(Scene& scene, glm::vec4 color) {
+  scene.albedo = [color](size_t, glm::vec3) { return color; };
   for (Face& face : scene.faces) {
     const int width = face.texture.width();
     const int height = face.texture.height();

@@ -85,6 +85,10 @@ struct Scene {
   glm::vec3 background{0.02f, 0.02f, 0.03f};  // linear RGB
   std::optional<Environment> environment;      // what reflective faces (and the skybox) show
   std::vector<glm::vec3> normals;              // per vertex: shading normals of reflective faces
+  // The function the textures were baked from, when there is one: texel (i, j) of face f holds
+  // albedo(f, the surface point of its centre). The analytic reference evaluates it at every
+  // subsample instead of filtering texels. Empty for textures that came from elsewhere (files).
+  std::function<glm::vec4(size_t face, glm::vec3 point)> albedo;
 
   size_t triangle_count() const { return faces.size() * 2; }
   std::array<glm::vec3, 4> corners(const Face& f) const;
@@ -111,7 +115,14 @@ void set_constant_textures(Scene& scene, glm::vec4 color);
 
 // The colour (linear RGB in [0.05, 0.95], alpha 1) the generators paint at world point p: one
 // smooth, colourful function of the 3D point with features 0.2 to 0.5 units wide, so a texture
-// baked from it is continuous across every shared edge and any seam error shows.
+// baked from it is continuous across every shared edge and any seam error shows. It holds no
+// lines (only waves of colour and round light spots), so nothing in it reads as a seam.
 glm::vec4 surface_pattern(glm::vec3 p);
+
+// Texel-scale detail: a colourful function of the 3D point whose features (half a wavelength)
+// are 2 to 4 times `texel_spacing` wide, in [0.05, 0.95], alpha 1. Continuous across every
+// shared edge like surface_pattern, but with detail that a seam method's filter footprint at a
+// seam actually resolves.
+glm::vec4 detail_pattern(glm::vec3 p, float texel_spacing);
 
 }  // namespace seamcl

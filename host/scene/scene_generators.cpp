@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <functional>
+#include <map>
 #include <mutex>
 #include <random>
 #include <system_error>
@@ -23,20 +25,39 @@ struct TextureSize {
   int height;
 };
 
-// Texture contents for every face, in parallel: baking the paper scene's ~9 million texels is
-// most of its generation time, and faces are independent, so the result does not depend on the
-// number of threads or their timing.
-void paint_textures(Scene& scene, const std::vector<TextureSize>& sizes,
-                    const GeneratorOptions& options) {
+float median_spacing(const Scene& scene, const std::vector<TextureSize>& sizes) {
+  std::vector<float> spacing;
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    const auto c = scene.corners(scene.faces[f]);
+    const float area = 0.5f * glm::length(glm::cross(c[2] - c[0], c[3] - c[1]));
+    spacing.push_back(std::sqrt(area / static_cast<float>(sizes[f].width * sizes[f].height)));
+  }
+  if (spacing.empty()) return 1.0f;
+  std::nth_element(spacing.begin(), spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2), spacing.end());
+  return spacing[spacing.size() / 2];
+}
+
+// The albedo the options ask for: content (or the constant colour), times the face's tint.
+std::function<glm::vec4(size_t, glm::vec3)> albedo_function(TextureContent content, float texel_spacing,
+                                                            const GeneratorOptions& options) {
+  const std::optional<glm::vec3> constant = options.constant_color;
+  const bool tint = options.tint;
+  return [=](size_t face, glm::vec3 p) {
+    const glm::vec4 color = constant                              ? glm::vec4(*constant, 1.0f)
+                            : content == TextureContent::Detail ? detail_pattern(p, texel_spacing)
+                                                                  : surface_pattern(p);
+    return tint ? color * glm::vec4(face_tint(face), 1.0f) : color;
+  };
+}
+
+// Texture contents for every face, in parallel, baked from scene.albedo: baking the paper
+// scene's ~9 million texels is most of its generation time, and faces are independent, so the
+// result does not depend on the number of threads or their timing.
+void bake_textures(Scene& scene, const std::vector<TextureSize>& sizes) {
   auto paint_face = [&](size_t f) {
     Face& face = scene.faces[f];
-    const glm::vec4 tint = options.tint ? glm::vec4(face_tint(f), 1.0f) : glm::vec4(1.0f);
-    const std::optional<glm::vec3> constant = options.constant_color;
-    auto color_at = [&](glm::vec3 p) {
-      return (constant ? glm::vec4(*constant, 1.0f) : surface_pattern(p)) * tint;
-    };
-    face.texture = build_mip_chain(
-        bake_face_texture(scene.corners(face), sizes[f].width, sizes[f].height, color_at));
+    face.texture = build_mip_chain(bake_face_texture(scene.corners(face), sizes[f].width, sizes[f].height,
+                                                     [&](glm::vec3 p) { return scene.albedo(f, p); }));
   };
   // Faces are handed out one at a time because their sizes differ by up to 64x.
   std::atomic<size_t> next_face{0};
@@ -64,6 +85,14 @@ void paint_textures(Scene& scene, const std::vector<TextureSize>& sizes,
   paint_remaining();
   for (std::thread& helper : helpers) helper.join();
   if (failure) std::rethrow_exception(failure);
+}
+
+// The generator's textures: `sizes` per face, painted as the options say over `content`, the
+// generator's own content.
+void paint_textures(Scene& scene, const std::vector<TextureSize>& sizes, const GeneratorOptions& options,
+                    TextureContent content = TextureContent::Surface) {
+  scene.albedo = albedo_function(options.content.value_or(content), median_spacing(scene, sizes), options);
+  bake_textures(scene, sizes);
 }
 
 // A grid of nx x nz quads over [x0, x1] x [z0, z1] at height y, facing +y (counter-clockwise seen
@@ -185,6 +214,112 @@ Scene make_cube(const GeneratorOptions& options) {
   return scene;
 }
 
+// A flat grid of nx x ny unit quads in the z = 0 plane, centred on the origin, facing +z, u along
+// +x and v along +y: every face's texture continues its neighbours', so with equal sizes the
+// grid is one texture (the seamless reference).
+void add_wall_grid(Scene& scene, int nx, int ny) {
+  const auto base = static_cast<uint32_t>(scene.positions.size());
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i)
+      scene.positions.emplace_back(static_cast<float>(i) - 0.5f * static_cast<float>(nx),
+                                   static_cast<float>(j) - 0.5f * static_cast<float>(ny), 0.0f);
+  auto vertex = [&](int i, int j) { return base + static_cast<uint32_t>(j * (nx + 1) + i); };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      scene.faces.push_back({{vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1), vertex(i, j + 1)}, {}});
+}
+
+// Magnification at a seam: two 16x16-texel unit quads side by side, the camera 1.2 units from
+// their shared edge, a little off-axis: about 12 texels across the view, so every
+// texel spans many pixels and a filter's taps at the seam are the neighbour's texels.
+Scene make_closeup_seam(const GeneratorOptions& options) {
+  Scene scene;
+  scene.name = "closeup-seam";
+  add_wall_grid(scene, 2, 1);
+  paint_textures(scene, std::vector<TextureSize>(scene.faces.size(), {16, 16}), options, TextureContent::Detail);
+  // Centred a little beside the seam: a vertical line through the target would project onto the
+  // image's middle column, exactly between two pixels.
+  set_orbit_and_camera(scene, Orbit{glm::vec3(0.15f, 0.05f, 0.0f), 1.2f, 0.25f, 20.0f}, 45.0f);
+  scene.light.to_light = glm::normalize(glm::vec3(0.3f, 0.5f, 1.0f));
+  return scene;
+}
+
+// Magnification at a corner: four 16x16-texel unit quads around one vertex (valence 4), seen
+// from 1.2 units, a little off-axis: footprints past the corner reach the diagonal face.
+Scene make_closeup_corner(const GeneratorOptions& options) {
+  Scene scene;
+  scene.name = "closeup-corner";
+  add_wall_grid(scene, 2, 2);
+  paint_textures(scene, std::vector<TextureSize>(scene.faces.size(), {16, 16}), options, TextureContent::Detail);
+  set_orbit_and_camera(scene, Orbit{glm::vec3(0.12f, 0.1f, 0.0f), 1.2f, 0.3f, -25.0f}, 45.0f);
+  scene.light.to_light = glm::normalize(glm::vec3(-0.3f, 0.4f, 1.0f));
+  return scene;
+}
+
+// A closed quad mesh with vertices of valence 3, 4 and 5: a pentagonal prism whose 7 faces are
+// each split into quads around their centre (a Catmull-Clark step without the smoothing), 30
+// quads. Texture sizes run from 1x1 to 256x256 side by side (powers of two per axis, non-square
+// included) and every face starts its vertex order at a different corner, so neighbours meet
+// rotated by every multiple of 90 degrees.
+Scene make_mixed(const GeneratorOptions& options) {
+  Scene scene;
+  scene.name = "mixed";
+  constexpr int kSides = 5;
+  constexpr float kRadius = 1.0f, kHalfHeight = 0.7f;
+  for (int ring = 0; ring < 2; ++ring)
+    for (int k = 0; k < kSides; ++k) {
+      const float angle = 2.0f * kPi * static_cast<float>(k) / kSides;
+      scene.positions.emplace_back(kRadius * std::cos(angle), ring == 0 ? -kHalfHeight : kHalfHeight,
+                                   kRadius * std::sin(angle));
+    }
+  std::vector<std::vector<uint32_t>> polygons;
+  std::vector<uint32_t> bottom, top;
+  for (uint32_t k = 0; k < kSides; ++k) {
+    bottom.push_back(k);
+    top.push_back(kSides + k);
+    polygons.push_back({k, (k + 1) % kSides, kSides + (k + 1) % kSides, kSides + k});
+  }
+  polygons.push_back(bottom);
+  polygons.push_back(top);
+  std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;  // shared, so the mesh stays closed
+  auto midpoint = [&](uint32_t a, uint32_t b) {
+    const auto key = std::minmax(a, b);
+    auto it = midpoints.find(key);
+    if (it != midpoints.end()) return it->second;
+    scene.positions.push_back(0.5f * (scene.positions[a] + scene.positions[b]));
+    return midpoints[key] = static_cast<uint32_t>(scene.positions.size() - 1);
+  };
+  std::mt19937 random(5u);
+  for (std::vector<uint32_t> polygon : polygons) {
+    glm::vec3 center(0.0f);
+    for (uint32_t v : polygon) center += scene.positions[v];
+    center /= static_cast<float>(polygon.size());
+    // Counter-clockwise seen from outside (the prism is convex around the origin).
+    const glm::vec3 normal = glm::cross(scene.positions[polygon[1]] - scene.positions[polygon[0]],
+                                        scene.positions[polygon[2]] - scene.positions[polygon[1]]);
+    if (glm::dot(normal, center) < 0.0f) std::reverse(polygon.begin(), polygon.end());
+    scene.positions.push_back(center);
+    const auto center_index = static_cast<uint32_t>(scene.positions.size() - 1);
+    const size_t n = polygon.size();
+    for (size_t i = 0; i < n; ++i) {
+      std::array<uint32_t, 4> quad = {polygon[i], midpoint(polygon[i], polygon[(i + 1) % n]), center_index,
+                                      midpoint(polygon[(i + n - 1) % n], polygon[i])};
+      std::rotate(quad.begin(), quad.begin() + random() % 4, quad.end());
+      scene.faces.push_back({quad, {}});
+    }
+  }
+  std::vector<TextureSize> sizes(scene.faces.size());
+  for (TextureSize& size : sizes) size = {1 << (random() % 9), 1 << (random() % 9)};
+  // Both extremes, whatever the draw: a 1x1 face beside a 256x256 one (faces 0 and 1 share an
+  // edge: consecutive quads of a polygon do).
+  sizes[0] = {1, 1};
+  sizes[1] = {256, 256};
+  paint_textures(scene, sizes, options);
+  set_orbit_and_camera(scene, Orbit{glm::vec3(0.0f), 3.2f, 1.9f, 15.0f}, 45.0f);
+  scene.light.to_light = glm::normalize(glm::vec3(0.4f, 1.0f, 0.5f));
+  return scene;
+}
+
 struct Generator {
   GeneratorInfo info;
   Scene (*make)(const GeneratorOptions&);
@@ -194,12 +329,23 @@ const std::vector<Generator>& generators() {
   static const std::vector<Generator> list = {
       {{"paper",
         "the paper's Figure 1: an upright torus (50x29 quads) on a ground plane (32x32 quads), "
-        "every face its own texture, sides 16 to 128, mixed and non-square"},
+        "every face its own texture, sides 16 to 128, mixed and non-square; minified, smooth content"},
        make_paper},
       {{"quad2", "two unit quads sharing one edge, textures 64x64 and 32x16"}, make_quad2},
       {{"plane", "a 128x128 ground plane of 64x64 quads (32x32 textures) at a grazing angle"},
        make_plane},
       {{"cube", "a closed cube of six 64x64-textured faces, seen obliquely"}, make_cube},
+      {{"closeup-seam", "magnified: two 16x16-texel unit quads, the camera 1.2 units from their shared edge; detail content",
+        TextureContent::Detail},
+       make_closeup_seam},
+      {{"closeup-corner",
+        "magnified: four 16x16-texel unit quads around a valence-4 vertex, seen from 1.2 units; detail content",
+        TextureContent::Detail},
+       make_closeup_corner},
+      {{"mixed",
+        "a closed mesh (a split pentagonal prism, 30 quads, vertices of valence 3, 4 and 5) with textures from 1x1 to "
+        "256x256 side by side and neighbours rotated by every multiple of 90 degrees"},
+       make_mixed},
       {{"envmap", "mirror and glossy spheres and a mirror torus in an analytic environment (skybox), "
                   "for the cube-map methods (cube_method)"},
        [](const GeneratorOptions& options) { return make_envmap_scene(options); }},
@@ -218,6 +364,24 @@ uint32_t hash32(uint32_t x) {
 }
 
 }  // namespace
+
+std::optional<TextureContent> parse_texture_content(std::string_view name) {
+  if (name == "surface") return TextureContent::Surface;
+  if (name == "detail") return TextureContent::Detail;
+  return std::nullopt;
+}
+
+std::string to_string(TextureContent content) {
+  return content == TextureContent::Detail ? "detail" : "surface";
+}
+
+std::vector<std::string> texture_content_names() { return {"surface", "detail"}; }
+
+float median_texel_spacing(const Scene& scene) {
+  std::vector<TextureSize> sizes;
+  for (const Face& face : scene.faces) sizes.push_back({face.texture.width(), face.texture.height()});
+  return median_spacing(scene, sizes);
+}
 
 const std::vector<GeneratorInfo>& scene_generators() {
   static const std::vector<GeneratorInfo> infos = [] {
@@ -255,6 +419,12 @@ glm::vec3 face_tint(size_t face_index) {
 }
 
 void apply_generator_options(Scene& scene, const GeneratorOptions& options) {
+  if (options.content && !options.constant_color) {
+    std::vector<TextureSize> sizes;
+    for (const Face& face : scene.faces) sizes.push_back({face.texture.width(), face.texture.height()});
+    paint_textures(scene, sizes, options);  // tint included
+    return;
+  }
   if (options.constant_color)
     set_constant_textures(scene, glm::vec4(*options.constant_color, 1.0f));
   if (options.constant_color && scene.environment) scene.environment->constant = *options.constant_color;
@@ -264,6 +434,11 @@ void apply_generator_options(Scene& scene, const GeneratorOptions& options) {
     const glm::vec4 tint(face_tint(f), 1.0f);
     for (TextureLevel& level : scene.faces[f].texture.levels)
       for (glm::vec4& texel : level.texels) texel *= tint;
+  }
+  if (scene.albedo) {
+    scene.albedo = [untinted = scene.albedo](size_t face, glm::vec3 p) {
+      return untinted(face, p) * glm::vec4(face_tint(face), 1.0f);
+    };
   }
 }
 

@@ -5,15 +5,25 @@
 #include <glm/glm.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <seamcl/scene/scene.h>
 
 namespace seamcl {
 
+// What a generated texture holds: `surface`, the smooth surface_pattern (features of 0.2 to 0.5
+// units); `detail`, detail_pattern with features of 2 to 4 texels of the scene's median face
+// (median_texel_spacing), the texel-scale regime in which seam methods differ most.
+enum class TextureContent { Surface, Detail };
+std::optional<TextureContent> parse_texture_content(std::string_view name);
+std::string to_string(TextureContent content);
+std::vector<std::string> texture_content_names();
+
 struct GeneratorOptions {
   bool tint = false;                        // multiply each face by its own pastel (face_tint)
-  std::optional<glm::vec3> constant_color;  // paint this colour instead of surface_pattern
+  std::optional<glm::vec3> constant_color;  // paint this colour instead of the content
+  std::optional<TextureContent> content;    // unset: the generator's own (GeneratorInfo)
   // envmap only: its environment (constant_color then makes it constant) and the roughness of
   // its mirror sphere, glossy sphere and torus.
   std::optional<Environment> environment;
@@ -23,20 +33,26 @@ struct GeneratorOptions {
 struct GeneratorInfo {
   std::string name;
   std::string description;
+  TextureContent content = TextureContent::Surface;  // its content unless options say otherwise
 };
 
-// paper, quad2, plane, cube; the first is the default scene.
+// paper, quad2, plane, cube, closeup-seam, closeup-corner, mixed; the first is the default scene.
 const std::vector<GeneratorInfo>& scene_generators();
 
 // Throws InputError (field "scene") for an unknown name.
 Scene generate_scene(const std::string& name, const GeneratorOptions& options);
 
+// The median over faces of sqrt(area / texels): the world size of a typical texel, the unit of
+// detail_pattern's features.
+float median_texel_spacing(const Scene& scene);
+
 // A light, distinct-looking colour for face `face_index`, the same on every run.
 glm::vec3 face_tint(size_t face_index);
 
 // Repaints the textures of an existing scene (e.g. one loaded from a file) as the options say:
-// constant_color replaces every texture (sizes kept), tint multiplies each face by face_tint.
-// Content painted from surface_pattern by a generator is unchanged by an empty options.
+// content repaints every texture with it (sizes kept), constant_color replaces every texture
+// (sizes kept), tint multiplies each face by face_tint; scene.albedo follows. Content painted by
+// a generator is unchanged by an empty options.
 void apply_generator_options(Scene& scene, const GeneratorOptions& options);
 
 }  // namespace seamcl

@@ -170,8 +170,17 @@ Environment read_environment(const json& value, const std::string& path) {
 }
 
 GeneratorOptions read_generator_options(const json& value, const std::string& path) {
-  const ObjectFields fields(value, path, {"tint", "constant_color", "environment", "roughness"});
+  const ObjectFields fields(value, path, {"tint", "constant_color", "content", "environment", "roughness"});
   GeneratorOptions options;
+  if (const json* content = fields.optional("content")) {
+    const std::string name = read_string(*content, fields.path_of("content"));
+    options.content = parse_texture_content(name);
+    if (!options.content) {
+      std::string known;
+      for (const std::string& n : texture_content_names()) known += (known.empty() ? "" : ", ") + n;
+      throw InputError(fields.path_of("content"), "unknown content '" + name + "' (known: " + known + ")");
+    }
+  }
   if (const json* environment = fields.optional("environment"))
     options.environment = read_environment(*environment, fields.path_of("environment"));
   if (const json* roughness = fields.optional("roughness")) {
@@ -376,6 +385,13 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name, cons
                                 [&color](glm::vec3 p) { return surface_pattern(p) * color; });
     scene.faces[f].texture = build_mip_chain(std::move(level0));
   }
+  // The same content as a function, for the analytic reference.
+  std::vector<std::pair<bool, glm::vec4>> contents;
+  for (const TexturePlan& plan : plans) contents.emplace_back(plan.constant, glm::vec4(plan.color, 1.0f));
+  scene.albedo = [contents](size_t face, glm::vec3 p) {
+    const auto& [constant, color] = contents[face];
+    return constant ? color : surface_pattern(p) * color;
+  };
   validate_scene(scene);
   return scene;
 }
@@ -392,6 +408,7 @@ Scene realize(SceneSource source, const GeneratorOptions& extra) {
     GeneratorOptions options = request->options;
     options.tint = options.tint || extra.tint;
     if (extra.constant_color) options.constant_color = extra.constant_color;
+    if (extra.content) options.content = extra.content;
     return generate_scene(request->name, options);
   }
   Scene scene = std::move(std::get<Scene>(source));

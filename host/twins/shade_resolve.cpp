@@ -40,6 +40,48 @@ glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& 
   return glm::vec3(albedo.x * f.light_color[0], albedo.y * f.light_color[1], albedo.z * f.light_color[2]) * lighting;
 }
 
+uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const TriangleSetup& t, float x, float y) {
+  const SurfaceUv s = interpolate_uv(t, x, y);
+  const TextureView textures = scene.textures();
+  auto weight_inside = [&](uint32_t face, float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
+    return filter_texture_reference(textures, face, f.sampler, SEAMCL_ADDRESS_BORDER, u, v, dudx, dvdx, dudy, dvdy).weight;
+  };
+  constexpr float tolerance = SEAMCL_SEAM_WEIGHT_TOLERANCE;
+  // NaN weights count as crossing: nothing shows the footprint stays inside.
+  const float own = weight_inside(t.face, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
+  const FaceNeighbors& n = scene.neighbors.at(t.face);
+  bool seam = false, boundary = false, any_edge = false;
+  for (int k = 0; k < 4; ++k) {
+    // The point and footprint mirrored across edge k (v = 0, u = 1, v = 1, u = 0): the weight
+    // there is what the (symmetric) filter puts beyond edge k.
+    const bool across_v = (k & 1) == 0;
+    const float offset = k == 1 || k == 2 ? 2.0f : 0.0f;
+    const float beyond = across_v ? weight_inside(t.face, s.u, offset - s.v, s.dudx, -s.dvdx, s.dudy, -s.dvdy)
+                                  : weight_inside(t.face, offset - s.u, s.v, -s.dudx, s.dvdx, -s.dudy, s.dvdy);
+    const bool crosses = !(beyond <= tolerance);
+    any_edge = any_edge || crosses;
+    if (n.neighbor[k] < 0) {
+      boundary = boundary || crosses;
+      continue;
+    }
+    // The same filter on the neighbour, as traverse carries it there.
+    const float* m = n.transform[k];
+    const float reach = weight_inside(static_cast<uint32_t>(n.neighbor[k]), m[0] * s.u + m[1] * s.v + m[2],
+                                      m[3] * s.u + m[4] * s.v + m[5], m[0] * s.dudx + m[1] * s.dvdx,
+                                      m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
+                                      m[3] * s.dudy + m[4] * s.dvdy);
+    seam = seam || crosses || !(reach <= tolerance);
+  }
+  seam = seam || (!any_edge && !(own >= 1.0f - tolerance));  // past a corner only
+  return seam ? SEAMCL_MASK_SEAM : boundary ? SEAMCL_MASK_BOUNDARY : SEAMCL_MASK_NONE;
+}
+
+uint8_t merge_mask(uint8_t a, uint8_t b) {
+  if (a == SEAMCL_MASK_SEAM || b == SEAMCL_MASK_SEAM) return SEAMCL_MASK_SEAM;
+  if (a == SEAMCL_MASK_BOUNDARY || b == SEAMCL_MASK_BOUNDARY) return SEAMCL_MASK_BOUNDARY;
+  return SEAMCL_MASK_NONE;
+}
+
 PixelFragment pixel_fragment(const FrameParams& f, const TriangleSetup& t, const uint32_t* ids, uint32_t slot, int x,
                              int y) {
   const std::vector<SampleOffset>& pattern = sample_pattern(f.sample_count);
@@ -92,6 +134,7 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
   constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
   ResolveReference out;
   out.pixels.resize(static_cast<size_t>(f.width) * f.height);
+  out.seam_mask.assign(out.pixels.size(), 0);
   const glm::vec3 background(f.background[0], f.background[1], f.background[2]);
   for (int y = 0; y < f.height; ++y) {
     for (int x = 0; x < f.width; ++x) {
@@ -100,6 +143,7 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
       auto sample_y = [&](int s) { return static_cast<float>(sample_fixed_y(y, pattern[s])) * to_pixels; };
       glm::vec3 sum(0.0f);
       int uncovered = 0;
+      uint8_t crosses = SEAMCL_MASK_NONE;
       for (int s = 0; s < samples; ++s) {
         const uint32_t slot = ids[s];
         if (slot == SEAMCL_NO_TRIANGLE) {
@@ -109,12 +153,14 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
         const TriangleSetup& t = setups.at(slot);
         if (f.shading_mode == SEAMCL_SHADE_SAMPLE) {
           sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s), cube_texels);
+          crosses = merge_mask(crosses, footprint_class(scene, f, t, sample_x(s), sample_y(s)));
           ++out.fragments;
           continue;
         }
         if (std::find(ids, ids + s, slot) != ids + s) continue;  // shaded at its first sample
         const PixelFragment fragment = pixel_fragment(f, t, ids, slot, x, y);
         sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y, cube_texels) * static_cast<float>(fragment.covered);
+        crosses = merge_mask(crosses, footprint_class(scene, f, t, fragment.x, fragment.y));
         ++out.fragments;
       }
       if (uncovered > 0 && f.environment.skybox) {
@@ -124,6 +170,7 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
         sum += background * static_cast<float>(uncovered);  // once: an empty pixel is exactly the background
       }
       out.pixels[static_cast<size_t>(y) * f.width + x] = glm::vec4(sum / static_cast<float>(samples), 1.0f);
+      out.seam_mask[static_cast<size_t>(y) * f.width + x] = crosses;
     }
   }
   return out;

@@ -38,9 +38,18 @@ PixelFragment pixel_fragment(const FrameParams& frame, const TriangleSetup& t, c
 bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& frame,
                                   const std::vector<TriangleSetup>& setups, const uint32_t* ids, int x, int y);
 
+// The seam mask class of the fragment of `t` shaded at (x, y) (see kernels/shade_resolve.cl):
+// SEAMCL_MASK_SEAM when its footprint crosses an edge shared with a neighbour (its own filter, or
+// the same filter carried onto the neighbour as traverse reads it), else SEAMCL_MASK_BOUNDARY when
+// it crosses a mesh boundary edge, else SEAMCL_MASK_NONE: there every seam method agrees.
+uint8_t footprint_class(const PackedScene& scene, const FrameParams& frame, const TriangleSetup& t, float x, float y);
+// A pixel's class over its fragments: seam over boundary over none.
+uint8_t merge_mask(uint8_t a, uint8_t b);
+
 struct ResolveReference {
   std::vector<glm::vec4> pixels;  // linear RGBA
   uint32_t fragments = 0;
+  std::vector<uint8_t> seam_mask;  // per pixel, SEAMCL_MASK_* over its fragments
 };
 ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& frame,
                                          const std::vector<TriangleSetup>& setups,
