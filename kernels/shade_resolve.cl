@@ -19,7 +19,8 @@
  * across edge k weighs more than SEAMCL_SEAM_WEIGHT_TOLERANCE inside the face (the filters are
  * symmetric, so this is the weight it puts beyond edge k); the same filter carried onto an edge
  * neighbour as traverse reads it (at the neighbour's own resolution, so a coarser neighbour's
- * taps reach further back) crosses when it weighs more than the tolerance inside the neighbour.
+ * taps reach further back) crosses when it weighs more than the tolerance inside the neighbour;
+ * likewise carried onto the diagonal face past a valence-4 corner (what traverse reads there).
  * SEAMCL_MASK_SEAM: some footprint crosses an edge shared with a neighbour (or leaves the face
  * past a corner only); else SEAMCL_MASK_BOUNDARY: some footprint crosses a mesh boundary edge
  * only; else SEAMCL_MASK_NONE, and there every seam method returns the same colour.
@@ -196,6 +197,19 @@ SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global cons
                                       m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
                                       m[3] * s.dudy + m[4] * s.dvdy);
     seam |= crosses | !(reach <= tolerance);
+  }
+  /* The diagonal face past each valence-4 corner, as traverse reads it: a coarser one's taps can
+   * reach back over the corner although no edge's footprint crosses. */
+  for (int k = 0; k < 4; ++k) {
+    const int other = n->corner[k];
+    if (other < 0) continue;
+    __global const float* m = n->corner_transform[k];
+    const FaceGpu g = faces[other];
+    const float reach = weight_inside(frame, &g, level_offsets, texels, srgb_to_linear, m[0] * s.u + m[1] * s.v + m[2],
+                                      m[3] * s.u + m[4] * s.v + m[5], m[0] * s.dudx + m[1] * s.dvdx,
+                                      m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
+                                      m[3] * s.dudy + m[4] * s.dvdy);
+    seam |= !(reach <= tolerance);
   }
   /* Taps outside past a corner only (no edge's mirror saw them): a seam, to be safe. */
   seam |= !any_edge && !(own >= 1.0f - tolerance);

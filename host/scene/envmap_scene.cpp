@@ -9,7 +9,11 @@ namespace {
 
 constexpr float kTwoPi = 6.28318530718f;
 
-MipChain unused_texture() { return build_mip_chain(TextureLevel{1, 1, {glm::vec4(0.5f, 0.5f, 0.5f, 1.0f)}}); }
+// Reflective faces show the environment, not their texture; it is a constant grey, which is also
+// the scene's albedo, so the analytic reference and the regime checks hold for it too.
+constexpr glm::vec4 kUnusedAlbedo(0.5f, 0.5f, 0.5f, 1.0f);
+
+MipChain unused_texture() { return build_mip_chain(TextureLevel{1, 1, {kUnusedAlbedo}}); }
 
 }  // namespace
 
@@ -69,6 +73,7 @@ void add_reflective_torus(Scene& scene, glm::vec3 center, float major_radius, fl
 Scene make_envmap_scene(const GeneratorOptions& options) {
   Scene scene;
   scene.name = "envmap";
+  scene.albedo = [](size_t, glm::vec3) { return kUnusedAlbedo; };
   Environment environment = options.environment.value_or(Environment{});
   if (options.constant_color) environment.constant = options.constant_color;
   scene.environment = environment;

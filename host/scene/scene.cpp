@@ -29,26 +29,6 @@ std::string size_text(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
 
-TextureLevel box_downsample(const TextureLevel& fine) {
-  TextureLevel coarse;
-  coarse.width = std::max(1, fine.width / 2);
-  coarse.height = std::max(1, fine.height / 2);
-  // A side that is already 1 is not halved, so its footprint along that axis is one texel.
-  const int step_x = fine.width / coarse.width;
-  const int step_y = fine.height / coarse.height;
-  const float weight = 1.0f / static_cast<float>(step_x * step_y);
-  coarse.texels.resize(static_cast<size_t>(coarse.width) * coarse.height);
-  for (int j = 0; j < coarse.height; ++j) {
-    for (int i = 0; i < coarse.width; ++i) {
-      glm::vec4 sum(0.0f);
-      for (int dy = 0; dy < step_y; ++dy)
-        for (int dx = 0; dx < step_x; ++dx) sum += fine.at(i * step_x + dx, j * step_y + dy);
-      coarse.texels[static_cast<size_t>(j) * coarse.width + i] = sum * weight;
-    }
-  }
-  return coarse;
-}
-
 // A sine with a continuous first derivative, within 1e-3 of std::sin and several times cheaper:
 // the pattern below is evaluated for every texel of every generated scene (millions), and only
 // its smoothness, not its exactness, matters for showing seams.
@@ -102,6 +82,26 @@ void check_texture(const MipChain& chain, const std::string& field) {
 }
 
 }  // namespace
+
+TextureLevel box_downsample(const TextureLevel& fine) {
+  TextureLevel coarse;
+  coarse.width = std::max(1, fine.width / 2);
+  coarse.height = std::max(1, fine.height / 2);
+  // A side that is already 1 is not halved, so its footprint along that axis is one texel.
+  const int step_x = fine.width / coarse.width;
+  const int step_y = fine.height / coarse.height;
+  const float weight = 1.0f / static_cast<float>(step_x * step_y);
+  coarse.texels.resize(static_cast<size_t>(coarse.width) * coarse.height);
+  for (int j = 0; j < coarse.height; ++j) {
+    for (int i = 0; i < coarse.width; ++i) {
+      glm::vec4 sum(0.0f);
+      for (int dy = 0; dy < step_y; ++dy)
+        for (int dx = 0; dx < step_x; ++dx) sum += fine.at(i * step_x + dx, j * step_y + dy);
+      coarse.texels[static_cast<size_t>(j) * coarse.width + i] = sum * weight;
+    }
+  }
+  return coarse;
+}
 
 MipChain build_mip_chain(TextureLevel level0) {
   if (!is_power_of_two(level0.width) || !is_power_of_two(level0.height))

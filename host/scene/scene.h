@@ -34,6 +34,10 @@ struct MipChain {
 // Builds the whole chain from level 0 (must be power-of-two sized).
 MipChain build_mip_chain(TextureLevel level0);
 
+// The next level of a chain: each side above 1 halved, each texel the mean of its 2x2 (2x1, 1x2)
+// block.
+TextureLevel box_downsample(const TextureLevel& fine);
+
 // A quad patch. Vertices are counter-clockwise seen from the front and carry uv (0,0), (1,0),
 // (1,1), (0,1) in order; it renders as triangles (v0,v1,v2) and (v0,v2,v3).
 struct Face {

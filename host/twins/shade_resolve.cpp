@@ -72,6 +72,17 @@ uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const Tr
                                       m[3] * s.dudy + m[4] * s.dvdy);
     seam = seam || crosses || !(reach <= tolerance);
   }
+  // The diagonal face past each valence-4 corner, as traverse reads it: a coarser one's taps can
+  // reach back over the corner although no edge's footprint crosses.
+  for (int k = 0; k < 4; ++k) {
+    if (n.corner[k] < 0) continue;
+    const float* m = n.corner_transform[k];
+    const float reach = weight_inside(static_cast<uint32_t>(n.corner[k]), m[0] * s.u + m[1] * s.v + m[2],
+                                      m[3] * s.u + m[4] * s.v + m[5], m[0] * s.dudx + m[1] * s.dvdx,
+                                      m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
+                                      m[3] * s.dudy + m[4] * s.dvdy);
+    seam = seam || !(reach <= tolerance);
+  }
   seam = seam || (!any_edge && !(own >= 1.0f - tolerance));  // past a corner only
   return seam ? SEAMCL_MASK_SEAM : boundary ? SEAMCL_MASK_BOUNDARY : SEAMCL_MASK_NONE;
 }
