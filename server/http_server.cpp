@@ -615,6 +615,7 @@ json HttpServer::make_methods_json() const {
         {"method", enum_option(method_names(), "method")},
         {"filter", enum_option(filter_names(), "filter")},
         {"zero_coverage", enum_option(zero_coverage_names(), "zero_coverage")},
+        {"cube_method", enum_option(cube_method_names(), "cube_method")},
         {"texels", enum_option(texel_format_names(), "texels")},
         {"shading", enum_option(shading_mode_names(), "shading")},
         {"msaa", {{"type", "integer"}, {"enum", {1, 2, 4, 8, 16}}, {"default", defaults.msaa}}},
