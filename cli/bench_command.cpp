@@ -21,9 +21,11 @@
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/eval/bench_merge.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
+#include <seamcl/eval/shard.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
@@ -39,6 +41,8 @@ struct BenchArgs : MeasureArgs {
   int frames = 60;
   int reference_frames = 1;
   bool no_errors = false;
+  std::string shard = "1/1";  // part K of N of the orbit's frames (host/eval/shard.h)
+  bool check_only = false;    // validate the options and the scene, render nothing
 };
 
 json base_request(const BenchArgs& a) {
@@ -88,6 +92,7 @@ struct Accum {
   json error_per_frame = json::array();
   std::vector<glm::vec4> previous;       // last frame's image, for temporal stability
   std::vector<double> temporal_seam, temporal_all;
+  json temporal_per_frame = json::array();  // per pair (k-1, k): {frame: k, mean, seam_mean or null}
   RenderResult current;
   size_t texture_bytes = 0, padding_bytes = 0, adjacency_bytes = 0;
 };
@@ -97,34 +102,6 @@ struct DifferenceAccum {
   int msaa = 0;
   Pool pool;
 };
-
-json stats_json(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const double med = median_of(v);
-  auto quantile = [&](double q) {
-    const double pos = q * static_cast<double>(v.size() - 1);
-    const size_t i = static_cast<size_t>(pos);
-    const double f = pos - static_cast<double>(i);
-    return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
-  };
-  double mean = 0;
-  for (double x : v) mean += x;
-  mean /= static_cast<double>(v.size());
-  return {{"median", med},
-          {"min", v.front()},
-          {"max", v.back()},
-          {"mean", mean},
-          {"p10", quantile(0.1)},
-          {"p90", quantile(0.9)},
-          {"spread", med > 0 ? (v.back() - v.front()) / med : 0.0},
-          {"frames", v.size()}};
-}
-
-double mean_of(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x;
-  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
-}
 
 class Progress {
  public:
@@ -166,12 +143,19 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
   const bool with_errors = !args.no_errors;
   const ReferenceSettings ref_settings = reference_settings(args);
   if (with_errors) (void)reference_render_options(frame, ref_settings);  // size and settings checked now
+  const Shard shard = parse_shard(args.shard);
+  const FrameRange range = shard_frames(shard, frame.frames);
 
   GeneratorOptions generator_options;
   generator_options.tint = frame.tint;
   SceneSourceOptions source;
   source.generator = generator_options;
   const Scene scene = load_scene_source(frame.scene, frame.texture, source);
+  if (args.check_only) {
+    std::printf("bench options valid: %s, part %s: frames %d..%d of %d\n", scene.name.c_str(), to_string(shard).c_str(),
+                range.first, range.end - 1, frame.frames);
+    return 0;
+  }
   const auto wall_start = std::chrono::steady_clock::now();
 
   ClRuntime runtime(global.device);
@@ -204,15 +188,31 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
   }
 
   const int frames = frame.frames;
-  const int error_frames = with_errors ? (frames + args.reference_frames - 1) / args.reference_frames : 0;
-  Progress progress(static_cast<size_t>(frames) * entries.size() + static_cast<size_t>(error_frames), false);
+  int error_frames = 0;
+  for (int k = range.first; k < range.end; ++k) error_frames += with_errors && k % args.reference_frames == 0 ? 1 : 0;
+  const bool lead_in = range.first > 0;
+  Progress progress(static_cast<size_t>(range.size() + (lead_in ? 1 : 0)) * entries.size() +
+                        static_cast<size_t>(error_frames),
+                    false);
   std::string reference_method;
   int reference_msaa = 0, references_cached = 0, references_rendered = 0;
   double reference_ms = 0;
   std::vector<int> error_frame_list;
   std::vector<size_t> seam_pixels_per_frame;
 
-  for (int k = 0; k < frames; ++k) {
+  // A part that starts later renders the frame before its first (untimed, unmeasured), so the
+  // temporal pair across its first frame is measured as an unsharded run measures it.
+  if (lead_in) {
+    const int k = range.first - 1;
+    const Camera camera = orbit_camera(scene, k, frames);
+    for (Accum& a : acc) {
+      MethodEntry entry = a.entry;
+      entry.options.frame = k;
+      a.previous = a.renderer->render(camera, entry.options).pixels;
+      progress.step(k, frames, "lead-in " + entry.method_name + " x" + std::to_string(entry.options.msaa));
+    }
+  }
+  for (int k = range.first; k < range.end; ++k) {
     RenderOptions frame_options = frame;
     frame_options.frame = k;
     const Camera camera = orbit_camera(scene, k, frames);
@@ -264,6 +264,9 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
         const ErrorStats seam = error_stats(change, &mask);
         if (seam.pixels > 0) a.temporal_seam.push_back(seam.mean);  // frames with no seam in view: skipped
         a.temporal_all.push_back(error_stats(change).mean);
+        a.temporal_per_frame.push_back({{"frame", k},
+                                        {"mean", a.temporal_all.back()},
+                                        {"seam_mean", seam.pixels > 0 ? json(seam.mean) : json(nullptr)}});
       }
     }
     for (DifferenceAccum& d : diffs) {
@@ -286,7 +289,7 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
       shade.push_back(t.shade);
       readback.push_back(t.readback);
     }
-    json ms = stats_json(total);
+    json ms = bench_timing_stats(total);
     ms["stages"] = {{"setup", median_of(setup)},     {"binning", median_of(binning)}, {"raster", median_of(raster)},
                     {"shade", median_of(shade)},     {"readback", median_of(readback)}};
     size_t nan_total = 0;
@@ -297,13 +300,16 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
                  {"filter", to_string(o.filter)},
                  {"ms", ms},
                  {"ms_per_frame", total},
+                 {"ms_stages_per_frame",
+                  {{"setup", setup}, {"binning", binning}, {"raster", raster}, {"shade", shade}, {"readback", readback}}},
                  {"nan_pixels", nan_total},
                  {"nan_pixels_per_frame", a.nan_per_frame},
                  {"temporal",
-                  {{"seam_mean", finite_or_zero(mean_of(a.temporal_seam))},
-                   {"mean", finite_or_zero(mean_of(a.temporal_all))},
+                  {{"seam_mean", finite_or_zero(mean_in_order(a.temporal_seam))},
+                   {"mean", finite_or_zero(mean_in_order(a.temporal_all))},
                    {"pairs", a.temporal_all.size()},
                    {"seam_pairs", a.temporal_seam.size()}}},
+                 {"temporal_per_frame", a.temporal_per_frame},
                  {"texture_bytes", a.texture_bytes},
                  {"padding_bytes", a.padding_bytes},
                  {"adjacency_bytes", a.adjacency_bytes}};
@@ -338,6 +344,7 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
                 {"size", size},
                 {"device", runtime.device_description()},
                 {"frames", frames},
+                {"shard", {{"index", shard.index}, {"count", shard.count}, {"first_frame", range.first}, {"end_frame", range.end}}},
                 {"reference_frames", args.reference_frames},
                 {"errors", with_errors},
                 {"error_frames", error_frame_list},
@@ -367,6 +374,10 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
                                " 8x reference").c_str()
                             : "off",
                 wall_s);
+    if (!shard.whole()) {
+      std::printf("part %s: frames %d..%d (seamcl merge combines the parts' --json output)\n", to_string(shard).c_str(),
+                  range.first, range.end - 1);
+    }
     std::printf("%-10s %4s %9s %9s %9s %7s %5s %10s %10s %10s %12s\n", "method", "msaa", "ms_med", "ms_min", "ms_max",
                 "spread", "nan", "mean", "seam_mean", "temporal", "tex_bytes");
     for (const json& r : results) {
@@ -398,6 +409,10 @@ Command add_bench_command(CLI::App& app) {
   cmd->add_flag("--no-errors", args->no_errors, "Skip the references and errors (times, NaN counts, temporal only)");
   cmd->add_option("--reference-frames", args->reference_frames,
                   "Measure errors on every K-th frame only (frames 0, K, 2K, ...): each needs an 8x reference [1]");
+  cmd->add_option("--shard", args->shard,
+                  "Run part K (1-based) of N: a contiguous block of the orbit's frames; `seamcl merge` combines "
+                  "the parts' JSON into the unsharded run's [1/1]");
+  cmd->add_flag("--check", args->check_only, "Validate the options (and the scene) and exit without rendering");
   return Command{cmd, [args](const GlobalOptions& global) { return run_bench(*args, global); }};
 }
 

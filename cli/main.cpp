@@ -29,7 +29,7 @@ using nlohmann::json;
 using namespace seamcl;
 
 struct RenderArgs {
-  std::optional<std::string> scene, texture, method, filter, zero_coverage, texels, size, shading;
+  std::optional<std::string> scene, texture, method, filter, zero_coverage, texels, size, shading, cube_method;
   std::optional<int> msaa, aniso, guard_band, frame, frames;
   std::optional<std::string> displacement_method;
   std::optional<int> tessellation, displacement_level;
@@ -57,6 +57,7 @@ json render_request(const RenderArgs& a) {
   if (a.filter) request["filter"] = *a.filter;
   if (a.zero_coverage) request["zero_coverage"] = *a.zero_coverage;
   if (a.texels) request["texels"] = *a.texels;
+  if (a.cube_method) request["cube_method"] = *a.cube_method;
   if (a.msaa) request["msaa"] = *a.msaa;
   if (a.aniso) request["aniso"] = *a.aniso;
   if (a.guard_band) request["guard_band"] = *a.guard_band;
@@ -194,6 +195,9 @@ int main(int argc, char** argv) {
   render->add_option("--zero-coverage", render_args.zero_coverage,
                      "discard with every tap outside the face: clamp (a clamped lookup) or nan (the raw 0/0) [clamp]");
   render->add_option("--texels", render_args.texels, "Texel storage: " + listed(texel_format_names()) + " [rgba8]");
+  render->add_option("--cube-method", render_args.cube_method,
+                     "Cube-map seam method of scenes with an environment (envmap): " + listed(cube_method_names()) +
+                         " [cube-seamless]");
   render->add_option("--msaa", render_args.msaa, "Samples per pixel: 1, 2, 4, 8 or 16 [1]");
   render->add_option("--aniso", render_args.aniso, "Maximum anisotropy, 1..16 [16]");
   render->add_option("--guard-band", render_args.guard_band, "guardband: band texels per side of every level, 1..16 [4]");
@@ -225,6 +229,8 @@ int main(int argc, char** argv) {
   extra_commands.push_back(seamcl::cli::add_serve_command(app));
   extra_commands.push_back(seamcl::cli::add_compare_command(app));
   extra_commands.push_back(seamcl::cli::add_bench_command(app));
+  extra_commands.push_back(seamcl::cli::add_merge_command(app));
+  extra_commands.push_back(seamcl::cli::add_cube_command(app));
 
   try {
     app.parse(argc, argv);

@@ -92,6 +92,51 @@ typedef struct {
   cl_float corner_transform[4][6];
 } FaceNeighbors;
 
+/* CubeSampler.method: how a cube-map lookup treats its filter taps at the faces' edges. */
+#define SEAMCL_CUBE_CLAMP 0    /* per-face clamp: the seams of D3D9 */
+#define SEAMCL_CUBE_SEAMLESS 1 /* taps past an edge read the adjacent face; corners: mean of 3 texels */
+#define SEAMCL_CUBE_STRETCH 2  /* faces baked with map_2 (edge texels shared), clamp */
+#define SEAMCL_CUBE_WARP 3     /* faces baked with the cubic warp, clamp */
+#define SEAMCL_CUBE_FIXUP 4    /* stretch-baked faces, coordinates scaled by 1 - exp2(lod)/n, clamp */
+#define SEAMCL_CUBE_DISCARD 5  /* border-zero taps renormalised per face (Toth 2013 on a cube) */
+/* Not a seam method: shade writes the lookup direction instead of the lookup (host/eval's
+ * analytic reference evaluates the environment along it). */
+#define SEAMCL_CUBE_DIRECTION 6
+
+/* A cube map's lookup. Texels: linear RGBA32F, face-major (+X, -X, +Y, -Y, +Z, -Z), each face's
+ * levels n, n/2, .., 1 in turn, rows top to bottom (t = 0 first): face f, level l starts at
+ * texel f * (4 n^2 - 1) / 3 + 4 (n^2 - (n >> l)^2) / 3. */
+typedef struct {
+  cl_int size;          /* level-0 face size n, a power of two; 0: the scene has no cube map */
+  cl_int level_count;   /* log2(n) + 1 */
+  cl_int method;        /* SEAMCL_CUBE_* */
+  cl_int filter;        /* SEAMCL_FILTER_BILINEAR, _TRILINEAR or _ANISO */
+  cl_int max_aniso;     /* 1..16 */
+  cl_int pad0;
+} CubeSampler;
+
+/* The environment's per-frame part. A view ray through pixel-space point (x, y) has the
+ * (unnormalised) direction ray_corner + x ray_dx + y ray_dy: linear for a pinhole camera, so its
+ * screen derivatives are ray_dx and ray_dy. */
+typedef struct {
+  CubeSampler sampler;
+  cl_float eye[3];        /* world space */
+  cl_float ray_corner[3];
+  cl_float ray_dx[3];
+  cl_float ray_dy[3];
+  cl_int skybox;          /* 1: samples no triangle covers show the environment */
+  cl_int pad0;
+} EnvironmentParams;
+
+/* A face that reflects the environment (FaceGpu.reflective indexes these): its corners (uv (0,0),
+ * (1,0), (1,1), (0,1)) and unit shading normals there, interpolated bilinearly in uv. */
+typedef struct {
+  cl_float position[4][3];
+  cl_float normal[4][3];
+  cl_float roughness;     /* 0: a mirror; > 0 widens the lookup's footprint (glossy) */
+  cl_int pad0[3];
+} ReflectiveFace;
+
 /* Per frame, read-only in every kernel. Screen space: pixels, origin at the top-left corner of
  * the image, y down; pixel (x, y) spans [x, x+1) x [y, y+1), its centre at (x+0.5, y+0.5). */
 typedef struct {
@@ -110,6 +155,7 @@ typedef struct {
   cl_float background[3];   /* linear RGB of samples no triangle covers */
   cl_int pad0;
   SamplerParams sampler;
+  EnvironmentParams environment; /* cube-map lookups (reflective faces, skybox); size 0: none */
 } FrameParams;
 
 /* One quad patch. Texture texels of all faces live in one buffer; level l of a face starts at
@@ -121,7 +167,7 @@ typedef struct {
   cl_int width, height;     /* level 0 size in texels, powers of two */
   cl_int level_count;       /* down to 1x1 */
   cl_float normal[3];       /* unit, world space, towards the front */
-  cl_int pad0;
+  cl_int reflective;        /* index into the ReflectiveFace table; -1: a diffuse, textured face */
 } FaceGpu;
 
 /* Output of triangle setup, one per clip slot (input triangle * SEAMCL_CLIP_SLOTS + k).

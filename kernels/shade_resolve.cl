@@ -9,6 +9,9 @@
  * own position. Resolve: box filter (mean over samples) into linear RGBA float, alpha 1.
  * Shading: uv and d(uv)/d(pixel) analytically from the 1/w, u/w, v/w planes, one texture lookup
  * (sample_texture with frame->sampler: the seam method), and lighting = light_color * (ambient + (1 - ambient) * max(0, n.l)) with the face normal.
+ * Reflective faces (FaceGpu.reflective >= 0, scenes with an environment, built with
+ * -DSEAMCL_CUBE=1 only) look the reflected view ray up in the cube map instead (shade_reflection),
+ * and uncovered samples show the environment when frame->environment.skybox is set.
  * Seam mask (only in programs built with -DSEAMCL_SEAM_MASK=1, so that renders without it pay
  * nothing): per pixel, over its fragments (each sample's with SEAMCL_SHADE_SAMPLE), whether a
  * texture footprint crosses a face edge. A fragment's own filter (same point, footprint, filter
@@ -16,13 +19,19 @@
  * across edge k weighs more than SEAMCL_SEAM_WEIGHT_TOLERANCE inside the face (the filters are
  * symmetric, so this is the weight it puts beyond edge k); the same filter carried onto an edge
  * neighbour as traverse reads it (at the neighbour's own resolution, so a coarser neighbour's
- * taps reach further back) crosses when it weighs more than the tolerance inside the neighbour.
+ * taps reach further back) crosses when it weighs more than the tolerance inside the neighbour;
+ * likewise carried onto the diagonal face past a valence-4 corner (what traverse reads there).
  * SEAMCL_MASK_SEAM: some footprint crosses an edge shared with a neighbour (or leaves the face
  * past a corner only); else SEAMCL_MASK_BOUNDARY: some footprint crosses a mesh boundary edge
  * only; else SEAMCL_MASK_NONE, and there every seam method returns the same colour.
  * Without guard bands only (GUARD 0): a band would count as inside.
  * Host guarantees: sample_triangle from raster of this frame; seam_mask holds width * height
- * bytes when SEAMCL_SEAM_MASK is 1 (unused otherwise). Twin: host/twins/shade_resolve.cpp. */
+ * bytes when SEAMCL_SEAM_MASK is 1 (unused otherwise). Twin: host/twins/shade_resolve.cpp
+ * (reflections: host/twins/shade_reflection.cpp). */
+
+#ifndef SEAMCL_CUBE
+#define SEAMCL_CUBE 0
+#endif
 
 #ifndef SEAMCL_SEAM_MASK
 #define SEAMCL_SEAM_MASK 0
@@ -54,11 +63,78 @@ SEAMCL_INLINE float plane_inv_w(__global const TriangleSetup* t, float x, float 
   return t->inv_w[0] + t->inv_w[1] * (x - t->ref_x) + t->inv_w[2] * (y - t->ref_y);
 }
 
+#if SEAMCL_CUBE
+/* The environment branch: compiled only into the programs of scenes with an environment, so that
+ * the patch-texture path of the others keeps vectorising (the cube lookup does not). */
+SEAMCL_INLINE float dot3(float3 a, float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+SEAMCL_INLINE float3 load3(__global const float* p) { return (float3)(p[0], p[1], p[2]); }
+
+/* The environment along direction d (its screen derivatives dx, dy), or, for the analytic
+ * reference (SEAMCL_CUBE_DIRECTION), the unit direction scaled by 1 + roughness. */
+__attribute__((noinline)) float3 environment_lookup(__constant FrameParams* frame, __global const float* cube_texels, float3 d,
+                                        float3 dx, float3 dy, float roughness) {
+  if (frame->environment.sampler.method == SEAMCL_CUBE_DIRECTION) {
+    return d * ((1.0f + roughness) / sqrt(dot3(d, d)));
+  }
+  const float4 c = sample_cube(cube_texels, frame->environment.sampler, d.x, d.y, d.z, dx.x, dx.y, dx.z, dy.x, dy.y,
+                               dy.z, roughness, -1.0f);
+  return (float3)(c.x, c.y, c.z);
+}
+
+/* A reflective face at uv: the point (piecewise linear over the two triangles, as rasterised),
+ * the normal (bilinear over the corners' normals, normalised), the view ray I from the eye and
+ * R = I - 2 (N.I) N, with screen derivatives by the chain rule through d(uv)/d(pixel). */
+__attribute__((noinline)) float3 shade_reflection(__constant FrameParams* frame, __global const ReflectiveFace* rf,
+                                      __global const float* cube_texels, SurfaceUv s) {
+  const float u = s.u, v = s.v;
+  const float3 p0 = load3(rf->position[0]), p1 = load3(rf->position[1]);
+  const float3 p2 = load3(rf->position[2]), p3 = load3(rf->position[3]);
+  const float3 n0 = load3(rf->normal[0]), n1 = load3(rf->normal[1]);
+  const float3 n2 = load3(rf->normal[2]), n3 = load3(rf->normal[3]);
+  const int first_triangle = u >= v;
+  const float3 pu = first_triangle ? p1 - p0 : p2 - p3;
+  const float3 pv = first_triangle ? p2 - p1 : p3 - p0;
+  const float3 eye = (float3)(frame->environment.eye[0], frame->environment.eye[1], frame->environment.eye[2]);
+  const float3 view = p0 + pu * u + pv * v - eye;
+  const float3 n = n0 * ((1.0f - u) * (1.0f - v)) + n1 * (u * (1.0f - v)) + n2 * (u * v) + n3 * ((1.0f - u) * v);
+  const float3 nu = (n1 - n0) * (1.0f - v) + (n2 - n3) * v;
+  const float3 nv = (n3 - n0) * (1.0f - u) + (n2 - n1) * u;
+  const float inv_length = 1.0f / sqrt(dot3(n, n));
+  const float3 normal = n * inv_length;
+  /* d(n/|n|) = (dn - N (N.dn)) / |n| */
+  const float3 dn_x = nu * s.dudx + nv * s.dvdx;
+  const float3 dn_y = nu * s.dudy + nv * s.dvdy;
+  const float3 dnormal_x = (dn_x - normal * dot3(normal, dn_x)) * inv_length;
+  const float3 dnormal_y = (dn_y - normal * dot3(normal, dn_y)) * inv_length;
+  const float3 dview_x = pu * s.dudx + pv * s.dvdx;
+  const float3 dview_y = pu * s.dudy + pv * s.dvdy;
+  const float n_dot_i = dot3(normal, view);
+  const float3 r = view - normal * (2.0f * n_dot_i);
+  const float3 dr_x = dview_x - (normal * (dot3(dnormal_x, view) + dot3(normal, dview_x)) + dnormal_x * n_dot_i) * 2.0f;
+  const float3 dr_y = dview_y - (normal * (dot3(dnormal_y, view) + dot3(normal, dview_y)) + dnormal_y * n_dot_i) * 2.0f;
+  return environment_lookup(frame, cube_texels, r, dr_x, dr_y, rf->roughness);
+}
+
+/* The skybox: the environment along the view ray through pixel-space point (x, y). */
+SEAMCL_INLINE float3 shade_sky(__constant FrameParams* frame, __global const float* cube_texels, float x, float y) {
+  __constant const EnvironmentParams* e = &frame->environment;
+  const float3 dx = (float3)(e->ray_dx[0], e->ray_dx[1], e->ray_dx[2]);
+  const float3 dy = (float3)(e->ray_dy[0], e->ray_dy[1], e->ray_dy[2]);
+  const float3 d = (float3)(e->ray_corner[0], e->ray_corner[1], e->ray_corner[2]) + dx * x + dy * y;
+  return environment_lookup(frame, cube_texels, d, dx, dy, 0.0f);
+}
+#endif
+
 SEAMCL_INLINE float3 shade_fragment(__constant FrameParams* frame, __global const TriangleSetup* t,
                              __global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
                              __global const uint* level_offsets, TEXEL_BUFFER texels,
-                             __global const float* srgb_to_linear, float x, float y) {
+                             __global const float* srgb_to_linear, __global const ReflectiveFace* reflective_faces,
+                             __global const float* cube_texels, float x, float y) {
   const SurfaceUv s = interpolate_uv(t, x, y);
+#if SEAMCL_CUBE
+  const int reflective = faces[t->face].reflective;
+  if (reflective >= 0) return shade_reflection(frame, reflective_faces + reflective, cube_texels, s);
+#endif
   const float4 albedo = sample_texture(faces, neighbors, t->face, level_offsets, texels, srgb_to_linear, frame->sampler,
                                        s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
   __global const FaceGpu* face = faces + t->face;
@@ -122,6 +198,19 @@ SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global cons
                                       m[3] * s.dudy + m[4] * s.dvdy);
     seam |= crosses | !(reach <= tolerance);
   }
+  /* The diagonal face past each valence-4 corner, as traverse reads it: a coarser one's taps can
+   * reach back over the corner although no edge's footprint crosses. */
+  for (int k = 0; k < 4; ++k) {
+    const int other = n->corner[k];
+    if (other < 0) continue;
+    __global const float* m = n->corner_transform[k];
+    const FaceGpu g = faces[other];
+    const float reach = weight_inside(frame, &g, level_offsets, texels, srgb_to_linear, m[0] * s.u + m[1] * s.v + m[2],
+                                      m[3] * s.u + m[4] * s.v + m[5], m[0] * s.dudx + m[1] * s.dvdx,
+                                      m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
+                                      m[3] * s.dudy + m[4] * s.dvdy);
+    seam |= !(reach <= tolerance);
+  }
   /* Taps outside past a corner only (no edge's mirror saw them): a seam, to be safe. */
   seam |= !any_edge && !(own >= 1.0f - tolerance);
   return seam ? (uchar)SEAMCL_MASK_SEAM : boundary ? (uchar)SEAMCL_MASK_BOUNDARY : (uchar)SEAMCL_MASK_NONE;
@@ -132,7 +221,8 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
                             __global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
                             __global const uint* level_offsets, TEXEL_BUFFER texels,
                             __global const float* srgb_to_linear, __global const uint* sample_triangle, __global float4* image,
-                            __global FrameStats* stats, __global uchar* seam_mask) {
+                            __global FrameStats* stats, __global uchar* seam_mask,
+                            __global const ReflectiveFace* reflective_faces, __global const float* cube_texels) {
   __local uint group_fragments;
   if (get_local_id(0) == 0 && get_local_id(1) == 0) group_fragments = 0;
   barrier(CLK_LOCAL_MEM_FENCE);
@@ -157,7 +247,7 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
       const float sample_x = (float)sample_fixed_x(x, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
       const float sample_y = (float)sample_fixed_y(y, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
       if (frame->shading_mode == SEAMCL_SHADE_SAMPLE) {
-        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, sample_x, sample_y);
+        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, sample_x, sample_y);
 #if SEAMCL_SEAM_MASK
         crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,
                                                       srgb_to_linear, sample_x, sample_y));
@@ -189,7 +279,7 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
         shade_x = centroid_x;
         shade_y = centroid_y;
       }
-      sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, shade_x, shade_y) *
+      sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, shade_x, shade_y) *
              (float)covered;
 #if SEAMCL_SEAM_MASK
       crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,
@@ -199,7 +289,15 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
     }
     /* Added once, so that an empty pixel is exactly the background (n*b/n is exact for n a power
      * of two; b+b+b... rounds). */
+#if SEAMCL_CUBE
+    if (uncovered > 0 && frame->environment.skybox) {
+      sum += shade_sky(frame, cube_texels, (float)x + 0.5f, (float)y + 0.5f) * (float)uncovered;
+    } else {
+      sum += background * (float)uncovered;
+    }
+#else
     sum += background * (float)uncovered;
+#endif
     const float3 color = sum / (float)samples;
     image[(size_t)y * (size_t)frame->width + (size_t)x] = (float4)(color, 1.0f);
 #if SEAMCL_SEAM_MASK

@@ -209,7 +209,7 @@ const std::map<std::string, std::vector<std::string>>& known_paths() {
   static const std::map<std::string, std::vector<std::string>> paths = {
       {"/", {"GET"}},           {"/health", {"GET"}},          {"/v1/scenes", {"GET"}}, {"/v1/assets", {"GET"}},
       {"/v1/methods", {"GET"}}, {"/v1/render", {"GET", "POST"}}, {"/v1/compare", {"POST"}}, {"/v1/reference", {"POST"}},
-      {"/openapi.json", {"GET"}}};
+      {"/openapi.json", {"GET"}}, {"/ready", {"GET"}}};
   return paths;
 }
 
@@ -615,6 +615,7 @@ json HttpServer::make_methods_json() const {
         {"method", enum_option(method_names(), "method")},
         {"filter", enum_option(filter_names(), "filter")},
         {"zero_coverage", enum_option(zero_coverage_names(), "zero_coverage")},
+        {"cube_method", enum_option(cube_method_names(), "cube_method")},
         {"texels", enum_option(texel_format_names(), "texels")},
         {"shading", enum_option(shading_mode_names(), "shading")},
         {"msaa", {{"type", "integer"}, {"enum", {1, 2, 4, 8, 16}}, {"default", defaults.msaa}}},
@@ -1148,6 +1149,19 @@ void HttpServer::install_routes() {
   });
   http.Get("/health", guarded([this](const httplib::Request&, httplib::Response& res) {
              res.set_content(json_text(health_json()), "application/json");
+           }));
+  // Readiness for a load balancer's health check: 200 once every slot is warm, else 503 (the
+  // balancer then sends nothing here); /health stays 200 from the moment the port listens.
+  http.Get("/ready", guarded([this](const httplib::Request&, httplib::Response& res) {
+             const json health = health_json();
+             const bool is_ready = health.at("status") == "ready";
+             res.status = is_ready ? 200 : 503;
+             if (!is_ready) res.set_header("Retry-After", "1");
+             res.set_content(json_text({{"ready", is_ready},
+                                        {"status", health.at("status")},
+                                        {"warming", health.at("warming")},
+                                        {"uptime_s", health.at("uptime_s")}}),
+                             "application/json");
            }));
   http.Get("/v1/scenes", guarded([this](const httplib::Request&, httplib::Response& res) {
              res.set_content(json_text(scenes_json()), "application/json");

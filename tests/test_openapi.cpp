@@ -74,7 +74,7 @@ TEST(OpenApi, EnumsAreTheParsersNames) {
   const std::vector<std::pair<std::string, std::vector<std::string>>> tables = {
       {"method", method_names()},           {"filter", filter_names()},
       {"shading", shading_mode_names()},    {"texels", texel_format_names()},
-      {"zero_coverage", zero_coverage_names()}};
+      {"zero_coverage", zero_coverage_names()}, {"cube_method", cube_method_names()}};
   for (const auto& [key, names] : tables) {
     for (const auto& [where, option] : option_schemas(key)) {
       EXPECT_EQ(option.value("type", ""), "string") << where;

@@ -327,9 +327,9 @@ TEST(Generators, ListsTheScenesWithPaperFirst) {
     EXPECT_FALSE(info.description.empty()) << info.name;
   }
   EXPECT_EQ(names, (std::vector<std::string>{"paper", "quad2", "plane", "cube", "closeup-seam", "closeup-corner",
-                                             "mixed", "displaced"}));
+                                             "mixed", "envmap", "displaced"}));
   const std::string message = expect_input_error([] { generate_scene("teapot", {}); }, "scene");
-  EXPECT_NE(message.find("unknown scene 'teapot' (known: paper, quad2, plane, cube, closeup-seam, closeup-corner, mixed, displaced)"),
+  EXPECT_NE(message.find("unknown scene 'teapot' (known: paper, quad2, plane, cube, closeup-seam, closeup-corner, mixed, envmap, displaced)"),
             std::string::npos)
       << message;
 }

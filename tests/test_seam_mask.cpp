@@ -151,10 +151,9 @@ TEST(SeamMask, OutsideTheMaskEveryMethodAgrees) {
     RenderOptions options = small_frame(4);
     const std::vector<uint8_t> mask = footprint_seam_mask(renderer, scene.camera, options);
     std::vector<std::vector<glm::vec4>> images;
-    // traverse-edges, the paper's Traverse, is the base: traverse with corners still differs off the
-    // mask by up to 3e-3 on these scenes (open in issue 10: the mask's corner reach and the
-    // diagonal face's do not agree yet).
-    for (Method method : {Method::TraverseEdges, Method::Clamp, Method::Black, Method::Discard, Method::Guardband}) {
+    // traverse (with the diagonal faces past corners) is the base; the mask reads those faces too.
+    for (Method method : {Method::Traverse, Method::TraverseEdges, Method::Clamp, Method::Black, Method::Discard,
+                          Method::Guardband}) {
       options.method = method;
       images.push_back(renderer.render(scene.camera, options).pixels);
     }

@@ -95,26 +95,6 @@ uint64_t chain_texels(int ulog2, int vlog2) {
   return total;
 }
 
-// The next level of a chain: each side above 1 halved, each texel the mean of its 2x2 (2x1, 1x2)
-// block, as build_mip_chain does.
-TextureLevel box_reduce(const TextureLevel& fine) {
-  TextureLevel coarse;
-  coarse.width = std::max(1, fine.width / 2);
-  coarse.height = std::max(1, fine.height / 2);
-  const int step_x = fine.width / coarse.width;
-  const int step_y = fine.height / coarse.height;
-  const float weight = 1.0f / static_cast<float>(step_x * step_y);
-  coarse.texels.resize(static_cast<size_t>(coarse.width) * coarse.height);
-  for (int j = 0; j < coarse.height; ++j)
-    for (int i = 0; i < coarse.width; ++i) {
-      glm::vec4 sum(0.0f);
-      for (int dy = 0; dy < step_y; ++dy)
-        for (int dx = 0; dx < step_x; ++dx) sum += fine.at(i * step_x + dx, j * step_y + dy);
-      coarse.texels[static_cast<size_t>(j) * coarse.width + i] = sum * weight;
-    }
-  return coarse;
-}
-
 TextureLevel filled_level(int width, int height, glm::vec4 value) {
   TextureLevel level;
   level.width = width;
@@ -767,7 +747,7 @@ class PtexDecoder {
           chain.levels.push_back(stored_level(k, rank, info, f));
           unpremultiply(chain.levels.back(), f, k);
         } else {
-          chain.levels.push_back(box_reduce(chain.levels.back()));
+          chain.levels.push_back(box_downsample(chain.levels.back()));
         }
       }
     }

@@ -1,5 +1,7 @@
 #include "pipeline/frame_params.h"
 
+#include "pipeline/environment_params.h"
+
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
@@ -18,6 +20,7 @@ FrameParams make_frame_params(const Scene& scene, const Camera& camera, const Re
   const glm::mat4 vp = view_projection(camera, options.width, options.height);
   const float* m = glm::value_ptr(vp);
   for (int i = 0; i < 16; ++i) p.view_proj[i] = m[i];
+  p.environment = environment_params(scene, camera, options);
   p.width = options.width;
   p.height = options.height;
   p.tiles_x = (options.width + SEAMCL_TILE_SIZE - 1) / SEAMCL_TILE_SIZE;

@@ -6,7 +6,8 @@
 #include <seamcl/kernels/seamcl_types.h>
 
 static_assert(sizeof(SamplerParams) == 32, "SamplerParams layout");
-static_assert(sizeof(FrameParams) == 184, "FrameParams layout");
+static_assert(sizeof(FrameParams) == 264, "FrameParams layout");
+static_assert(offsetof(FrameParams, environment) == 184);
 static_assert(offsetof(FrameParams, sampler) == 152);
 static_assert(offsetof(FrameParams, width) == 64);
 static_assert(offsetof(FrameParams, near_w) == 96);
@@ -14,6 +15,7 @@ static_assert(offsetof(FrameParams, light_dir) == 108);
 static_assert(offsetof(FrameParams, background) == 136);
 static_assert(sizeof(FaceGpu) == 48, "FaceGpu layout");
 static_assert(offsetof(FaceGpu, normal) == 32);
+static_assert(offsetof(FaceGpu, reflective) == 44);
 static_assert(sizeof(TriangleSetup) == 112, "TriangleSetup layout");
 static_assert(offsetof(TriangleSetup, edge_a) == 24);
 static_assert(offsetof(TriangleSetup, bbox_min_x) == 48);
@@ -26,3 +28,8 @@ static_assert(offsetof(FaceNeighbors, transform) == 16);
 static_assert(offsetof(FaceNeighbors, corner) == 112);
 static_assert(offsetof(FaceNeighbors, corner_transform) == 128);
 static_assert(offsetof(SamplerParams, traverse) == 20);
+static_assert(sizeof(CubeSampler) == 24, "CubeSampler layout");
+static_assert(sizeof(EnvironmentParams) == 80, "EnvironmentParams layout");
+static_assert(offsetof(EnvironmentParams, ray_dy) == 60);
+static_assert(sizeof(ReflectiveFace) == 112, "ReflectiveFace layout");
+static_assert(offsetof(ReflectiveFace, roughness) == 96);

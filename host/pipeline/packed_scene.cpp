@@ -5,6 +5,7 @@
 #include "core/srgb.h"
 #include "pipeline/adjacency.h"
 #include "pipeline/guard_band.h"
+#include "pipeline/reflective_face.h"
 
 #include <limits>
 #include <stdexcept>
@@ -41,6 +42,8 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
     gpu.normal[0] = n.x;
     gpu.normal[1] = n.y;
     gpu.normal[2] = n.z;
+    gpu.reflective = face.roughness >= 0.0f ? static_cast<cl_int>(out.reflective_faces.size()) : -1;
+    if (face.roughness >= 0.0f) out.reflective_faces.push_back(reflective_face(scene, face));
     for (size_t l = 0; l < face.texture.levels.size(); ++l) {
       const TextureLevel banded = guard_band > 0 ? guard_banded_level(scene, out.neighbors, static_cast<uint32_t>(f),
                                                                       static_cast<int>(l), guard_band)

@@ -20,6 +20,7 @@ struct PackedScene {
   size_t band_texels = 0;               // of all stored texels, those in bands
   std::vector<uint32_t> texels8;        // RGBA8, sRGB-encoded RGB (format Rgba8)
   std::vector<float> texels32;          // linear RGBA32F, 4 floats a texel (format Rgba32f)
+  std::vector<ReflectiveFace> reflective_faces;  // of faces with roughness >= 0 (FaceGpu.reflective)
 
   int input_triangles() const { return static_cast<int>(faces.size() * 2); }
   TextureView textures() const { return {&faces, &neighbors, &level_offsets, format, &texels8, &texels32, guard_band}; }

@@ -41,7 +41,7 @@ size_t saturating_mul(size_t a, size_t b) {
 }
 
 size_t RenderMemory::scene_device_bytes() const {
-  return add(add(add(positions, faces), add(neighbors, level_offsets)), texels);
+  return add(add(add(add(positions, faces), add(neighbors, level_offsets)), texels), environment);
 }
 size_t RenderMemory::frame_device_bytes() const { return add(add(add(setups, tiles), add(tile_lists, samples)), image); }
 size_t RenderMemory::device_bytes() const { return add(add(scene_device_bytes(), constants), frame_device_bytes()); }
@@ -54,7 +54,11 @@ SceneSizes scene_sizes(const Scene& scene) {
   SceneSizes sizes;
   sizes.vertices = scene.positions.size();
   sizes.faces.reserve(scene.faces.size());
-  for (const Face& face : scene.faces) sizes.faces.emplace_back(face.texture.width(), face.texture.height());
+  for (const Face& face : scene.faces) {
+    sizes.faces.emplace_back(face.texture.width(), face.texture.height());
+    if (face.roughness >= 0.0f) ++sizes.reflective_faces;
+  }
+  sizes.cube_size = scene.environment ? scene.environment->cube_size : 0;
   return sizes;
 }
 
@@ -103,6 +107,10 @@ RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options
   m.neighbors = device_array(faces, sizeof(FaceNeighbors));
   m.level_offsets = device_array(m.textures.levels, sizeof(uint32_t));
   m.texels = device_array(m.textures.texels, options.texels == TexelFormat::Rgba8 ? sizeof(uint32_t) : 4 * sizeof(float));
+  const size_t cube_side = static_cast<size_t>(std::max(scene.cube_size, 0));
+  const size_t cube_texels = scene.cube_size > 0 ? 6 * (4 * cube_side * cube_side - 1) / 3 : 0;
+  m.environment = add(device_array(scene.reflective_faces, sizeof(ReflectiveFace)),
+                      device_array(mul(cube_texels, 4), sizeof(float)));
 
   m.constants = 256 * sizeof(float) + sizeof(FrameParams) + sizeof(FrameStats);
 
@@ -128,7 +136,8 @@ RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options
 
   m.host_scene = scene_host_bytes(scene);
   m.host_packed = add(add(mul(scene.vertices, sizeof(cl_float4)), mul(faces, sizeof(FaceGpu) + sizeof(FaceNeighbors))),
-                      add(mul(m.textures.levels, sizeof(uint32_t)), m.textures.texture_bytes));
+                      add(add(mul(m.textures.levels, sizeof(uint32_t)), m.textures.texture_bytes),
+                          add(mul(scene.reflective_faces, sizeof(ReflectiveFace)), mul(cube_texels, 4 * sizeof(float)))));
   m.host_image = mul(pixels, sizeof(glm::vec4));
   return m;
 }

@@ -36,6 +36,8 @@ namespace seamcl {
 struct SceneSizes {
   size_t vertices = 0;
   std::vector<std::pair<int, int>> faces;  // level-0 texture width x height, per face
+  size_t reflective_faces = 0;             // faces with roughness >= 0
+  int cube_size = 0;                       // the environment's cube size; 0: no environment
 
   size_t triangle_count() const { return faces.size() * 2; }
 };
@@ -68,6 +70,7 @@ struct RenderMemory {
   size_t neighbors = 0;      // FaceNeighbors per face (adjacency_bytes)
   size_t level_offsets = 0;  // uint per level
   size_t texels = 0;         // texture_bytes
+  size_t environment = 0;    // ReflectiveFace per reflective face + the cube map's RGBA32F texels
   // Device: per Renderer, whatever the request.
   size_t constants = 0;      // sRGB table, FrameParams, FrameStats
   // Device: sized by the request (what release_frame_buffers frees).
@@ -84,7 +87,7 @@ struct RenderMemory {
   size_t host_image = 0;   // RenderResult::pixels, float4 per pixel
 
   // The sums saturate at SIZE_MAX like every figure here.
-  size_t scene_device_bytes() const;  // positions + faces + neighbors + level_offsets + texels
+  size_t scene_device_bytes() const;  // positions + faces + neighbors + level_offsets + texels + environment
   size_t frame_device_bytes() const;  // setups + tiles + tile_lists + samples + image
   // Exact as described above (tile lists at their initial size).
   size_t device_bytes() const;        // scene + constants + frame

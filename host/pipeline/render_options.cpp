@@ -46,6 +46,13 @@ constexpr std::array<std::pair<TexelFormat, const char*>, 2> kTexelFormats{
     {{TexelFormat::Rgba8, "rgba8"}, {TexelFormat::Rgba32f, "rgba32f"}}};
 constexpr std::array<std::pair<ShadingMode, const char*>, 3> kShadingModes{
     {{ShadingMode::Pixel, "pixel"}, {ShadingMode::Centroid, "centroid"}, {ShadingMode::Sample, "sample"}}};
+constexpr std::array<std::pair<CubeMethod, const char*>, 6> kCubeMethods{
+    {{CubeMethod::Clamp, "cube-clamp"},
+     {CubeMethod::Seamless, "cube-seamless"},
+     {CubeMethod::Stretch, "cube-stretch"},
+     {CubeMethod::Warp, "cube-warp"},
+     {CubeMethod::Fixup, "cube-fixup"},
+     {CubeMethod::Discard, "cube-discard"}}};
 constexpr std::array<std::pair<ImageFormat, const char*>, 2> kFormats{{{ImageFormat::Png, "png"}, {ImageFormat::Exr, "exr"}}};
 
 std::string joined(const std::vector<std::string>& names) {
@@ -110,6 +117,9 @@ std::vector<std::string> zero_coverage_names() { return enum_names(kZeroCoverage
 std::optional<TexelFormat> parse_texel_format(std::string_view name) { return parse_enum(name, kTexelFormats); }
 std::string to_string(TexelFormat format) { return enum_name(format, kTexelFormats); }
 std::vector<std::string> texel_format_names() { return enum_names(kTexelFormats); }
+std::optional<CubeMethod> parse_cube_method(std::string_view name) { return parse_enum(name, kCubeMethods); }
+std::string to_string(CubeMethod method) { return enum_name(method, kCubeMethods); }
+std::vector<std::string> cube_method_names() { return enum_names(kCubeMethods); }
 
 bool reads_adjacency(Method method) { return method == Method::Traverse || method == Method::TraverseEdges; }
 
@@ -196,6 +206,8 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
       options.tessellation = int_field(value, key, 1, SEAMCL_MAX_TESSELLATION);
     } else if (key == "displacement_level") {
       options.displacement_level = int_field(value, key, 0, 16);
+    } else if (key == "cube_method") {
+      options.cube_method = enum_field(value, key, "cube method", kCubeMethods);
     } else {
       throw InputError(key, "unknown option");
     }
@@ -225,7 +237,8 @@ nlohmann::json to_json(const RenderOptions& options) {
                         {"guard_band", options.guard_band},
                         {"size", std::to_string(options.width) + "x" + std::to_string(options.height)},
                         {"shading", to_string(options.shading)},
-                        {"tint", options.tint}};
+                        {"tint", options.tint},
+                        {"cube_method", to_string(options.cube_method)}};
   if (!options.texture.empty()) out["texture"] = options.texture;
   if (options.displacement) {
     out["displacement_method"] = to_string(*options.displacement);

@@ -34,6 +34,17 @@ enum class ZeroCoverage { Clamp, Nan };
 // sample (supersampling).
 enum class ShadingMode { Pixel, Centroid, Sample };
 enum class ImageFormat { Png, Exr };
+// How a cube-map lookup (reflective faces and the skybox of scenes with an environment) treats
+// the cube's edges; a setting of its own, since patch methods and cube methods never meet in one
+// lookup (see kernels/seamcl_types.h, SEAMCL_CUBE_*):
+//   cube-clamp    - per-face clamp (the seams of D3D9 and old consoles);
+//   cube-seamless - taps past an edge read the adjacent face, corners the mean of three texels;
+//   cube-stretch  - faces baked with map_2 (edge texels on the cube edge), clamp;
+//   cube-warp     - faces baked with the cubic warp of the texel centres, clamp;
+//   cube-fixup    - stretch-baked faces, lookup coordinates scaled by 1 - exp2(lod)/n;
+//   cube-discard  - taps outside the face weigh zero, the rest renormalised (Toth 2013 where its
+//                   assumption, a geometric edge under the seam, fails).
+enum class CubeMethod { Clamp, Seamless, Stretch, Warp, Fixup, Discard };
 
 std::optional<Method> parse_method(std::string_view name);
 std::string to_string(Method method);
@@ -54,6 +65,9 @@ std::vector<std::string> zero_coverage_names();
 std::optional<TexelFormat> parse_texel_format(std::string_view name);
 std::string to_string(TexelFormat format);
 std::vector<std::string> texel_format_names();
+std::optional<CubeMethod> parse_cube_method(std::string_view name);
+std::string to_string(CubeMethod method);
+std::vector<std::string> cube_method_names();
 
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr long long kMaxSamplesPerImage = 1LL << 28;  // width * height * msaa
@@ -74,6 +88,7 @@ struct RenderOptions {
   std::optional<int> frame;     // orbit frame, with `frames`
   int frames = 60;
   bool tint = false;            // built-in scenes: a base colour per face
+  CubeMethod cube_method = CubeMethod::Seamless;  // scenes with an environment only
   // Displacement (docs/displacement.md): off unless a method is asked for; then every patch is
   // tessellated into a (T+1)^2 grid displaced by the scene's maps at displacement_level.
   std::optional<DisplacementMethod> displacement;
@@ -84,7 +99,7 @@ struct RenderOptions {
 // Reads the keys present in `request` over the defaults. Throws InputError naming the key on a
 // wrong type, an out-of-range value or an unknown key. Keys: scene, texture, method, filter, msaa, aniso,
 // size ("WxH"), shading, centroid (bool, same as shading=centroid), zero_coverage, texels,
-// guard_band, frame, frames, tint, displacement_method, tessellation, displacement_level.
+// guard_band, frame, frames, tint, cube_method, displacement_method, tessellation, displacement_level.
 RenderOptions parse_render_options(const nlohmann::json& request);
 nlohmann::json to_json(const RenderOptions& options);
 

@@ -13,6 +13,7 @@
 #include "pipeline/adjacency.h"
 #include "pipeline/frame_params.h"
 #include "pipeline/tessellation_stage.h"
+#include <seamcl/pipeline/packed_cube.h>
 
 namespace seamcl {
 namespace {
@@ -45,6 +46,10 @@ struct Renderer::Impl {
   PackedScene packed;
   bool uploaded = false;  // packed and its buffers are current (a failed pack leaves neither)
   cl::Buffer positions, faces, neighbors, level_offsets, texels, srgb_table;
+  // The environment: reflective faces (with the scene) and the cube map baked for the method.
+  cl::Buffer reflective_faces, cube_texels;
+  std::optional<CubeBake> cube_bake_uploaded;
+  std::vector<float> cube_host;
 
   // Frame buffers, grown on demand.
   cl::Buffer frame_params, stats, setups, tile_counts, tile_offsets, tile_cursors, tile_lists, sample_triangle, image;
@@ -59,6 +64,7 @@ struct Renderer::Impl {
   std::optional<DisplacementSettings> tessellation_settings;  // what `tessellation` holds
   bool displaced = false;        // this frame runs the tessellation stage
   std::string program_key;       // the current program variant's build options
+  bool direction_output = false;  // render_directions: SEAMCL_CUBE_DIRECTION
 
   explicit Impl(ClRuntime& rt) : runtime(rt) {
     const auto& table = srgb_to_linear_table();
@@ -70,7 +76,7 @@ struct Renderer::Impl {
 
   // Makes the kernels of the program variant for this texel format and sampler current.
   void use_kernels(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask) {
-    const std::string options = program_options(format, sampler, with_seam_mask);
+    const std::string options = program_options(format, sampler, with_seam_mask, scene->environment.has_value());
     program_key = options;
     auto it = kernel_sets.find(options);
     if (it == kernel_sets.end()) {
@@ -98,15 +104,33 @@ struct Renderer::Impl {
     neighbors = upload(packed.neighbors);
     level_offsets = upload(packed.level_offsets);
     texels = format == TexelFormat::Rgba8 ? upload(packed.texels8) : upload(packed.texels32);
+    reflective_faces = upload(packed.reflective_faces);
     uploaded = true;
   }
 
   void release_scene_buffers() {
     uploaded = false;
     packed = PackedScene{};
-    positions = faces = neighbors = level_offsets = texels = cl::Buffer();
+    positions = faces = neighbors = level_offsets = texels = reflective_faces = cube_texels = cl::Buffer();
+    cube_bake_uploaded.reset();
+    cube_host = {};
     tessellation.release();
     tessellation_settings.reset();
+  }
+
+  // Bakes and uploads the environment's cube map as `bake` unless it is the one there; a scene
+  // without an environment gets a one-element stand-in (the kernels never read it).
+  void upload_cube(std::optional<CubeBake> bake) {
+    if (cube_texels() != nullptr && cube_bake_uploaded == bake) return;
+    cube_texels = cl::Buffer();
+    cube_host = {};
+    if (bake) {
+      const Environment& environment = *scene->environment;
+      cube_host = pack_cube_texels(
+          bake_cube_map(environment_function(environment), environment.cube_size, *bake, environment.bake_samples));
+    }
+    cube_texels = upload(cube_host);
+    cube_bake_uploaded = bake;
   }
 
   void release_frame_buffers() {
@@ -234,6 +258,8 @@ struct Renderer::Impl {
     } else {
       shade_kernel.setArg(10, sizeof(cl_mem), nullptr);  // a null buffer: the variant never touches it
     }
+    shade_kernel.setArg(11, reflective_faces);
+    shade_kernel.setArg(12, cube_texels);
     queue.enqueueNDRangeKernel(shade_kernel, cl::NullRange, tile_grid, tile_group, nullptr, next(ev.shade));
 
     pixels.resize(static_cast<size_t>(p.width) * p.height);
@@ -277,7 +303,8 @@ size_t Renderer::device_bytes() const {
   const Impl& i = *impl_;
   size_t bytes = 0;
   for (const cl::Buffer* buffer :
-       {&i.positions, &i.faces, &i.neighbors, &i.level_offsets, &i.texels, &i.srgb_table, &i.frame_params, &i.stats,
+       {&i.positions, &i.faces, &i.neighbors, &i.level_offsets, &i.texels, &i.reflective_faces, &i.cube_texels,
+        &i.srgb_table, &i.frame_params, &i.stats,
         &i.setups, &i.tile_counts, &i.tile_offsets, &i.tile_cursors, &i.tile_lists, &i.sample_triangle, &i.image,
         &i.seam_mask}) {
     if ((*buffer)() != nullptr) bytes += buffer->getInfo<CL_MEM_SIZE>();
@@ -291,6 +318,8 @@ const Scene& Renderer::scene() const {
 }
 
 const PackedScene& Renderer::packed_scene() const { return impl_->packed; }
+
+const std::vector<float>& Renderer::cube_texels() const { return impl_->cube_host; }
 
 RenderResult Renderer::render(const Camera& camera, const RenderOptions& options, bool with_seam_mask) {
   if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
@@ -307,6 +336,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   if (!impl_->uploaded || options.texels != impl_->packed.format || sampler.guard_band != impl_->packed.guard_band) {
     impl_->pack_and_upload(options.texels, sampler.guard_band);
   }
+  impl_->upload_cube(impl_->scene->environment ? std::optional(cube_bake(options.cube_method)) : std::nullopt);
   impl_->use_kernels(options.texels, sampler, with_seam_mask);
   impl_->displaced = options.displacement.has_value();
   if (impl_->displaced) {
@@ -323,6 +353,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   for (result.attempts = 1;; ++result.attempts) {
     FrameParams params = make_frame_params(*impl_->scene, camera, options, impl_->bin_capacity);
     if (impl_->displaced) params.input_triangles = static_cast<cl_int>(impl_->tessellation.packed().triangle_count());
+    if (impl_->direction_output) params.environment.sampler.method = SEAMCL_CUBE_DIRECTION;
     impl_->ensure_frame_buffers(params);
     impl_->bin_capacity = params.bin_capacity;
     impl_->last_params = params;
@@ -360,7 +391,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   }
 }
 
-std::string program_options(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask) {
+std::string program_options(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask, bool environment) {
   return std::string(format == TexelFormat::Rgba32f ? "-DSEAMCL_TEXELS_F32=1" : "-DSEAMCL_TEXELS_F32=0") +
          " -DSEAMCL_SAMPLER_FILTER=" + std::to_string(sampler.filter) +
          " -DSEAMCL_SAMPLER_ADDRESS=" + std::to_string(sampler.address) +
@@ -368,7 +399,20 @@ std::string program_options(TexelFormat format, const SamplerParams& sampler, bo
          " -DSEAMCL_SAMPLER_ZERO_COVERAGE=" + std::to_string(sampler.zero_coverage) +
          " -DSEAMCL_SAMPLER_TRAVERSE=" + std::to_string(sampler.traverse) +
          " -DSEAMCL_SAMPLER_GUARD_BAND=" + std::to_string(sampler.guard_band) +
-         (with_seam_mask ? " -DSEAMCL_SEAM_MASK=1" : "");
+         (with_seam_mask ? " -DSEAMCL_SEAM_MASK=1" : "") + (environment ? " -DSEAMCL_CUBE=1" : "");
+}
+
+RenderResult Renderer::render_directions(const Camera& camera, const RenderOptions& options) {
+  if (!has_scene() || !impl_->scene->environment) throw std::logic_error("render_directions needs an environment");
+  impl_->direction_output = true;
+  try {
+    RenderResult result = render(camera, options);
+    impl_->direction_output = false;
+    return result;
+  } catch (...) {
+    impl_->direction_output = false;
+    throw;
+  }
 }
 
 void Renderer::warm_up(const RenderOptions& options) {

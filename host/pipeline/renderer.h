@@ -45,8 +45,10 @@ struct RenderResult {
 // The build options of the program variant that reads `format` texels with `sampler`'s filter,
 // address mode, renormalisation and zero-coverage rule fixed at build time (max_aniso stays a
 // run-time parameter). See the specialisation note in kernels/texture_sample.cl.
-// with_seam_mask builds the shade stage that also writes the seam mask.
-std::string program_options(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask = false);
+// with_seam_mask builds the shade stage that also writes the seam mask; with `environment`, the
+// shade stage's environment branch is compiled in (-DSEAMCL_CUBE=1).
+std::string program_options(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask = false,
+                            bool environment = false);
 
 class Renderer {
  public:
@@ -60,6 +62,9 @@ class Renderer {
   void load_scene(const Scene& scene, TexelFormat format = TexelFormat::Rgba8);
   const Scene& scene() const;
   const PackedScene& packed_scene() const;
+  // The cube map of the last render's cube method as uploaded (pack_cube_texels), for the twins;
+  // empty for a scene without an environment.
+  const std::vector<float>& cube_texels() const;
   bool has_scene() const;
 
   // Frees the buffers sized by a request (triangle setups, tiles and tile lists, the sample
@@ -86,6 +91,12 @@ class Renderer {
   // renders without it pay nothing). The mask reads the faces' own texels without guard bands:
   // with Method::Guardband it throws InputError("method"); any other method gives the same mask.
   RenderResult render(const Camera& camera, const RenderOptions& options, bool with_seam_mask = false);
+
+  // For the analytic reference of scenes with an environment (host/eval/cube_metrics.h): every
+  // environment lookup (reflective fragments, skybox) writes its unit direction times
+  // 1 + roughness instead of a colour (SEAMCL_CUBE_DIRECTION). Use msaa 1: a resolve would mix
+  // directions. Throws std::logic_error for a scene without an environment.
+  RenderResult render_directions(const Camera& camera, const RenderOptions& options);
 
   // Renders one tiny frame of the loaded scene with these options (method, filter, texels) so
   // that the program variant is built and PoCL compiles every kernel for its local size now

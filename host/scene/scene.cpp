@@ -29,26 +29,6 @@ std::string size_text(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
 
-TextureLevel box_downsample(const TextureLevel& fine) {
-  TextureLevel coarse;
-  coarse.width = std::max(1, fine.width / 2);
-  coarse.height = std::max(1, fine.height / 2);
-  // A side that is already 1 is not halved, so its footprint along that axis is one texel.
-  const int step_x = fine.width / coarse.width;
-  const int step_y = fine.height / coarse.height;
-  const float weight = 1.0f / static_cast<float>(step_x * step_y);
-  coarse.texels.resize(static_cast<size_t>(coarse.width) * coarse.height);
-  for (int j = 0; j < coarse.height; ++j) {
-    for (int i = 0; i < coarse.width; ++i) {
-      glm::vec4 sum(0.0f);
-      for (int dy = 0; dy < step_y; ++dy)
-        for (int dx = 0; dx < step_x; ++dx) sum += fine.at(i * step_x + dx, j * step_y + dy);
-      coarse.texels[static_cast<size_t>(j) * coarse.width + i] = sum * weight;
-    }
-  }
-  return coarse;
-}
-
 // A sine with a continuous first derivative, within 1e-3 of std::sin and several times cheaper:
 // the pattern below is evaluated for every texel of every generated scene (millions), and only
 // its smoothness, not its exactness, matters for showing seams.
@@ -102,6 +82,26 @@ void check_texture(const MipChain& chain, const std::string& field) {
 }
 
 }  // namespace
+
+TextureLevel box_downsample(const TextureLevel& fine) {
+  TextureLevel coarse;
+  coarse.width = std::max(1, fine.width / 2);
+  coarse.height = std::max(1, fine.height / 2);
+  // A side that is already 1 is not halved, so its footprint along that axis is one texel.
+  const int step_x = fine.width / coarse.width;
+  const int step_y = fine.height / coarse.height;
+  const float weight = 1.0f / static_cast<float>(step_x * step_y);
+  coarse.texels.resize(static_cast<size_t>(coarse.width) * coarse.height);
+  for (int j = 0; j < coarse.height; ++j) {
+    for (int i = 0; i < coarse.width; ++i) {
+      glm::vec4 sum(0.0f);
+      for (int dy = 0; dy < step_y; ++dy)
+        for (int dx = 0; dx < step_x; ++dx) sum += fine.at(i * step_x + dx, j * step_y + dy);
+      coarse.texels[static_cast<size_t>(j) * coarse.width + i] = sum * weight;
+    }
+  }
+  return coarse;
+}
 
 MipChain build_mip_chain(TextureLevel level0) {
   if (!is_power_of_two(level0.width) || !is_power_of_two(level0.height))
@@ -251,6 +251,29 @@ Camera orbit_camera(const Scene& scene, int frame, int frames) {
   return camera;
 }
 
+namespace {
+
+// A reflective face needs an environment to reflect and a unit shading normal at each corner.
+void check_reflective_face(const Scene& scene, const Face& face, const std::string& face_field) {
+  if (face.roughness < 0.0f) return;
+  if (!(face.roughness <= 4.0f)) throw InputError(face_field + ".roughness", "must be in 0..4 (or < 0: diffuse)");
+  if (!scene.environment) throw InputError(face_field + ".roughness", "a reflective face needs an environment");
+  if (scene.normals.size() != scene.positions.size()) {
+    throw InputError("normals", "reflective faces need one normal per position (" +
+                                    std::to_string(scene.positions.size()) + "), got " +
+                                    std::to_string(scene.normals.size()));
+  }
+  for (uint32_t v : face.vertices) {
+    const glm::vec3 n = scene.normals[v];
+    const float length = glm::length(n);
+    if (!(std::fabs(length - 1.0f) < 1e-3f)) {
+      throw InputError("normals[" + std::to_string(v) + "]", "must be a unit vector");
+    }
+  }
+}
+
+}  // namespace
+
 void validate_scene(const Scene& scene) {
   if (scene.faces.empty()) throw InputError("faces", "the scene has no faces");
   for (size_t i = 0; i < scene.positions.size(); ++i)
@@ -272,7 +295,9 @@ void validate_scene(const Scene& scene) {
     if (!(area_measure > 0.0f) || !std::isfinite(area_measure))
       throw InputError(face_field + ".vertices", "the quad is degenerate (zero area)");
     check_texture(face.texture, face_field + ".texture");
+    check_reflective_face(scene, face, face_field);
   }
+  if (scene.environment) validate_environment(*scene.environment);
 
   const Camera& camera = scene.camera;
   check_vec3(camera.eye, "camera.eye");

@@ -11,6 +11,8 @@
 
 #include <glm/glm.hpp>
 
+#include <seamcl/scene/environment.h>
+
 namespace seamcl {
 
 struct Displacement;  // per-face displacement maps (scene/displacement_map.h)
@@ -35,11 +37,18 @@ struct MipChain {
 // Builds the whole chain from level 0 (must be power-of-two sized).
 MipChain build_mip_chain(TextureLevel level0);
 
+// The next level of a chain: each side above 1 halved, each texel the mean of its 2x2 (2x1, 1x2)
+// block.
+TextureLevel box_downsample(const TextureLevel& fine);
+
 // A quad patch. Vertices are counter-clockwise seen from the front and carry uv (0,0), (1,0),
 // (1,1), (0,1) in order; it renders as triangles (v0,v1,v2) and (v0,v2,v3).
 struct Face {
   std::array<uint32_t, 4> vertices{};
   MipChain texture;
+  // < 0: a diffuse face showing its texture. >= 0: the face reflects the scene's environment
+  // (0 a mirror; more widens the lookup, glossy), shaded with Scene::normals.
+  float roughness = -1.0f;
 };
 
 // The point of the face at (u, v), piecewise linear over its two triangles exactly as rendered,
@@ -81,6 +90,8 @@ struct Scene {
   std::optional<Orbit> orbit;  // needed for --frame
   Light light;
   glm::vec3 background{0.02f, 0.02f, 0.03f};  // linear RGB
+  std::optional<Environment> environment;      // what reflective faces (and the skybox) show
+  std::vector<glm::vec3> normals;              // per vertex: shading normals of reflective faces
   // The function the textures were baked from, when there is one: texel (i, j) of face f holds
   // albedo(f, the surface point of its centre). The analytic reference evaluates it at every
   // subsample instead of filtering texels. Empty for textures that came from elsewhere (files).

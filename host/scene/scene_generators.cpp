@@ -13,6 +13,7 @@
 #include <thread>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/scene/envmap_scene.h>
 #include "scene/displaced_scene.h"
 
 namespace seamcl {
@@ -346,6 +347,9 @@ const std::vector<Generator>& generators() {
         "a closed mesh (a split pentagonal prism, 30 quads, vertices of valence 3, 4 and 5) with textures from 1x1 to "
         "256x256 side by side and neighbours rotated by every multiple of 90 degrees"},
        make_mixed},
+      {{"envmap", "mirror and glossy spheres and a mirror torus in an analytic environment (skybox), "
+                  "for the cube-map methods (cube_method)"},
+       [](const GeneratorOptions& options) { return make_envmap_scene(options); }},
       {{"displaced",
         "a closed cube-sphere of 24 quads with displacement maps (2x2 to 33x33 samples, neighbours rotated); "
         "render it with displacement_method"},
@@ -428,6 +432,7 @@ void apply_generator_options(Scene& scene, const GeneratorOptions& options) {
   }
   if (options.constant_color)
     set_constant_textures(scene, glm::vec4(*options.constant_color, 1.0f));
+  if (options.constant_color && scene.environment) scene.environment->constant = *options.constant_color;
   if (!options.tint) return;
   // The box filter is linear, so scaling every level equals re-filtering a scaled level 0.
   for (size_t f = 0; f < scene.faces.size(); ++f) {

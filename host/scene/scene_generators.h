@@ -24,6 +24,10 @@ struct GeneratorOptions {
   bool tint = false;                        // multiply each face by its own pastel (face_tint)
   std::optional<glm::vec3> constant_color;  // paint this colour instead of the content
   std::optional<TextureContent> content;    // unset: the generator's own (GeneratorInfo)
+  // envmap only: its environment (constant_color then makes it constant) and the roughness of
+  // its mirror sphere, glossy sphere and torus.
+  std::optional<Environment> environment;
+  std::optional<glm::vec3> roughness;
 };
 
 struct GeneratorInfo {

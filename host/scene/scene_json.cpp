@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/scene/cube_map.h>
 
 namespace seamcl {
 namespace {
@@ -139,8 +140,37 @@ glm::vec3 read_color(const json& value, const std::string& path) {
   return color;
 }
 
+// The environment of reflective faces and the skybox (Environment, environment.h).
+Environment read_environment(const json& value, const std::string& path) {
+  const ObjectFields fields(value, path,
+                            {"cube_size", "bake_samples", "skybox", "constant", "sun_direction", "sun_radius",
+                             "sun_color", "zenith", "horizon", "ground"});
+  Environment e;
+  if (const json* v = fields.optional("cube_size")) e.cube_size = read_int(*v, fields.path_of("cube_size"), 1, kMaxCubeSize);
+  if (const json* v = fields.optional("bake_samples")) e.bake_samples = read_int(*v, fields.path_of("bake_samples"), 1, 8);
+  if (const json* v = fields.optional("skybox")) e.skybox = read_bool(*v, fields.path_of("skybox"));
+  if (const json* v = fields.optional("constant")) e.constant = read_color(*v, fields.path_of("constant"));
+  AnalyticEnvironment& a = e.analytic;
+  if (const json* v = fields.optional("sun_direction")) a.sun_direction = read_vec3(*v, fields.path_of("sun_direction"));
+  if (const json* v = fields.optional("sun_radius")) a.sun_radius = read_float(*v, fields.path_of("sun_radius"));
+  if (const json* v = fields.optional("sun_color")) a.sun_color = read_color(*v, fields.path_of("sun_color"));
+  if (const json* v = fields.optional("zenith")) a.zenith = read_color(*v, fields.path_of("zenith"));
+  if (const json* v = fields.optional("horizon")) a.horizon = read_color(*v, fields.path_of("horizon"));
+  if (const json* v = fields.optional("ground")) a.ground = read_color(*v, fields.path_of("ground"));
+  try {
+    validate_environment(e);
+  } catch (const InputError& error) {
+    // validate_environment names "environment.FIELD"; here the field lives at `path`.
+    const std::string prefix = "environment";
+    const std::string sub = error.field().substr(std::min(error.field().size(), prefix.size()));
+    throw InputError(path + sub, std::string(error.what()).substr(error.field().size() + 2));
+  }
+  a.sun_direction = glm::normalize(a.sun_direction);
+  return e;
+}
+
 GeneratorOptions read_generator_options(const json& value, const std::string& path) {
-  const ObjectFields fields(value, path, {"tint", "constant_color", "content"});
+  const ObjectFields fields(value, path, {"tint", "constant_color", "content", "environment", "roughness"});
   GeneratorOptions options;
   if (const json* content = fields.optional("content")) {
     const std::string name = read_string(*content, fields.path_of("content"));
@@ -150,6 +180,16 @@ GeneratorOptions read_generator_options(const json& value, const std::string& pa
       for (const std::string& n : texture_content_names()) known += (known.empty() ? "" : ", ") + n;
       throw InputError(fields.path_of("content"), "unknown content '" + name + "' (known: " + known + ")");
     }
+  }
+  if (const json* environment = fields.optional("environment"))
+    options.environment = read_environment(*environment, fields.path_of("environment"));
+  if (const json* roughness = fields.optional("roughness")) {
+    const glm::vec3 r = read_vec3(*roughness, fields.path_of("roughness"));
+    for (int k = 0; k < 3; ++k) {
+      if (!(r[k] >= 0.0f && r[k] <= 4.0f))
+        throw InputError(element_path(fields.path_of("roughness"), static_cast<size_t>(k)), "must be in 0..4");
+    }
+    options.roughness = r;
   }
   if (const json* tint = fields.optional("tint"))
     options.tint = read_bool(*tint, fields.path_of("tint"));
@@ -259,7 +299,7 @@ Light read_light(const json& value) {
 
 Scene read_explicit_scene(const json& doc, const std::string& default_name, const FaceImageLoader& load_image) {
   const ObjectFields fields(
-      doc, "", {"name", "positions", "faces", "camera", "orbit", "light", "background"});
+      doc, "", {"name", "positions", "faces", "camera", "orbit", "light", "background", "environment", "normals"});
   Scene scene;
   scene.name = default_name;
   if (const json* name = fields.optional("name")) scene.name = read_string(*name, "name");
@@ -274,7 +314,7 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name, cons
   size_t total_texels = 0;
   for (size_t f = 0; f < faces.size(); ++f) {
     const std::string face_path = element_path("faces", f);
-    const ObjectFields face_fields(faces[f], face_path, {"vertices", "texture"});
+    const ObjectFields face_fields(faces[f], face_path, {"vertices", "texture", "roughness"});
     const std::string vertices_path = face_fields.path_of("vertices");
     const json& vertices = read_array(face_fields.required("vertices"), vertices_path);
     if (vertices.size() != 4)
@@ -289,8 +329,15 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name, cons
                                          std::to_string(scene.positions.size()) + " positions)");
       face.vertices[k] = static_cast<uint32_t>(index);
     }
+    if (const json* roughness = face_fields.optional("roughness")) {
+      face.roughness = read_float(*roughness, face_fields.path_of("roughness"));
+      if (!(face.roughness >= 0.0f && face.roughness <= 4.0f))
+        throw InputError(face_fields.path_of("roughness"), "must be in 0..4");
+    }
     const std::string texture_path = face_fields.path_of("texture");
-    plans.push_back(read_texture(face_fields.required("texture"), texture_path));
+    // A reflective face never reads its texture: it may leave it out (then 1 x 1).
+    const json* texture = face.roughness >= 0.0f ? face_fields.optional("texture") : &face_fields.required("texture");
+    plans.push_back(texture ? read_texture(*texture, texture_path) : TexturePlan{1, 1, true, glm::vec3(0.5f), {}});
     if (!plans.back().image.empty() && !load_image)
       throw InputError(texture_path + ".image", "image files cannot be read here (an inline scene names no files)");
     total_texels += static_cast<size_t>(plans.back().width) * plans.back().height;
@@ -305,6 +352,16 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name, cons
   if (const json* light = fields.optional("light")) scene.light = read_light(*light);
   if (const json* background = fields.optional("background"))
     scene.background = read_color(*background, "background");
+  if (const json* environment = fields.optional("environment"))
+    scene.environment = read_environment(*environment, "environment");
+  if (const json* normals = fields.optional("normals")) {
+    const json& list = read_array(*normals, "normals");
+    for (size_t i = 0; i < list.size(); ++i) {
+      const glm::vec3 n = read_vec3(list[i], element_path("normals", i));
+      if (!(glm::length(n) > 0.0f)) throw InputError(element_path("normals", i), "must not be zero");
+      scene.normals.push_back(glm::normalize(n));
+    }
+  }
 
   // Textures last: baking is the expensive part, so a document is checked in full first.
   for (size_t f = 0; f < scene.faces.size(); ++f) {

@@ -4,6 +4,7 @@
 
 #include "twins/raster.h"
 #include "twins/sample_pattern.h"
+#include "twins/shade_reflection.h"
 #include "twins/texture_sample.h"
 
 namespace seamcl {
@@ -26,8 +27,11 @@ SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y) {
   return r;
 }
 
-glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& f, const TriangleSetup& t, float x, float y) {
+glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& f, const TriangleSetup& t, float x, float y,
+                                   const std::vector<float>* cube_texels) {
   const SurfaceUv s = interpolate_uv(t, x, y);
+  const int reflective = scene.faces.at(t.face).reflective;
+  if (reflective >= 0) return shade_reflection_reference(f, scene.reflective_faces.at(reflective), *cube_texels, s);
   const glm::vec4 albedo =
       sample_texture_reference(scene.textures(), t.face, f.sampler, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
   const FaceGpu& face = scene.faces.at(t.face);
@@ -67,6 +71,17 @@ uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const Tr
                                       m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
                                       m[3] * s.dudy + m[4] * s.dvdy);
     seam = seam || crosses || !(reach <= tolerance);
+  }
+  // The diagonal face past each valence-4 corner, as traverse reads it: a coarser one's taps can
+  // reach back over the corner although no edge's footprint crosses.
+  for (int k = 0; k < 4; ++k) {
+    if (n.corner[k] < 0) continue;
+    const float* m = n.corner_transform[k];
+    const float reach = weight_inside(static_cast<uint32_t>(n.corner[k]), m[0] * s.u + m[1] * s.v + m[2],
+                                      m[3] * s.u + m[4] * s.v + m[5], m[0] * s.dudx + m[1] * s.dvdx,
+                                      m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
+                                      m[3] * s.dudy + m[4] * s.dvdy);
+    seam = seam || !(reach <= tolerance);
   }
   seam = seam || (!any_edge && !(own >= 1.0f - tolerance));  // past a corner only
   return seam ? SEAMCL_MASK_SEAM : boundary ? SEAMCL_MASK_BOUNDARY : SEAMCL_MASK_NONE;
@@ -111,6 +126,7 @@ bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& f
   for (int s = 0; s < f.sample_count; ++s) {
     if (ids[s] == SEAMCL_NO_TRIANGLE || std::find(ids, ids + s, ids[s]) != ids + s) continue;
     const TriangleSetup& t = setups.at(ids[s]);
+    if (scene.faces.at(t.face).reflective >= 0) continue;  // a cube-map lookup: no patch taps
     const PixelFragment fragment = pixel_fragment(f, t, ids, ids[s], x, y);
     const SurfaceUv uv = interpolate_uv(t, fragment.x, fragment.y);
     const FilterSum sum =
@@ -122,7 +138,8 @@ bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& f
 
 ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& f,
                                          const std::vector<TriangleSetup>& setups,
-                                         const std::vector<uint32_t>& sample_triangle) {
+                                         const std::vector<uint32_t>& sample_triangle,
+                                         const std::vector<float>* cube_texels) {
   const int samples = f.sample_count;
   const std::vector<SampleOffset>& pattern = sample_pattern(samples);
   constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
@@ -146,18 +163,23 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
         }
         const TriangleSetup& t = setups.at(slot);
         if (f.shading_mode == SEAMCL_SHADE_SAMPLE) {
-          sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s));
+          sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s), cube_texels);
           crosses = merge_mask(crosses, footprint_class(scene, f, t, sample_x(s), sample_y(s)));
           ++out.fragments;
           continue;
         }
         if (std::find(ids, ids + s, slot) != ids + s) continue;  // shaded at its first sample
         const PixelFragment fragment = pixel_fragment(f, t, ids, slot, x, y);
-        sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y) * static_cast<float>(fragment.covered);
+        sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y, cube_texels) * static_cast<float>(fragment.covered);
         crosses = merge_mask(crosses, footprint_class(scene, f, t, fragment.x, fragment.y));
         ++out.fragments;
       }
-      sum += background * static_cast<float>(uncovered);  // once: an empty pixel is exactly the background
+      if (uncovered > 0 && f.environment.skybox) {
+        sum += shade_sky_reference(f, *cube_texels, static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f) *
+               static_cast<float>(uncovered);
+      } else {
+        sum += background * static_cast<float>(uncovered);  // once: an empty pixel is exactly the background
+      }
       out.pixels[static_cast<size_t>(y) * f.width + x] = glm::vec4(sum / static_cast<float>(samples), 1.0f);
       out.seam_mask[static_cast<size_t>(y) * f.width + x] = crosses;
     }

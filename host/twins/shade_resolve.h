@@ -17,8 +17,11 @@ struct SurfaceUv {
 };
 SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y);
 
-// Colour of one fragment: texture lookup times the face's Lambert lighting.
-glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& frame, const TriangleSetup& t, float x, float y);
+// Colour of one fragment: texture lookup times the face's Lambert lighting; on a reflective face
+// the environment along the reflected ray (twins/shade_reflection.h), from `cube_texels` (the
+// renderer's Renderer::cube_texels(); needed by scenes with an environment only).
+glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& frame, const TriangleSetup& t, float x,
+                                   float y, const std::vector<float>* cube_texels = nullptr);
 
 // A triangle's fragment in one pixel (pixel or centroid shading): the samples it covers and
 // where it is shaded. `ids` are the pixel's sample winners; `slot` must be among them.
@@ -31,6 +34,7 @@ PixelFragment pixel_fragment(const FrameParams& frame, const TriangleSetup& t, c
 
 // Whether some fragment of pixel (x, y) (pixel or centroid shading) has no filter tap inside its
 // face (nor, for traverse, its neighbours): the fragments zero_coverage=nan turns into NaN.
+// Reflective faces (cube-map lookups) have no patch taps and never count.
 bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& frame,
                                   const std::vector<TriangleSetup>& setups, const uint32_t* ids, int x, int y);
 
@@ -49,6 +53,7 @@ struct ResolveReference {
 };
 ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& frame,
                                          const std::vector<TriangleSetup>& setups,
-                                         const std::vector<uint32_t>& sample_triangle);
+                                         const std::vector<uint32_t>& sample_triangle,
+                                         const std::vector<float>* cube_texels = nullptr);
 
 }  // namespace seamcl

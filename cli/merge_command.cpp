@@ -1,0 +1,87 @@
+// seamcl merge: the parts of a sharded bench (`seamcl bench --shard K/N --json`, one file each)
+// combined into the JSON one unsharded run gives (host/eval/bench_merge.h says which statistics
+// merge exactly, which are recomputed from the merged samples and which are not exact).
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <seamcl/core/input_error.h>
+#include <seamcl/eval/bench_merge.h>
+#include "commands.h"
+
+namespace seamcl::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A part of 1000 frames x 40 entries is a few MiB; anything far larger is not a part.
+constexpr std::uintmax_t kMaxPartBytes = 256ull << 20;
+
+struct MergeArgs {
+  std::vector<std::string> parts;
+  std::string output;
+};
+
+BenchPart read_part(const std::string& path) {
+  std::error_code ec;
+  const std::uintmax_t bytes = fs::file_size(path, ec);
+  if (ec || !fs::is_regular_file(path)) throw InputError("parts", path + ": not a readable file");
+  if (bytes > kMaxPartBytes) {
+    throw InputError("parts", path + ": " + std::to_string(bytes >> 20) + " MiB, over the " +
+                                  std::to_string(kMaxPartBytes >> 20) + " MiB a part may have");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("parts", path + ": cannot be opened");
+  std::ostringstream text;
+  text << in.rdbuf();
+  BenchPart part{path, nlohmann::json::parse(text.str(), nullptr, false)};
+  if (part.json.is_discarded()) throw InputError("parts", path + ": not valid JSON");
+  return part;
+}
+
+// Written next to the target and renamed over it, so a reader never sees half a file.
+void write_atomically(const std::string& path, const std::string& text) {
+  const std::string temporary = path + ".part-" + std::to_string(::getpid());
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError("output", path + ": cannot be written");
+    out << text;
+    if (!out.flush()) throw std::runtime_error("writing " + temporary + " failed");
+  }
+  fs::rename(temporary, path);
+}
+
+int run_merge(const MergeArgs& args) {
+  std::vector<BenchPart> parts;
+  for (const std::string& path : args.parts) parts.push_back(read_part(path));
+  const nlohmann::json merged = merge_bench_parts(parts);
+  const std::string text = merged.dump(2) + "\n";
+  if (args.output.empty() || args.output == "-") {
+    std::cout << text;
+  } else {
+    write_atomically(args.output, text);
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_merge_command(CLI::App& app) {
+  auto args = std::make_shared<MergeArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "merge", "Combine the parts of a sharded bench (bench --shard K/N --json, one file each) into one run's JSON");
+  cmd->add_option("parts", args->parts, "The parts' JSON files, in any order; all N parts of one batch")->required();
+  cmd->add_option("-o,--output", args->output, "Write the merged JSON here (- or none: stdout)");
+  return Command{cmd, [args](const GlobalOptions&) { return run_merge(*args); }};
+}
+
+}  // namespace seamcl::cli

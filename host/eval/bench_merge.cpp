@@ -1,0 +1,490 @@
+#include <seamcl/eval/bench_merge.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <map>
+
+#include <seamcl/core/input_error.h>
+#include <seamcl/eval/comparison.h>
+
+namespace seamcl {
+
+using nlohmann::json;
+
+json bench_timing_stats(std::vector<double> v) {
+  if (v.empty()) throw std::invalid_argument("bench_timing_stats: no values");
+  std::sort(v.begin(), v.end());
+  const double med = median_of(v);
+  auto quantile = [&](double q) {
+    const double pos = q * static_cast<double>(v.size() - 1);
+    const size_t i = static_cast<size_t>(pos);
+    const double f = pos - static_cast<double>(i);
+    return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
+  };
+  double mean = 0;
+  for (double x : v) mean += x;
+  mean /= static_cast<double>(v.size());
+  return {{"median", med},
+          {"min", v.front()},
+          {"max", v.back()},
+          {"mean", mean},
+          {"p10", quantile(0.1)},
+          {"p90", quantile(0.9)},
+          {"spread", med > 0 ? (v.back() - v.front()) / med : 0.0},
+          {"frames", v.size()}};
+}
+
+double mean_in_order(const std::vector<double>& values) {
+  double s = 0;
+  for (double x : values) s += x;
+  return values.empty() ? 0.0 : s / static_cast<double>(values.size());
+}
+
+namespace {
+
+// Reading a part defensively: every missing key or wrong type is an InputError naming the key's
+// path and the part.
+class Reader {
+ public:
+  explicit Reader(const BenchPart& part) : part_(part) {}
+
+  [[noreturn]] void refuse(const std::string& path, const std::string& why) const {
+    throw InputError(path, part_.name + ": " + why);
+  }
+  const json& at(const json& object, const std::string& key, const std::string& path) const {
+    if (!object.is_object()) refuse(path, "expected an object around '" + key + "'");
+    const auto it = object.find(key);
+    if (it == object.end()) refuse(path, "missing (is this `seamcl bench --shard K/N --json` output?)");
+    return *it;
+  }
+  const json& array(const json& object, const std::string& key, const std::string& path) const {
+    const json& a = at(object, key, path);
+    if (!a.is_array()) refuse(path, "expected an array");
+    return a;
+  }
+  double number(const json& value, const std::string& path) const {
+    if (!value.is_number()) refuse(path, "expected a number");
+    const double d = value.get<double>();
+    if (!std::isfinite(d)) refuse(path, "expected a finite number");
+    return d;
+  }
+  double number(const json& object, const std::string& key, const std::string& path) const {
+    return number(at(object, key, path), path);
+  }
+  uint64_t count(const json& object, const std::string& key, const std::string& path) const {
+    const json& v = at(object, key, path);
+    if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<int64_t>() >= 0)) {
+      refuse(path, "expected a count (an integer >= 0)");
+    }
+    return v.get<uint64_t>();
+  }
+  int integer(const json& object, const std::string& key, const std::string& path) const {
+    const json& v = at(object, key, path);
+    if (!v.is_number_integer() || v.get<int64_t>() < INT32_MIN || v.get<int64_t>() > INT32_MAX) {
+      refuse(path, "expected an integer");
+    }
+    return static_cast<int>(v.get<int64_t>());
+  }
+  const std::string& name() const { return part_.name; }
+
+ private:
+  const BenchPart& part_;
+};
+
+// Appends a[key] of every part, in part order (the parts are sorted by their frames).
+json concat(const std::vector<Reader>& readers, const std::vector<const json*>& objects, const std::string& key,
+            const std::string& path) {
+  json out = json::array();
+  for (size_t i = 0; i < objects.size(); ++i) {
+    for (const json& v : readers[i].array(*objects[i], key, path)) out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<double> numbers(const Reader& reader, const json& array, const std::string& path) {
+  std::vector<double> out;
+  out.reserve(array.size());
+  for (const json& v : array) out.push_back(reader.number(v, path));
+  return out;
+}
+
+// Keys that must be equal in every part (the same batch); the first part's value is kept.
+void require_same(const std::vector<Reader>& readers, const std::vector<const json*>& objects,
+                  const std::vector<std::string>& keys, const std::string& prefix, json& out) {
+  for (const std::string& key : keys) {
+    const std::string path = prefix + key;
+    const json& first = readers[0].at(*objects[0], key, path);
+    for (size_t i = 1; i < objects.size(); ++i) {
+      if (readers[i].at(*objects[i], key, path) != first) {
+        readers[i].refuse(path, "differs from " + readers[0].name() + "'s: parts of different batches");
+      }
+    }
+    out[key] = first;
+  }
+}
+
+// A curve [[x, fraction of n], ...] of every part -> the curve of the pooled pixels: the
+// fractions become counts again (each is count / n in double, so rounding recovers the count),
+// are summed and divided by the summed n, as one run divides its count.
+json merge_curve(const std::vector<Reader>& readers, const std::vector<const json*>& curves,
+                 const std::vector<uint64_t>& pixels, const std::string& path) {
+  std::vector<uint64_t> counts;
+  json xs = json::array();
+  uint64_t total_pixels = 0;
+  for (size_t i = 0; i < curves.size(); ++i) {
+    const Reader& r = readers[i];
+    const json& curve = *curves[i];
+    if (!curve.is_array()) r.refuse(path, "expected an array");
+    const uint64_t n = pixels[i];
+    if (i == 0) counts.assign(curve.size(), 0);
+    if (curve.size() != counts.size()) r.refuse(path, "has another number of points than " + readers[0].name() + "'s");
+    for (size_t j = 0; j < curve.size(); ++j) {
+      if (!curve[j].is_array() || curve[j].size() != 2) r.refuse(path, "expected [x, fraction] pairs");
+      (void)r.number(curve[j][0], path);
+      const double fraction = r.number(curve[j][1], path);
+      if (i == 0) {
+        xs.push_back(curve[j][0]);
+      } else if (curve[j][0] != xs[j]) {
+        r.refuse(path, "has other x values than " + readers[0].name() + "'s");
+      }
+      const double c = fraction * static_cast<double>(n);
+      const double rounded = std::round(c);
+      if (fraction < 0 || fraction > 1 || std::abs(c - rounded) > 1e-6 * std::max(1.0, c)) {
+        r.refuse(path, "a fraction that is not a count of the " + std::to_string(n) + " pixels");
+      }
+      counts[j] += static_cast<uint64_t>(rounded);
+    }
+    total_pixels += n;
+  }
+  json out = json::array();
+  for (size_t j = 0; j < counts.size(); ++j) {
+    out.push_back({xs[j], total_pixels == 0 ? 0.0 : static_cast<double>(counts[j]) / static_cast<double>(total_pixels)});
+  }
+  return out;
+}
+
+// Both curves of a pooled statistic: `curve` over `pixels`, `seam_curve` over `seam_pixels`
+// (the counts read from counts_of[i]).
+void merge_curves(const std::vector<Reader>& readers, const std::vector<const json*>& curve_owners,
+                  const std::vector<const json*>& counts_of, const std::string& prefix, const std::string& count_prefix,
+                  json& out) {
+  for (const auto& [key, pixels_key] : std::vector<std::pair<std::string, std::string>>{
+           {"curve", "pixels"}, {"seam_curve", "seam_pixels"}}) {
+    std::vector<const json*> curves;
+    std::vector<uint64_t> pixels;
+    for (size_t i = 0; i < curve_owners.size(); ++i) {
+      curves.push_back(&readers[i].at(*curve_owners[i], key, prefix + key));
+      pixels.push_back(readers[i].count(*counts_of[i], pixels_key, count_prefix + pixels_key));
+    }
+    out[key] = merge_curve(readers, curves, pixels, prefix + key);
+  }
+}
+
+// The pooled error statistics of errors_json (plus `frames` where present), of every part.
+json merge_errors(const std::vector<Reader>& readers, const std::vector<const json*>& objects,
+                  const std::string& prefix, json out) {
+  for (const char* key : {"pixels", "seam_pixels", "off_seam_pixels", "nan_pixels", "seam_nan_pixels"}) {
+    uint64_t sum = 0;
+    for (size_t i = 0; i < objects.size(); ++i) sum += readers[i].count(*objects[i], key, prefix + key);
+    out[key] = sum;
+  }
+  if (objects[0]->contains("frames")) {
+    uint64_t sum = 0;
+    for (size_t i = 0; i < objects.size(); ++i) sum += readers[i].count(*objects[i], "frames", prefix + "frames");
+    out["frames"] = sum;
+  }
+  // (statistic prefix, its pixel count)
+  const std::vector<std::pair<std::string, std::string>> pools = {
+      {"", "pixels"}, {"seam_", "seam_pixels"}, {"off_seam_", "off_seam_pixels"}};
+  for (const auto& [pool, pixels_key] : pools) {
+    double weighted = 0, largest = 0, largest_p99 = 0;
+    uint64_t pixels = 0;
+    for (size_t i = 0; i < objects.size(); ++i) {
+      const Reader& r = readers[i];
+      const uint64_t n = r.count(*objects[i], pixels_key, prefix + pixels_key);
+      const double mean = r.number(*objects[i], pool + "mean", prefix + pool + "mean");
+      const double max = r.number(*objects[i], pool + "max", prefix + pool + "max");
+      const double p99 = r.number(*objects[i], pool + "p99", prefix + pool + "p99");
+      if (n == 0) continue;
+      weighted += mean * static_cast<double>(n);
+      pixels += n;
+      largest = std::max(largest, max);
+      largest_p99 = std::max(largest_p99, p99);
+    }
+    out[pool + "mean"] = pixels == 0 ? 0.0 : weighted / static_cast<double>(pixels);
+    out[pool + "max"] = largest;
+    out[pool + "p99"] = largest_p99;
+  }
+  // bench's pooled seam_coverage: kept when the parts agree, else pixel-weighted.
+  {
+    const double first = readers[0].number(*objects[0], "seam_coverage", prefix + "seam_coverage");
+    bool same = true;
+    double weighted = 0;
+    uint64_t pixels = 0;
+    for (size_t i = 0; i < objects.size(); ++i) {
+      const double c = readers[i].number(*objects[i], "seam_coverage", prefix + "seam_coverage");
+      const uint64_t n = readers[i].count(*objects[i], "pixels", prefix + "pixels");
+      same = same && c == first;
+      weighted += c * static_cast<double>(n);
+      pixels += n;
+    }
+    out["seam_coverage"] = same ? first : (pixels == 0 ? 0.0 : weighted / static_cast<double>(pixels));
+  }
+  return out;
+}
+
+json merge_result(const std::vector<Reader>& readers, const std::vector<const json*>& items, bool with_errors,
+                  const std::string& prefix) {
+  json out = json::object();
+  require_same(readers, items, {"method", "msaa", "aniso", "filter", "texture_bytes", "padding_bytes", "adjacency_bytes"},
+               prefix, out);
+  // Times: the samples of every frame, then their statistics as one run computes them.
+  out["ms_per_frame"] = concat(readers, items, "ms_per_frame", prefix + "ms_per_frame");
+  std::vector<double> total;
+  for (const json& v : out["ms_per_frame"]) total.push_back(readers[0].number(v, prefix + "ms_per_frame"));
+  if (total.empty()) readers[0].refuse(prefix + "ms_per_frame", "no frames in any part");
+  json ms = bench_timing_stats(total);
+  json stages_per_frame = json::object();
+  json stage_medians = json::object();
+  const json& first_stages = readers[0].at(*items[0], "ms_stages_per_frame", prefix + "ms_stages_per_frame");
+  if (!first_stages.is_object()) readers[0].refuse(prefix + "ms_stages_per_frame", "expected an object");
+  for (const auto& [stage, unused] : first_stages.items()) {
+    (void)unused;
+    std::vector<const json*> stage_objects;
+    for (size_t i = 0; i < items.size(); ++i) {
+      stage_objects.push_back(&readers[i].at(*items[i], "ms_stages_per_frame", prefix + "ms_stages_per_frame"));
+    }
+    stages_per_frame[stage] = concat(readers, stage_objects, stage, prefix + "ms_stages_per_frame." + stage);
+    stage_medians[stage] = median_of(numbers(readers[0], stages_per_frame[stage], prefix + "ms_stages_per_frame." + stage));
+  }
+  ms["stages"] = stage_medians;
+  out["ms"] = ms;
+  out["ms_stages_per_frame"] = stages_per_frame;
+
+  out["nan_pixels_per_frame"] = concat(readers, items, "nan_pixels_per_frame", prefix + "nan_pixels_per_frame");
+  uint64_t nan_total = 0;
+  for (const json& v : out["nan_pixels_per_frame"]) {
+    if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<int64_t>() >= 0)) {
+      readers[0].refuse(prefix + "nan_pixels_per_frame", "expected counts");
+    }
+    nan_total += v.get<uint64_t>();
+  }
+  out["nan_pixels"] = nan_total;
+
+  // Temporal: the per-pair values in frame order (each part carries the pair across its first
+  // frame), averaged as one run averages them; pairs without seam pixels have seam_mean null.
+  out["temporal_per_frame"] = concat(readers, items, "temporal_per_frame", prefix + "temporal_per_frame");
+  std::vector<double> all, seam;
+  for (const json& pair : out["temporal_per_frame"]) {
+    all.push_back(readers[0].number(pair, "mean", prefix + "temporal_per_frame.mean"));
+    const json& s = readers[0].at(pair, "seam_mean", prefix + "temporal_per_frame.seam_mean");
+    if (!s.is_null()) seam.push_back(readers[0].number(s, prefix + "temporal_per_frame.seam_mean"));
+  }
+  out["temporal"] = {{"seam_mean", finite_or_zero(mean_in_order(seam))},
+                     {"mean", finite_or_zero(mean_in_order(all))},
+                     {"pairs", all.size()},
+                     {"seam_pairs", seam.size()}};
+
+  if (with_errors) {
+    std::vector<const json*> errors;
+    for (size_t i = 0; i < items.size(); ++i) errors.push_back(&readers[i].at(*items[i], "error", prefix + "error"));
+    out["error"] = merge_errors(readers, errors, prefix + "error.", json::object());
+    merge_curves(readers, items, errors, prefix, prefix + "error.", out);
+    out["error_per_frame"] = concat(readers, items, "error_per_frame", prefix + "error_per_frame");
+  }
+  return out;
+}
+
+json merge_difference(const std::vector<Reader>& readers, const std::vector<const json*>& items,
+                      const std::string& prefix) {
+  json out = json::object();
+  require_same(readers, items, {"a", "b", "msaa"}, prefix, out);
+  out = merge_errors(readers, items, prefix, out);
+  merge_curves(readers, items, items, prefix, prefix, out);
+  return out;
+}
+
+json merge_notes() {
+  return {
+      {"exact",
+       {"results[].ms_per_frame, ms_stages_per_frame, nan_pixels_per_frame, error_per_frame, temporal_per_frame: "
+        "concatenated in frame order",
+        "seam_pixels_per_frame, error_frames: concatenated in frame order",
+        "results[].nan_pixels, error.{pixels, seam_pixels, off_seam_pixels, nan_pixels, seam_nan_pixels, frames}, "
+        "reference.{cached, rendered}: sums",
+        "results[].error.{max, seam_max, off_seam_max}, differences[].{max, seam_max, off_seam_max}: the largest part's",
+        "results[].curve, seam_curve, differences[].curve, seam_curve: counts of pixels summed, over the summed pixels"}},
+      {"recomputed",
+       {"results[].ms.{median, min, max, mean, p10, p90, spread, frames} and ms.stages: from the merged "
+        "ms_per_frame and ms_stages_per_frame, with bench's own functions (timings are new measurements in every run)",
+        "results[].temporal: from the merged temporal_per_frame, in frame order (each part renders the frame "
+        "before its first, so no pair is lost at a part's edge)"}},
+      {"inexact",
+       {"results[].error.{mean, seam_mean, off_seam_mean}, differences[].{mean, seam_mean, off_seam_mean}: "
+        "pixel-weighted means of the parts' means (an unsharded run sums the sorted pooled pixels: equal to "
+        "about 1e-15 relative, not bit for bit)",
+        "results[].error.{p99, seam_p99, off_seam_p99}, differences[].{p99, ...}: the largest part's p99, an "
+        "upper bound of the pooled nearest-rank p99 (which needs every pixel)",
+        "wall_s, reference.ms: sums over the parts (work done, not the batch's wall time)"}}};
+}
+
+}  // namespace
+
+json merge_bench_parts(const std::vector<BenchPart>& input) {
+  if (input.empty()) throw InputError("parts", "no parts to merge");
+  // Order the parts by their shard index, checking that they are the N parts of one batch.
+  std::vector<Reader> readers;
+  std::vector<std::pair<int, size_t>> order;  // (index, position in input)
+  int count = 0;
+  std::map<int, std::string> seen;
+  for (size_t i = 0; i < input.size(); ++i) {
+    Reader r(input[i]);
+    if (!input[i].json.is_object()) r.refuse("parts", "not a JSON object");
+    const json& shard = r.at(input[i].json, "shard", "shard");
+    const int index = r.integer(shard, "index", "shard.index");
+    const int n = r.integer(shard, "count", "shard.count");
+    if (n < 1 || index < 1 || index > n) r.refuse("shard", "index must be in 1..count");
+    if (i == 0) count = n;
+    if (n != count) r.refuse("shard.count", "is " + std::to_string(n) + ", " + input[0].name + "'s is " + std::to_string(count));
+    const auto [it, fresh] = seen.emplace(index, input[i].name);
+    if (!fresh) r.refuse("shard.index", "part " + std::to_string(index) + "/" + std::to_string(n) + " is also " + it->second);
+    order.emplace_back(index, i);
+  }
+  if (static_cast<int>(order.size()) != count) {
+    std::string missing;
+    for (int k = 1; k <= count && missing.size() < 200; ++k) {
+      if (!seen.count(k)) missing += (missing.empty() ? "" : ", ") + std::to_string(k) + "/" + std::to_string(count);
+    }
+    throw InputError("parts", "parts missing: " + missing + " (got " + std::to_string(order.size()) + " of " +
+                                  std::to_string(count) + ")");
+  }
+  std::sort(order.begin(), order.end());
+  std::vector<const json*> tops;
+  for (const auto& [index, i] : order) {
+    (void)index;
+    readers.emplace_back(input[i]);
+    tops.push_back(&input[i].json);
+  }
+
+  json out = json::object();
+  require_same(readers, tops, {"scene", "size", "frames", "reference_frames", "errors", "order", "seam_radius", "options"},
+               "", out);
+  const json& errors_flag = out["errors"];
+  if (!errors_flag.is_boolean()) readers[0].refuse("errors", "expected true or false");
+  const bool with_errors = errors_flag.get<bool>();
+  if (!out["frames"].is_number_integer()) readers[0].refuse("frames", "expected an integer");
+  const int frames = out["frames"].get<int>();
+
+  // The parts' frames must tile 0..frames-1 in order.
+  int expected_first = 0;
+  json parts_info = json::array();
+  for (size_t i = 0; i < tops.size(); ++i) {
+    const Reader& r = readers[i];
+    const json& shard = r.at(*tops[i], "shard", "shard");
+    const int first = r.integer(shard, "first_frame", "shard.first_frame");
+    const int end = r.integer(shard, "end_frame", "shard.end_frame");
+    if (first != expected_first || end <= first || end > frames) {
+      r.refuse("shard.first_frame", "frames [" + std::to_string(first) + ", " + std::to_string(end) +
+                                        ") do not continue the parts before it at frame " + std::to_string(expected_first));
+    }
+    expected_first = end;
+    parts_info.push_back({{"name", r.name()},
+                          {"shard", std::to_string(r.integer(shard, "index", "shard.index")) + "/" + std::to_string(count)},
+                          {"first_frame", first},
+                          {"end_frame", end},
+                          {"wall_s", r.number(*tops[i], "wall_s", "wall_s")},
+                          {"device", r.at(*tops[i], "device", "device")}});
+  }
+  if (expected_first != frames) {
+    readers.back().refuse("shard.end_frame", "the parts end at frame " + std::to_string(expected_first) + " of " +
+                                                 std::to_string(frames));
+  }
+
+  // One device for all, or the distinct ones named together.
+  std::vector<std::string> devices;
+  for (const json& p : parts_info) {
+    const std::string d = p["device"].is_string() ? p["device"].get<std::string>() : p["device"].dump();
+    if (std::find(devices.begin(), devices.end(), d) == devices.end()) devices.push_back(d);
+  }
+  std::string device;
+  for (const std::string& d : devices) device += (device.empty() ? "" : " | ") + d;
+  out["device"] = device;
+
+  out["error_frames"] = concat(readers, tops, "error_frames", "error_frames");
+  out["seam_pixels_per_frame"] = concat(readers, tops, "seam_pixels_per_frame", "seam_pixels_per_frame");
+  double wall = 0;
+  for (const json& p : parts_info) wall += p["wall_s"].get<double>();
+  out["wall_s"] = wall;
+  out["shard"] = {{"index", 1}, {"count", 1}, {"first_frame", 0}, {"end_frame", frames}};
+
+  // Results: the same entries, in the same order, in every part.
+  const size_t entries = readers[0].array(*tops[0], "results", "results").size();
+  json results = json::array();
+  for (size_t e = 0; e < entries; ++e) {
+    const std::string prefix = "results[" + std::to_string(e) + "].";
+    std::vector<const json*> items;
+    for (size_t i = 0; i < tops.size(); ++i) {
+      const json& list = readers[i].array(*tops[i], "results", "results");
+      if (list.size() != entries) readers[i].refuse("results", "has another number of entries than " + readers[0].name() + "'s");
+      items.push_back(&list[e]);
+    }
+    results.push_back(merge_result(readers, items, with_errors, prefix));
+  }
+  out["results"] = results;
+
+  const size_t diffs = readers[0].array(*tops[0], "differences", "differences").size();
+  json differences = json::array();
+  for (size_t d = 0; d < diffs; ++d) {
+    const std::string prefix = "differences[" + std::to_string(d) + "].";
+    std::vector<const json*> items;
+    for (size_t i = 0; i < tops.size(); ++i) {
+      const json& list = readers[i].array(*tops[i], "differences", "differences");
+      if (list.size() != diffs) readers[i].refuse("differences", "has another number of entries than " + readers[0].name() + "'s");
+      items.push_back(&list[d]);
+    }
+    json merged = merge_difference(readers, items, prefix);
+    uint64_t frames_sum = 0;
+    for (size_t i = 0; i < items.size(); ++i) frames_sum += readers[i].count(*items[i], "frames", prefix + "frames");
+    merged["frames"] = frames_sum;
+    differences.push_back(merged);
+  }
+  out["differences"] = differences;
+
+  if (with_errors) {
+    // How references were made: from the parts that made any (a part may have no error frame).
+    json reference = json::object();
+    uint64_t cached = 0, rendered = 0;
+    double ms = 0;
+    std::vector<Reader> makers;
+    std::vector<const json*> made;
+    for (size_t i = 0; i < tops.size(); ++i) {
+      const json& ref = readers[i].at(*tops[i], "reference", "reference");
+      const uint64_t c = readers[i].count(ref, "cached", "reference.cached");
+      const uint64_t r = readers[i].count(ref, "rendered", "reference.rendered");
+      cached += c;
+      rendered += r;
+      ms += readers[i].number(ref, "ms", "reference.ms");
+      if (c + r > 0) {
+        makers.push_back(readers[i]);
+        made.push_back(&ref);
+      }
+    }
+    if (made.empty()) {
+      reference = readers[0].at(*tops[0], "reference", "reference");
+    } else {
+      require_same(makers, made, {"method", "msaa", "scale", "filter", "filter_width", "B", "C"}, "reference.", reference);
+    }
+    reference["cached"] = cached;
+    reference["rendered"] = rendered;
+    reference["ms"] = ms;
+    out["reference"] = reference;
+  }
+
+  json notes = merge_notes();
+  notes["parts"] = parts_info;
+  out["merge"] = notes;
+  return out;
+}
+
+}  // namespace seamcl

@@ -1,0 +1,200 @@
+#include <seamcl/eval/cube_metrics.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <seamcl/pipeline/cube_lookups.h>
+#include <seamcl/pipeline/packed_cube.h>
+#include <seamcl/scene/cube_map.h>
+
+namespace seamcl {
+namespace {
+
+// An edge: components a and b at sign_a, sign_b, the third (c) running along it.
+struct Edge {
+  int a, b, c;
+  float sign_a, sign_b;
+};
+
+std::vector<Edge> cube_edges() {
+  std::vector<Edge> out;
+  for (int a = 0; a < 3; ++a)
+    for (int b = a + 1; b < 3; ++b)
+      for (float sa : {-1.0f, 1.0f})
+        for (float sb : {-1.0f, 1.0f}) out.push_back({a, b, 3 - a - b, sa, sb});
+  return out;
+}
+
+// The point `inside` face-coordinate units into face A (major a) or B (major b) from the edge
+// point at `along`.
+glm::vec3 edge_point(const Edge& e, float along, bool face_a, float inside) {
+  glm::vec3 d(0.0f);
+  d[e.a] = e.sign_a;
+  d[e.b] = e.sign_b;
+  d[e.c] = along;
+  if (face_a) {
+    d[e.b] *= 1.0f - inside;
+  } else {
+    d[e.a] *= 1.0f - inside;
+  }
+  return d;
+}
+
+// Samples of one cube-edge pixel lie within 0.25 radians of each other.
+constexpr float kContinuousCos = 0.9689124f;  // cos(0.25)
+
+double rgb_norm(glm::vec4 v) { return glm::length(glm::dvec3(v.r, v.g, v.b)); }
+
+// Directions over a disk of half-angle `angle` around unit d (Vogel's spiral, 16 points).
+std::vector<glm::vec3> disk_directions(glm::vec3 d, float angle) {
+  const glm::vec3 helper = std::fabs(d.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+  const glm::vec3 t = glm::normalize(glm::cross(d, helper));
+  const glm::vec3 b = glm::cross(d, t);
+  const float radius = std::tan(angle);
+  constexpr int kPoints = 16;
+  std::vector<glm::vec3> out;
+  for (int k = 0; k < kPoints; ++k) {
+    const float r = radius * std::sqrt((static_cast<float>(k) + 0.5f) / kPoints);
+    const float phi = 2.39996323f * static_cast<float>(k);
+    out.push_back(glm::normalize(d + t * (r * std::cos(phi)) + b * (r * std::sin(phi))));
+  }
+  return out;
+}
+
+}  // namespace
+
+EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environment, CubeMethod method, int size,
+                                int points) {
+  const DirectionFunction radiance = environment_function(environment);
+  const CubeMap cube = bake_cube_map(radiance, size, cube_bake(method), environment.bake_samples);
+  CubeLookups lookups(runtime, cube);
+  const CubeSampler sampler = cube_sampler(method, Filter::Trilinear, 16, size);
+  EdgeMeasures out;
+  out.size = size;
+  const std::vector<Edge> edges = cube_edges();
+  auto along = [&](int k) { return -1.0f + (2.0f * static_cast<float>(k) + 1.0f) / static_cast<float>(points); };
+
+  // Zero order, per lod: both sides 1e-4 face widths from the edge.
+  for (int lod = 0; lod < cube.level_count(); ++lod) {
+    std::vector<CubeLookup> batch;
+    for (const Edge& e : edges) {
+      for (int k = 0; k < points; ++k) {
+        for (bool face_a : {true, false}) {
+          batch.push_back({edge_point(e, along(k), face_a, 2e-4f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f,
+                           static_cast<float>(lod)});
+        }
+      }
+    }
+    const std::vector<glm::vec4> values = lookups.sample(batch, sampler);
+    double sum = 0, worst = 0;
+    for (size_t i = 0; i < values.size(); i += 2) {
+      const double step = rgb_norm(values[i] - values[i + 1]);
+      sum += step;
+      worst = std::max(worst, step);
+    }
+    out.seam_step_mean.push_back(sum / static_cast<double>(values.size() / 2));
+    out.seam_step_max.push_back(worst);
+  }
+
+  // First order at lod 0: points 0.25 and 0.75 level-0 texels (2/n face units each) inside.
+  const float texel = 2.0f / static_cast<float>(size);
+  const float offsets[2] = {0.25f * texel, 0.75f * texel};
+  std::vector<CubeLookup> batch;
+  std::vector<glm::vec3> directions;
+  for (const Edge& e : edges) {
+    for (int k = 0; k < points; ++k) {
+      for (bool face_a : {true, false}) {
+        for (float inside : offsets) {
+          directions.push_back(edge_point(e, along(k), face_a, inside));
+          batch.push_back({directions.back(), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, 0.0f});
+        }
+      }
+    }
+  }
+  const std::vector<glm::vec4> values = lookups.sample(batch, sampler);
+  double jump_sum = 0, environment_sum = 0;
+  auto jump = [](glm::vec4 a_near, glm::vec4 a_far, glm::vec4 b_near, glm::vec4 b_far) {
+    // Slopes per texel along A -> B: (near - far) / 0.5 on A, (far - near) / 0.5 on B.
+    return ((b_far - b_near) - (a_near - a_far)) * 2.0f;
+  };
+  for (size_t i = 0; i < values.size(); i += 4) {
+    glm::vec4 env[4];
+    for (int k = 0; k < 4; ++k) env[k] = radiance(glm::normalize(directions[i + k]));
+    const glm::vec4 method_jump = jump(values[i], values[i + 1], values[i + 2], values[i + 3]);
+    const glm::vec4 environment_jump = jump(env[0], env[1], env[2], env[3]);
+    jump_sum += rgb_norm(method_jump - environment_jump);
+    environment_sum += rgb_norm(environment_jump);
+  }
+  const double count = static_cast<double>(values.size() / 4);
+  out.first_order_jump = jump_sum / count;
+  out.environment_first_order_jump = environment_sum / count;
+  return out;
+}
+
+CubeReference cube_reference(Renderer& renderer, const Camera& camera, const RenderOptions& options, int scale) {
+  const Scene& scene = renderer.scene();
+  if (!scene.environment) throw std::invalid_argument("cube_reference needs a scene with an environment");
+  RenderOptions big = options;
+  big.width = options.width * scale;
+  big.height = options.height * scale;
+  big.msaa = 1;
+  big.shading = ShadingMode::Pixel;
+  const RenderResult directions = renderer.render_directions(camera, big);
+  const DirectionFunction radiance = environment_function(*scene.environment);
+
+  CubeReference out;
+  out.width = options.width;
+  out.height = options.height;
+  out.pixels.assign(static_cast<size_t>(out.width) * out.height, glm::vec4(0.0f));
+  out.cube_edge.assign(out.pixels.size(), 0);
+  const glm::vec4 background(scene.background, 1.0f);
+  const float inv = 1.0f / static_cast<float>(scale * scale);
+  for (int y = 0; y < out.height; ++y) {
+    for (int x = 0; x < out.width; ++x) {
+      glm::vec4 sum(0.0f);
+      int first_face = -1;
+      bool crosses = false;
+      // A pixel whose samples' directions spread wide (a silhouette: reflection against sky, or
+      // a grazing fold) or that shows background is not a cube-edge pixel, whatever faces its
+      // samples select: its error is the silhouette's.
+      bool continuous = true;
+      glm::vec3 first_direction(0.0f);
+      for (int sy = 0; sy < scale; ++sy) {
+        for (int sx = 0; sx < scale; ++sx) {
+          const glm::vec4 p = directions.pixels[static_cast<size_t>(y * scale + sy) * big.width + (x * scale + sx)];
+          const glm::vec3 d(p);
+          const float length = glm::length(d);
+          if (!(length > 0.5f)) {  // not an environment lookup: the background (skybox off)
+            sum += background;
+            continuous = false;
+            continue;
+          }
+          const glm::vec3 unit = d / length;
+          if (first_face < 0) first_direction = unit;
+          continuous = continuous && glm::dot(unit, first_direction) > kContinuousCos;
+          const float roughness = length - 1.0f;
+          if (roughness > 1e-4f) {
+            glm::vec4 disk(0.0f);
+            const std::vector<glm::vec3> spread = disk_directions(unit, 0.5f * roughness);
+            for (const glm::vec3& s : spread) disk += radiance(s);
+            sum += disk / static_cast<float>(spread.size());
+          } else {
+            sum += radiance(unit);
+          }
+          const int face = cube_coords(unit).face;
+          crosses = crosses || (first_face >= 0 && face != first_face);
+          if (first_face < 0) first_face = face;
+        }
+      }
+      const size_t i = static_cast<size_t>(y) * out.width + x;
+      out.pixels[i] = glm::vec4(glm::vec3(sum * inv), 1.0f);
+      const bool edge = crosses && continuous;
+      out.cube_edge[i] = edge ? 1 : 0;
+      out.edge_pixels += edge ? 1 : 0;
+    }
+  }
+  return out;
+}
+
+}  // namespace seamcl

@@ -1,0 +1,45 @@
+// How the cube-map seam methods do, measured against the analytic environment itself (never
+// against another method): the seam step at the 12 edges per mip level, the first-order jump
+// across them, and the error of rendered frames against the environment integrated over each
+// pixel's footprint.
+#pragma once
+#include <vector>
+
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/eval/metrics.h>
+#include <seamcl/pipeline/render_options.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/environment.h>
+
+namespace seamcl {
+
+// Along each of the 12 edges at `points` evenly spaced places, lookups (one trilinear lookup at
+// an explicit lod) just inside each of the two faces, 1e-4 face widths from the edge.
+struct EdgeMeasures {
+  int size = 0;
+  std::vector<double> seam_step_mean;  // per lod 0..log2(n): mean |f(face A) - f(face B)| (RGB 2-norm)
+  std::vector<double> seam_step_max;
+  // At lod 0: the one-sided slopes (per level-0 texel) from points 0.25 and 0.75 texel inside
+  // each face; the jump is slope_B - slope_A (oriented from A to B) minus the environment's own
+  // jump there, mean of its RGB 2-norm. Stretch and warp trade the zero-order seam for this.
+  double first_order_jump = 0;
+  double environment_first_order_jump = 0;  // the analytic environment's own mean |jump|
+};
+EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environment, CubeMethod method, int size,
+                                int points = 32);
+
+// The analytic reference of a frame of a scene with an environment: rendered at `scale` times
+// the width and height with 1 sample per pixel, each sample the environment along its lookup
+// direction (a mirror's exactly; a glossy one's averaged over a disk of half-angle roughness / 2,
+// the footprint the lookup widens by), then box-averaged over scale x scale. `cube_edge` marks the
+// pixels whose samples select more than one cube face (their footprint crosses a cube edge) and
+// lie within 0.25 radians of each other (not a silhouette, whose error is not the seam's).
+struct CubeReference {
+  int width = 0, height = 0;
+  std::vector<glm::vec4> pixels;
+  std::vector<uint8_t> cube_edge;
+  size_t edge_pixels = 0;
+};
+CubeReference cube_reference(Renderer& renderer, const Camera& camera, const RenderOptions& options, int scale = 8);
+
+}  // namespace seamcl
