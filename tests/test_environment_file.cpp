@@ -8,10 +8,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <functional>
 #include <limits>
 #include <string>
 #include <vector>
+
+#include <sys/wait.h>
 
 #include <nlohmann/json.hpp>
 
@@ -255,6 +258,44 @@ TEST(EnvironmentFile, OversizedAndMisshapenPixelsAreRefusedBeforeUse) {
                      "f", "holds 3 pixels");
   expect_input_error([&] { environment_image_from_pixels(EnvironmentLayout::Faces, {short_pixels}, {"f"}); }, "f",
                      "needs 6");
+}
+
+// Runs the seamcl binary in `dir`; stdout and stderr into files there.
+int run_seamcl(const EnvironmentDir& dir, const std::string& args, std::string& out, std::string& err) {
+  const std::string command = "cd '" + dir.file("") + "' && '" + std::string(SEAMCL_BINARY) + "' " + args +
+                              " >stdout.txt 2>stderr.txt </dev/null";
+  const int status = std::system(command.c_str());
+  auto slurp = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  out = slurp(dir.file("stdout.txt"));
+  err = slurp(dir.file("stderr.txt"));
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(EnvironmentFile, CubeMetricsRunOnAnImageEnvironmentFromASceneFile) {
+  EnvironmentDir dir;
+  // A constant image: every method must then show no seam and no error; the analytic default does.
+  write_image(dir.file("grey.exr"), 32, 16, std::vector<glm::vec4>(512, glm::vec4(0.25f, 0.5f, 0.75f, 1.0f)));
+  dir.scene(R"({"file": "grey.exr"})");
+  const std::string common = " --cube-sizes 4 --size 24x24 --repeat 1 --reference-scale 2 --json";
+  std::string out, err;
+  ASSERT_EQ(run_seamcl(dir, "cube-metrics --scene scene.json" + common, out, err), 0) << err;
+  const nlohmann::json image = nlohmann::json::parse(out);
+  ASSERT_EQ(image.at("results").size(), 6u);
+  for (const auto& entry : image.at("results")) {
+    for (const auto& step : entry.at("seam_step")) EXPECT_LT(step.get<double>(), 1e-5) << entry.at("cube_method");
+    EXPECT_LT(entry.at("error").at("max").get<double>(), 1e-3) << entry.at("cube_method");
+  }
+  ASSERT_EQ(run_seamcl(dir, "cube-metrics --scene envmap --cube-methods cube-clamp" + common, out, err), 0) << err;
+  const nlohmann::json analytic = nlohmann::json::parse(out);
+  EXPECT_GT(analytic.at("results").at(0).at("seam_step").at(0).get<double>(), 1e-3);
+
+  dir.scene(R"({"file": "nowhere.exr"})");
+  EXPECT_EQ(run_seamcl(dir, "cube-metrics --scene scene.json" + common, out, err), 2);
+  EXPECT_NE(err.find("options.environment.file"), std::string::npos) << err;
+  EXPECT_NE(err.find("nowhere.exr"), std::string::npos) << err;
 }
 
 }  // namespace
