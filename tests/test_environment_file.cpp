@@ -239,12 +239,17 @@ TEST(EnvironmentFile, HostileInputsAreRefusedNamingTheField) {
                      "options.environment.faces[0]", "square");
   expect_input_error(load(R"({"file": "sky.exr", "constant": [1, 1, 1]})"), "options.environment.constant",
                      "image environment");
-  // An inline scene names files nobody reads: refused when the environment is used, not ignored.
-  const Scene inline_scene = parse_scene_json(
-      nlohmann::json::parse(R"({"generator": "envmap", "options": {"environment": {"file": "sky.exr"}}})"));
-  ASSERT_TRUE(inline_scene.environment.has_value());
-  expect_input_error([&] { environment_function(*inline_scene.environment); }, "options.environment.file",
-                     "not read");
+  // An inline scene (the service's) has no file to resolve names against: refused when parsed.
+  expect_input_error(
+      [] {
+        parse_scene_json(
+            nlohmann::json::parse(R"({"generator": "envmap", "options": {"environment": {"file": "sky.exr"}}})"));
+      },
+      "options.environment.file", "inline");
+  // An environment that names files nobody read is refused when used, not shown as the analytic one.
+  Environment unread;
+  unread.files = EnvironmentFiles{EnvironmentLayout::Faces, {"a", "b", "c", "d", "e", "f"}, "environment"};
+  expect_input_error([&] { environment_function(unread); }, "environment.faces", "not read");
 }
 
 TEST(EnvironmentFile, OversizedAndMisshapenPixelsAreRefusedBeforeUse) {

@@ -477,7 +477,14 @@ SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load
 }  // namespace
 
 Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_image) {
-  return realize(read_document(doc, "scene", load_image), {});
+  Scene scene = realize(read_document(doc, "scene", load_image), {});
+  // A document without a file behind it: nothing would read an environment's image files.
+  if (scene.environment && scene.environment->files) {
+    const EnvironmentFiles& files = *scene.environment->files;
+    throw InputError(files.field + (files.layout == EnvironmentLayout::Faces ? ".faces" : ".file"),
+                     "an inline scene can name no image file (use a scene file)");
+  }
+  return scene;
 }
 
 Scene load_scene_file(const std::string& path, const FaceImageLoader& load_image) {
