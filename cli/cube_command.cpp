@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <seamcl/assets/scene_source.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
@@ -90,7 +91,8 @@ int run(const CubeArgs& args, const GlobalOptions& global) {
                                                    {"frames", args.frames}});
   if (args.repeat < 1 || args.repeat > 100) throw InputError("repeat", "must be in 1..100");
   if (args.reference_scale < 1 || args.reference_scale > 16) throw InputError("reference_scale", "must be in 1..16");
-  Scene scene = load_scene(base.scene, {});
+  // Through host/assets, so that a scene file's environment may be an image file.
+  Scene scene = load_scene_source(base.scene);
   if (!scene.environment) throw InputError("scene", "'" + base.scene + "' has no environment (try envmap)");
   const Camera camera = scene.orbit ? orbit_camera(scene, args.frame, args.frames) : scene.camera;
   if (!args.images_dir.empty()) std::filesystem::create_directories(args.images_dir);
@@ -184,7 +186,7 @@ Command add_cube_command(CLI::App& app) {
   args->cube_methods = all;
   CLI::App* command = app.add_subcommand(
       "cube-metrics", "Measure every cube-map seam method against the analytic environment, per cube size");
-  command->add_option("--scene", args->scene, "A scene with an environment [envmap]");
+  command->add_option("--scene", args->scene, "A scene with an environment, built-in or a scene file (its environment may be an image) [envmap]");
   command->add_option("--cube-methods", args->cube_methods, "Comma list of cube methods [" + all + "]");
   command->add_option("--cube-sizes", args->cube_sizes, "Comma list of cube face sizes, powers of two [16,64,256]");
   command->add_option("--size", args->size, "Image size WIDTHxHEIGHT [160x180]");

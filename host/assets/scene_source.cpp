@@ -9,6 +9,7 @@
 #include <utility>
 
 #include <seamcl/assets/asset_scene.h>
+#include "assets/environment_file.h"
 #include <seamcl/assets/face_image.h>
 #include <seamcl/assets/obj_mesh.h>
 #include <seamcl/core/input_error.h>
@@ -117,7 +118,9 @@ struct Loader {
       const FaceImageLoader load_image = [this, directory](const std::string& name, const std::string& field) {
         return read_face_image(resolve(name, directory, field), field);
       };
-      return load_scene(path, options.generator, load_image);
+      Scene scene = load_scene(path, options.generator, load_image);
+      if (scene.environment) load_environment_files(*scene.environment, directory, resolve);
+      return scene;
     }
     try {
       Scene scene = mesh_scene_file(doc, path);
@@ -163,7 +166,9 @@ Scene load_scene_source(const std::string& scene, const std::string& texture, co
   const Loader loader{options, options.resolve ? options.resolve : AssetPathResolver(resolve_any_path)};
   if (is_builtin_scene(scene)) {
     if (!texture.empty()) throw InputError("texture", "goes with an .obj scene, not the built-in scene '" + scene + "'");
-    return generate_scene(scene, options.generator);
+    Scene out = generate_scene(scene, options.generator);
+    if (out.environment) load_environment_files(*out.environment, "", loader.resolve);
+    return out;
   }
   const std::string path = loader.resolve(scene, "", "scene");
   const std::optional<AssetKind> kind = asset_kind_of_path(path);

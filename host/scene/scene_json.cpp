@@ -144,8 +144,40 @@ glm::vec3 read_color(const json& value, const std::string& path) {
 Environment read_environment(const json& value, const std::string& path) {
   const ObjectFields fields(value, path,
                             {"cube_size", "bake_samples", "skybox", "constant", "sun_direction", "sun_radius",
-                             "sun_color", "zenith", "horizon", "ground"});
+                             "sun_color", "zenith", "horizon", "ground", "file", "layout", "faces"});
   Environment e;
+  // An image environment: the names only; host/assets reads the files (load_environment_files).
+  const json* file = fields.optional("file");
+  const json* layout = fields.optional("layout");
+  const json* faces = fields.optional("faces");
+  if (file && faces) throw InputError(fields.path_of("faces"), "cannot go with file (one image or six faces)");
+  if (layout && !file) throw InputError(fields.path_of("layout"), "goes with file");
+  if (file) {
+    EnvironmentFiles files{EnvironmentLayout::Equirect, {read_string(*file, fields.path_of("file"))}, path};
+    if (files.names[0].empty()) throw InputError(fields.path_of("file"), "must be a file name (a non-empty string)");
+    if (layout) {
+      const std::string name = read_string(*layout, fields.path_of("layout"));
+      const std::optional<EnvironmentLayout> parsed = parse_environment_layout(name);
+      if (!parsed || *parsed == EnvironmentLayout::Faces)
+        throw InputError(fields.path_of("layout"), "unknown layout '" + name + "' (known: equirect, cross; six "
+                                                   "face images go in \"faces\")");
+      files.layout = *parsed;
+    }
+    e.files = std::move(files);
+  }
+  if (faces) {
+    const json& names = read_array(*faces, fields.path_of("faces"));
+    if (names.size() != 6)
+      throw InputError(fields.path_of("faces"), "must name 6 files (+X, -X, +Y, -Y, +Z, -Z), got " +
+                                                    std::to_string(names.size()));
+    EnvironmentFiles files{EnvironmentLayout::Faces, {}, path};
+    for (size_t k = 0; k < names.size(); ++k) {
+      const std::string element = element_path(fields.path_of("faces"), k);
+      files.names.push_back(read_string(names[k], element));
+      if (files.names.back().empty()) throw InputError(element, "must be a file name (a non-empty string)");
+    }
+    e.files = std::move(files);
+  }
   if (const json* v = fields.optional("cube_size")) e.cube_size = read_int(*v, fields.path_of("cube_size"), 1, kMaxCubeSize);
   if (const json* v = fields.optional("bake_samples")) e.bake_samples = read_int(*v, fields.path_of("bake_samples"), 1, 8);
   if (const json* v = fields.optional("skybox")) e.skybox = read_bool(*v, fields.path_of("skybox"));
@@ -445,7 +477,14 @@ SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load
 }  // namespace
 
 Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_image) {
-  return realize(read_document(doc, "scene", load_image), {});
+  Scene scene = realize(read_document(doc, "scene", load_image), {});
+  // A document without a file behind it: nothing would read an environment's image files.
+  if (scene.environment && scene.environment->files) {
+    const EnvironmentFiles& files = *scene.environment->files;
+    throw InputError(files.field + (files.layout == EnvironmentLayout::Faces ? ".faces" : ".file"),
+                     "an inline scene can name no image file (use a scene file)");
+  }
+  return scene;
 }
 
 Scene load_scene_file(const std::string& path, const FaceImageLoader& load_image) {
