@@ -1,5 +1,5 @@
 // seamcl cube-metrics: every cube-map seam method at every cube size, measured against the
-// analytic environment (host/eval/cube_metrics.h): seam step per lod at the 12 edges, first-order
+// scene's environment function (analytic, or an image loaded from a scene file; host/eval/cube_metrics.h): seam step per lod at the 12 edges, first-order
 // jump, error of an envmap frame against the environment integrated over each pixel (all pixels
 // and those whose footprint crosses a cube edge), time per frame and cube-map memory.
 #include <algorithm>
