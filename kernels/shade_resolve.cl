@@ -162,6 +162,18 @@ SEAMCL_INLINE float weight_inside(__constant FrameParams* frame, const FaceGpu* 
       .weight;
 }
 
+/* The weight the same filter puts inside face `other` at this point and footprint carried into its
+ * uv by the map m (an edge's or a corner's transform), as traverse reads it there. */
+SEAMCL_INLINE float weight_carried(__constant FrameParams* frame, __global const FaceGpu* faces, int other,
+                                   __global const float* m, __global const uint* level_offsets, TEXEL_BUFFER texels,
+                                   __global const float* srgb_to_linear, const SurfaceUv* s) {
+  const FaceGpu g = faces[other];
+  return weight_inside(frame, &g, level_offsets, texels, srgb_to_linear, m[0] * s->u + m[1] * s->v + m[2],
+                       m[3] * s->u + m[4] * s->v + m[5], m[0] * s->dudx + m[1] * s->dvdx,
+                       m[3] * s->dudx + m[4] * s->dvdx, m[0] * s->dudy + m[1] * s->dvdy,
+                       m[3] * s->dudy + m[4] * s->dvdy);
+}
+
 SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global const TriangleSetup* t,
                                     __global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
                                     __global const uint* level_offsets, TEXEL_BUFFER texels,
@@ -191,11 +203,7 @@ SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global cons
       continue;
     }
     __global const float* m = n->transform[k];
-    const FaceGpu g = faces[other];
-    const float reach = weight_inside(frame, &g, level_offsets, texels, srgb_to_linear, m[0] * s.u + m[1] * s.v + m[2],
-                                      m[3] * s.u + m[4] * s.v + m[5], m[0] * s.dudx + m[1] * s.dvdx,
-                                      m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
-                                      m[3] * s.dudy + m[4] * s.dvdy);
+    const float reach = weight_carried(frame, faces, other, m, level_offsets, texels, srgb_to_linear, &s);
     seam |= crosses | !(reach <= tolerance);
   }
   /* The diagonal face past each valence-4 corner, as traverse reads it: a coarser one's taps can
@@ -204,11 +212,7 @@ SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global cons
     const int other = n->corner[k];
     if (other < 0) continue;
     __global const float* m = n->corner_transform[k];
-    const FaceGpu g = faces[other];
-    const float reach = weight_inside(frame, &g, level_offsets, texels, srgb_to_linear, m[0] * s.u + m[1] * s.v + m[2],
-                                      m[3] * s.u + m[4] * s.v + m[5], m[0] * s.dudx + m[1] * s.dvdx,
-                                      m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
-                                      m[3] * s.dudy + m[4] * s.dvdy);
+    const float reach = weight_carried(frame, faces, other, m, level_offsets, texels, srgb_to_linear, &s);
     seam |= !(reach <= tolerance);
   }
   /* Taps outside past a corner only (no edge's mirror saw them): a seam, to be safe. */

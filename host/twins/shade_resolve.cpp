@@ -46,6 +46,12 @@ uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const Tr
   auto weight_inside = [&](uint32_t face, float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
     return filter_texture_reference(textures, face, f.sampler, SEAMCL_ADDRESS_BORDER, u, v, dudx, dvdx, dudy, dvdy).weight;
   };
+  // The same filter on face `other` at this point and footprint carried into its uv by map m.
+  auto weight_carried = [&](int32_t other, const float* m) {
+    return weight_inside(static_cast<uint32_t>(other), m[0] * s.u + m[1] * s.v + m[2], m[3] * s.u + m[4] * s.v + m[5],
+                         m[0] * s.dudx + m[1] * s.dvdx, m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
+                         m[3] * s.dudy + m[4] * s.dvdy);
+  };
   constexpr float tolerance = SEAMCL_SEAM_WEIGHT_TOLERANCE;
   // NaN weights count as crossing: nothing shows the footprint stays inside.
   const float own = weight_inside(t.face, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
@@ -65,22 +71,14 @@ uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const Tr
       continue;
     }
     // The same filter on the neighbour, as traverse carries it there.
-    const float* m = n.transform[k];
-    const float reach = weight_inside(static_cast<uint32_t>(n.neighbor[k]), m[0] * s.u + m[1] * s.v + m[2],
-                                      m[3] * s.u + m[4] * s.v + m[5], m[0] * s.dudx + m[1] * s.dvdx,
-                                      m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
-                                      m[3] * s.dudy + m[4] * s.dvdy);
+    const float reach = weight_carried(n.neighbor[k], n.transform[k]);
     seam = seam || crosses || !(reach <= tolerance);
   }
   // The diagonal face past each valence-4 corner, as traverse reads it: a coarser one's taps can
   // reach back over the corner although no edge's footprint crosses.
   for (int k = 0; k < 4; ++k) {
     if (n.corner[k] < 0) continue;
-    const float* m = n.corner_transform[k];
-    const float reach = weight_inside(static_cast<uint32_t>(n.corner[k]), m[0] * s.u + m[1] * s.v + m[2],
-                                      m[3] * s.u + m[4] * s.v + m[5], m[0] * s.dudx + m[1] * s.dvdx,
-                                      m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
-                                      m[3] * s.dudy + m[4] * s.dvdy);
+    const float reach = weight_carried(n.corner[k], n.corner_transform[k]);
     seam = seam || !(reach <= tolerance);
   }
   seam = seam || (!any_edge && !(own >= 1.0f - tolerance));  // past a corner only
