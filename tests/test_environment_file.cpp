@@ -8,9 +8,11 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <functional>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "assets/environment_file.h"
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/io/image_io.h>
@@ -301,6 +304,51 @@ TEST(EnvironmentFile, CubeMetricsRunOnAnImageEnvironmentFromASceneFile) {
   EXPECT_EQ(run_seamcl(dir, "cube-metrics --scene scene.json" + common, out, err), 2);
   EXPECT_NE(err.find("options.environment.file"), std::string::npos) << err;
   EXPECT_NE(err.find("nowhere.exr"), std::string::npos) << err;
+}
+
+TEST(EnvironmentFile, DamagedFilesAreRefusedAndNeverCrash) {
+  // Truncations and bit flips of a small EXR and PNG equirect: every damaged file either loads
+  // (finite texels of the equirect's size) or is refused with an InputError naming the field;
+  // nothing else escapes and nothing crashes.
+  EnvironmentDir dir;
+  std::mt19937 random(20261129);
+  int refused = 0, loaded = 0;
+  for (const std::string extension : {"exr", "png"}) {
+    const std::string clean = dir.file("clean." + extension);
+    write_image(clean, 16, 8, equirect_pixels(16, 8));
+    std::ifstream in(clean, std::ios::binary);
+    const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_GT(bytes.size(), 64u);
+    std::vector<std::vector<char>> damaged;
+    for (size_t length = 0; length < bytes.size(); length += std::max<size_t>(1, bytes.size() / 48))
+      damaged.emplace_back(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(length));
+    for (int flip = 0; flip < 96; ++flip) {
+      std::vector<char> copy = bytes;
+      for (int bit = 0; bit < 1 + flip % 4; ++bit) {
+        const size_t at = random() % copy.size();
+        copy[at] = static_cast<char>(copy[at] ^ (1 << (random() % 8)));
+      }
+      damaged.push_back(std::move(copy));
+    }
+    const std::string name = "damaged." + extension;
+    for (const std::vector<char>& file : damaged) {
+      std::ofstream(dir.file(name), std::ios::binary | std::ios::trunc).write(file.data(), static_cast<std::streamsize>(file.size()));
+      EnvironmentFiles files;
+      files.names = {name};
+      files.field = "environment";
+      try {
+        const EnvironmentImage image = read_environment_files(files, dir.file(""), resolve_any_path);
+        EXPECT_EQ(image.texels.size(), static_cast<size_t>(image.width) * image.height);
+        for (const glm::vec3& texel : image.texels) ASSERT_TRUE(std::isfinite(texel.x + texel.y + texel.z));
+        ++loaded;
+      } catch (const InputError& error) {
+        EXPECT_EQ(std::string(error.field()).rfind("environment", 0), 0u) << error.what();
+        ++refused;
+      }
+    }
+  }
+  EXPECT_GT(refused, 40) << "truncated files must be refused";
+  std::cout << "damaged environment files: " << refused << " refused, " << loaded << " loaded\n";
 }
 
 }  // namespace
