@@ -24,5 +24,6 @@ Command add_compare_command(CLI::App& app);  // cli/compare_command.cpp
 Command add_bench_command(CLI::App& app);    // cli/bench_command.cpp
 Command add_merge_command(CLI::App& app);    // cli/merge_command.cpp
 Command add_cube_command(CLI::App& app);     // cli/cube_command.cpp
+Command add_displacement_command(CLI::App& app);  // cli/displacement_command.cpp
 
 }  // namespace seamcl::cli

@@ -18,6 +18,7 @@
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
+#include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/io/image_io.h>
@@ -146,6 +147,13 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
     results.push_back(item);
   }
 
+  // Watertightness of the displaced surface at this camera (docs/displacement.md), at the first rate.
+  json displacement;
+  if (frame.displacement) {
+    progress("displacement: gap and crack pixels of " + to_string(*frame.displacement));
+    displacement = measure_displacement(runtime, scene, camera, entries.front().options, 0, 0).to_json();
+  }
+
   const json summary = targets.summary_json(entries.front().options.msaa, true);
   const std::string size = std::to_string(frame.width) + "x" + std::to_string(frame.height);
   if (args.json_out) {
@@ -158,6 +166,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
       out["frames"] = frame.frames;
     }
     if (!args.images_dir.empty()) out["images"] = args.images_dir;
+    if (!displacement.is_null()) out["displacement"] = displacement;
     std::cout << out.dump(2) << "\n";
   } else {
     std::printf("%s %s; seam mask: pixels whose texture footprint crosses a face edge\n", scene.name.c_str(), size.c_str());
@@ -175,6 +184,14 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
                     e["mean"].get<double>(), e["seam_mean"].get<double>(), e["seam_p99"].get<double>(),
                     e["off_seam_mean"].get<double>(), e["off_seam_p99"].get<double>(), e["nan_pixels"].get<size_t>());
       }
+    }
+    if (!displacement.is_null()) {
+      std::printf("displacement %s, T %d: max gap %.3g, crack pixels %s (msaa %d)\n",
+                  displacement["method"].get<std::string>().c_str(), displacement["tessellation"].get<int>(),
+                  displacement["max_gap"].get<double>(),
+                  displacement["crack_pixels"].is_null() ? "n/a (open mesh)"
+                                                         : std::to_string(displacement["crack_pixels"].get<size_t>()).c_str(),
+                  entries.front().options.msaa);
     }
   }
   return 0;

@@ -1,8 +1,18 @@
 #include "measure_args.h"
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/pipeline/displacement_method.h>
 
 namespace seamcl::cli {
+namespace {
+
+std::string listed(const std::vector<std::string>& names) {
+  std::string s;
+  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+}  // namespace
 
 void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& default_methods) {
   a.methods = default_methods;
@@ -16,6 +26,10 @@ void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& d
   command->add_option("--texels", a.texels, "Texel storage: rgba8 or rgba32f [rgba8]");
   command->add_option("--size", a.size, "Image size WIDTHxHEIGHT [480x540]");
   command->add_option("--shading", a.shading, "Where to shade: pixel, centroid or sample [pixel]");
+  command->add_option("--displacement-method", a.displacement_method,
+                      "Tessellate and displace with this method: " + listed(displacement_method_names()) + " [off]");
+  command->add_option("--tessellation", a.tessellation, "Displacement: each patch a (T+1)^2 grid, T 1..64 [8]");
+  command->add_option("--displacement-level", a.displacement_level, "Displacement: the maps' level sampled, 0..16 [0]");
   command->add_flag("--tint", a.tint, "Built-in scenes: tint each face a different base colour");
   command->add_option("--reference-method", a.reference_method,
                       "Method of the 8x reference render [traverse if available, else discard]");
@@ -42,6 +56,9 @@ nlohmann::json measure_request(const MeasureArgs& a) {
   if (a.size) request["size"] = *a.size;
   if (a.shading) request["shading"] = *a.shading;
   if (a.tint) request["tint"] = true;
+  if (a.displacement_method) request["displacement_method"] = *a.displacement_method;
+  if (a.tessellation) request["tessellation"] = *a.tessellation;
+  if (a.displacement_level) request["displacement_level"] = *a.displacement_level;
   return request;
 }
 

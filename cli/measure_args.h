@@ -14,6 +14,8 @@ namespace seamcl::cli {
 struct MeasureArgs {
   std::optional<std::string> scene, texture, filter, zero_coverage, texels, size, shading;
   std::optional<int> aniso;
+  std::optional<std::string> displacement_method;
+  std::optional<int> tessellation, displacement_level;
   std::string methods;
   std::string msaa = "1,2,4,8";
   bool tint = false;

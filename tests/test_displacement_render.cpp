@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -254,6 +255,86 @@ TEST(DisplacementCli, BadInputExitsTwoNamingTheField) {
     EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
     EXPECT_EQ(r.err.find(c.field + ":") != std::string::npos, true) << c.args << "\n" << r.err;
   }
+}
+
+// seamcl displacement-metrics: every method at every T in one JSON; the watertight methods must
+// measure exactly 0 and the others not, so the command cannot pass by reporting zeros.
+TEST(DisplacementMetricsCli, EveryMethodAndLevelInOneJson) {
+  const CliRun r = run_cli(
+      "displacement-metrics --size 48x54 --msaa 1 --frames 3 --tessellation 2,5 --repeat 1 --no-progress --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("scene"), "displaced");
+  EXPECT_EQ(j.at("crack_frames"), 3);
+  EXPECT_TRUE(j.at("closed_mesh").get<bool>());
+  const auto& results = j.at("results");
+  ASSERT_EQ(results.size(), 2u * seamcl::displacement_method_names().size());
+  std::set<std::pair<std::string, int>> seen;
+  for (const auto& e : results) {
+    const std::string method = e.at("method");
+    const int t = e.at("tessellation");
+    seen.insert({method, t});
+    EXPECT_EQ(e.at("crack_frames"), 3) << method;
+    EXPECT_GT(e.at("frame_ms").get<double>(), 0.0) << method;
+    EXPECT_EQ(e.at("vertices").get<size_t>(), 24u * static_cast<size_t>((t + 1) * (t + 1))) << method << " T " << t;
+    const bool watertight = method == "zipper" || method == "ownership" || method == "fixed";
+    if (watertight) {
+      EXPECT_EQ(e.at("max_gap").get<double>(), 0.0) << method << " T " << t;
+      EXPECT_EQ(e.at("differing_pairs").get<size_t>(), 0u) << method << " T " << t;
+      EXPECT_EQ(e.at("crack_pixels").get<size_t>(), 0u) << method << " T " << t;
+    } else {
+      EXPECT_GT(e.at("max_gap").get<double>(), 0.0) << method << " T " << t;
+    }
+  }
+  EXPECT_EQ(seen.size(), results.size()) << "each (method, T) once";
+}
+
+TEST(DisplacementMetricsCli, BadInputExitsTwoNamingTheField) {
+  struct Case {
+    std::string args, field;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"--methods naive,wobbly", "methods"},
+           {"--tessellation 4,0", "tessellation"},
+           {"--tessellation 65", "tessellation"},
+           {"--tessellation four", "tessellation"},
+           {"--level 17", "displacement_level"},
+           {"--frames -1", "frames"},
+           {"--repeat 0", "repeat"},
+           {"--scene paper", "scene"},
+           {"--size 0x4", "size"},
+       }) {
+    // The case's option, then small defaults for the others (so a check that failed to refuse
+    // still ends quickly).
+    std::string command = "displacement-metrics --no-progress " + c.args;
+    for (const std::string& option : {"--size 16x16", "--frames 1", "--repeat 1"}) {
+      if (c.args.find(option.substr(0, option.find(' ') + 1)) == std::string::npos) command += " " + option;
+    }
+    const CliRun r = run_cli(command);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.field + ":"), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_TRUE(r.out.empty()) << c.args << ": nothing measured before the check";
+  }
+}
+
+// compare takes the displacement options (their names as render's) and reports the displaced
+// frame's gap and cracks beside the seam methods' errors.
+TEST(DisplacementCompareCli, CompareMeasuresTheDisplacedFrame) {
+  const CliRun r = run_cli(
+      "compare --scene displaced --displacement-method fixed --tessellation 3 --methods discard --msaa 1 --size 32x36 "
+      "--repeat 1 --no-cache --no-progress --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("options").at("displacement_method"), "fixed");
+  EXPECT_EQ(j.at("options").at("tessellation"), 3);
+  const auto& d = j.at("displacement");
+  EXPECT_EQ(d.at("method"), "fixed");
+  EXPECT_EQ(d.at("max_gap").get<double>(), 0.0);
+  EXPECT_EQ(d.at("crack_pixels").get<size_t>(), 0u);
+
+  const CliRun bad = run_cli("compare --scene displaced --displacement-method wobbly --size 16x16 --no-progress");
+  EXPECT_EQ(bad.code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("displacement_method:"), std::string::npos) << bad.err;
 }
 
 }  // namespace

@@ -160,7 +160,7 @@ PackedDisplacement pack_displacement(const Scene& scene, const DisplacementSetti
   if (!scene.displacement) {
     throw InputError("displacement", "scene '" + scene.name +
                                          "' has no displacement maps (the built-in 'displaced' scene has; an .obj "
-                                         "takes them with --displacement FILE.ptx)");
+                                         "takes them with --displacement-map FILE.ptx)");
   }
   const Displacement& source = *scene.displacement;
   validate_displacement(source, scene.faces.size());
