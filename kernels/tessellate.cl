@@ -252,7 +252,6 @@ __kernel void tessellated_setup(__constant FrameParams* frame, __constant Tessel
 
   /* From here on as triangle_setup (kernels/triangle_setup.cl), per micro-triangle. */
   ClipVertex polygon[3 + 5];
-  int count = 3;
   for (int k = 0; k < 3; ++k) {
     const TessVertex tv = vertices[vid[corner[k]]];
     const __constant float* m = frame->view_proj;
@@ -262,33 +261,6 @@ __kernel void tessellated_setup(__constant FrameParams* frame, __constant Tessel
     polygon[k].u = tv.u;
     polygon[k].v = tv.v;
   }
-  for (int plane = 0; plane < 5 && count > 0; ++plane) {
-    float d[8];
-    int outside = 0;
-    for (int k = 0; k < count; ++k) {
-      d[k] = clip_distance(polygon[k], plane, frame);
-      outside += d[k] < 0.0f;
-    }
-    if (outside == 0) continue;
-    ClipVertex clipped[3 + 5];
-    int n = 0;
-    for (int k = 0; k < count; ++k) {
-      const int l = (k + 1) % count;
-      if (d[k] >= 0.0f) clipped[n++] = polygon[k];
-      if ((d[k] >= 0.0f) != (d[l] >= 0.0f)) {
-        clipped[n++] = d[k] >= 0.0f ? clip_lerp(polygon[k], polygon[l], d[k], d[l])
-                                    : clip_lerp(polygon[l], polygon[k], d[l], d[k]);
-      }
-    }
-    count = n;
-    for (int k = 0; k < count; ++k) polygon[k] = clipped[k];
-  }
-  uint visible = 0;
-  for (int k = 0; k < SEAMCL_CLIP_SLOTS; ++k) {
-    TriangleSetup s = empty_setup((uint)patch);
-    if (k + 2 < count) s = setup_screen_triangle(polygon[0], polygon[k + 1], polygon[k + 2], (uint)patch, frame);
-    visible += s.bbox_max_x >= s.bbox_min_x && s.bbox_max_y >= s.bbox_min_y;
-    out[tri * SEAMCL_CLIP_SLOTS + k] = s;
-  }
+  const uint visible = clip_and_setup(polygon, (uint)patch, frame, out + (size_t)tri * SEAMCL_CLIP_SLOTS);
   if (visible > 0) atomic_add(&stats->visible_triangles, visible);
 }

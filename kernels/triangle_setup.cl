@@ -139,30 +139,13 @@ SEAMCL_INLINE TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, 
   return s;
 }
 
-__kernel void triangle_setup(__constant FrameParams* frame, __global const float4* positions,
-                             __global const FaceGpu* faces, __global TriangleSetup* out,
-                             __global FrameStats* stats) {
-  const int t = (int)get_global_id(0);
-  if (t >= frame->input_triangles) return;
-  const uint face_index = (uint)(t / 2);
-  const FaceGpu face = faces[face_index];
-  const int corner[3] = {0, (t & 1) ? 2 : 1, (t & 1) ? 3 : 2};
-  const float corner_u[4] = {0.0f, 1.0f, 1.0f, 0.0f};
-  const float corner_v[4] = {0.0f, 0.0f, 1.0f, 1.0f};
-
-  ClipVertex polygon[3 + 5];
+/* Clips the triangle polygon[0..2] (clip space, with uv) against the five planes and writes the
+ * fan of the clipped polygon as SEAMCL_CLIP_SLOTS setups (empty ones past its end) to out; returns
+ * how many are visible. triangle_setup and tessellate.cl's tessellated_setup both call it, so
+ * their micro-triangles and faces clip and snap identically. */
+SEAMCL_INLINE uint clip_and_setup(ClipVertex* polygon, uint face_index, __constant FrameParams* frame,
+                                  __global TriangleSetup* out) {
   int count = 3;
-  for (int i = 0; i < 3; ++i) {
-    const float4 p = positions[face.vertex[corner[i]]];
-    const __constant float* m = frame->view_proj;
-    /* column-major: clip = M * (p, 1) */
-    polygon[i].x = m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12];
-    polygon[i].y = m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13];
-    polygon[i].w = m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15];
-    polygon[i].u = corner_u[corner[i]];
-    polygon[i].v = corner_v[corner[i]];
-  }
-
   for (int plane = 0; plane < 5 && count > 0; ++plane) {
     float d[8];
     int outside = 0;
@@ -190,7 +173,34 @@ __kernel void triangle_setup(__constant FrameParams* frame, __global const float
     TriangleSetup s = empty_setup(face_index);
     if (k + 2 < count) s = setup_screen_triangle(polygon[0], polygon[k + 1], polygon[k + 2], face_index, frame);
     visible += s.bbox_max_x >= s.bbox_min_x && s.bbox_max_y >= s.bbox_min_y;
-    out[t * SEAMCL_CLIP_SLOTS + k] = s;
+    out[k] = s;
   }
+  return visible;
+}
+
+__kernel void triangle_setup(__constant FrameParams* frame, __global const float4* positions,
+                             __global const FaceGpu* faces, __global TriangleSetup* out,
+                             __global FrameStats* stats) {
+  const int t = (int)get_global_id(0);
+  if (t >= frame->input_triangles) return;
+  const uint face_index = (uint)(t / 2);
+  const FaceGpu face = faces[face_index];
+  const int corner[3] = {0, (t & 1) ? 2 : 1, (t & 1) ? 3 : 2};
+  const float corner_u[4] = {0.0f, 1.0f, 1.0f, 0.0f};
+  const float corner_v[4] = {0.0f, 0.0f, 1.0f, 1.0f};
+
+  ClipVertex polygon[3 + 5];
+  for (int i = 0; i < 3; ++i) {
+    const float4 p = positions[face.vertex[corner[i]]];
+    const __constant float* m = frame->view_proj;
+    /* column-major: clip = M * (p, 1) */
+    polygon[i].x = m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12];
+    polygon[i].y = m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13];
+    polygon[i].w = m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15];
+    polygon[i].u = corner_u[corner[i]];
+    polygon[i].v = corner_v[corner[i]];
+  }
+
+  const uint visible = clip_and_setup(polygon, face_index, frame, out + (size_t)t * SEAMCL_CLIP_SLOTS);
   if (visible > 0) atomic_add(&stats->visible_triangles, visible);
 }
