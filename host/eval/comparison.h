@@ -75,7 +75,7 @@ EntryResult measure_entry(Renderer& renderer, const Camera& camera, const Method
 EntryResult measure_entry(Renderer& renderer, const Camera& camera, const MethodEntry& entry, int repeat,
                           const EntryTargets& targets, const ShouldStop& should_stop = {});
 
-// seamcl compare's loop: per entry, (re)load `scene` in the entry's texel format, warm up, then
+// seamcl compare's loop: load `scene` (once, before the first entry), then per entry warm up and
 // measure_entry. Entries are measured one after the other (entry-major). should_stop is asked
 // before every entry and before every timed render (so a stop waits for one render at most);
 // when it says stop, Cancelled is thrown and nothing is returned.
