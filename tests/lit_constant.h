@@ -14,6 +14,7 @@ namespace seamcl_tests {
 struct SeamCheck {
   size_t checked = 0;  // pixels with at least one covered sample
   size_t off = 0;      // of those, pixels that differ from the lit constant by more than 1e-5
+  size_t brighter = 0; // of those, pixels brighter than it by more than 1e-5 in some channel
   float worst = 0;     // largest difference, linear RGB
 };
 
@@ -49,6 +50,7 @@ inline SeamCheck compare_with_lit_constant(seamcl::Renderer& renderer, const sea
       const float difference = glm::length(got - expected);
       check.worst = std::max(check.worst, std::isnan(difference) ? INFINITY : difference);
       check.off += !(difference <= 1e-5f);
+      check.brighter += glm::any(glm::greaterThan(got, expected + glm::vec3(1e-5f)));
     }
   }
   return check;

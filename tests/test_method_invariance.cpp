@@ -21,6 +21,7 @@
 #include <seamcl/pipeline/texture_lookups.h>
 #include "core/srgb.h"
 #include "pipeline/adjacency.h"
+#include "lit_constant.h"
 #include "test_meshes.h"
 #include "test_support.h"
 #include "twins/texture_sample.h"
@@ -192,50 +193,6 @@ TEST(Methods, LookupsDoNotDependOnTheVertexOrderOfAnyFace) {
   }
 }
 
-namespace {
-
-struct ConstantCheck {
-  size_t covered = 0;   // pixels with a covered sample
-  size_t off = 0;       // of those, pixels more than 1e-5 from the lit constant
-  size_t brighter = 0;  // of those, pixels brighter than it in some channel
-  float worst = 0.0f;
-};
-
-// Every covered pixel against the lit constant mixed by coverage (each sample: its face's
-// lighting, or the background).
-ConstantCheck against_lit_constant(Renderer& renderer, const RenderResult& result, glm::vec3 stored) {
-  const Scene& scene = renderer.scene();
-  const FrameParams frame = renderer.last_frame_params();
-  const std::vector<TriangleSetup> setups = renderer.read_setups();
-  const std::vector<uint32_t> winners = renderer.read_sample_triangles();
-  const int samples = frame.sample_count;
-  ConstantCheck check;
-  for (size_t pixel = 0; pixel < result.pixels.size(); ++pixel) {
-    glm::vec3 expected(0.0f);
-    bool covered = false;
-    for (int s = 0; s < samples; ++s) {
-      const uint32_t slot = winners[pixel * samples + s];
-      if (slot == SEAMCL_NO_TRIANGLE) {
-        expected += scene.background;
-        continue;
-      }
-      covered = true;
-      const float n_dot_l = glm::dot(scene.face_normal(scene.faces[setups[slot].face]), glm::normalize(scene.light.to_light));
-      expected += stored * scene.light.color * (scene.light.ambient + (1 - scene.light.ambient) * std::max(n_dot_l, 0.0f));
-    }
-    if (!covered) continue;
-    expected /= static_cast<float>(samples);
-    ++check.covered;
-    const glm::vec3 got(result.pixels[pixel]);
-    const float difference = glm::length(got - expected);
-    check.worst = std::max(check.worst, std::isnan(difference) ? INFINITY : difference);
-    check.off += !(difference <= 1e-5f);
-    check.brighter += glm::any(glm::greaterThan(got, expected + glm::vec3(1e-5f)));
-  }
-  return check;
-}
-
-}  // namespace
 
 TEST(Methods, ConstantColourIsExactOnClosedMeshesOfMixedResolution) {
   const glm::vec3 color(0.7f, 0.45f, 0.25f);
@@ -256,8 +213,9 @@ TEST(Methods, ConstantColourIsExactOnClosedMeshesOfMixedResolution) {
           options.msaa = msaa;
           options.method = method;
           options.filter = filter;
-          const ConstantCheck check = against_lit_constant(renderer, renderer.render(scene.camera, options), stored);
-          EXPECT_GT(check.covered, 64u * 64u / 4);
+          const seamcl_tests::SeamCheck check =
+              seamcl_tests::compare_with_lit_constant(renderer, renderer.render(scene.camera, options), stored);
+          EXPECT_GT(check.checked, 64u * 64u / 4);
           EXPECT_EQ(check.brighter, 0u) << "worst " << check.worst;
           if (method == Method::Black) {
             // Taps past the edges weigh zero and nothing renormalises: the seams darken.
