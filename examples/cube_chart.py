@@ -10,7 +10,7 @@ One figure, one column per cube size n:
     /usr/bin/python3 examples/cube_chart.py docs/results/cubemap/cube_metrics.json -o docs/results/cubemap/speed_accuracy.png
 """
 import argparse
-import json
+import os
 import sys
 
 import matplotlib
@@ -18,23 +18,18 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+sys.dont_write_bytecode = True  # no __pycache__ beside the sources
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from metrics_json import load_results  # noqa: E402
+
 MARKERS = "osD^v<>p*h"
 
 
 def load(path):
     """The results of one cube-metrics answer, checked field by field (a clear error names the field)."""
-    try:
-        with open(path) as f:
-            answer = json.load(f)
-    except (OSError, json.JSONDecodeError) as error:
-        raise ValueError(f"{path}: {error}") from error
-    results = answer.get("results") if isinstance(answer, dict) else None
-    if not isinstance(results, list) or not results:
-        raise ValueError(f"{path}: 'results' must be a non-empty list (seamcl cube-metrics --json)")
+    answer, results = load_results(path, "seamcl cube-metrics --json",
+                                   ("cube_method", "cube_size", "ms", "edge_error", "seam_step"))
     for k, r in enumerate(results):
-        for field in ("cube_method", "cube_size", "ms", "edge_error", "seam_step"):
-            if not isinstance(r, dict) or field not in r:
-                raise ValueError(f"{path}: results[{k}].{field} is missing")
         if not isinstance(r["seam_step"], list) or not r["seam_step"]:
             raise ValueError(f"{path}: results[{k}].seam_step must be a non-empty list")
     return answer, results

@@ -13,7 +13,7 @@ One figure, three panels:
         -o docs/results/displacement/methods.png
 """
 import argparse
-import json
+import os
 import sys
 
 import matplotlib
@@ -21,24 +21,18 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+sys.dont_write_bytecode = True  # no __pycache__ beside the sources
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from metrics_json import load_results  # noqa: E402
+
 MARKERS = "osD^v<>p*h"
 FIELDS = ("method", "tessellation", "max_gap", "crack_pixels", "frame_ms", "tessellate_ms", "extra_bytes")
 
 
 def load(path):
     """The results of one displacement-metrics answer, checked field by field (errors name the field)."""
-    try:
-        with open(path) as f:
-            answer = json.load(f)
-    except (OSError, json.JSONDecodeError) as error:
-        raise ValueError(f"{path}: {error}") from error
-    results = answer.get("results") if isinstance(answer, dict) else None
-    if not isinstance(results, list) or not results:
-        raise ValueError(f"{path}: 'results' must be a non-empty list (seamcl displacement-metrics --json)")
+    answer, results = load_results(path, "seamcl displacement-metrics --json", FIELDS)
     for k, r in enumerate(results):
-        for field in FIELDS:
-            if not isinstance(r, dict) or field not in r:
-                raise ValueError(f"{path}: results[{k}].{field} is missing (seamcl displacement-metrics --json)")
         for field in ("tessellation", "max_gap", "frame_ms", "tessellate_ms", "extra_bytes"):
             if not isinstance(r[field], (int, float)) or r[field] < 0:
                 raise ValueError(f"{path}: results[{k}].{field} must be a number >= 0")
