@@ -1,5 +1,7 @@
-/* Stage 3: raster. One work-item per pixel, work-groups of one tile (SEAMCL_TILE_SIZE^2): every
- * work-item of a group walks the same tile list, which keeps the loop uniform for the vectoriser.
+/* Stage 3: raster. One work-item per row of a tile (SEAMCL_TILE_SIZE pixels, one lane of a
+ * 16-wide vector each): the work-item walks its tile's list once and tests the whole row at every
+ * sample position with vector integer adds, so the per-sample work is written vectorised rather
+ * than left to PoCL's work-item loop (which cannot vectorise a loop over a per-pixel list).
  *
  * For each sample of the pixel (D3D11 standard positions, below), a triangle covers it iff all
  * three edge functions are >= 0 at the sample's fixed-point position (top-left rule folded into
@@ -7,8 +9,13 @@
  * triangle of largest 1/w, ties going to the lower slot index, so the result does not depend on
  * the order of the tile list. Output: sample_triangle[(y * width + x) * sample_count + s], the
  * winning slot or SEAMCL_NO_TRIANGLE.
- * Host guarantees: bin lists built for this frame; bin_entries <= bin_capacity (else it re-runs).
- * Twin: host/raster.cpp. */
+ * Edge functions: E(P) is affine, so E at a sample is E at the row's first pixel centre (64-bit,
+ * once per triangle and row) plus a * (lane * ONE + 16 * ox) + b * (16 * oy). When those offsets
+ * are below 2^29 (|a| + |b| < SEAMCL_RASTER_NARROW_EDGE) the row value, clamped to +-2^29, plus
+ * the offset has the sign of the exact sum and fits 32 bits: the common case runs on int16. Wider
+ * edges (triangles over ~500 pixels) take the same steps on long16.
+ * Host guarantees: bin lists built for this frame; bin_entries <= bin_capacity (else it re-runs);
+ * global size (tiles_x, tiles_y * SEAMCL_TILE_SIZE). Twin: host/twins/raster.cpp. */
 
 /* D3D11 standard sample positions in 1/16 pixel from the pixel centre, y down; rows for 1, 2,
  * 4, 8 and 16 samples (row = log2(count)). */
@@ -32,46 +39,102 @@ SEAMCL_INLINE long sample_fixed_y(int y, int row, int s) {
   return (long)y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2 + sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
 }
 
+#if SEAMCL_TILE_SIZE != 16
+#error "raster keeps one tile row in a 16-wide vector"
+#endif
+
+/* Edges whose |a| + |b| is below this keep every in-row offset (< 4096 (|a| + |b|)) under 2^29. */
+#define SEAMCL_RASTER_NARROW_EDGE (1 << 17)
+#define SEAMCL_RASTER_CLAMP (1 << 29)
+
+/* The depth test of one sample of the row: lanes in `covered` (-1) where `slot` is nearer (or as
+ * near and of lower slot) take it. */
+SEAMCL_INLINE void raster_depth_test(__global const TriangleSetup* t, uint slot, int16 covered, int16 px, int py,
+                                     float* best_depth, uint* best_slot) {
+  const float16 fx = convert_float16(px) * (1.0f / SEAMCL_SUBPIXEL_ONE);
+  const float fy = (float)py * (1.0f / SEAMCL_SUBPIXEL_ONE);
+  const float16 depth = t->inv_w[0] + t->inv_w[1] * (fx - t->ref_x) + t->inv_w[2] * (fy - t->ref_y);
+  const float16 old_depth = vload16(0, best_depth);
+  const uint16 old_slot = vload16(0, best_slot);
+  const int16 wins = covered & ((depth > old_depth) | ((depth == old_depth) & (slot < old_slot)));
+  vstore16(select(old_depth, depth, wins), 0, best_depth);
+  vstore16(select(old_slot, (uint16)slot, wins), 0, best_slot);
+}
+
 __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup* setups,
                      __global const uint* tile_counts, __global const uint* tile_offsets,
                      __global const uint* tile_lists, __global uint* sample_triangle) {
-  const int x = (int)get_global_id(0);
+  const int tile_x = (int)get_global_id(0);
   const int y = (int)get_global_id(1);
-  if (x >= frame->width || y >= frame->height) return;
+  if (tile_x >= frame->tiles_x || y >= frame->height) return;
+  const int x0 = tile_x * SEAMCL_TILE_SIZE;
   const int samples = frame->sample_count;
   const int row = sample_pattern_row(samples);
-  const int tile = (y / SEAMCL_TILE_SIZE) * frame->tiles_x + x / SEAMCL_TILE_SIZE;
+  const int tile = (y / SEAMCL_TILE_SIZE) * frame->tiles_x + tile_x;
   const uint begin = tile_offsets[tile];
   const uint end = min(begin + tile_counts[tile], frame->bin_capacity);
+  const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const int16 x = x0 + lane;
+  /* Fixed-point x of each lane's pixel centre; the row's y. */
+  const int16 centre_x = x * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
+  const int centre_y = y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
 
-  float best_depth[SEAMCL_MAX_SAMPLES];
-  uint best_slot[SEAMCL_MAX_SAMPLES];
+  /* Per sample s, lanes [16 s, 16 s + 16). */
+  float best_depth[SEAMCL_MAX_SAMPLES * SEAMCL_TILE_SIZE];
+  uint best_slot[SEAMCL_MAX_SAMPLES * SEAMCL_TILE_SIZE];
   for (int s = 0; s < samples; ++s) {
-    best_depth[s] = -INFINITY;
-    best_slot[s] = SEAMCL_NO_TRIANGLE;
+    vstore16((float16)(-INFINITY), s, best_depth);
+    vstore16((uint16)(SEAMCL_NO_TRIANGLE), s, best_slot);
   }
   for (uint entry = begin; entry < end; ++entry) {
     const uint slot = tile_lists[entry];
     __global const TriangleSetup* t = setups + slot;
-    if (x < t->bbox_min_x || x > t->bbox_max_x || y < t->bbox_min_y || y > t->bbox_max_y) continue;
-    for (int s = 0; s < samples; ++s) {
-      const long px = sample_fixed_x(x, row, s);
-      const long py = sample_fixed_y(y, row, s);
-      const long e0 = t->edge_a[0] * px + t->edge_b[0] * py + t->edge_c[0];
-      const long e1 = t->edge_a[1] * px + t->edge_b[1] * py + t->edge_c[1];
-      const long e2 = t->edge_a[2] * px + t->edge_b[2] * py + t->edge_c[2];
-      if ((e0 | e1 | e2) < 0) continue;
-      const float fx = (float)px * (1.0f / SEAMCL_SUBPIXEL_ONE);
-      const float fy = (float)py * (1.0f / SEAMCL_SUBPIXEL_ONE);
-      const float depth = t->inv_w[0] + t->inv_w[1] * (fx - t->ref_x) + t->inv_w[2] * (fy - t->ref_y);
-      if (depth > best_depth[s] || (depth == best_depth[s] && slot < best_slot[s])) {
-        best_depth[s] = depth;
-        best_slot[s] = slot;
+    if (y < t->bbox_min_y || y > t->bbox_max_y || x0 + SEAMCL_TILE_SIZE - 1 < t->bbox_min_x || x0 > t->bbox_max_x) continue;
+    /* The twin visits the pixels of the bounding box only. */
+    const int16 in_box = (x >= t->bbox_min_x) & (x <= t->bbox_max_x);
+    int wide = 0;
+    for (int i = 0; i < 3; ++i) wide |= (long)abs(t->edge_a[i]) + (long)abs(t->edge_b[i]) >= SEAMCL_RASTER_NARROW_EDGE;
+    if (!wide) {
+      int16 e[3];
+      for (int i = 0; i < 3; ++i) {
+        const long at_row = (long)t->edge_a[i] * (x0 * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2) +
+                            (long)t->edge_b[i] * centre_y + t->edge_c[i];
+        const int clamped = (int)clamp(at_row, (long)-SEAMCL_RASTER_CLAMP, (long)SEAMCL_RASTER_CLAMP);
+        e[i] = clamped + t->edge_a[i] * SEAMCL_SUBPIXEL_ONE * lane;
+      }
+      for (int s = 0; s < samples; ++s) {
+        const int ox = sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16);
+        const int oy = sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
+        const int16 any_negative = (e[0] + (t->edge_a[0] * ox + t->edge_b[0] * oy)) |
+                                   (e[1] + (t->edge_a[1] * ox + t->edge_b[1] * oy)) |
+                                   (e[2] + (t->edge_a[2] * ox + t->edge_b[2] * oy));
+        const int16 covered = in_box & (any_negative >= 0);
+        if (!any(covered)) continue;
+        raster_depth_test(t, slot, covered, centre_x + ox, centre_y + oy, best_depth + s * SEAMCL_TILE_SIZE,
+                          best_slot + s * SEAMCL_TILE_SIZE);
+      }
+    } else {
+      long16 e[3];
+      const long16 lane_x = convert_long16(centre_x);
+      for (int i = 0; i < 3; ++i) e[i] = (long)t->edge_a[i] * lane_x + (long)t->edge_b[i] * centre_y + t->edge_c[i];
+      for (int s = 0; s < samples; ++s) {
+        const long ox = sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16);
+        const long oy = sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
+        const long16 any_negative = (e[0] + (t->edge_a[0] * ox + t->edge_b[0] * oy)) |
+                               (e[1] + (t->edge_a[1] * ox + t->edge_b[1] * oy)) |
+                               (e[2] + (t->edge_a[2] * ox + t->edge_b[2] * oy));
+        const int16 covered = in_box & convert_int16(any_negative >= 0);
+        if (!any(covered)) continue;
+        raster_depth_test(t, slot, covered, centre_x + (int)ox, centre_y + (int)oy, best_depth + s * SEAMCL_TILE_SIZE,
+                          best_slot + s * SEAMCL_TILE_SIZE);
       }
     }
   }
-  __global uint* out = sample_triangle + ((size_t)y * (size_t)frame->width + (size_t)x) * (size_t)samples;
-  for (int s = 0; s < samples; ++s) out[s] = best_slot[s];
+  const int lanes = min(SEAMCL_TILE_SIZE, frame->width - x0);
+  __global uint* out = sample_triangle + ((size_t)y * (size_t)frame->width + (size_t)x0) * (size_t)samples;
+  for (int l = 0; l < lanes; ++l) {
+    for (int s = 0; s < samples; ++s) out[l * samples + s] = best_slot[s * SEAMCL_TILE_SIZE + l];
+  }
 }
 
 /* The sample pattern as the raster stage uses it, for the test against the D3D11 tables. */
