@@ -47,18 +47,64 @@ SEAMCL_INLINE long sample_fixed_y(int y, int row, int s) {
 #define SEAMCL_RASTER_NARROW_EDGE (1 << 17)
 #define SEAMCL_RASTER_CLAMP (1 << 29)
 
-/* The depth test of one sample of the row: lanes in `covered` (-1) where `slot` is nearer (or as
- * near and of lower slot) take it. */
-SEAMCL_INLINE void raster_depth_test(__global const TriangleSetup* t, uint slot, int16 covered, int16 px, int py,
-                                     float* best_depth, uint* best_slot) {
+/* 1/w of t's plane at the lanes' fixed-point sample positions (px, py): the twin's float steps. */
+SEAMCL_INLINE float16 raster_depth(__global const TriangleSetup* t, int16 px, int py) {
   const float16 fx = convert_float16(px) * (1.0f / SEAMCL_SUBPIXEL_ONE);
   const float fy = (float)py * (1.0f / SEAMCL_SUBPIXEL_ONE);
-  const float16 depth = t->inv_w[0] + t->inv_w[1] * (fx - t->ref_x) + t->inv_w[2] * (fy - t->ref_y);
-  const float16 old_depth = vload16(0, best_depth);
+  return t->inv_w[0] + t->inv_w[1] * (fx - t->ref_x) + t->inv_w[2] * (fy - t->ref_y);
+}
+
+/* Whether some lane of a mask is set (-1): an OR tree, which PoCL's any() is not (it tests the
+ * lanes one by one). */
+SEAMCL_INLINE int raster_any(int16 mask) {
+  const int8 m8 = mask.lo | mask.hi;
+  const int4 m4 = m8.lo | m8.hi;
+  const int2 m2 = m4.lo | m4.hi;
+  return (m2.x | m2.y) < 0;
+}
+
+/* The smallest lane of v. */
+SEAMCL_INLINE uint raster_min_lane(uint16 v) {
+  const uint8 m8 = min(v.lo, v.hi);
+  const uint4 m4 = min(m8.lo, m8.hi);
+  const uint2 m2 = min(m4.lo, m4.hi);
+  return min(m2.x, m2.y);
+}
+
+/* Whether t's 1/w plane is finite (never NaN) at every pixel-space point below 2^24: then any
+ * depth beats the empty sample's -infinity, and an uncontested sample needs no depth. */
+SEAMCL_INLINE int raster_plane_is_tame(__global const TriangleSetup* t) {
+  const float reach = 0x1p24f;
+  const float bound = fabs(t->inv_w[0]) + fabs(t->inv_w[1]) * (fabs(t->ref_x) + reach) +
+                      fabs(t->inv_w[2]) * (fabs(t->ref_y) + reach);
+  return bound < 0x1p100f; /* false for NaN and infinite coefficients */
+}
+
+/* One sample of the row: the lanes in `covered` (-1) take `slot` where they have no triangle yet,
+ * or where it is nearer than theirs (or as near and of lower slot). Depths are computed only for
+ * such contests (overlapping front faces: rare, as back faces are culled), both from their planes
+ * with the same steps, so the result is the eager z-buffer's (whose empty samples hold -infinity:
+ * a plane that is not tame contests them too, and its NaN depths never win).
+ * px: the lanes' fixed-point x. */
+SEAMCL_INLINE void raster_take(__global const TriangleSetup* setups, uint slot, int tame, int16 covered, int16 px,
+                               int py, uint* best_slot) {
   const uint16 old_slot = vload16(0, best_slot);
-  const int16 wins = covered & ((depth > old_depth) | ((depth == old_depth) & (slot < old_slot)));
-  vstore16(select(old_depth, depth, wins), 0, best_depth);
-  vstore16(select(old_slot, (uint16)slot, wins), 0, best_slot);
+  const int16 empty = old_slot == (uint16)SEAMCL_NO_TRIANGLE;
+  int16 contested = covered & ~empty;
+  int16 takes = covered & empty;
+  if (!tame || raster_any(contested)) {
+    const float16 depth = raster_depth(setups + slot, px, py);
+    takes &= ~isnan(depth); /* -infinity ties the empty sample and wins on slot; NaN never wins */
+    /* One winner at a time: all lanes held by it are decided with one vector of its depths. */
+    while (raster_any(contested)) {
+      const uint other = raster_min_lane(select((uint16)SEAMCL_NO_TRIANGLE, old_slot, contested));
+      const int16 held = contested & (old_slot == other);
+      const float16 other_depth = raster_depth(setups + other, px, py);
+      takes |= held & ((depth > other_depth) | ((depth == other_depth) & (slot < other)));
+      contested &= ~held;
+    }
+  }
+  vstore16(select(old_slot, (uint16)slot, takes), 0, best_slot);
 }
 
 __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup* setups,
@@ -79,19 +125,16 @@ __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup
   const int16 centre_x = x * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
   const int centre_y = y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
 
-  /* Per sample s, lanes [16 s, 16 s + 16). */
-  float best_depth[SEAMCL_MAX_SAMPLES * SEAMCL_TILE_SIZE];
+  /* Winning slot per sample s and lane: [16 s + lane]. */
   uint best_slot[SEAMCL_MAX_SAMPLES * SEAMCL_TILE_SIZE];
-  for (int s = 0; s < samples; ++s) {
-    vstore16((float16)(-INFINITY), s, best_depth);
-    vstore16((uint16)(SEAMCL_NO_TRIANGLE), s, best_slot);
-  }
+  for (int s = 0; s < samples; ++s) vstore16((uint16)(SEAMCL_NO_TRIANGLE), s, best_slot);
   for (uint entry = begin; entry < end; ++entry) {
     const uint slot = tile_lists[entry];
     __global const TriangleSetup* t = setups + slot;
     if (y < t->bbox_min_y || y > t->bbox_max_y || x0 + SEAMCL_TILE_SIZE - 1 < t->bbox_min_x || x0 > t->bbox_max_x) continue;
     /* The twin visits the pixels of the bounding box only. */
     const int16 in_box = (x >= t->bbox_min_x) & (x <= t->bbox_max_x);
+    const int tame = raster_plane_is_tame(t);
     int wide = 0;
     for (int i = 0; i < 3; ++i) wide |= (long)abs(t->edge_a[i]) + (long)abs(t->edge_b[i]) >= SEAMCL_RASTER_NARROW_EDGE;
     if (!wide) {
@@ -102,16 +145,32 @@ __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup
         const int clamped = (int)clamp(at_row, (long)-SEAMCL_RASTER_CLAMP, (long)SEAMCL_RASTER_CLAMP);
         e[i] = clamped + t->edge_a[i] * SEAMCL_SUBPIXEL_ONE * lane;
       }
+      /* Lanes whose every sample position (all within [-8, 7] / 16 pixel of the centre) is
+       * inside all three edges, and lanes outside one edge at all of them: only the others
+       * (pixels an edge crosses) need the test per sample. */
+      int16 full = in_box, outside = (int16)(0);
+      for (int i = 0; i < 3; ++i) {
+        const int a = t->edge_a[i], b = t->edge_b[i];
+        const int low = a * (a > 0 ? -128 : 112) + b * (b > 0 ? -128 : 112);
+        const int high = a * (a > 0 ? 112 : -128) + b * (b > 0 ? 112 : -128);
+        full &= e[i] + low >= 0;
+        outside |= e[i] + high < 0;
+      }
+      const int16 partial = in_box & ~full & ~outside;
+      const int any_partial = raster_any(partial);
+      if (!any_partial && !raster_any(full)) continue;
       for (int s = 0; s < samples; ++s) {
         const int ox = sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16);
         const int oy = sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
-        const int16 any_negative = (e[0] + (t->edge_a[0] * ox + t->edge_b[0] * oy)) |
-                                   (e[1] + (t->edge_a[1] * ox + t->edge_b[1] * oy)) |
-                                   (e[2] + (t->edge_a[2] * ox + t->edge_b[2] * oy));
-        const int16 covered = in_box & (any_negative >= 0);
-        if (!any(covered)) continue;
-        raster_depth_test(t, slot, covered, centre_x + ox, centre_y + oy, best_depth + s * SEAMCL_TILE_SIZE,
-                          best_slot + s * SEAMCL_TILE_SIZE);
+        int16 covered = full;
+        if (any_partial) {
+          const int16 any_negative = (e[0] + (t->edge_a[0] * ox + t->edge_b[0] * oy)) |
+                                     (e[1] + (t->edge_a[1] * ox + t->edge_b[1] * oy)) |
+                                     (e[2] + (t->edge_a[2] * ox + t->edge_b[2] * oy));
+          covered |= partial & (any_negative >= 0);
+          if (!raster_any(covered)) continue;
+        }
+        raster_take(setups, slot, tame, covered, centre_x + ox, centre_y + oy, best_slot + s * SEAMCL_TILE_SIZE);
       }
     } else {
       long16 e[3];
@@ -124,9 +183,8 @@ __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup
                                (e[1] + (t->edge_a[1] * ox + t->edge_b[1] * oy)) |
                                (e[2] + (t->edge_a[2] * ox + t->edge_b[2] * oy));
         const int16 covered = in_box & convert_int16(any_negative >= 0);
-        if (!any(covered)) continue;
-        raster_depth_test(t, slot, covered, centre_x + (int)ox, centre_y + (int)oy, best_depth + s * SEAMCL_TILE_SIZE,
-                          best_slot + s * SEAMCL_TILE_SIZE);
+        if (!raster_any(covered)) continue;
+        raster_take(setups, slot, tame, covered, centre_x + (int)ox, centre_y + (int)oy, best_slot + s * SEAMCL_TILE_SIZE);
       }
     }
   }
