@@ -107,7 +107,8 @@ SEAMCL_INLINE void raster_take(__global const TriangleSetup* setups, uint slot, 
       const uint other = raster_min_lane(select((uint16)SEAMCL_NO_TRIANGLE, old_slot, contested));
       const int16 held = contested & (old_slot == other);
       const float16 other_depth = raster_depth(setups + other, px, py);
-      takes |= held & ((depth > other_depth) | ((depth == other_depth) & (slot < other)));
+      const int16 lower_slot = (int16)(slot < other ? -1 : 0); /* a scalar comparison gives 1, not -1 */
+      takes |= held & ((depth > other_depth) | ((depth == other_depth) & lower_slot));
       contested &= ~held;
     }
   }
