@@ -19,7 +19,8 @@
  * Depths are computed only where a covered sample already has a triangle (overlapping front
  * faces), both from their planes with the twin's float steps: the eager z-buffer's result.
  * Host guarantees: bin lists built for this frame; bin_entries <= bin_capacity (else it re-runs);
- * global size (tiles_x, tiles_y * SEAMCL_TILE_SIZE). Twin: host/twins/raster.cpp. */
+ * global size (tiles_x, tiles_y * SEAMCL_TILE_SIZE); image sides <= 16384 (kMaxImageSide), so
+ * fixed-point sample positions fit 32 bits and convert to float exactly. Twin: host/twins/raster.cpp. */
 
 /* D3D11 standard sample positions in 1/16 pixel from the pixel centre, y down; rows for 1, 2,
  * 4, 8 and 16 samples (row = log2(count)). */
