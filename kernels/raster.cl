@@ -1,5 +1,6 @@
-/* Stage 3: raster. One work-item per pixel, work-groups of one tile (SEAMCL_TILE_SIZE^2): every
- * work-item of a group walks the same tile list, which keeps the loop uniform for the vectoriser.
+/* Stage 3: raster. One work-item per row of a tile (SEAMCL_TILE_SIZE pixels): it walks its tile's
+ * list once and tests the row with 16-wide integer vectors, written vectorised here because
+ * PoCL's work-item loop cannot vectorise a loop over a per-pixel list.
  *
  * For each sample of the pixel (D3D11 standard positions, below), a triangle covers it iff all
  * three edge functions are >= 0 at the sample's fixed-point position (top-left rule folded into
@@ -7,8 +8,19 @@
  * triangle of largest 1/w, ties going to the lower slot index, so the result does not depend on
  * the order of the tile list. Output: sample_triangle[(y * width + x) * sample_count + s], the
  * winning slot or SEAMCL_NO_TRIANGLE.
- * Host guarantees: bin lists built for this frame; bin_entries <= bin_capacity (else it re-runs).
- * Twin: host/raster.cpp. */
+ * Edge functions are affine: E at a sample is E at a pixel centre (64-bit) plus a * dx + b * dy
+ * for the sample's small offset. With |offsets| < 2^29 the centre value clamped to +-2^29, plus
+ * the offset, has the sign of the exact sum and fits 32 bits, so the common case runs on int16;
+ * edges too long for that bound take the same steps on long16.
+ * Up to 4 samples a row runs by lanes (the vector over the row's 16 pixels, a loop over samples);
+ * from 8 samples by pixels (the vector over a pixel's samples, a loop over the pixels in the
+ * triangle's box, where whole pixels inside or outside an edge skip the per-sample test): cost
+ * then follows the covered pixels, not pixels x samples.
+ * Depths are computed only where a covered sample already has a triangle (overlapping front
+ * faces), both from their planes with the twin's float steps: the eager z-buffer's result.
+ * Host guarantees: bin lists built for this frame; bin_entries <= bin_capacity (else it re-runs);
+ * global size (tiles_x, tiles_y * SEAMCL_TILE_SIZE); image sides <= 16384 (kMaxImageSide), so
+ * fixed-point sample positions fit 32 bits and convert to float exactly. Twin: host/twins/raster.cpp. */
 
 /* D3D11 standard sample positions in 1/16 pixel from the pixel centre, y down; rows for 1, 2,
  * 4, 8 and 16 samples (row = log2(count)). */
@@ -32,46 +44,241 @@ SEAMCL_INLINE long sample_fixed_y(int y, int row, int s) {
   return (long)y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2 + sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
 }
 
-__kernel void raster(__constant FrameParams* frame, __global const TriangleSetup* setups,
-                     __global const uint* tile_counts, __global const uint* tile_offsets,
-                     __global const uint* tile_lists, __global uint* sample_triangle) {
-  const int x = (int)get_global_id(0);
-  const int y = (int)get_global_id(1);
-  if (x >= frame->width || y >= frame->height) return;
-  const int samples = frame->sample_count;
-  const int row = sample_pattern_row(samples);
-  const int tile = (y / SEAMCL_TILE_SIZE) * frame->tiles_x + x / SEAMCL_TILE_SIZE;
-  const uint begin = tile_offsets[tile];
-  const uint end = min(begin + tile_counts[tile], frame->bin_capacity);
+#if SEAMCL_TILE_SIZE != 16
+#error "raster keeps one tile row in a 16-wide vector"
+#endif
+#if SEAMCL_MAX_SAMPLES != 16
+#error "raster keeps one pixel's samples in a 16-wide vector"
+#endif
 
-  float best_depth[SEAMCL_MAX_SAMPLES];
-  uint best_slot[SEAMCL_MAX_SAMPLES];
-  for (int s = 0; s < samples; ++s) {
-    best_depth[s] = -INFINITY;
-    best_slot[s] = SEAMCL_NO_TRIANGLE;
+/* Edges whose |a| + |b| is below this keep every in-row offset (< 4096 (|a| + |b|)) under 2^29. */
+#define SEAMCL_RASTER_NARROW_EDGE (1 << 17)
+#define SEAMCL_RASTER_CLAMP (1 << 29)
+
+/* 1/w of t's plane at the lanes' fixed-point sample positions (px, py): the twin's float steps. */
+SEAMCL_INLINE float16 raster_depth(__global const TriangleSetup* t, int16 px, int16 py) {
+  const float16 fx = convert_float16(px) * (1.0f / SEAMCL_SUBPIXEL_ONE);
+  const float16 fy = convert_float16(py) * (1.0f / SEAMCL_SUBPIXEL_ONE);
+  return t->inv_w[0] + t->inv_w[1] * (fx - t->ref_x) + t->inv_w[2] * (fy - t->ref_y);
+}
+
+/* Whether some lane of a mask is set (-1): an OR tree, which PoCL's any() is not (it tests the
+ * lanes one by one). */
+SEAMCL_INLINE int raster_any(int16 mask) {
+  const int8 m8 = mask.lo | mask.hi;
+  const int4 m4 = m8.lo | m8.hi;
+  const int2 m2 = m4.lo | m4.hi;
+  return (m2.x | m2.y) < 0;
+}
+
+/* The smallest lane of v. */
+SEAMCL_INLINE uint raster_min_lane(uint16 v) {
+  const uint8 m8 = min(v.lo, v.hi);
+  const uint4 m4 = min(m8.lo, m8.hi);
+  const uint2 m2 = min(m4.lo, m4.hi);
+  return min(m2.x, m2.y);
+}
+
+/* Whether t's 1/w plane is finite (never NaN) at every pixel-space point below 2^24: then any
+ * depth beats the empty sample's -infinity, and an uncontested sample needs no depth. */
+SEAMCL_INLINE int raster_plane_is_tame(__global const TriangleSetup* t) {
+  const float reach = 0x1p24f;
+  const float bound = fabs(t->inv_w[0]) + fabs(t->inv_w[1]) * (fabs(t->ref_x) + reach) +
+                      fabs(t->inv_w[2]) * (fabs(t->ref_y) + reach);
+  return bound < 0x1p100f; /* false for NaN and infinite coefficients */
+}
+
+/* One sample of the row: the lanes in `covered` (-1) take `slot` where they have no triangle yet,
+ * or where it is nearer than theirs (or as near and of lower slot). Depths are computed only for
+ * such contests (overlapping front faces: rare, as back faces are culled), both from their planes
+ * with the same steps, so the result is the eager z-buffer's (whose empty samples hold -infinity:
+ * a plane that is not tame contests them too, and its NaN depths never win).
+ * (px, py): the lanes' fixed-point positions. */
+SEAMCL_INLINE void raster_take(__global const TriangleSetup* setups, uint slot, int tame, int16 covered, int16 px,
+                               int16 py, uint* best_slot) {
+  const uint16 old_slot = vload16(0, best_slot);
+  const int16 empty = old_slot == (uint16)SEAMCL_NO_TRIANGLE;
+  int16 contested = covered & ~empty;
+  int16 takes = covered & empty;
+  if (!tame || raster_any(contested)) {
+    const float16 depth = raster_depth(setups + slot, px, py);
+    takes &= ~isnan(depth); /* -infinity ties the empty sample and wins on slot; NaN never wins */
+    /* One winner at a time: all lanes held by it are decided with one vector of its depths. */
+    while (raster_any(contested)) {
+      const uint other = raster_min_lane(select((uint16)SEAMCL_NO_TRIANGLE, old_slot, contested));
+      const int16 held = contested & (old_slot == other);
+      const float16 other_depth = raster_depth(setups + other, px, py);
+      const int16 lower_slot = (int16)(slot < other ? -1 : 0); /* a scalar comparison gives 1, not -1 */
+      takes |= held & ((depth > other_depth) | ((depth == other_depth) & lower_slot));
+      contested &= ~held;
+    }
   }
+  vstore16(select(old_slot, (uint16)slot, takes), 0, best_slot);
+}
+
+/* Rows of one sample (or few): the vector runs over the row's 16 pixels, the loop over samples;
+ * winners stored per sample [16 s + lane]. */
+SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, __global const uint* tile_lists, uint begin,
+                                       uint end, int x0, int y, int samples, int row, uint* best_slot) {
+  const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const int16 x = x0 + lane;
+  /* Fixed-point x of each lane's pixel centre; the row's y. */
+  const int16 centre_x = x * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
+  const int centre_y = y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
   for (uint entry = begin; entry < end; ++entry) {
     const uint slot = tile_lists[entry];
     __global const TriangleSetup* t = setups + slot;
-    if (x < t->bbox_min_x || x > t->bbox_max_x || y < t->bbox_min_y || y > t->bbox_max_y) continue;
-    for (int s = 0; s < samples; ++s) {
-      const long px = sample_fixed_x(x, row, s);
-      const long py = sample_fixed_y(y, row, s);
-      const long e0 = t->edge_a[0] * px + t->edge_b[0] * py + t->edge_c[0];
-      const long e1 = t->edge_a[1] * px + t->edge_b[1] * py + t->edge_c[1];
-      const long e2 = t->edge_a[2] * px + t->edge_b[2] * py + t->edge_c[2];
-      if ((e0 | e1 | e2) < 0) continue;
-      const float fx = (float)px * (1.0f / SEAMCL_SUBPIXEL_ONE);
-      const float fy = (float)py * (1.0f / SEAMCL_SUBPIXEL_ONE);
-      const float depth = t->inv_w[0] + t->inv_w[1] * (fx - t->ref_x) + t->inv_w[2] * (fy - t->ref_y);
-      if (depth > best_depth[s] || (depth == best_depth[s] && slot < best_slot[s])) {
-        best_depth[s] = depth;
-        best_slot[s] = slot;
+    if (y < t->bbox_min_y || y > t->bbox_max_y || x0 + SEAMCL_TILE_SIZE - 1 < t->bbox_min_x || x0 > t->bbox_max_x) continue;
+    /* The twin visits the pixels of the bounding box only. */
+    const int16 in_box = (x >= t->bbox_min_x) & (x <= t->bbox_max_x);
+    const int tame = raster_plane_is_tame(t);
+    int wide = 0;
+    for (int i = 0; i < 3; ++i) wide |= (long)abs(t->edge_a[i]) + (long)abs(t->edge_b[i]) >= SEAMCL_RASTER_NARROW_EDGE;
+    if (!wide) {
+      int16 e[3];
+      for (int i = 0; i < 3; ++i) {
+        const long at_row = (long)t->edge_a[i] * (x0 * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2) +
+                            (long)t->edge_b[i] * centre_y + t->edge_c[i];
+        const int clamped = (int)clamp(at_row, (long)-SEAMCL_RASTER_CLAMP, (long)SEAMCL_RASTER_CLAMP);
+        e[i] = clamped + t->edge_a[i] * SEAMCL_SUBPIXEL_ONE * lane;
+      }
+      /* Lanes whose every sample position (all within [-8, 7] / 16 pixel of the centre) is
+       * inside all three edges, and lanes outside one edge at all of them: only the others
+       * (pixels an edge crosses) need the test per sample. */
+      int16 full = in_box, outside = (int16)(0);
+      for (int i = 0; i < 3; ++i) {
+        const int a = t->edge_a[i], b = t->edge_b[i];
+        const int low = a * (a > 0 ? -128 : 112) + b * (b > 0 ? -128 : 112);
+        const int high = a * (a > 0 ? 112 : -128) + b * (b > 0 ? 112 : -128);
+        full &= e[i] + low >= 0;
+        outside |= e[i] + high < 0;
+      }
+      const int16 partial = in_box & ~full & ~outside;
+      const int any_partial = raster_any(partial);
+      if (!any_partial && !raster_any(full)) continue;
+      for (int s = 0; s < samples; ++s) {
+        const int ox = sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16);
+        const int oy = sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
+        int16 covered = full;
+        if (any_partial) {
+          const int16 any_negative = (e[0] + (t->edge_a[0] * ox + t->edge_b[0] * oy)) |
+                                     (e[1] + (t->edge_a[1] * ox + t->edge_b[1] * oy)) |
+                                     (e[2] + (t->edge_a[2] * ox + t->edge_b[2] * oy));
+          covered |= partial & (any_negative >= 0);
+          if (!raster_any(covered)) continue;
+        }
+        raster_take(setups, slot, tame, covered, centre_x + ox, (int16)(centre_y + oy), best_slot + s * SEAMCL_TILE_SIZE);
+      }
+    } else {
+      long16 e[3];
+      const long16 lane_x = convert_long16(centre_x);
+      for (int i = 0; i < 3; ++i) e[i] = (long)t->edge_a[i] * lane_x + (long)t->edge_b[i] * centre_y + t->edge_c[i];
+      for (int s = 0; s < samples; ++s) {
+        const long ox = sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16);
+        const long oy = sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
+        const long16 any_negative = (e[0] + (t->edge_a[0] * ox + t->edge_b[0] * oy)) |
+                               (e[1] + (t->edge_a[1] * ox + t->edge_b[1] * oy)) |
+                               (e[2] + (t->edge_a[2] * ox + t->edge_b[2] * oy));
+        const int16 covered = in_box & convert_int16(any_negative >= 0);
+        if (!raster_any(covered)) continue;
+        raster_take(setups, slot, tame, covered, centre_x + (int)ox, (int16)(centre_y + (int)oy), best_slot + s * SEAMCL_TILE_SIZE);
       }
     }
   }
-  __global uint* out = sample_triangle + ((size_t)y * (size_t)frame->width + (size_t)x) * (size_t)samples;
-  for (int s = 0; s < samples; ++s) out[s] = best_slot[s];
+}
+
+/* Edges whose |a| + |b| is below this keep a pixel's sample offsets (<= 128 (|a| + |b|)) under 2^29. */
+#define SEAMCL_RASTER_NARROW_PIXEL_EDGE (1 << 22)
+
+/* Rows of many samples: the vector runs over one pixel's samples (lanes past the count off), the
+ * loop over the pixels of the row inside the triangle's box; winners stored per pixel
+ * [16 lane + s]. A pixel whose sample box [-8, 7] / 16 lies inside all three edges is covered at
+ * every sample, one outside an edge at none: only pixels an edge crosses test their samples. */
+SEAMCL_INLINE void raster_row_by_pixels(__global const TriangleSetup* setups, __global const uint* tile_lists,
+                                        uint begin, uint end, int x0, int y, int samples, int row, uint* best_slot) {
+  int offset_x[SEAMCL_MAX_SAMPLES], offset_y[SEAMCL_MAX_SAMPLES];
+  for (int s = 0; s < SEAMCL_MAX_SAMPLES; ++s) {
+    offset_x[s] = s < samples ? sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16) : 0;
+    offset_y[s] = s < samples ? sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16) : 0;
+  }
+  const int16 sample_x = vload16(0, offset_x);
+  const int16 sample_y = vload16(0, offset_y);
+  const int16 valid = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15) < samples;
+  const int centre_y = y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
+  const int16 py = centre_y + sample_y;
+  for (uint entry = begin; entry < end; ++entry) {
+    const uint slot = tile_lists[entry];
+    __global const TriangleSetup* t = setups + slot;
+    if (y < t->bbox_min_y || y > t->bbox_max_y || x0 + SEAMCL_TILE_SIZE - 1 < t->bbox_min_x || x0 > t->bbox_max_x) continue;
+    const int tame = raster_plane_is_tame(t);
+    /* Per edge: its value at the first pixel's centre, its step per pixel, and its lowest and
+     * highest change over the sample box. */
+    long e[3], step[3], low[3], high[3];
+    int narrow = 1;
+    int16 d[3];
+    const int first = max(t->bbox_min_x, x0) - x0, last = min(t->bbox_max_x, x0 + SEAMCL_TILE_SIZE - 1) - x0;
+    for (int i = 0; i < 3; ++i) {
+      const long a = t->edge_a[i], b = t->edge_b[i];
+      e[i] = a * ((x0 + first) * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2) + b * centre_y + t->edge_c[i];
+      step[i] = a * SEAMCL_SUBPIXEL_ONE;
+      low[i] = a * (a > 0 ? -128 : 112) + b * (b > 0 ? -128 : 112);
+      high[i] = a * (a > 0 ? 112 : -128) + b * (b > 0 ? 112 : -128);
+      narrow &= abs(a) + abs(b) < SEAMCL_RASTER_NARROW_PIXEL_EDGE;
+    }
+    /* The change at each sample, in 32 bits when the edges are narrow (else unused). */
+    for (int i = 0; i < 3; ++i) d[i] = narrow ? t->edge_a[i] * sample_x + t->edge_b[i] * sample_y : (int16)(0);
+    for (int l = first; l <= last; ++l, e[0] += step[0], e[1] += step[1], e[2] += step[2]) {
+      if (e[0] + high[0] < 0 || e[1] + high[1] < 0 || e[2] + high[2] < 0) continue;
+      int16 covered = valid;
+      if (e[0] + low[0] < 0 || e[1] + low[1] < 0 || e[2] + low[2] < 0) {
+        if (narrow) {
+          int c[3];
+          for (int i = 0; i < 3; ++i) c[i] = (int)clamp(e[i], (long)-SEAMCL_RASTER_CLAMP, (long)SEAMCL_RASTER_CLAMP);
+          covered &= ((c[0] + d[0]) | (c[1] + d[1]) | (c[2] + d[2])) >= 0;
+        } else {
+          const long16 wide_x = convert_long16(sample_x), wide_y = convert_long16(sample_y);
+          long16 any_negative = (long16)(0);
+          for (int i = 0; i < 3; ++i) any_negative |= e[i] + (long)t->edge_a[i] * wide_x + (long)t->edge_b[i] * wide_y;
+          covered &= convert_int16(any_negative >= 0);
+        }
+        if (!raster_any(covered)) continue;
+      }
+      const int centre_x = (x0 + l) * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
+      raster_take(setups, slot, tame, covered, centre_x + sample_x, py, best_slot + l * SEAMCL_TILE_SIZE);
+    }
+  }
+}
+
+/* From this many samples on, rows go by pixels (fewer steps per covered pixel) rather than lanes. */
+#define SEAMCL_RASTER_BY_PIXELS_FROM 8
+
+__kernel void raster(__constant FrameParams* frame, __global const TriangleSetup* setups,
+                     __global const uint* tile_counts, __global const uint* tile_offsets,
+                     __global const uint* tile_lists, __global uint* sample_triangle) {
+  const int tile_x = (int)get_global_id(0);
+  const int y = (int)get_global_id(1);
+  if (tile_x >= frame->tiles_x || y >= frame->height) return;
+  const int x0 = tile_x * SEAMCL_TILE_SIZE;
+  const int samples = frame->sample_count;
+  const int row = sample_pattern_row(samples);
+  const int tile = (y / SEAMCL_TILE_SIZE) * frame->tiles_x + tile_x;
+  const uint begin = tile_offsets[tile];
+  const uint end = min(begin + tile_counts[tile], frame->bin_capacity);
+  const int lanes = min(SEAMCL_TILE_SIZE, frame->width - x0);
+  __global uint* out = sample_triangle + ((size_t)y * (size_t)frame->width + (size_t)x0) * (size_t)samples;
+  uint best_slot[SEAMCL_MAX_SAMPLES * SEAMCL_TILE_SIZE];
+  for (int i = 0; i < SEAMCL_MAX_SAMPLES; ++i) vstore16((uint16)(SEAMCL_NO_TRIANGLE), i, best_slot);
+  if (samples < SEAMCL_RASTER_BY_PIXELS_FROM) {
+    raster_row_by_lanes(setups, tile_lists, begin, end, x0, y, samples, row, best_slot);
+    for (int l = 0; l < lanes; ++l) {
+      for (int s = 0; s < samples; ++s) out[l * samples + s] = best_slot[s * SEAMCL_TILE_SIZE + l];
+    }
+  } else {
+    raster_row_by_pixels(setups, tile_lists, begin, end, x0, y, samples, row, best_slot);
+    for (int l = 0; l < lanes; ++l) {
+      for (int s = 0; s < samples; ++s) out[l * samples + s] = best_slot[l * SEAMCL_TILE_SIZE + s];
+    }
+  }
 }
 
 /* The sample pattern as the raster stage uses it, for the test against the D3D11 tables. */

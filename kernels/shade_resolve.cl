@@ -242,54 +242,62 @@ __kernel void shade_resolve(__constant FrameParams* frame, __global const Triang
     float3 sum = (float3)(0.0f);
     int uncovered = 0;
     uchar crosses = SEAMCL_MASK_NONE;
-    for (int s = 0; s < samples; ++s) {
-      const uint slot = ids[s];
-      if (slot == SEAMCL_NO_TRIANGLE) {
-        ++uncovered;
-        continue;
-      }
-      const float sample_x = (float)sample_fixed_x(x, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
-      const float sample_y = (float)sample_fixed_y(y, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
-      if (frame->shading_mode == SEAMCL_SHADE_SAMPLE) {
+    if (frame->shading_mode == SEAMCL_SHADE_SAMPLE) {
+      for (int s = 0; s < samples; ++s) {
+        const uint slot = ids[s];
+        if (slot == SEAMCL_NO_TRIANGLE) {
+          ++uncovered;
+          continue;
+        }
+        const float sample_x = (float)sample_fixed_x(x, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
+        const float sample_y = (float)sample_fixed_y(y, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
         sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, sample_x, sample_y);
 #if SEAMCL_SEAM_MASK
         crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,
                                                       srgb_to_linear, sample_x, sample_y));
 #endif
         ++fragments;
-        continue;
       }
-      int first = 1;
-      for (int r = 0; r < s; ++r) first &= ids[r] != slot;
-      if (!first) continue;
-      /* First sample of this triangle: count its samples and their centroid. */
-      int covered = 0;
-      float centroid_x = 0.0f, centroid_y = 0.0f;
-      for (int r = s; r < samples; ++r) {
-        if (ids[r] != slot) continue;
-        ++covered;
-        centroid_x += (float)sample_fixed_x(x, row, r) * (1.0f / SEAMCL_SUBPIXEL_ONE);
-        centroid_y += (float)sample_fixed_y(y, row, r) * (1.0f / SEAMCL_SUBPIXEL_ONE);
-      }
-      centroid_x /= (float)covered;
-      centroid_y /= (float)covered;
-      float shade_x = (float)x + 0.5f;
-      float shade_y = (float)y + 0.5f;
-      /* Centroid shading keeps the centre when every sample is covered (as D3D and GL do): the
-       * centroid of a full pattern is not the centre (16x: (-1/32, -1/32)). */
-      const int partly_covered = covered < samples;
-      if ((frame->shading_mode == SEAMCL_SHADE_CENTROID && partly_covered) ||
-          !(plane_inv_w(setups + slot, shade_x, shade_y) > 0.0f)) {
-        shade_x = centroid_x;
-        shade_y = centroid_y;
-      }
-      sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, shade_x, shade_y) *
-             (float)covered;
+    } else {
+      /* Each distinct triangle once, in the order of its first sample: one pass over the samples
+       * gives its coverage mask, so a pixel costs samples x distinct triangles compares. */
+      uint done = 0;
+      for (int s = 0; s < samples; ++s) {
+        if ((done >> s) & 1u) continue;
+        const uint slot = ids[s];
+        uint mask = 0;
+        for (int r = s; r < samples; ++r) mask |= (uint)(ids[r] == slot) << r;
+        done |= mask;
+        const int covered = (int)popcount(mask);
+        if (slot == SEAMCL_NO_TRIANGLE) {
+          uncovered = covered;
+          continue;
+        }
+        float shade_x = (float)x + 0.5f;
+        float shade_y = (float)y + 0.5f;
+        /* Centroid shading keeps the centre when every sample is covered (as D3D and GL do): the
+         * centroid of a full pattern is not the centre (16x: (-1/32, -1/32)). */
+        const int partly_covered = covered < samples;
+        if ((frame->shading_mode == SEAMCL_SHADE_CENTROID && partly_covered) ||
+            !(plane_inv_w(setups + slot, shade_x, shade_y) > 0.0f)) {
+          /* The mean of the covered samples' positions, summed in sample order. */
+          float centroid_x = 0.0f, centroid_y = 0.0f;
+          for (int r = s; r < samples; ++r) {
+            if (((mask >> r) & 1u) == 0) continue;
+            centroid_x += (float)sample_fixed_x(x, row, r) * (1.0f / SEAMCL_SUBPIXEL_ONE);
+            centroid_y += (float)sample_fixed_y(y, row, r) * (1.0f / SEAMCL_SUBPIXEL_ONE);
+          }
+          shade_x = centroid_x / (float)covered;
+          shade_y = centroid_y / (float)covered;
+        }
+        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, shade_x, shade_y) *
+               (float)covered;
 #if SEAMCL_SEAM_MASK
-      crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,
-                                                    srgb_to_linear, shade_x, shade_y));
+        crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,
+                                                      srgb_to_linear, shade_x, shade_y));
 #endif
-      ++fragments;
+        ++fragments;
+      }
     }
     /* Added once, so that an empty pixel is exactly the background (n*b/n is exact for n a power
      * of two; b+b+b... rounds). */

@@ -240,7 +240,10 @@ struct Renderer::Impl {
     raster_kernel.setArg(3, tile_offsets);
     raster_kernel.setArg(4, tile_lists);
     raster_kernel.setArg(5, sample_triangle);
-    queue.enqueueNDRangeKernel(raster_kernel, cl::NullRange, tile_grid, tile_group, nullptr, next(ev.raster));
+    // One work-item per tile row (kernels/raster.cl keeps a row in a 16-wide vector).
+    queue.enqueueNDRangeKernel(raster_kernel, cl::NullRange,
+                               cl::NDRange(static_cast<size_t>(p.tiles_x), static_cast<size_t>(p.tiles_y) * SEAMCL_TILE_SIZE),
+                               cl::NDRange(1, SEAMCL_TILE_SIZE), nullptr, next(ev.raster));
 
     shade_kernel.setArg(0, frame_params);
     shade_kernel.setArg(1, setups);
