@@ -431,12 +431,14 @@ SEAMCL_INLINE FilterSum filter_texture(const FaceGpu* face, __global const uint*
 }
 
 /* Whether any tap of face `other` can weigh anything in a lookup (derivatives in this face's uv)
- * whose point lies at least `distance` (uv) outside the other face's square. Conservative: a
+ * whose point must travel at least distance_u along u and distance_v along v (uv, this face's
+ * frame; a negative distance never decides) to reach the other face's square. Conservative: a
  * neighbour it rules out would add exactly nothing, so skipping it changes no bit of the result;
- * it spares interior lookups the neighbours' filters. The bound, term by term, is argued in the
- * twin (host/twins/texture_sample.cpp, neighbor_may_contribute). */
-SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, int max_aniso, float distance, float dudx,
-                                          float dvdx, float dudy, float dvdy) {
+ * it spares interior lookups the neighbours' filters, with no division (the sides are powers of
+ * two, so multiplying by them is exact). The bound, term by term, is argued in the twin
+ * (host/twins/texture_sample.cpp, neighbor_may_contribute). */
+SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, int max_aniso, float distance_u,
+                                          float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
   const float axis_x = fabs(dudx) + fabs(dvdx);
   const float axis_y = fabs(dudy) + fabs(dvdy);
   const float axes = axis_x + axis_y;
@@ -444,17 +446,20 @@ SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, int 
   const float longest = fmax(axis_x, axis_y);
   const float shortest = fmin(axis_x, axis_y);
   const float min_side = (float)min(other->width, other->height);
-  const float aspect = (float)max(other->width, other->height) / min_side;
+  const float max_side = (float)max(other->width, other->height);
   const float probe_axis = filter == SEAMCL_FILTER_ANISO ? fmax(shortest, longest / (float)max_aniso) : longest;
-  const float texel = filter == SEAMCL_FILTER_BILINEAR
-                          ? 1.0f / min_side
-                          : fmin(1.0f, fmax(2.0f / min_side, 2.01f * aspect * probe_axis));
-  const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f * longest
-                       : filter == SEAMCL_FILTER_EWA ? (1.0f + aspect) * axes
-                                                     : 0.0f;
-  const float reach = spread + texel * (1.0f + (float)GUARD);
-  const float counted = distance > 2.0f ? 2.0f : distance;
-  return !(counted >= reach);
+  /* texel * min_side */
+  const float texel_sides = filter == SEAMCL_FILTER_BILINEAR ? 1.0f
+                                                             : fmin(min_side, fmax(2.0f, 2.01f * max_side * probe_axis));
+  const float spread_u = filter == SEAMCL_FILTER_ANISO ? 0.5f * fmax(fabs(dudx), fabs(dudy))
+                         : filter == SEAMCL_FILTER_EWA ? (1.0f + max_side / min_side) * axes
+                                                       : 0.0f;
+  const float spread_v = filter == SEAMCL_FILTER_ANISO ? 0.5f * fmax(fabs(dvdx), fabs(dvdy)) : spread_u;
+  const float texel_reach = texel_sides * (1.0f + (float)GUARD);
+  const float counted_u = distance_u > 2.0f ? 2.0f : distance_u;
+  const float counted_v = distance_v > 2.0f ? 2.0f : distance_v;
+  return !(counted_u * min_side >= spread_u * min_side + texel_reach ||
+           counted_v * min_side >= spread_v * min_side + texel_reach);
 }
 
 /* The same filter, border-addressed, on face `other` at this lookup's point and footprint carried
@@ -464,13 +469,16 @@ SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, int 
  * the very probes the filter would take (their line and the coarser level's texel); either
  * skips the filter. EWA has only the first. */
 SEAMCL_INLINE void accumulate_across(FilterSum* sum, __global const FaceGpu* faces, int other,
-                                     __global const float* t, float distance, __global const uint* level_offsets,
+                                     __global const float* t, float distance_u, float distance_v,
+                                     __global const uint* level_offsets,
                                      TEXEL_BUFFER texels, __global const float* srgb_to_linear, int filter,
                                      int max_aniso, float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   if (other < 0) return;
   const FaceGpu g = faces[other];
   const int early_out = SEAMCL_TRAVERSE_EARLY_OUT;
-  if (early_out && !neighbor_may_contribute(&g, filter, max_aniso, distance, dudx, dvdx, dudy, dvdy)) return;
+  if (early_out && !neighbor_may_contribute(&g, filter, max_aniso, distance_u, distance_v, dudx, dvdx, dudy, dvdy)) {
+    return;
+  }
   const float gu = t[0] * u + t[1] * v + t[2];
   const float gv = t[3] * u + t[4] * v + t[5];
   const float gdudx = t[0] * dudx + t[1] * dvdx, gdvdx = t[3] * dudx + t[4] * dvdx;
@@ -516,16 +524,21 @@ SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* 
                                         __global const float* srgb_to_linear, int filter, int max_aniso, int corners,
                                         float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   __global const FaceNeighbors* n = neighbors + face_index;
-  /* How far the point lies inside each edge: the least distance to the face across it. */
+  /* How far the point lies inside each edge: the least distance to the face across it, along v
+   * (edges 0 and 2) or u (1 and 3); the other axis never decides (-1). */
   const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
   for (int k = 0; k < 4; ++k) {
-    accumulate_across(sum, faces, n->neighbor[k], n->transform[k], inside[k], level_offsets, texels,
-                      srgb_to_linear, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy);
+    const int along_v = (k & 1) == 0;
+    accumulate_across(sum, faces, n->neighbor[k], n->transform[k], along_v ? -1.0f : inside[k],
+                      along_v ? inside[k] : -1.0f, level_offsets, texels, srgb_to_linear, filter, max_aniso, u, v,
+                      dudx, dvdx, dudy, dvdy);
   }
   if (!corners) return;
-  /* Corner k lies between edges k-1 and k. */
+  /* Corner k lies between edges k-1 and k: past both. */
   for (int k = 0; k < 4; ++k) {
-    accumulate_across(sum, faces, n->corner[k], n->corner_transform[k], fmax(inside[(k + 3) & 3], inside[k]),
+    const float a = inside[(k + 3) & 3], b = inside[k];
+    const int b_along_v = (k & 1) == 0;
+    accumulate_across(sum, faces, n->corner[k], n->corner_transform[k], b_along_v ? a : b, b_along_v ? b : a,
                       level_offsets, texels, srgb_to_linear, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy);
   }
 }

@@ -345,9 +345,12 @@ TEST(Traverse, SkipsOnlyNeighboursThatWouldAddNothing) {
       const int k = j % 4;
       const int other = j < 4 ? n.neighbor[k] : n.corner[k];
       if (other < 0) continue;
-      const float distance = j < 4 ? inside[k] : std::fmax(inside[(k + 3) % 4], inside[k]);
+      // Along u and v: an edge's distance on its axis (v for edges 0 and 2), a corner's on both.
+      const bool k_along_v = k % 2 == 0;
+      const float a = j < 4 ? -1.0f : inside[(k + 3) % 4], b = inside[k];
+      const float distance_u = k_along_v ? a : b, distance_v = k_along_v ? b : a;
       if (neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], sampler.filter, sampler.max_aniso, 0,
-                                  distance, dudx, dvdx, dudy, dvdy)) {
+                                  distance_u, distance_v, dudx, dvdx, dudy, dvdy)) {
         ++kept;
         continue;
       }

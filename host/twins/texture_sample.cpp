@@ -296,8 +296,8 @@ FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, 
   return sum;
 }
 
-bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, int guard_band, float distance, float dudx,
-                             float dvdx, float dudy, float dvdy) {
+bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, int guard_band, float distance_u,
+                             float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
   // Footprint axes by their 1-norms in uv: no shorter than their lengths, and kept by the maps
   // between faces (which only permute and negate u and v).
   const float axis_x = std::fabs(dudx) + std::fabs(dvdx);
@@ -308,7 +308,7 @@ bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, in
   const float longest = std::fmax(axis_x, axis_y);
   const float shortest = std::fmin(axis_x, axis_y);
   const float min_side = static_cast<float>(std::min(other.width, other.height));
-  const float aspect = static_cast<float>(std::max(other.width, other.height)) / min_side;
+  const float max_side = static_cast<float>(std::max(other.width, other.height));
   // A tap weighs something only within one texel of its probe. The coarsest texel the other
   // face's filter can weigh (uv): bilinear reads level 0; the others a trilinear pair at lod (at
   // least 0) and the next level, whose texels are up to twice 2^lod level-0 texels (2.01:
@@ -316,23 +316,28 @@ bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, in
   // axis in the other face's level-0 texels (at most max side x `longest`); aniso's that divided
   // by its N probes, N >= min(major / minor, max_aniso), so at most the longer of the minor axis
   // and major / max_aniso (the minor one measured in the other face's texels: still no longer
-  // than max side x `shortest`).
+  // than max side x `shortest`). Kept multiplied by min_side (a power of two: exact), so that
+  // the kernel divides nothing.
   const float probe_axis =
       filter == SEAMCL_FILTER_ANISO ? std::fmax(shortest, longest / static_cast<float>(max_aniso)) : longest;
-  const float texel = filter == SEAMCL_FILTER_BILINEAR
-                          ? 1.0f / min_side
-                          : std::fmin(1.0f, std::fmax(2.0f / min_side, 2.01f * aspect * probe_axis));
-  // How far the probes spread from the point: aniso's over half the major axis; EWA's ellipse
-  // over both axes, its minor one grown up to `aspect` times in uv by the eccentricity clamp.
-  const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f * longest
-                       : filter == SEAMCL_FILTER_EWA ? (1.0f + aspect) * axes
-                                                     : 0.0f;
+  const float texel_sides =
+      filter == SEAMCL_FILTER_BILINEAR ? 1.0f : std::fmin(min_side, std::fmax(2.0f, 2.01f * max_side * probe_axis));
+  // How far the probes spread from the point along u and v: aniso's over half its major axis,
+  // which is one of the two screen axes (whichever the other face's texels make longer); EWA's
+  // ellipse over both axes, its minor one grown up to max/min side times in uv by the
+  // eccentricity clamp.
+  const float spread_u = filter == SEAMCL_FILTER_ANISO ? 0.5f * std::fmax(std::fabs(dudx), std::fabs(dudy))
+                         : filter == SEAMCL_FILTER_EWA ? (1.0f + max_side / min_side) * axes
+                                                       : 0.0f;
+  const float spread_v = filter == SEAMCL_FILTER_ANISO ? 0.5f * std::fmax(std::fabs(dvdx), std::fabs(dvdy)) : spread_u;
   // A guard band's texels read as inside too.
-  const float reach = spread + texel * (1.0f + static_cast<float>(guard_band));
+  const float texel_reach = texel_sides * (1.0f + static_cast<float>(guard_band));
   // EWA pulls a centre more than two face widths out back to two widths: count no distance
   // beyond 2. A NaN distance is never skipped.
-  const float counted = distance > 2.0f ? 2.0f : distance;
-  return !(counted >= reach);
+  const float counted_u = distance_u > 2.0f ? 2.0f : distance_u;
+  const float counted_v = distance_v > 2.0f ? 2.0f : distance_v;
+  return !(counted_u * min_side >= spread_u * min_side + texel_reach ||
+           counted_v * min_side >= spread_v * min_side + texel_reach);
 }
 
 bool lookup_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float u, float v, float dudx,
@@ -362,11 +367,11 @@ FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const Samp
   // Traverse: each neighbour at this point and footprint carried into its uv, border-addressed,
   // so it weighs only the taps that fall inside it. A neighbour whose taps cannot reach the
   // point is skipped: it would add nothing.
-  auto add_across = [&](int other, const float* t, float distance) {
+  auto add_across = [&](int other, const float* t, float distance_u, float distance_v) {
     if (other < 0) return;
     const FaceGpu& g = tex.faces->at(static_cast<size_t>(other));
-    if (early_out && !neighbor_may_contribute(g, sampler.filter, sampler.max_aniso, tex.guard_band, distance, dudx, dvdx,
-                                              dudy, dvdy)) {
+    if (early_out && !neighbor_may_contribute(g, sampler.filter, sampler.max_aniso, tex.guard_band, distance_u, distance_v,
+                                              dudx, dvdx, dudy, dvdy)) {
       return;
     }
     const float gu = t[0] * u + t[1] * v + t[2], gv = t[3] * u + t[4] * v + t[5];
@@ -381,13 +386,21 @@ FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const Samp
     sum.color += s.color;
     sum.weight += s.weight;
   };
-  // How far the point lies inside each edge: the least distance to the face across it.
+  // How far the point lies inside each edge: the least distance to the face across it, along v
+  // (edges 0 and 2) or u (1 and 3); the other axis never decides (-1).
   const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
   const FaceNeighbors& n = tex.neighbors->at(face);
-  for (int k = 0; k < 4; ++k) add_across(n.neighbor[k], n.transform[k], inside[k]);
+  for (int k = 0; k < 4; ++k) {
+    const bool along_v = k % 2 == 0;
+    add_across(n.neighbor[k], n.transform[k], along_v ? -1.0f : inside[k], along_v ? inside[k] : -1.0f);
+  }
   if (sampler.traverse != SEAMCL_TRAVERSE_CORNERS) return sum;
-  // Past a valence-4 corner, the diagonal face (corner k lies between edges k-1 and k).
-  for (int k = 0; k < 4; ++k) add_across(n.corner[k], n.corner_transform[k], std::fmax(inside[(k + 3) % 4], inside[k]));
+  // Past a valence-4 corner, the diagonal face (corner k lies between edges k-1 and k): past both.
+  for (int k = 0; k < 4; ++k) {
+    const float a = inside[(k + 3) % 4], b = inside[k];
+    const bool b_along_v = k % 2 == 0;
+    add_across(n.corner[k], n.corner_transform[k], b_along_v ? a : b, b_along_v ? b : a);
+  }
   return sum;
 }
 

@@ -19,10 +19,11 @@ FilterSum filter_texture_reference(const TextureView& textures, uint32_t face, c
                                    int address, float u, float v, float dudx, float dvdx, float dudy, float dvdy);
 // Whether any tap of face `other` can weigh anything in a lookup with `filter` (SEAMCL_FILTER_*;
 // derivatives in this face's uv; `guard_band` texels per level stored around each level)
-// whose point lies at least `distance` (uv) outside the other face's square: a conservative
-// bound, so a neighbour it rules out would have added exactly nothing. Traverse skips those.
-bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, int guard_band, float distance, float dudx,
-                             float dvdx, float dudy, float dvdy);
+// whose point must travel at least distance_u along u and distance_v along v (this face's uv; a
+// negative distance never decides) to reach the other face's square: a conservative bound, so a
+// neighbour it rules out would have added exactly nothing. Traverse skips those.
+bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, int guard_band, float distance_u,
+                             float distance_v, float dudx, float dvdx, float dudy, float dvdy);
 // Whether a border-addressed lookup with `filter` on `face` (its own uv and derivatives) can put
 // weight inside it (or in its guard band of `guard_band` texels per level): bilinear, trilinear
 // and aniso test the very probes the filter takes (their line, and a texel of the coarser level
