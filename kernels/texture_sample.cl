@@ -663,7 +663,17 @@ SEAMCL_INLINE void aniso_group_lookup(__global const FaceGpu* faces, __global co
   p.lod = plan[4];
   p.weight = plan[5];
   FilterSum sum = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
-  accumulate_probes(&sum, &face, level_offsets, texels, srgb_to_linear, p, SAMPLER_ADDRESS(sampler));
+  /* Unrolled, and without accumulate_probes' skipping of probes past a border (they add zero):
+   * straight-line code is what PoCL vectorises across work-items. */
+  float pu = p.first_u;
+  float pv = p.first_v;
+#pragma unroll
+  for (int k = 0; k < probes; ++k) {
+    accumulate_trilinear(&sum, &face, level_offsets, texels, srgb_to_linear, pu, pv, p.lod, p.weight,
+                         SAMPLER_ADDRESS(sampler));
+    pu += p.step_u;
+    pv += p.step_v;
+  }
   const float4 c = resolve_sum(sum, &face, level_offsets, texels, srgb_to_linear, sampler, q[1], q[2], q[3], q[4],
                                q[5], q[6]);
   __global float* o = (__global float*)out + 4 * i;
