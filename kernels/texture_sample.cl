@@ -242,8 +242,8 @@ SEAMCL_INLINE int coarser_level(const FaceGpu* face, float lod) {
  * A bilinear tap weighs something only while the point lies less than half a texel of its level
  * past the texel's edge (or the guard band's, which border addressing reads as inside); the test
  * allows a whole texel and half a probe step more than the spread, which absorbs the rounding of
- * the probes' positions. Conservative: a lookup it rules
- * out adds exactly nothing, so skipping it changes no bit. A NaN anywhere reads as "may reach". */
+ * the probes' positions. Conservative: a lookup it rules out adds exactly nothing, so skipping it
+ * changes no bit. A NaN anywhere reads as "may reach". */
 SEAMCL_INLINE int probe_reaches_face(float u, float v, float reach_u, float reach_v) {
   return !(u + reach_u <= 0.0f || u - reach_u >= 1.0f || v + reach_v <= 0.0f || v - reach_v >= 1.0f);
 }
