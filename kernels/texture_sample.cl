@@ -51,7 +51,10 @@
  * finite x but makes whatever it is added to depend on x, so the pair is no longer independent.
  * Kernels with a varying-length loop (aniso, ewa) stay scalar anyway; there a tie only costs, so
  * it is compiled out. */
-#if defined(SEAMCL_SAMPLER_FILTER) && SEAMCL_SAMPLER_FILTER >= SEAMCL_FILTER_ANISO
+#ifndef SEAMCL_ANISO_GROUPED
+#define SEAMCL_ANISO_GROUPED 0
+#endif
+#if defined(SEAMCL_SAMPLER_FILTER) && SEAMCL_SAMPLER_FILTER >= SEAMCL_FILTER_ANISO && !SEAMCL_ANISO_GROUPED
 #define TIE(x) 0.0f
 #define TIED(value, x) (value)
 #else
@@ -59,6 +62,13 @@
 /* value, unless x is NaN (then x): a select that orders value after x */
 #define TIED(value, x) ((x) == (x) ? (value) : (x))
 #endif
+/* Build-time switch for the tests that run lookups with and without the early-outs (traverse's
+ * neighbor_may_contribute and probes_reach_face, border-addressed aniso's probes past the edge)
+ * and require the same bits; 1 (on) everywhere else. */
+#ifndef SEAMCL_TRAVERSE_EARLY_OUT
+#define SEAMCL_TRAVERSE_EARLY_OUT 1
+#endif
+
 #if SEAMCL_TEXELS_F32
 #define TEXEL_BUFFER __global const float*
 #else
@@ -220,33 +230,93 @@ SEAMCL_INLINE float lod_of(float len2) {
   return 0.5f * approx_log2(fmax(len2, 1e-30f));
 }
 
-SEAMCL_INLINE void accumulate_aniso(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
-                             TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
-                             Footprint f, int max_aniso, int address) {
+/* The level whose texels are the coarsest a trilinear lookup at `lod` reads (the chain's clamp
+ * applied as accumulate_trilinear applies it). */
+SEAMCL_INLINE int coarser_level(const FaceGpu* face, float lod) {
+  lod = fmin(fmax(lod, 0.0f), (float)(face->level_count - 1));
+  return min((int)lod + 1, face->level_count - 1);
+}
+
+/* Whether a border-addressed lookup of bilinear probes on `level` of `face`, centred at (u, v) and
+ * spread no further than (half_u, half_v) (uv) from it, can put weight on a texel inside the face.
+ * A bilinear tap weighs something only while the point lies less than half a texel of its level
+ * past the texel's edge (or the guard band's, which border addressing reads as inside); the test
+ * allows a whole texel and half a probe step more than the spread, which absorbs the rounding of
+ * the probes' positions. Conservative: a lookup it rules out adds exactly nothing, so skipping it
+ * changes no bit. A NaN anywhere reads as "may reach". */
+SEAMCL_INLINE int probe_reaches_face(float u, float v, float reach_u, float reach_v) {
+  return !(u + reach_u <= 0.0f || u - reach_u >= 1.0f || v + reach_v <= 0.0f || v - reach_v >= 1.0f);
+}
+
+SEAMCL_INLINE int probes_reach_face(const FaceGpu* face, int level, float u, float v, float half_u, float half_v) {
+  return probe_reaches_face(u, v, half_u + (1.0f + (float)GUARD) / (float)max(face->width >> level, 1),
+                            half_v + (1.0f + (float)GUARD) / (float)max(face->height >> level, 1));
+}
+
+/* The line of trilinear probes an aniso lookup takes, computed once so that the reach test of
+ * traverse (probes_reach_face) and the filter read the same values. */
+typedef struct {
+  int probes;                 /* N */
+  float weight;               /* 1 / N, each probe's */
+  float lod;                  /* each probe's, before the chain's clamp */
+  float step_u, step_v;       /* from one probe to the next (uv) */
+  float first_u, first_v;     /* probe 0 */
+} AnisoProbes;
+
+SEAMCL_INLINE AnisoProbes aniso_probes(const FaceGpu* face, float u, float v, Footprint f, int max_aniso) {
+  AnisoProbes p;
   const int x_major = f.len2_x >= f.len2_y;
   const float major2 = x_major ? f.len2_x : f.len2_y;
   const float minor2 = x_major ? f.len2_y : f.len2_x;
   /* N = min(ceil(major / minor), max_aniso) probes; ratio computed on squares, then sqrt. */
   /* A line footprint takes the most probes; a point footprint one. */
   const float ratio = minor2 > 0.0f ? sqrt(major2 / minor2) : major2 > 0.0f ? (float)max_aniso : 1.0f;
-  const int probes = f.finite ? clamp((int)__builtin_ceilf(fmin(ratio, 16.0f)), 1, max_aniso) : 1;
-  const float inv_probes = 1.0f / (float)probes;
+  p.probes = f.finite ? clamp((int)__builtin_ceilf(fmin(ratio, 16.0f)), 1, max_aniso) : 1;
+  p.weight = 1.0f / (float)p.probes;
   /* Each probe is trilinear at log2(major / N). */
-  const float lod = f.finite ? lod_of(major2) - approx_log2((float)probes) : (float)(face->level_count - 1);
-  const float step_u = (x_major ? f.ax_u : f.ay_u) * inv_probes;
-  const float step_v = (x_major ? f.ax_v : f.ay_v) * inv_probes;
+  p.lod = f.finite ? lod_of(major2) - approx_log2((float)p.probes) : (float)(face->level_count - 1);
+  p.step_u = (x_major ? f.ax_u : f.ay_u) * p.weight;
+  p.step_v = (x_major ? f.ax_v : f.ay_v) * p.weight;
   /* Probe i sits at (i + 0.5) / N - 0.5 of the major axis from the centre. */
-  float pu = u + step_u * (0.5f - 0.5f * (float)probes);
-  float pv = v + step_v * (0.5f - 0.5f * (float)probes);
+  p.first_u = u + p.step_u * (0.5f - 0.5f * (float)p.probes);
+  p.first_v = v + p.step_v * (0.5f - 0.5f * (float)p.probes);
   if (!f.finite) {
-    pu = u;
-    pv = v;
+    p.first_u = u;
+    p.first_v = v;
   }
-  for (int i = 0; i < probes; ++i) {
-    accumulate_trilinear(sum, face, level_offsets, texels, srgb_to_linear, pu, pv, lod, inv_probes, address);
-    pu += step_u;
-    pv += step_v;
+  return p;
+}
+
+/* Border-addressed, a probe whose taps all lie outside the face adds exactly nothing (weight 0
+ * times each texel): the probes past an edge are skipped, so that a lookup pays only for the
+ * part of its footprint that lies on the face (discard's lookups at an edge, traverse's on a
+ * neighbour). The test is probe_reaches_face's; the level is the coarser one the probes read. */
+SEAMCL_INLINE void accumulate_probes(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
+                                     TEXEL_BUFFER texels, __global const float* srgb_to_linear, AnisoProbes p,
+                                     int address) {
+  float pu = p.first_u;
+  float pv = p.first_v;
+  const int level = coarser_level(face, p.lod);
+  const float reach_u = (1.0f + (float)GUARD) / (float)max(face->width >> level, 1);
+  const float reach_v = (1.0f + (float)GUARD) / (float)max(face->height >> level, 1);
+  for (int i = 0; i < p.probes; ++i) {
+    if (!SEAMCL_TRAVERSE_EARLY_OUT || address != SEAMCL_ADDRESS_BORDER || probe_reaches_face(pu, pv, reach_u, reach_v)) {
+      accumulate_trilinear(sum, face, level_offsets, texels, srgb_to_linear, pu, pv, p.lod, p.weight, address);
+    }
+    pu += p.step_u;
+    pv += p.step_v;
   }
+}
+
+SEAMCL_INLINE void accumulate_aniso(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
+                             TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
+                             Footprint f, int max_aniso, int address) {
+  accumulate_probes(sum, face, level_offsets, texels, srgb_to_linear, aniso_probes(face, u, v, f, max_aniso), address);
+}
+
+/* The trilinear filter's lod: the footprint's longer axis; a non-finite one reads the coarsest level. */
+SEAMCL_INLINE float trilinear_lod(const FaceGpu* face, Footprint f) {
+  return f.finite ? lod_of(fmax(f.len2_x, f.len2_y)) : (float)(face->level_count - 1);
 }
 
 /* EWA over one level (pbrt-v4's MIPMap::EWA, Gaussian alpha = 2): the weights are divided by
@@ -351,8 +421,7 @@ SEAMCL_INLINE FilterSum filter_texture(const FaceGpu* face, __global const uint*
   if (filter == SEAMCL_FILTER_BILINEAR) {
     accumulate_bilinear(&sum, texels, srgb_to_linear, face_level(face, level_offsets, 0), u, v, 1.0f, address);
   } else if (filter == SEAMCL_FILTER_TRILINEAR) {
-    const float lod = f.finite ? lod_of(fmax(f.len2_x, f.len2_y)) : (float)(face->level_count - 1);
-    accumulate_trilinear(&sum, face, level_offsets, texels, srgb_to_linear, u, v, lod, 1.0f, address);
+    accumulate_trilinear(&sum, face, level_offsets, texels, srgb_to_linear, u, v, trilinear_lod(face, f), 1.0f, address);
   } else if (filter == SEAMCL_FILTER_ANISO) {
     accumulate_aniso(&sum, face, level_offsets, texels, srgb_to_linear, u, v, f, max_aniso, address);
   } else {
@@ -362,42 +431,80 @@ SEAMCL_INLINE FilterSum filter_texture(const FaceGpu* face, __global const uint*
 }
 
 /* Whether any tap of face `other` can weigh anything in a lookup (derivatives in this face's uv)
- * whose point lies at least `distance` (uv) outside the other face's square. Conservative: a
+ * whose point must travel at least distance_u along u and distance_v along v (uv, this face's
+ * frame; a negative distance never decides) to reach the other face's square. Conservative: a
  * neighbour it rules out would add exactly nothing, so skipping it changes no bit of the result;
- * it spares interior lookups the neighbours' filters. The bound, term by term, is argued in the
- * twin (host/twins/texture_sample.cpp, neighbor_may_contribute). */
-SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, float distance, float dudx, float dvdx,
-                                          float dudy, float dvdy) {
+ * it spares interior lookups the neighbours' filters, with no division (the sides are powers of
+ * two, so multiplying by them is exact). The bound, term by term, is argued in the twin
+ * (host/twins/texture_sample.cpp, neighbor_may_contribute). */
+SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, int max_aniso, float distance_u,
+                                          float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
   const float axis_x = fabs(dudx) + fabs(dvdx);
   const float axis_y = fabs(dudy) + fabs(dvdy);
   const float axes = axis_x + axis_y;
   if (!(axes < INFINITY)) return 1;
   const float longest = fmax(axis_x, axis_y);
+  const float shortest = fmin(axis_x, axis_y);
   const float min_side = (float)min(other->width, other->height);
-  const float aspect = (float)max(other->width, other->height) / min_side;
-  const float texel = filter == SEAMCL_FILTER_BILINEAR ? 1.0f / min_side
-                                                       : fmin(1.0f, fmax(1.0f / min_side, 2.01f * aspect * longest));
-  const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f * longest
-                       : filter == SEAMCL_FILTER_EWA ? (1.0f + aspect) * axes
-                                                     : 0.0f;
-  const float reach = spread + texel;
-  const float counted = distance > 2.0f ? 2.0f : distance;
-  return !(counted >= reach);
+  const float max_side = (float)max(other->width, other->height);
+  const float probe_axis = filter == SEAMCL_FILTER_ANISO ? fmax(shortest, longest / (float)max_aniso) : longest;
+  /* texel * min_side */
+  const float texel_sides = filter == SEAMCL_FILTER_BILINEAR ? 1.0f
+                                                             : fmin(min_side, fmax(2.0f, 2.01f * max_side * probe_axis));
+  const float spread_u = filter == SEAMCL_FILTER_ANISO ? 0.5f * fmax(fabs(dudx), fabs(dudy))
+                         : filter == SEAMCL_FILTER_EWA ? (1.0f + max_side / min_side) * axes
+                                                       : 0.0f;
+  const float spread_v = filter == SEAMCL_FILTER_ANISO ? 0.5f * fmax(fabs(dvdx), fabs(dvdy)) : spread_u;
+  const float texel_reach = texel_sides * (1.0f + (float)GUARD);
+  const float counted_u = distance_u > 2.0f ? 2.0f : distance_u;
+  const float counted_v = distance_v > 2.0f ? 2.0f : distance_v;
+  return !(counted_u * min_side >= spread_u * min_side + texel_reach ||
+           counted_v * min_side >= spread_v * min_side + texel_reach);
 }
 
 /* The same filter, border-addressed, on face `other` at this lookup's point and footprint carried
- * into its uv by the map t, added to `sum`: the taps that fall inside `other`. */
+ * into its uv by the map t, added to `sum`: the taps that fall inside `other`. Most lookups lie
+ * too far inside their own face to reach it: first a test on the footprint's size against the
+ * distance (neighbor_may_contribute, no footprint in the other face's texels needed), then one on
+ * the very probes the filter would take (their line and the coarser level's texel); either
+ * skips the filter. EWA has only the first. */
 SEAMCL_INLINE void accumulate_across(FilterSum* sum, __global const FaceGpu* faces, int other,
-                                     __global const float* t, float distance, __global const uint* level_offsets,
+                                     __global const float* t, float distance_u, float distance_v,
+                                     __global const uint* level_offsets,
                                      TEXEL_BUFFER texels, __global const float* srgb_to_linear, int filter,
                                      int max_aniso, float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   if (other < 0) return;
   const FaceGpu g = faces[other];
-  if (!neighbor_may_contribute(&g, filter, distance, dudx, dvdx, dudy, dvdy)) return;
-  const FilterSum s = filter_texture(&g, level_offsets, texels, srgb_to_linear, filter, SEAMCL_ADDRESS_BORDER,
-                                     max_aniso, t[0] * u + t[1] * v + t[2], t[3] * u + t[4] * v + t[5],
-                                     t[0] * dudx + t[1] * dvdx, t[3] * dudx + t[4] * dvdx,
-                                     t[0] * dudy + t[1] * dvdy, t[3] * dudy + t[4] * dvdy);
+  const int early_out = SEAMCL_TRAVERSE_EARLY_OUT;
+  if (early_out && !neighbor_may_contribute(&g, filter, max_aniso, distance_u, distance_v, dudx, dvdx, dudy, dvdy)) {
+    return;
+  }
+  const float gu = t[0] * u + t[1] * v + t[2];
+  const float gv = t[3] * u + t[4] * v + t[5];
+  const float gdudx = t[0] * dudx + t[1] * dvdx, gdvdx = t[3] * dudx + t[4] * dvdx;
+  const float gdudy = t[0] * dudy + t[1] * dvdy, gdvdy = t[3] * dudy + t[4] * dvdy;
+  FilterSum s = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  if (filter == SEAMCL_FILTER_BILINEAR) {
+    if (early_out && !probes_reach_face(&g, 0, gu, gv, 0.0f, 0.0f)) return;
+    accumulate_bilinear(&s, texels, srgb_to_linear, face_level(&g, level_offsets, 0), gu, gv, 1.0f,
+                        SEAMCL_ADDRESS_BORDER);
+  } else if (filter == SEAMCL_FILTER_TRILINEAR) {
+    const float lod = trilinear_lod(&g, footprint(&g, gdudx, gdvdx, gdudy, gdvdy));
+    if (early_out && !probes_reach_face(&g, coarser_level(&g, lod), gu, gv, 0.0f, 0.0f)) return;
+    accumulate_trilinear(&s, &g, level_offsets, texels, srgb_to_linear, gu, gv, lod, 1.0f, SEAMCL_ADDRESS_BORDER);
+  } else if (filter == SEAMCL_FILTER_ANISO) {
+    const AnisoProbes p = aniso_probes(&g, gu, gv, footprint(&g, gdudx, gdvdx, gdudy, gdvdy), max_aniso);
+    /* The probes lie within (N - 1) / 2 steps of the centre; N / 2 leaves half a step spare. */
+    const float spread = 0.5f * (float)p.probes;
+    if (early_out && !probes_reach_face(&g, coarser_level(&g, p.lod), gu, gv, spread * fabs(p.step_u),
+                                        spread * fabs(p.step_v))) {
+      return;
+    }
+    accumulate_probes(&s, &g, level_offsets, texels, srgb_to_linear, p, SEAMCL_ADDRESS_BORDER);
+  } else {
+    s = filter_texture(&g, level_offsets, texels, srgb_to_linear, filter, SEAMCL_ADDRESS_BORDER, max_aniso, gu, gv,
+                       gdudx, gdvdx, gdudy, gdvdy);
+  }
   sum->r += s.r;
   sum->g += s.g;
   sum->b += s.b;
@@ -417,16 +524,21 @@ SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* 
                                         __global const float* srgb_to_linear, int filter, int max_aniso, int corners,
                                         float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   __global const FaceNeighbors* n = neighbors + face_index;
-  /* How far the point lies inside each edge: the least distance to the face across it. */
+  /* How far the point lies inside each edge: the least distance to the face across it, along v
+   * (edges 0 and 2) or u (1 and 3); the other axis never decides (-1). */
   const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
   for (int k = 0; k < 4; ++k) {
-    accumulate_across(sum, faces, n->neighbor[k], n->transform[k], inside[k], level_offsets, texels,
-                      srgb_to_linear, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy);
+    const int along_v = (k & 1) == 0;
+    accumulate_across(sum, faces, n->neighbor[k], n->transform[k], along_v ? -1.0f : inside[k],
+                      along_v ? inside[k] : -1.0f, level_offsets, texels, srgb_to_linear, filter, max_aniso, u, v,
+                      dudx, dvdx, dudy, dvdy);
   }
   if (!corners) return;
-  /* Corner k lies between edges k-1 and k. */
+  /* Corner k lies between edges k-1 and k: past both. */
   for (int k = 0; k < 4; ++k) {
-    accumulate_across(sum, faces, n->corner[k], n->corner_transform[k], fmax(inside[(k + 3) & 3], inside[k]),
+    const float a = inside[(k + 3) & 3], b = inside[k];
+    const int b_along_v = (k & 1) == 0;
+    accumulate_across(sum, faces, n->corner[k], n->corner_transform[k], b_along_v ? a : b, b_along_v ? b : a,
                       level_offsets, texels, srgb_to_linear, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy);
   }
 }
@@ -435,6 +547,21 @@ SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* 
  * colour. Without renormalisation the sum is the colour (border taps added black). With it
  * (discard, traverse), colour = sum / weight over the taps read; when none was, zero_coverage
  * decides: a clamped trilinear lookup at the centre clamped to the face, or the raw 0/0. */
+/* The colour of a lookup's FilterSum as the seam method asks for it (see sample_texture). */
+SEAMCL_INLINE float4 resolve_sum(FilterSum sum, const FaceGpu* face, __global const uint* level_offsets,
+                                 TEXEL_BUFFER texels, __global const float* srgb_to_linear, SamplerParams sampler,
+                                 float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
+  if (!SAMPLER_RENORMALIZE(sampler)) return (float4)(sum.r, sum.g, sum.b, sum.a);
+  const int clamp_when_uncovered = SAMPLER_ZERO_COVERAGE(sampler) == SEAMCL_ZERO_COVERAGE_CLAMP;
+  if (clamp_when_uncovered && sum.weight == 0.0f) {
+    sum = filter_texture(face, level_offsets, texels, srgb_to_linear, SEAMCL_FILTER_TRILINEAR, SEAMCL_ADDRESS_CLAMP,
+                         sampler.max_aniso, fmin(fmax(u, 0.0f), 1.0f), fmin(fmax(v, 0.0f), 1.0f), dudx, dvdx, dudy,
+                         dvdy);
+  }
+  const float inv_weight = 1.0f / sum.weight;
+  return (float4)(sum.r * inv_weight, sum.g * inv_weight, sum.b * inv_weight, sum.a * inv_weight);
+}
+
 SEAMCL_INLINE float4 sample_texture(__global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
                                     uint face_index, __global const uint* level_offsets, TEXEL_BUFFER texels,
                                     __global const float* srgb_to_linear, SamplerParams sampler,
@@ -447,15 +574,7 @@ SEAMCL_INLINE float4 sample_texture(__global const FaceGpu* faces, __global cons
                          SAMPLER_FILTER(sampler), sampler.max_aniso,
                          SAMPLER_TRAVERSE(sampler) == SEAMCL_TRAVERSE_CORNERS, u, v, dudx, dvdx, dudy, dvdy);
   }
-  if (!SAMPLER_RENORMALIZE(sampler)) return (float4)(sum.r, sum.g, sum.b, sum.a);
-  const int clamp_when_uncovered = SAMPLER_ZERO_COVERAGE(sampler) == SEAMCL_ZERO_COVERAGE_CLAMP;
-  if (clamp_when_uncovered && sum.weight == 0.0f) {
-    sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, SEAMCL_FILTER_TRILINEAR, SEAMCL_ADDRESS_CLAMP,
-                         sampler.max_aniso, fmin(fmax(u, 0.0f), 1.0f), fmin(fmax(v, 0.0f), 1.0f), dudx, dvdx, dudy,
-                         dvdy);
-  }
-  const float inv_weight = 1.0f / sum.weight;
-  return (float4)(sum.r * inv_weight, sum.g * inv_weight, sum.b * inv_weight, sum.a * inv_weight);
+  return resolve_sum(sum, &face, level_offsets, texels, srgb_to_linear, sampler, u, v, dudx, dvdx, dudy, dvdy);
 }
 
 /* Lookups for tests and benchmarks, one per work-item: lookups[7 i ..] = face (as a float), u, v,
@@ -498,3 +617,95 @@ __kernel void texture_filter_batch(__global const FaceGpu* faces, __global const
   out[i] = (float4)(sum.r, sum.g, sum.b, sum.a);
   weights[i] = sum.weight;
 }
+
+#if SEAMCL_ANISO_GROUPED
+/* Aniso lookups grouped by probe count (built with -DSEAMCL_ANISO_GROUPED=1, SEAMCL_SAMPLER_FILTER
+ * aniso and no traverse; host/pipeline/texture_lookups.cpp runs them). PoCL leaves a loop whose
+ * trip count varies per work-item scalar, and with it the whole lookup; with one kernel per
+ * probe count the loop is uniform, and the work-items run side by side. Pass 1 plans every
+ * lookup (aniso_probes: first probe, step, lod, N); the host orders the lookups by N; pass 2
+ * runs each group through the kernel of its N, which takes the same probes from the plan.
+ * plans[6 i ..] = first_u, first_v, step_u, step_v, lod, weight; probe_counts[i] = N. */
+__kernel void aniso_plan_batch(__global const FaceGpu* faces, SamplerParams sampler, __global const float* lookups,
+                               uint count, __global float* plans, __global uchar* probe_counts) {
+  const uint i = get_global_id(0);
+  if (i >= count) return;
+  __global const float* q = lookups + 7 * i;
+  const FaceGpu face = faces[(uint)q[0]];
+  const AnisoProbes p = aniso_probes(&face, q[1], q[2], footprint(&face, q[3], q[4], q[5], q[6]), sampler.max_aniso);
+  __global float* o = plans + 6 * i;
+  o[0] = p.first_u;
+  o[1] = p.first_v;
+  o[2] = p.step_u;
+  o[3] = p.step_v;
+  o[4] = p.lod;
+  o[5] = p.weight;
+  probe_counts[i] = (uchar)p.probes;
+}
+
+SEAMCL_INLINE void aniso_group_lookup(__global const FaceGpu* faces, __global const uint* level_offsets,
+                                      TEXEL_BUFFER texels, __global const float* srgb_to_linear, SamplerParams sampler,
+                                      __global const float* lookups, __global const float* plans,
+                                      __global const uint* order, uint first, uint count, __global float4* out,
+                                      int probes) {
+  const uint j = get_global_id(0);
+  if (j >= count) return;
+  const uint i = order[first + j];
+  __global const float* q = lookups + 7 * i;
+  __global const float* plan = plans + 6 * i;
+  const FaceGpu face = faces[(uint)q[0]];
+  AnisoProbes p;
+  p.probes = probes;
+  p.first_u = plan[0];
+  p.first_v = plan[1];
+  p.step_u = plan[2];
+  p.step_v = plan[3];
+  p.lod = plan[4];
+  p.weight = plan[5];
+  FilterSum sum = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  /* Unrolled, and without accumulate_probes' skipping of probes past a border (they add zero):
+   * straight-line code is what PoCL vectorises across work-items. */
+  float pu = p.first_u;
+  float pv = p.first_v;
+#pragma unroll
+  for (int k = 0; k < probes; ++k) {
+    accumulate_trilinear(&sum, &face, level_offsets, texels, srgb_to_linear, pu, pv, p.lod, p.weight,
+                         SAMPLER_ADDRESS(sampler));
+    pu += p.step_u;
+    pv += p.step_v;
+  }
+  const float4 c = resolve_sum(sum, &face, level_offsets, texels, srgb_to_linear, sampler, q[1], q[2], q[3], q[4],
+                               q[5], q[6]);
+  __global float* o = (__global float*)out + 4 * i;
+  o[0] = c.x;
+  o[1] = c.y;
+  o[2] = c.z;
+  o[3] = c.w;
+}
+
+#define SEAMCL_ANISO_GROUP_KERNEL(N)                                                                              \
+  __kernel void aniso_group_batch_##N(__global const FaceGpu* faces, __global const uint* level_offsets,          \
+                                      TEXEL_BUFFER texels, __global const float* srgb_to_linear,                  \
+                                      SamplerParams sampler, __global const float* lookups,                       \
+                                      __global const float* plans, __global const uint* order, uint first,        \
+                                      uint count, __global float4* out) {                                         \
+    aniso_group_lookup(faces, level_offsets, texels, srgb_to_linear, sampler, lookups, plans, order, first, count, \
+                       out, N);                                                                                   \
+  }
+SEAMCL_ANISO_GROUP_KERNEL(1)
+SEAMCL_ANISO_GROUP_KERNEL(2)
+SEAMCL_ANISO_GROUP_KERNEL(3)
+SEAMCL_ANISO_GROUP_KERNEL(4)
+SEAMCL_ANISO_GROUP_KERNEL(5)
+SEAMCL_ANISO_GROUP_KERNEL(6)
+SEAMCL_ANISO_GROUP_KERNEL(7)
+SEAMCL_ANISO_GROUP_KERNEL(8)
+SEAMCL_ANISO_GROUP_KERNEL(9)
+SEAMCL_ANISO_GROUP_KERNEL(10)
+SEAMCL_ANISO_GROUP_KERNEL(11)
+SEAMCL_ANISO_GROUP_KERNEL(12)
+SEAMCL_ANISO_GROUP_KERNEL(13)
+SEAMCL_ANISO_GROUP_KERNEL(14)
+SEAMCL_ANISO_GROUP_KERNEL(15)
+SEAMCL_ANISO_GROUP_KERNEL(16)
+#endif

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <set>
 #include <string>
@@ -344,9 +345,12 @@ TEST(Traverse, SkipsOnlyNeighboursThatWouldAddNothing) {
       const int k = j % 4;
       const int other = j < 4 ? n.neighbor[k] : n.corner[k];
       if (other < 0) continue;
-      const float distance = j < 4 ? inside[k] : std::fmax(inside[(k + 3) % 4], inside[k]);
-      if (neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], sampler.filter, distance, dudx, dvdx, dudy,
-                                  dvdy)) {
+      // Along u and v: an edge's distance on its axis (v for edges 0 and 2), a corner's on both.
+      const bool k_along_v = k % 2 == 0;
+      const float a = j < 4 ? -1.0f : inside[(k + 3) % 4], b = inside[k];
+      const float distance_u = k_along_v ? a : b, distance_v = k_along_v ? b : a;
+      if (neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], sampler.filter, sampler.max_aniso, 0,
+                                  distance_u, distance_v, dudx, dvdx, dudy, dvdy)) {
         ++kept;
         continue;
       }
@@ -361,4 +365,149 @@ TEST(Traverse, SkipsOnlyNeighboursThatWouldAddNothing) {
   }
   // The bound is not vacuous: interior lookups do skip.
   EXPECT_GT(skipped, kept / 4);
+}
+
+namespace {
+
+// Lookups that crowd the edges and corners of their face, footprints from a hundredth of a
+// texel to a whole face, isotropic to needle-thin: where an early-out would go wrong if it could.
+std::vector<Lookup> lookups_near_edges(size_t face_count, size_t count, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::vector<Lookup> lookups(count);
+  for (Lookup& l : lookups) {
+    l.face = static_cast<uint32_t>(rng() % face_count);
+    // Half the points within a tenth of an edge (either side), the rest anywhere around the face.
+    auto coordinate = [&]() {
+      if (rng() % 2 == 0) return uniform(rng, -0.2f, 1.2f);
+      const float edge = static_cast<float>(rng() % 2);
+      return edge + std::pow(10.0f, uniform(rng, -5.0f, -1.0f)) * (rng() % 2 == 0 ? 1.0f : -1.0f);
+    };
+    l.u = coordinate();
+    l.v = coordinate();
+    const float scale = std::pow(10.0f, uniform(rng, -4.5f, 0.0f));
+    const float stretch = std::pow(10.0f, uniform(rng, -2.0f, 0.0f));
+    const float angle = uniform(rng, 0.0f, 6.2831853f);
+    // Axis x the major one, axis y shorter by `stretch`, both turned by `angle`.
+    l.dudx = scale * std::cos(angle);
+    l.dvdx = scale * std::sin(angle);
+    l.dudy = -scale * stretch * std::sin(angle) * (rng() % 2 == 0 ? 1.0f : -1.0f);
+    l.dvdy = scale * stretch * std::cos(angle);
+  }
+  return lookups;
+}
+
+bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+bool same_bits(const FilterSum& a, const FilterSum& b) {
+  bool same = same_bits(a.weight, b.weight);
+  for (int c = 0; c < 4; ++c) same &= same_bits(a.color[c], b.color[c]);
+  return same;
+}
+
+}  // namespace
+
+TEST(Traverse, ReachTestSkipsOnlyNeighboursThatWouldAddNothing) {
+  // lookup_may_reach_face tests the probes a bilinear, trilinear or aniso lookup takes on the
+  // neighbour against its square: every neighbour it rules out must weigh exactly zero, and it
+  // must rule out most neighbours of lookups well inside their face (what makes traverse cheap).
+  Scene scene = seamcl_tests::subdivided_cube(2);
+  seamcl_tests::set_textures(scene, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+  const PackedScene packed = pack_scene(scene, TexelFormat::Rgba32f);
+  const TextureView view = packed.textures();
+  const std::vector<Lookup> lookups = lookups_near_edges(scene.faces.size(), 20000, 9);
+  std::mt19937 rng(10);
+  size_t skipped = 0, kept = 0, reaching = 0;
+  for (const Lookup& l : lookups) {
+    const Filter filter = static_cast<Filter>(rng() % 3);  // bilinear, trilinear, aniso
+    const SamplerParams sampler = sampler_params(Method::Traverse, filter, 1 + static_cast<int>(rng() % 16), ZeroCoverage::Clamp);
+    const FaceNeighbors& n = packed.neighbors[l.face];
+    for (int j = 0; j < 8; ++j) {
+      const int k = j % 4;
+      const int other = j < 4 ? n.neighbor[k] : n.corner[k];
+      if (other < 0) continue;
+      const UvMap map = uv_map(j < 4 ? n.transform[k] : n.corner_transform[k]);
+      const glm::vec2 p = map.point({l.u, l.v}), dx = map.direction({l.dudx, l.dvdx}), dy = map.direction({l.dudy, l.dvdy});
+      const FaceGpu& g = packed.faces[static_cast<size_t>(other)];
+      const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER,
+                                                   p.x, p.y, dx.x, dx.y, dy.x, dy.y);
+      reaching += s.weight > 0.0f;
+      if (lookup_may_reach_face(g, 0, sampler.filter, sampler.max_aniso, p.x, p.y, dx.x, dx.y, dy.x, dy.y)) {
+        ++kept;
+        continue;
+      }
+      ++skipped;
+      ASSERT_EQ(s.weight, 0.0f) << "face " << l.face << " neighbour " << other << " (" << (j < 4 ? "edge " : "corner ")
+                                << k << ") at " << l.u << "," << l.v << " " << to_string(filter);
+      ASSERT_TRUE(same_bits(s, FilterSum{})) << "a skipped neighbour adds colour";
+    }
+  }
+  EXPECT_GT(skipped, kept);
+  // Not loose: of the neighbours it keeps, most do hold weight (the test is about the probes).
+  EXPECT_GT(reaching, kept / 2) << "kept " << kept << " reaching " << reaching;
+}
+
+TEST(Traverse, EarlyOutsChangeNoBitOfTheTwin) {
+  // The twin's traverse with its early-outs (neighbor_may_contribute, lookup_may_reach_face)
+  // and without them, on faces of mixed sizes (valence 3, 4, 5) and on paper: the same bits.
+  Scene prism = seamcl_tests::split_pentagonal_prism();
+  seamcl_tests::set_textures(prism, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+  for (const char* name : {"prism", "paper"}) {
+    const Scene scene = std::string(name) == "prism" ? prism : generate_scene(name, {});
+    const PackedScene packed = pack_scene(scene, TexelFormat::Rgba32f);
+    const std::vector<Lookup> lookups = lookups_near_edges(scene.faces.size(), 4000, 11);
+    size_t changed = 0, crossing = 0;
+    for (Filter filter : {Filter::Bilinear, Filter::Trilinear, Filter::Aniso, Filter::Ewa}) {
+      for (Method method : {Method::Traverse, Method::TraverseEdges}) {
+        const SamplerParams sampler = sampler_params(method, filter, 16, ZeroCoverage::Clamp);
+        for (const Lookup& l : lookups) {
+          const FilterSum fast = method_sum_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx,
+                                                      l.dudy, l.dvdy, true);
+          const FilterSum every = method_sum_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx,
+                                                       l.dudy, l.dvdy, false);
+          const FilterSum own = filter_texture_reference(packed.textures(), l.face, sampler, SEAMCL_ADDRESS_BORDER,
+                                                         l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+          crossing += every.weight > own.weight;
+          if (!same_bits(fast, every) && changed++ < 3) {
+            ADD_FAILURE() << name << " " << to_string(method) << " " << to_string(filter) << " face " << l.face << " at "
+                          << l.u << "," << l.v << ": weight " << fast.weight << " vs " << every.weight;
+          }
+        }
+      }
+    }
+    EXPECT_EQ(changed, 0u) << name;
+    EXPECT_GT(crossing, lookups.size()) << name << ": the lookups should cross edges often";
+  }
+}
+
+TEST(KernelVsTwin, TraverseEarlyOutsChangeNoBitOfTheKernel) {
+  // The kernel built with SEAMCL_TRAVERSE_EARLY_OUT=0 filters every neighbour; with the early-outs
+  // (as renders run) its sums and colours must be the same bits.
+  Scene prism = seamcl_tests::split_pentagonal_prism();
+  seamcl_tests::set_textures(prism, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+  for (const char* name : {"prism", "paper"}) {
+    const Scene scene = std::string(name) == "prism" ? prism : generate_scene(name, {});
+    const TexelFormat format = std::string(name) == "prism" ? TexelFormat::Rgba32f : TexelFormat::Rgba8;
+    const PackedScene packed = pack_scene(scene, format);
+    const std::vector<Lookup> lookups = lookups_near_edges(scene.faces.size(), 4000, 12);
+    TextureLookups fast(shared_runtime(), packed), every(shared_runtime(), packed);
+    every.set_traverse_early_out(false);
+    fast.set_lookups(lookups);
+    every.set_lookups(lookups);
+    for (Filter filter : {Filter::Bilinear, Filter::Trilinear, Filter::Aniso, Filter::Ewa}) {
+      SCOPED_TRACE(testing::Message() << name << " " << to_string(filter));
+      const SamplerParams sampler = sampler_params(Method::Traverse, filter, 16, ZeroCoverage::Clamp);
+      const std::vector<FilterSum> a = fast.filter(sampler), b = every.filter(sampler);
+      const std::vector<glm::vec4> ca = fast.sample(sampler), cb = every.sample(sampler);
+      size_t changed = 0;
+      for (size_t i = 0; i < lookups.size(); ++i) {
+        bool same = same_bits(a[i], b[i]);
+        for (int c = 0; c < 4; ++c) same &= same_bits(ca[i][c], cb[i][c]) || (std::isnan(ca[i][c]) && std::isnan(cb[i][c]));
+        if (!same && changed++ < 3) {
+          ADD_FAILURE() << "lookup " << i << ": weight " << a[i].weight << " vs " << b[i].weight << ", red " << ca[i].r
+                        << " vs " << cb[i].r;
+        }
+      }
+      EXPECT_EQ(changed, 0u);
+    }
+  }
 }

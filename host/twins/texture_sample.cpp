@@ -103,28 +103,79 @@ Footprint footprint(const FaceGpu& face, float dudx, float dvdx, float dudy, flo
 
 float lod_of(float len2) { return 0.5f * approx_log2(std::fmax(len2, 1e-30f)); }
 
-void accumulate_aniso(FilterSum& sum, const TextureView& tex, const FaceGpu& face, float u, float v, const Footprint& f,
-                      int max_aniso, int address) {
+// The line of trilinear probes of an aniso lookup (the kernel's AnisoProbes).
+struct AnisoProbes {
+  int probes;              // N
+  float weight;            // 1 / N, each probe's
+  float lod;               // each probe's, before the chain's clamp
+  float step_u, step_v;    // from one probe to the next (uv)
+  float first_u, first_v;  // probe 0
+};
+
+AnisoProbes aniso_probes(const FaceGpu& face, float u, float v, const Footprint& f, int max_aniso) {
   const bool x_major = f.len2_x >= f.len2_y;
   const float major2 = x_major ? f.len2_x : f.len2_y;
   const float minor2 = x_major ? f.len2_y : f.len2_x;
   // N = min(ceil(major / minor), max_aniso) trilinear probes at log2(major / N).
   // A line footprint takes the most probes; a point footprint one.
   const float ratio = minor2 > 0.0f ? std::sqrt(major2 / minor2) : major2 > 0.0f ? static_cast<float>(max_aniso) : 1.0f;
-  const int probes = f.finite ? std::clamp(static_cast<int>(std::ceil(std::fmin(ratio, 16.0f))), 1, max_aniso) : 1;
-  const float inv_probes = 1.0f / static_cast<float>(probes);
-  const float lod = f.finite ? lod_of(major2) - approx_log2(static_cast<float>(probes))
-                             : static_cast<float>(face.level_count - 1);
-  const float step_u = (x_major ? f.ax_u : f.ay_u) * inv_probes;
-  const float step_v = (x_major ? f.ax_v : f.ay_v) * inv_probes;
+  AnisoProbes p{};
+  p.probes = f.finite ? std::clamp(static_cast<int>(std::ceil(std::fmin(ratio, 16.0f))), 1, max_aniso) : 1;
+  p.weight = 1.0f / static_cast<float>(p.probes);
+  p.lod = f.finite ? lod_of(major2) - approx_log2(static_cast<float>(p.probes)) : static_cast<float>(face.level_count - 1);
+  p.step_u = (x_major ? f.ax_u : f.ay_u) * p.weight;
+  p.step_v = (x_major ? f.ax_v : f.ay_v) * p.weight;
   // Probe i at (i + 0.5) / N - 0.5 of the major axis from the centre.
-  float pu = f.finite ? u + step_u * (0.5f - 0.5f * static_cast<float>(probes)) : u;
-  float pv = f.finite ? v + step_v * (0.5f - 0.5f * static_cast<float>(probes)) : v;
-  for (int i = 0; i < probes; ++i) {
-    accumulate_trilinear(sum, tex, face, pu, pv, lod, inv_probes, address);
-    pu += step_u;
-    pv += step_v;
+  p.first_u = f.finite ? u + p.step_u * (0.5f - 0.5f * static_cast<float>(p.probes)) : u;
+  p.first_v = f.finite ? v + p.step_v * (0.5f - 0.5f * static_cast<float>(p.probes)) : v;
+  return p;
+}
+
+float trilinear_lod(const FaceGpu& face, const Footprint& f) {
+  return f.finite ? lod_of(std::fmax(f.len2_x, f.len2_y)) : static_cast<float>(face.level_count - 1);
+}
+
+// The level whose texels are the coarsest a trilinear lookup at `lod` reads.
+int coarser_level(const FaceGpu& face, float lod) {
+  lod = std::fmin(std::fmax(lod, 0.0f), static_cast<float>(face.level_count - 1));
+  return std::min(static_cast<int>(lod) + 1, face.level_count - 1);
+}
+
+// Whether a bilinear probe at (u, v) can weigh a texel inside the face (border address mode),
+// `reach` being a texel of the level it reads: a tap weighs something only while the point lies
+// less than half a texel past the texel's edge; the other half absorbs rounding. NaN: may reach.
+bool probe_reaches_face(float u, float v, float reach_u, float reach_v) {
+  return !(u + reach_u <= 0.0f || u - reach_u >= 1.0f || v + reach_v <= 0.0f || v - reach_v >= 1.0f);
+}
+
+// The same for probes on `level` centred at (u, v) and spread no further than (half_u, half_v).
+// The band's texels (`pad` each side) count as inside.
+bool probes_reach_face(const FaceGpu& face, int pad, int level, float u, float v, float half_u, float half_v) {
+  const float texels = 1.0f + static_cast<float>(pad);
+  return probe_reaches_face(u, v, half_u + texels / static_cast<float>(std::max(face.width >> level, 1)),
+                            half_v + texels / static_cast<float>(std::max(face.height >> level, 1)));
+}
+
+// Border-addressed, probes whose taps all lie outside the face add exactly nothing: skipped, as
+// the kernel skips them.
+void accumulate_probes(FilterSum& sum, const TextureView& tex, const FaceGpu& face, const AnisoProbes& p, int address) {
+  float pu = p.first_u, pv = p.first_v;
+  const int level = coarser_level(face, p.lod);
+  const float texels = 1.0f + static_cast<float>(tex.guard_band);
+  const float reach_u = texels / static_cast<float>(std::max(face.width >> level, 1));
+  const float reach_v = texels / static_cast<float>(std::max(face.height >> level, 1));
+  for (int i = 0; i < p.probes; ++i) {
+    if (address != SEAMCL_ADDRESS_BORDER || probe_reaches_face(pu, pv, reach_u, reach_v)) {
+      accumulate_trilinear(sum, tex, face, pu, pv, p.lod, p.weight, address);
+    }
+    pu += p.step_u;
+    pv += p.step_v;
   }
+}
+
+void accumulate_aniso(FilterSum& sum, const TextureView& tex, const FaceGpu& face, float u, float v, const Footprint& f,
+                      int max_aniso, int address) {
+  accumulate_probes(sum, tex, face, aniso_probes(face, u, v, f, max_aniso), address);
 }
 
 // pbrt-v4's EWA on one level (Gaussian, alpha 2), weights divided by their total over the
@@ -232,11 +283,9 @@ FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, 
     case SEAMCL_FILTER_BILINEAR:
       accumulate_bilinear(sum, tex, face_level(tex, face, 0), u, v, 1.0f, address);
       break;
-    case SEAMCL_FILTER_TRILINEAR: {
-      const float lod = f.finite ? lod_of(std::fmax(f.len2_x, f.len2_y)) : static_cast<float>(face.level_count - 1);
-      accumulate_trilinear(sum, tex, face, u, v, lod, 1.0f, address);
+    case SEAMCL_FILTER_TRILINEAR:
+      accumulate_trilinear(sum, tex, face, u, v, trilinear_lod(face, f), 1.0f, address);
       break;
-    }
     case SEAMCL_FILTER_ANISO:
       accumulate_aniso(sum, tex, face, u, v, f, sampler.max_aniso, address);
       break;
@@ -247,8 +296,8 @@ FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, 
   return sum;
 }
 
-bool neighbor_may_contribute(const FaceGpu& other, int filter, float distance, float dudx, float dvdx, float dudy,
-                             float dvdy) {
+bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, int guard_band, float distance_u,
+                             float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
   // Footprint axes by their 1-norms in uv: no shorter than their lengths, and kept by the maps
   // between faces (which only permute and negate u and v).
   const float axis_x = std::fabs(dudx) + std::fabs(dvdx);
@@ -257,55 +306,101 @@ bool neighbor_may_contribute(const FaceGpu& other, int filter, float distance, f
   // A non-finite footprint sends every filter to the coarsest level: it may reach anything.
   if (!(axes < INFINITY)) return true;
   const float longest = std::fmax(axis_x, axis_y);
+  const float shortest = std::fmin(axis_x, axis_y);
   const float min_side = static_cast<float>(std::min(other.width, other.height));
-  const float aspect = static_cast<float>(std::max(other.width, other.height)) / min_side;
+  const float max_side = static_cast<float>(std::max(other.width, other.height));
   // A tap weighs something only within one texel of its probe. The coarsest texel the other
-  // face's filter can weigh (uv): bilinear reads level 0; the others a trilinear pair at lod <=
-  // log2 of the longer axis in its level-0 texels (at most max side x `longest`), whose second
-  // level's texels are up to twice that long (2.01: approx_log2's error); none is longer than
-  // the face.
-  const float texel = filter == SEAMCL_FILTER_BILINEAR
-                          ? 1.0f / min_side
-                          : std::fmin(1.0f, std::fmax(1.0f / min_side, 2.01f * aspect * longest));
-  // How far the probes spread from the point: aniso's over half the major axis; EWA's ellipse
-  // over both axes, its minor one grown up to `aspect` times in uv by the eccentricity clamp.
-  const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f * longest
-                       : filter == SEAMCL_FILTER_EWA ? (1.0f + aspect) * axes
-                                                     : 0.0f;
-  const float reach = spread + texel;
+  // face's filter can weigh (uv): bilinear reads level 0; the others a trilinear pair at lod (at
+  // least 0) and the next level, whose texels are up to twice 2^lod level-0 texels (2.01:
+  // approx_log2's error); none is longer than the face. Trilinear's lod is log2 of the longer
+  // axis in the other face's level-0 texels (at most max side x `longest`); aniso's that divided
+  // by its N probes, N >= min(major / minor, max_aniso), so at most the longer of the minor axis
+  // and major / max_aniso (the minor one measured in the other face's texels: still no longer
+  // than max side x `shortest`). Kept multiplied by min_side (a power of two: exact), so that
+  // the kernel divides nothing.
+  const float probe_axis =
+      filter == SEAMCL_FILTER_ANISO ? std::fmax(shortest, longest / static_cast<float>(max_aniso)) : longest;
+  const float texel_sides =
+      filter == SEAMCL_FILTER_BILINEAR ? 1.0f : std::fmin(min_side, std::fmax(2.0f, 2.01f * max_side * probe_axis));
+  // How far the probes spread from the point along u and v: aniso's over half its major axis,
+  // which is one of the two screen axes (whichever the other face's texels make longer); EWA's
+  // ellipse over both axes, its minor one grown up to max/min side times in uv by the
+  // eccentricity clamp.
+  const float spread_u = filter == SEAMCL_FILTER_ANISO ? 0.5f * std::fmax(std::fabs(dudx), std::fabs(dudy))
+                         : filter == SEAMCL_FILTER_EWA ? (1.0f + max_side / min_side) * axes
+                                                       : 0.0f;
+  const float spread_v = filter == SEAMCL_FILTER_ANISO ? 0.5f * std::fmax(std::fabs(dvdx), std::fabs(dvdy)) : spread_u;
+  // A guard band's texels read as inside too.
+  const float texel_reach = texel_sides * (1.0f + static_cast<float>(guard_band));
   // EWA pulls a centre more than two face widths out back to two widths: count no distance
   // beyond 2. A NaN distance is never skipped.
-  const float counted = distance > 2.0f ? 2.0f : distance;
-  return !(counted >= reach);
+  const float counted_u = distance_u > 2.0f ? 2.0f : distance_u;
+  const float counted_v = distance_v > 2.0f ? 2.0f : distance_v;
+  return !(counted_u * min_side >= spread_u * min_side + texel_reach ||
+           counted_v * min_side >= spread_v * min_side + texel_reach);
+}
+
+bool lookup_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float u, float v, float dudx,
+                           float dvdx, float dudy, float dvdy) {
+  const Footprint f = footprint(face, dudx, dvdx, dudy, dvdy);
+  switch (filter) {
+    case SEAMCL_FILTER_BILINEAR:
+      return probes_reach_face(face, guard_band, 0, u, v, 0.0f, 0.0f);
+    case SEAMCL_FILTER_TRILINEAR:
+      return probes_reach_face(face, guard_band, coarser_level(face, trilinear_lod(face, f)), u, v, 0.0f, 0.0f);
+    case SEAMCL_FILTER_ANISO: {
+      const AnisoProbes p = aniso_probes(face, u, v, f, max_aniso);
+      // The probes lie within (N - 1) / 2 steps of the centre; N / 2 leaves half a step spare.
+      const float spread = 0.5f * static_cast<float>(p.probes);
+      return probes_reach_face(face, guard_band, coarser_level(face, p.lod), u, v, spread * std::fabs(p.step_u),
+                               spread * std::fabs(p.step_v));
+    }
+    default:
+      return true;  // EWA: neighbor_may_contribute only
+  }
 }
 
 FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const SamplerParams& sampler, float u, float v,
-                               float dudx, float dvdx, float dudy, float dvdy) {
+                               float dudx, float dvdx, float dudy, float dvdy, bool early_out) {
   FilterSum sum = filter_texture_reference(tex, face, sampler, sampler.address, u, v, dudx, dvdx, dudy, dvdy);
   if (sampler.traverse == SEAMCL_TRAVERSE_NONE) return sum;
   // Traverse: each neighbour at this point and footprint carried into its uv, border-addressed,
   // so it weighs only the taps that fall inside it. A neighbour whose taps cannot reach the
   // point is skipped: it would add nothing.
-  auto add_across = [&](int other, const float* t, float distance) {
+  auto add_across = [&](int other, const float* t, float distance_u, float distance_v) {
     if (other < 0) return;
-    if (!neighbor_may_contribute(tex.faces->at(static_cast<size_t>(other)), sampler.filter, distance, dudx, dvdx, dudy,
-                                 dvdy)) {
+    const FaceGpu& g = tex.faces->at(static_cast<size_t>(other));
+    if (early_out && !neighbor_may_contribute(g, sampler.filter, sampler.max_aniso, tex.guard_band, distance_u, distance_v,
+                                              dudx, dvdx, dudy, dvdy)) {
       return;
     }
-    const FilterSum s = filter_texture_reference(tex, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER,
-                                                 t[0] * u + t[1] * v + t[2], t[3] * u + t[4] * v + t[5],
-                                                 t[0] * dudx + t[1] * dvdx, t[3] * dudx + t[4] * dvdx,
-                                                 t[0] * dudy + t[1] * dvdy, t[3] * dudy + t[4] * dvdy);
+    const float gu = t[0] * u + t[1] * v + t[2], gv = t[3] * u + t[4] * v + t[5];
+    const float gdudx = t[0] * dudx + t[1] * dvdx, gdvdx = t[3] * dudx + t[4] * dvdx;
+    const float gdudy = t[0] * dudy + t[1] * dvdy, gdvdy = t[3] * dudy + t[4] * dvdy;
+    // Then the probes the filter would take there, against the other face's square.
+    if (early_out && !lookup_may_reach_face(g, tex.guard_band, sampler.filter, sampler.max_aniso, gu, gv, gdudx, gdvdx, gdudy, gdvdy)) {
+      return;
+    }
+    const FilterSum s = filter_texture_reference(tex, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER, gu,
+                                                 gv, gdudx, gdvdx, gdudy, gdvdy);
     sum.color += s.color;
     sum.weight += s.weight;
   };
-  // How far the point lies inside each edge: the least distance to the face across it.
+  // How far the point lies inside each edge: the least distance to the face across it, along v
+  // (edges 0 and 2) or u (1 and 3); the other axis never decides (-1).
   const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
   const FaceNeighbors& n = tex.neighbors->at(face);
-  for (int k = 0; k < 4; ++k) add_across(n.neighbor[k], n.transform[k], inside[k]);
+  for (int k = 0; k < 4; ++k) {
+    const bool along_v = k % 2 == 0;
+    add_across(n.neighbor[k], n.transform[k], along_v ? -1.0f : inside[k], along_v ? inside[k] : -1.0f);
+  }
   if (sampler.traverse != SEAMCL_TRAVERSE_CORNERS) return sum;
-  // Past a valence-4 corner, the diagonal face (corner k lies between edges k-1 and k).
-  for (int k = 0; k < 4; ++k) add_across(n.corner[k], n.corner_transform[k], std::fmax(inside[(k + 3) % 4], inside[k]));
+  // Past a valence-4 corner, the diagonal face (corner k lies between edges k-1 and k): past both.
+  for (int k = 0; k < 4; ++k) {
+    const float a = inside[(k + 3) % 4], b = inside[k];
+    const bool b_along_v = k % 2 == 0;
+    add_across(n.corner[k], n.corner_transform[k], b_along_v ? a : b, b_along_v ? b : a);
+  }
   return sum;
 }
 

@@ -18,16 +18,24 @@ float approx_log2(float x);
 FilterSum filter_texture_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler,
                                    int address, float u, float v, float dudx, float dvdx, float dudy, float dvdy);
 // Whether any tap of face `other` can weigh anything in a lookup with `filter` (SEAMCL_FILTER_*;
-// derivatives in this face's uv)
-// whose point lies at least `distance` (uv) outside the other face's square: a conservative
-// bound, so a neighbour it rules out would have added exactly nothing. Traverse skips those.
-bool neighbor_may_contribute(const FaceGpu& other, int filter, float distance, float dudx, float dvdx, float dudy,
-                             float dvdy);
+// derivatives in this face's uv; `guard_band` texels per level stored around each level)
+// whose point must travel at least distance_u along u and distance_v along v (this face's uv; a
+// negative distance never decides) to reach the other face's square: a conservative bound, so a
+// neighbour it rules out would have added exactly nothing. Traverse skips those.
+bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, int guard_band, float distance_u,
+                             float distance_v, float dudx, float dvdx, float dudy, float dvdy);
+// Whether a border-addressed lookup with `filter` on `face` (its own uv and derivatives) can put
+// weight inside it (or in its guard band of `guard_band` texels per level): bilinear, trilinear
+// and aniso test the very probes the filter takes (their line, and a texel of the coarser level
+// read); EWA always may. Conservative, like the above.
+bool lookup_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float u, float v, float dudx,
+                           float dvdx, float dudy, float dvdy);
 // What a method sums before renormalising: filter_texture_reference on the face with the
 // sampler's address mode and, for traverse, on each edge neighbour (border) through its uv
-// transform, and with corners, on the diagonal face past each valence-4 corner.
+// transform, and with corners, on the diagonal face past each valence-4 corner. `early_out`
+// false reads every neighbour, for the tests that check the early-outs change nothing.
 FilterSum method_sum_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler, float u, float v,
-                               float dudx, float dvdx, float dudy, float dvdy);
+                               float dudx, float dvdx, float dudy, float dvdy, bool early_out = true);
 // The lookup as a seam method asks for it (renormalisation and zero-coverage rule included).
 glm::vec4 sample_texture_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler, float u,
                                    float v, float dudx, float dvdx, float dudy, float dvdy);
