@@ -153,7 +153,7 @@ int run_sweep(const BenchArgs& args, const GlobalOptions& global) {
     source.generator = generator;
     return load_scene_source(settings.base.scene, settings.base.texture, source);
   };
-  if (!args.json_out) settings.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  settings.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };  // stdout stays JSON
   validate_sweep(axes, settings);
   if (args.check_only) {
     std::printf("sweep options valid: %s\n", args.sweep.c_str());

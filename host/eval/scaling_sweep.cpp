@@ -155,86 +155,101 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
   json sweeps = json::array();
   for (SweepAxis axis : axes) {
     const std::vector<SweepPoint> points = sweep_points(axis, settings.base);
-    json point_list = json::array();
-    // The scene is made again only when the point asks for another one (faces, texels).
-    std::optional<std::pair<std::optional<int>, std::optional<int>>> loaded_key;
-    std::unique_ptr<Scene> scene;
-    std::unique_ptr<Renderer> renderer;
-    std::vector<std::vector<double>> totals(settings.methods.size());  // per method, per point: the median
-    std::vector<double> xs;
-    for (const SweepPoint& point : points) {
-      const std::pair key{point.faces, point.texture_scale_log2};
-      if (!loaded_key || *loaded_key != key) {
-        renderer.reset();  // the old scene's buffers go before the new one is made
-        scene.reset();
+    const size_t method_count = settings.methods.size();
+    std::vector<json> point_json(points.size());
+    std::vector<std::vector<double>> totals(method_count, std::vector<double>(points.size()));  // medians
+    std::vector<std::vector<double>> minima(method_count, std::vector<double>(points.size()));
+    std::vector<double> xs(points.size());
+    auto options_of = [&](const SweepPoint& point, size_t m) {
+      RenderOptions options = settings.base;
+      options.method = *parse_method(settings.methods[m]);
+      options.width = point.width;
+      options.height = point.height;
+      options.msaa = point.msaa;
+      return options;
+    };
+    // Points that share a scene (pixels, msaa: all of them) are measured together, the repeats
+    // interleaved (every point and method once per round), so that the machine's load, which
+    // drifts, falls on all of them alike; a point with a scene of its own (faces, texels) alone.
+    for (size_t begin = 0; begin < points.size();) {
+      const auto key_of = [](const SweepPoint& p) { return std::pair{p.faces, p.texture_scale_log2}; };
+      size_t end = begin;
+      while (end < points.size() && key_of(points[end]) == key_of(points[begin])) ++end;
+      std::unique_ptr<Scene> scene;
+      {
         GeneratorOptions generator;
         generator.tint = settings.base.tint;
         generator.defer_textures = true;
-        generator.faces = point.faces;
-        generator.texture_scale_log2 = point.texture_scale_log2;
+        generator.faces = points[begin].faces;
+        generator.texture_scale_log2 = points[begin].texture_scale_log2;
         scene = std::make_unique<Scene>(settings.make_scene(generator));
-        renderer = std::make_unique<Renderer>(runtime);
-        renderer->load_scene(*scene, settings.base.texels);
-        loaded_key = key;
       }
-      renderer->release_frame_buffers();
-      json results = json::array();
-      unsigned fragments = 0;
-      for (size_t m = 0; m < settings.methods.size(); ++m) {
-        RenderOptions options = settings.base;
-        options.method = *parse_method(settings.methods[m]);
-        options.width = point.width;
-        options.height = point.height;
-        options.msaa = point.msaa;
-        if (settings.progress) {
-          settings.progress("sweep " + to_string(axis) + ": " + std::to_string(point.width) + "x" +
-                            std::to_string(point.height) + " msaa " + std::to_string(point.msaa) + ", " +
-                            std::to_string(scene->faces.size()) + " faces, " + std::to_string(scene->texel_count()) +
-                            " texels, " + settings.methods[m]);
+      Renderer renderer(runtime);
+      renderer.load_scene(*scene, settings.base.texels);
+      for (size_t i = begin; i < end; ++i) {
+        for (size_t m = 0; m < method_count; ++m) {
+          if (settings.progress) {
+            settings.progress("sweep " + to_string(axis) + ": " + std::to_string(points[i].width) + "x" +
+                              std::to_string(points[i].height) + " msaa " + std::to_string(points[i].msaa) + ", " +
+                              std::to_string(scene->faces.size()) + " faces, " + std::to_string(scene->texel_count()) +
+                              " texels, " + settings.methods[m]);
+          }
+          renderer.warm_up(options_of(points[i], m));
         }
-        renderer->warm_up(options);
-        std::vector<StageTimes> runs;
-        std::vector<double> total;
-        RenderResult last;
-        for (int r = 0; r < settings.repeats; ++r) {
-          last = renderer->render(scene->camera, options);
-          runs.push_back(last.ms);
-          total.push_back(last.ms.total);
+      }
+      std::vector<std::vector<std::vector<StageTimes>>> runs(end - begin, std::vector<std::vector<StageTimes>>(method_count));
+      std::vector<unsigned> fragments(end - begin, 0);
+      for (int r = 0; r < settings.repeats; ++r) {
+        for (size_t i = begin; i < end; ++i) {
+          for (size_t m = 0; m < method_count; ++m) {
+            const RenderResult result = renderer.render(scene->camera, options_of(points[i], m));
+            runs[i - begin][m].push_back(result.ms);
+            fragments[i - begin] = result.stats.fragments;
+          }
         }
-        fragments = last.stats.fragments;
-        json ms = bench_timing_stats(total);
-        totals[m].push_back(ms.at("median").get<double>());
-        results.push_back({{"method", settings.methods[m]}, {"ms", ms}, {"stages", stage_medians(runs)}});
       }
-      const size_t pixels = static_cast<size_t>(point.width) * static_cast<size_t>(point.height);
-      const PackedScene& packed = renderer->packed_scene();
-      double x = 0;
-      switch (axis) {
-        case SweepAxis::Pixels: x = static_cast<double>(pixels); break;
-        case SweepAxis::Faces: x = static_cast<double>(scene->faces.size()); break;
-        case SweepAxis::Msaa: x = point.msaa; break;
-        case SweepAxis::Texels: x = static_cast<double>(scene->texel_count()); break;
+      for (size_t i = begin; i < end; ++i) {
+        const SweepPoint& point = points[i];
+        json results = json::array();
+        for (size_t m = 0; m < method_count; ++m) {
+          std::vector<double> total;
+          for (const StageTimes& t : runs[i - begin][m]) total.push_back(t.total);
+          json ms = bench_timing_stats(total);
+          totals[m][i] = ms.at("median").get<double>();
+          minima[m][i] = ms.at("min").get<double>();
+          results.push_back({{"method", settings.methods[m]}, {"ms", ms}, {"stages", stage_medians(runs[i - begin][m])}});
+        }
+        const size_t pixels = static_cast<size_t>(point.width) * static_cast<size_t>(point.height);
+        double x = 0;
+        switch (axis) {
+          case SweepAxis::Pixels: x = static_cast<double>(pixels); break;
+          case SweepAxis::Faces: x = static_cast<double>(scene->faces.size()); break;
+          case SweepAxis::Msaa: x = point.msaa; break;
+          case SweepAxis::Texels: x = static_cast<double>(scene->texel_count()); break;
+        }
+        xs[i] = x;
+        point_json[i] = {{"x", x},
+                         {"width", point.width},
+                         {"height", point.height},
+                         {"pixels", pixels},
+                         {"msaa", point.msaa},
+                         {"faces", scene->faces.size()},
+                         {"triangles", scene->triangle_count()},
+                         {"texels", scene->texel_count()},
+                         {"packed_texel_bytes", renderer.packed_scene().texture_bytes()},
+                         {"fragments", fragments[i - begin]},
+                         {"generator_faces", point.faces ? json(*point.faces) : json(nullptr)},
+                         {"texture_scale_log2", point.texture_scale_log2 ? json(*point.texture_scale_log2) : json(nullptr)},
+                         {"results", results}};
       }
-      xs.push_back(x);
-      point_list.push_back({{"x", x},
-                            {"width", point.width},
-                            {"height", point.height},
-                            {"pixels", pixels},
-                            {"msaa", point.msaa},
-                            {"faces", scene->faces.size()},
-                            {"triangles", scene->triangle_count()},
-                            {"texels", scene->texel_count()},
-                            {"packed_texel_bytes", packed.texture_bytes()},
-                            {"fragments", fragments},
-                            {"generator_faces", point.faces ? json(*point.faces) : json(nullptr)},
-                            {"texture_scale_log2", point.texture_scale_log2 ? json(*point.texture_scale_log2) : json(nullptr)},
-                            {"results", results}});
+      begin = end;
     }
+    const json point_list = point_json;
     // Ratios from the first point: to the target's point (the first at or past its x ratio) and
     // to the last.
     json ratios = json::array();
     const std::optional<Target> target = target_of(axis);
-    for (size_t m = 0; m < settings.methods.size(); ++m) {
+    for (size_t m = 0; m < method_count; ++m) {
       std::vector<size_t> ends;
       if (target) {
         for (size_t i = 1; i < xs.size(); ++i) {
@@ -254,6 +269,8 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
                           {"to_x", xs[i]},
                           {"x_ratio", x_ratio},
                           {"time_ratio", time_ratio},
+                          // The fastest renders' ratio: the least disturbed by a shared machine.
+                          {"time_ratio_of_minima", minima[m][i] / minima[m][0]},
                           {"max_time_ratio", has_target ? json(target->max_time_ratio) : json(nullptr)},
                           {"met", has_target ? json(time_ratio <= target->max_time_ratio) : json(nullptr)}});
       }

@@ -7,6 +7,7 @@
 #include "pipeline/guard_band.h"
 #include "pipeline/reflective_face.h"
 
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -45,17 +46,41 @@ void pack_face_texels(const Scene& scene, PackedScene& out, size_t f, size_t fir
   }
 }
 
+// Guard bands of a scene with deferred textures. A face's band reads the levels of the faces
+// across its edges and around its corners, all of which share a vertex with it; so the faces are
+// packed in order, each face's chain made just before the first face that reads it and dropped
+// after the last. Only that moving window of faces (about a ring of the mesh) holds float texels
+// at once, never the whole scene.
+void pack_banded_deferred(const Scene& scene, PackedScene& out, const std::vector<size_t>& first_level) {
+  const size_t count = scene.faces.size();
+  std::vector<std::vector<uint32_t>> faces_at_vertex(scene.positions.size());
+  for (size_t f = 0; f < count; ++f)
+    for (uint32_t v : scene.faces[f].vertices) faces_at_vertex[v].push_back(static_cast<uint32_t>(f));
+  auto readers_of = [&](size_t f) {  // the faces f's band may read: those sharing a vertex with it, f included
+    std::vector<uint32_t> around;
+    for (uint32_t v : scene.faces[f].vertices) around.insert(around.end(), faces_at_vertex[v].begin(), faces_at_vertex[v].end());
+    std::sort(around.begin(), around.end());
+    around.erase(std::unique(around.begin(), around.end()), around.end());
+    return around;
+  };
+  std::vector<size_t> last_reader(count);
+  for (size_t f = 0; f < count; ++f)
+    for (uint32_t g : readers_of(f)) last_reader[g] = std::max(last_reader[g], f);
+  Scene window = scene;  // deferred chains (sizes only) but for the faces in the window
+  for (size_t f = 0; f < count; ++f) {
+    const std::vector<uint32_t> around = readers_of(f);
+    for (uint32_t g : around)
+      if (is_deferred(window.faces[g].texture)) window.faces[g].texture = face_texture(scene, g);
+    pack_face_texels(window, out, f, first_level[f]);
+    for (uint32_t g : around)
+      if (last_reader[g] == f && is_deferred(scene.faces[g].texture)) window.faces[g].texture = scene.faces[g].texture;  // sizes only again
+  }
+}
+
 }  // namespace
 
 PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
   if (guard_band < 0 || guard_band > kMaxGuardBand) throw std::invalid_argument("guard band out of range");
-  if (guard_band > 0 && has_deferred_textures(scene)) {
-    // A band reads the neighbours' levels, so every face's chain must exist at once: guardband
-    // renders of a deferred scene pay the float copy while packing (and only then).
-    Scene built = scene;
-    materialize_textures(built);
-    return pack_scene(built, format, guard_band);
-  }
   PackedScene out;
   out.format = format;
   out.guard_band = guard_band;
@@ -101,7 +126,11 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
   } else {
     out.texels32.resize(stored_texels * 4);
   }
-  for_each_face_in_parallel(scene.faces.size(), [&](size_t f) { pack_face_texels(scene, out, f, first_level[f]); });
+  if (guard_band > 0 && has_deferred_textures(scene)) {
+    pack_banded_deferred(scene, out, first_level);
+  } else {
+    for_each_face_in_parallel(scene.faces.size(), [&](size_t f) { pack_face_texels(scene, out, f, first_level[f]); });
+  }
   return out;
 }
 
