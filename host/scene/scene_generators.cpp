@@ -162,7 +162,9 @@ Scene make_paper(const GeneratorOptions& options) {
   // thousandths above it.
   const glm::vec3 torus_center(0.0f, kMajorRadius + kMinorRadius, 0.0f);
   add_torus(scene, torus_center, kMajorRadius, kMinorRadius, segments(50), segments(29));
-  const int ground = segments(32);
+  // The ground takes what the torus leaves of the count (32 x 32 for the paper scene itself).
+  const int torus_faces = segments(50) * segments(29);
+  const int ground = std::max(3, static_cast<int>(std::lround(std::sqrt(std::max(target - torus_faces, 9.0)))));
   add_ground_grid(scene, ground, ground, -8.0f, 8.0f, -8.0f, 8.0f, 0.0f);
 
   std::mt19937 random(20130805u);

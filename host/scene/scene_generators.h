@@ -34,7 +34,7 @@ struct GeneratorOptions {
   bool defer_textures = false;
   // paper only, for scaling measurements (seamcl bench --sweep). faces: about this many faces
   // (kMinPaperFaces..kMaxPaperFaces; the torus and the ground subdivided in proportion, within 2%
-  // of it), each texture's area divided by the power of two nearest faces / 2,474 so that the
+  // of it or 5 faces), each texture's area divided by the power of two nearest faces / 2,474 so that the
   // scene keeps about the original's texels (sides stop at 1). texture_scale_log2: every texture
   // side times 2^k (kMinTextureScaleLog2..kMaxTextureScaleLog2), after the face count's scaling.
   // Unset (or 2,474 and 0): the paper scene itself.
