@@ -84,7 +84,9 @@ struct RenderMemory {
   size_t tile_lists_bound = 0;  // upper bound of tile_lists after growth (see above)
 
   // Host.
-  size_t host_scene = 0;   // the Renderer's Scene copy: positions, faces, float RGBA texels of every level
+  // The Renderer's Scene copy: positions, faces, float RGBA texels of every level. A scene whose
+  // textures are deferred (Scene::texture_source) holds none of those texels: an upper bound then.
+  size_t host_scene = 0;
   size_t host_packed = 0;  // PackedScene's arrays (the device scene buffers without their minimum)
   size_t host_image = 0;   // RenderResult::pixels, float4 per pixel
 
@@ -129,7 +131,9 @@ struct MeasuredMemory {
   size_t packed_texels = 0;         // stored texels of every level of every face, guard bands included
   size_t packed_texel_bytes = 0;    // their bytes (PackedScene::texture_bytes)
   size_t host_packed_bytes = 0;     // every packed array the Renderer holds (texels, tables, positions, faces)
-  size_t device_bytes = 0;          // the Renderer's device buffers (Renderer::device_bytes)
+  // The Renderer's device buffers (Renderer::device_bytes). On a device sharing host memory the
+  // texel buffer is the packed array itself, so these bytes overlap host_packed_bytes there.
+  size_t device_bytes = 0;
   size_t scene_float_texel_bytes = 0;     // float RGBA texels the caller's Scene holds (0: deferred)
   size_t renderer_float_texel_bytes = 0;  // the same in the Renderer's copy of the scene
 };
