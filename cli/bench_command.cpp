@@ -25,6 +25,7 @@
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
+#include <seamcl/eval/scaling_sweep.h>
 #include <seamcl/eval/shard.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
@@ -43,6 +44,8 @@ struct BenchArgs : MeasureArgs {
   bool no_errors = false;
   std::string shard = "1/1";  // part K of N of the orbit's frames (host/eval/shard.h)
   bool check_only = false;    // validate the options and the scene, render nothing
+  std::string sweep;          // scaling sweeps instead of the orbit (host/eval/scaling_sweep.h)
+  int sweep_repeats = 5;
 };
 
 json base_request(const BenchArgs& a) {
@@ -132,7 +135,48 @@ class Progress {
   bool tty_, quiet_;
 };
 
+std::string join_names(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
+// --sweep: the scaling sweeps (one JSON, the chart's input: examples/scaling_chart.py).
+int run_sweep(const BenchArgs& args, const GlobalOptions& global) {
+  const std::vector<SweepAxis> axes = parse_sweep(args.sweep);
+  SweepSettings settings;
+  settings.base = parse_render_options(measure_request(args));
+  settings.methods = split_list(args.methods, "methods");
+  settings.repeats = args.sweep_repeats;
+  settings.make_scene = [&](const GeneratorOptions& generator) {
+    SceneSourceOptions source;
+    source.generator = generator;
+    return load_scene_source(settings.base.scene, settings.base.texture, source);
+  };
+  settings.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };  // stdout stays JSON
+  validate_sweep(axes, settings);
+  if (args.check_only) {
+    std::printf("sweep options valid: %s\n", args.sweep.c_str());
+    return 0;
+  }
+  ClRuntime runtime(global.device);
+  const json out = run_scaling_sweeps(runtime, axes, settings);
+  if (args.json_out) {
+    std::cout << out.dump(2) << "\n";
+    return 0;
+  }
+  for (const json& sweep : out.at("sweeps")) {
+    for (const json& r : sweep.at("ratios")) {
+      std::printf("%-7s %-10s x %8.2f -> time x %7.3f%s\n", sweep.at("axis").get<std::string>().c_str(),
+                  r.at("method").get<std::string>().c_str(), r.at("x_ratio").get<double>(), r.at("time_ratio").get<double>(),
+                  r.at("met").is_null() ? "" : (r.at("met").get<bool>() ? " (target met)" : " (target missed)"));
+    }
+  }
+  return 0;
+}
+
 int run_bench(const BenchArgs& args, const GlobalOptions& global) {
+  if (!args.sweep.empty()) return run_sweep(args, global);
   // Validate everything before any work.
   const json base = base_request(args);
   const RenderOptions frame = parse_render_options(base);
@@ -413,6 +457,10 @@ Command add_bench_command(CLI::App& app) {
                   "Run part K (1-based) of N: a contiguous block of the orbit's frames; `seamcl merge` combines "
                   "the parts' JSON into the unsharded run's [1/1]");
   cmd->add_flag("--check", args->check_only, "Validate the options (and the scene) and exit without rendering");
+  cmd->add_option("--sweep", args->sweep,
+                  "Scaling sweeps instead of the orbit: a comma list of " + join_names(sweep_axis_names()) +
+                      ", or all (time against image pixels, paper's face count at equal pixels, MSAA rate, texels)");
+  cmd->add_option("--sweep-repeats", args->sweep_repeats, "Timed renders per method and sweep point (median) [5]");
   return Command{cmd, [args](const GlobalOptions& global) { return run_bench(*args, global); }};
 }
 

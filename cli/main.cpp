@@ -17,6 +17,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/io/image_io.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
@@ -83,6 +84,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
   const auto scene_start = std::chrono::steady_clock::now();
   SceneSourceOptions source;
   source.generator.tint = options.tint;
+  source.generator.defer_textures = true;  // baked face by face while packing: no float copy of them all
   Scene scene = load_scene_source(options.scene, options.texture, source);
   if (!args.displacement_map.empty()) attach_ptex_displacement(scene, args.displacement_map);
   const Camera camera = options.frame ? orbit_camera(scene, *options.frame, options.frames) : scene.camera;
@@ -128,6 +130,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
       out["triangles"] = report.triangles;
     }
     if (!args.output.empty()) out["output"] = args.output;
+    out["memory"] = to_json(measure_memory(scene, renderer));  // peak over everything above
     std::cout << out.dump(2) << "\n";
   } else {
     std::printf("%s: %dx%d msaa %d, %.2f ms (setup %.2f, binning %.2f, raster %.2f, shade %.2f), %u fragments%s%s\n",

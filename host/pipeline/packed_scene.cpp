@@ -7,10 +7,77 @@
 #include "pipeline/guard_band.h"
 #include "pipeline/reflective_face.h"
 
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 namespace seamcl {
+namespace {
+
+// Writes face f's levels (banded when guard_band > 0) at their offsets in `out`'s texels.
+void pack_face_texels(const Scene& scene, PackedScene& out, size_t f, size_t first_level) {
+  // A deferred face's chain is made here and dropped on return: one face's floats at a time.
+  const MipChain made = is_deferred(scene.faces[f].texture) ? face_texture(scene, f) : MipChain{};
+  const MipChain& chain = made.levels.empty() ? scene.faces[f].texture : made;
+  for (size_t l = 0; l < chain.levels.size(); ++l) {
+    const TextureLevel banded = out.guard_band > 0 ? guard_banded_level(scene, out.neighbors, static_cast<uint32_t>(f),
+                                                                        static_cast<int>(l), out.guard_band)
+                                                   : TextureLevel{};
+    const TextureLevel& level = out.guard_band > 0 ? banded : chain.levels[l];
+    const size_t band = static_cast<size_t>(out.guard_band);
+    if (level.texels.size() != (static_cast<size_t>(chain.levels[l].width) + 2 * band) *
+                                   (static_cast<size_t>(chain.levels[l].height) + 2 * band)) {
+      throw std::logic_error("pack_scene: face " + std::to_string(f) + " level " + std::to_string(l) +
+                             " holds other than its size's texels");
+    }
+    size_t at = out.level_offsets[first_level + l];
+    for (const glm::vec4& texel : level.texels) {
+      if (out.format == TexelFormat::Rgba8) {
+        out.texels8[at++] = encode_srgb8(texel);
+      } else {
+        float* stored = &out.texels32[4 * at++];
+        stored[0] = texel.r;
+        stored[1] = texel.g;
+        stored[2] = texel.b;
+        stored[3] = texel.a;
+      }
+    }
+  }
+}
+
+// Guard bands of a scene with deferred textures. A face's band reads the levels of the faces
+// across its edges and around its corners, all of which share a vertex with it; so the faces are
+// packed in order, each face's chain made just before the first face that reads it and dropped
+// after the last. Only that moving window of faces (about a ring of the mesh) holds float texels
+// at once, never the whole scene.
+void pack_banded_deferred(const Scene& scene, PackedScene& out, const std::vector<size_t>& first_level) {
+  const size_t count = scene.faces.size();
+  std::vector<std::vector<uint32_t>> faces_at_vertex(scene.positions.size());
+  for (size_t f = 0; f < count; ++f)
+    for (uint32_t v : scene.faces[f].vertices) faces_at_vertex[v].push_back(static_cast<uint32_t>(f));
+  auto readers_of = [&](size_t f) {  // the faces f's band may read: those sharing a vertex with it, f included
+    std::vector<uint32_t> around;
+    for (uint32_t v : scene.faces[f].vertices) around.insert(around.end(), faces_at_vertex[v].begin(), faces_at_vertex[v].end());
+    std::sort(around.begin(), around.end());
+    around.erase(std::unique(around.begin(), around.end()), around.end());
+    return around;
+  };
+  std::vector<size_t> last_reader(count);
+  for (size_t f = 0; f < count; ++f)
+    for (uint32_t g : readers_of(f)) last_reader[g] = std::max(last_reader[g], f);
+  Scene window = scene;  // deferred chains (sizes only) but for the faces in the window
+  for (size_t f = 0; f < count; ++f) {
+    const std::vector<uint32_t> around = readers_of(f);
+    for (uint32_t g : around)
+      if (is_deferred(window.faces[g].texture)) window.faces[g].texture = face_texture(scene, g);
+    pack_face_texels(window, out, f, first_level[f]);
+    for (uint32_t g : around)
+      if (last_reader[g] == f && is_deferred(scene.faces[g].texture)) window.faces[g].texture = scene.faces[g].texture;  // sizes only again
+  }
+}
+
+}  // namespace
 
 PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
   if (guard_band < 0 || guard_band > kMaxGuardBand) throw std::invalid_argument("guard band out of range");
@@ -24,11 +91,9 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
   // Exactly what is stored, bands included: growing by push_back would hold up to 3x meanwhile.
   const size_t stored_texels = packed_texture_memory(scene_sizes(scene), format, guard_band).texels;
   if (stored_texels > std::numeric_limits<uint32_t>::max() / 4) throw std::length_error("scene textures exceed 2^30 texels");
-  if (format == TexelFormat::Rgba8) {
-    out.texels8.reserve(stored_texels);
-  } else {
-    out.texels32.reserve(stored_texels * 4);
-  }
+  // First the tables, from the sizes alone (a level stores (w + 2 band) x (h + 2 band) texels) ...
+  std::vector<size_t> first_level(scene.faces.size());
+  const size_t band = static_cast<size_t>(guard_band);
   size_t texels = 0;
   for (size_t f = 0; f < scene.faces.size(); ++f) {
     const Face& face = scene.faces[f];
@@ -44,27 +109,27 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
     gpu.normal[2] = n.z;
     gpu.reflective = face.roughness >= 0.0f ? static_cast<cl_int>(out.reflective_faces.size()) : -1;
     if (face.roughness >= 0.0f) out.reflective_faces.push_back(reflective_face(scene, face));
-    for (size_t l = 0; l < face.texture.levels.size(); ++l) {
-      const TextureLevel banded = guard_band > 0 ? guard_banded_level(scene, out.neighbors, static_cast<uint32_t>(f),
-                                                                      static_cast<int>(l), guard_band)
-                                                 : TextureLevel{};
-      const TextureLevel& level = guard_band > 0 ? banded : face.texture.levels[l];
-      // Offsets are 32-bit texel indices (and 4x that for float texels).
-      if ((texels + level.texels.size()) * 4 > std::numeric_limits<uint32_t>::max()) {
-        throw std::length_error("scene textures exceed 2^30 texels");
-      }
+    first_level[f] = out.level_offsets.size();
+    for (const TextureLevel& level : face.texture.levels) {
+      const size_t own = static_cast<size_t>(level.width) * static_cast<size_t>(level.height);
+      const size_t stored = (static_cast<size_t>(level.width) + 2 * band) * (static_cast<size_t>(level.height) + 2 * band);
       out.level_offsets.push_back(static_cast<uint32_t>(texels));
-      texels += level.texels.size();
-      out.band_texels += level.texels.size() - face.texture.levels[l].texels.size();
-      for (const glm::vec4& texel : level.texels) {
-        if (format == TexelFormat::Rgba8) {
-          out.texels8.push_back(encode_srgb8(texel));
-        } else {
-          out.texels32.insert(out.texels32.end(), {texel.r, texel.g, texel.b, texel.a});
-        }
-      }
+      texels += stored;
+      out.band_texels += stored - own;
     }
     out.faces.push_back(gpu);
+  }
+  if (texels != stored_texels) throw std::logic_error("pack_scene: level sizes disagree with packed_texture_memory");
+  // ... then the texels, faces in parallel, each into its own range: exactly sized up front.
+  if (format == TexelFormat::Rgba8) {
+    out.texels8.resize(stored_texels);
+  } else {
+    out.texels32.resize(stored_texels * 4);
+  }
+  if (guard_band > 0 && has_deferred_textures(scene)) {
+    pack_banded_deferred(scene, out, first_level);
+  } else {
+    for_each_face_in_parallel(scene.faces.size(), [&](size_t f) { pack_face_texels(scene, out, f, first_level[f]); });
   }
   return out;
 }

@@ -35,6 +35,9 @@ struct PackedScene {
 inline constexpr int kMaxGuardBand = 16;
 
 // With guard_band > 0 every level is stored with that many band texels each side (guard_band.h).
+// Faces are packed in parallel. A deferred face's chain (Scene::texture_source) is made while
+// it is packed and dropped right after (with guard bands, kept while its neighbours are packed),
+// so that packing never holds the float copy of every texture: the packed texels are what stays.
 PackedScene pack_scene(const Scene& scene, TexelFormat format = TexelFormat::Rgba8, int guard_band = 0);
 
 }  // namespace seamcl

@@ -6,6 +6,13 @@
 
 #include <seamcl/pipeline/gpu_types.h>
 #include <seamcl/pipeline/packed_scene.h>
+#include <seamcl/pipeline/renderer.h>
+
+#include <sys/resource.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
 
 namespace seamcl {
 namespace {
@@ -144,6 +151,67 @@ RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options
 
 RenderMemory render_memory(const Scene& scene, const RenderOptions& options) {
   return render_memory(scene_sizes(scene), options);
+}
+
+namespace {
+
+// "VmHWM:     123456 kB" -> bytes; 0 when the line is not there.
+size_t status_kilobytes(const std::string& status, const std::string& key) {
+  std::istringstream lines(status);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.rfind(key + ":", 0) != 0) continue;
+    std::istringstream fields(line.substr(key.size() + 1));
+    size_t kilobytes = 0;
+    std::string unit;
+    if (fields >> kilobytes >> unit && unit == "kB") return saturating_mul(kilobytes, 1024);
+    return 0;
+  }
+  return 0;
+}
+
+}  // namespace
+
+ProcessMemory process_memory() {
+  ProcessMemory memory;
+  std::ifstream file("/proc/self/status");
+  if (file) {
+    std::ostringstream text;
+    text << file.rdbuf();
+    memory.peak_rss_bytes = status_kilobytes(text.str(), "VmHWM");
+    memory.rss_bytes = status_kilobytes(text.str(), "VmRSS");
+  }
+  if (memory.peak_rss_bytes == 0) {
+    rusage usage{};
+    if (getrusage(RUSAGE_SELF, &usage) == 0) memory.peak_rss_bytes = saturating_mul(static_cast<size_t>(usage.ru_maxrss), 1024);
+  }
+  return memory;
+}
+
+MeasuredMemory measure_memory(const Scene& caller_scene, const Renderer& renderer) {
+  MeasuredMemory m;
+  m.process = process_memory();
+  const PackedScene& packed = renderer.packed_scene();
+  m.packed_texels = packed.texel_count();
+  m.packed_texel_bytes = packed.texture_bytes();
+  m.host_packed_bytes = packed.positions.size() * sizeof(cl_float4) + packed.faces.size() * sizeof(FaceGpu) +
+                        packed.adjacency_bytes() + packed.level_offsets.size() * sizeof(uint32_t) +
+                        packed.texture_bytes() + packed.reflective_faces.size() * sizeof(ReflectiveFace);
+  m.device_bytes = renderer.device_bytes();
+  m.scene_float_texel_bytes = caller_scene.stored_texel_count() * sizeof(glm::vec4);
+  if (renderer.has_scene()) m.renderer_float_texel_bytes = renderer.scene().stored_texel_count() * sizeof(glm::vec4);
+  return m;
+}
+
+nlohmann::json to_json(const MeasuredMemory& m) {
+  return {{"peak_rss_bytes", m.process.peak_rss_bytes},
+          {"rss_bytes", m.process.rss_bytes},
+          {"packed_texels", m.packed_texels},
+          {"packed_texel_bytes", m.packed_texel_bytes},
+          {"host_packed_bytes", m.host_packed_bytes},
+          {"device_bytes", m.device_bytes},
+          {"scene_float_texel_bytes", m.scene_float_texel_bytes},
+          {"renderer_float_texel_bytes", m.renderer_float_texel_bytes}};
 }
 
 }  // namespace seamcl

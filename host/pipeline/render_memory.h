@@ -23,6 +23,8 @@
 #include <utility>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/scene/scene.h>
 
@@ -82,7 +84,9 @@ struct RenderMemory {
   size_t tile_lists_bound = 0;  // upper bound of tile_lists after growth (see above)
 
   // Host.
-  size_t host_scene = 0;   // the Renderer's Scene copy: positions, faces, float RGBA texels of every level
+  // The Renderer's Scene copy: positions, faces, float RGBA texels of every level. A scene whose
+  // textures are deferred (Scene::texture_source) holds none of those texels: an upper bound then.
+  size_t host_scene = 0;
   size_t host_packed = 0;  // PackedScene's arrays (the device scene buffers without their minimum)
   size_t host_image = 0;   // RenderResult::pixels, float4 per pixel
 
@@ -109,5 +113,35 @@ size_t saturating_mul(size_t a, size_t b);
 // What one Scene holds in memory (positions, faces, every level's float RGBA texels): the
 // Renderer's copy, or the caller's.
 size_t scene_host_bytes(const SceneSizes& scene);
+
+// What this process holds, as Linux counts it: VmHWM and VmRSS of /proc/self/status (where that
+// cannot be read, getrusage's ru_maxrss for the peak and 0 for the current). The peak includes the
+// OpenCL runtime's own (PoCL's floor: about 227 MB for the two-face quad2 render).
+struct ProcessMemory {
+  size_t peak_rss_bytes = 0;
+  size_t rss_bytes = 0;
+};
+ProcessMemory process_memory();
+
+class Renderer;
+
+// What one loaded scene costs, measured after a render: for `render --json` and the benches.
+struct MeasuredMemory {
+  ProcessMemory process;
+  size_t packed_texels = 0;         // stored texels of every level of every face, guard bands included
+  size_t packed_texel_bytes = 0;    // their bytes (PackedScene::texture_bytes)
+  size_t host_packed_bytes = 0;     // every packed array the Renderer holds (texels, tables, positions, faces)
+  // The Renderer's device buffers (Renderer::device_bytes). On a device sharing host memory the
+  // texel buffer is the packed array itself, so these bytes overlap host_packed_bytes there.
+  size_t device_bytes = 0;
+  size_t scene_float_texel_bytes = 0;     // float RGBA texels the caller's Scene holds (0: deferred)
+  size_t renderer_float_texel_bytes = 0;  // the same in the Renderer's copy of the scene
+};
+
+// Reads the process's memory now; the packed and device figures of the renderer's loaded scene.
+MeasuredMemory measure_memory(const Scene& caller_scene, const Renderer& renderer);
+// {"peak_rss_bytes", "rss_bytes", "packed_texels", "packed_texel_bytes", "host_packed_bytes",
+//  "device_bytes", "scene_float_texel_bytes", "renderer_float_texel_bytes"}
+nlohmann::json to_json(const MeasuredMemory& memory);
 
 }  // namespace seamcl

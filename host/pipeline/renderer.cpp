@@ -103,15 +103,16 @@ struct Renderer::Impl {
     faces = upload(packed.faces);
     neighbors = upload(packed.neighbors);
     level_offsets = upload(packed.level_offsets);
-    texels = format == TexelFormat::Rgba8 ? upload(packed.texels8) : upload(packed.texels32);
+    texels = format == TexelFormat::Rgba8 ? upload_shared(packed.texels8) : upload_shared(packed.texels32);
     reflective_faces = upload(packed.reflective_faces);
     uploaded = true;
   }
 
   void release_scene_buffers() {
     uploaded = false;
-    packed = PackedScene{};
+    // The buffers first: the texel buffer may be the packed array itself (upload_shared).
     positions = faces = neighbors = level_offsets = texels = reflective_faces = cube_texels = cl::Buffer();
+    packed = PackedScene{};
     cube_bake_uploaded.reset();
     cube_host = {};
     tessellation.release();
@@ -153,6 +154,17 @@ struct Renderer::Impl {
     cl::Buffer buffer(runtime.context(), CL_MEM_READ_ONLY, bytes);
     if (!data.empty()) runtime.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, data.size() * sizeof(T), data.data());
     return buffer;
+  }
+
+  // The packed texels, the largest array: on a device that shares the host's memory (PoCL on the
+  // CPU) the buffer is the packed array itself (CL_MEM_USE_HOST_PTR), so the texels are held once
+  // rather than twice (issue 14); `packed` outlives it (release_scene_buffers drops the buffers
+  // first, and renders wait for their commands). Elsewhere a device copy, as upload() makes.
+  template <typename T>
+  cl::Buffer upload_shared(const std::vector<T>& data) {
+    if (data.empty() || runtime.device().getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>() != CL_TRUE) return upload(data);
+    return cl::Buffer(runtime.context(), CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, data.size() * sizeof(T),
+                      const_cast<T*>(data.data()));
   }
 
   static void grow(cl::Buffer& buffer, size_t& capacity, size_t needed, size_t element_bytes, const cl::Context& context) {

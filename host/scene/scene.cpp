@@ -1,8 +1,14 @@
 #include <seamcl/scene/scene.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
 #include <string>
+#include <system_error>
+#include <thread>
 
 #include <seamcl/core/input_error.h>
 
@@ -47,7 +53,7 @@ void check_vec3(glm::vec3 v, const std::string& field) {
   if (!is_finite(v)) throw InputError(field, "must be finite");
 }
 
-void check_texture(const MipChain& chain, const std::string& field) {
+void check_texture(const MipChain& chain, const std::string& field, bool may_defer) {
   if (chain.levels.empty()) throw InputError(field, "has no mip levels");
   const int width = chain.width();
   const int height = chain.height();
@@ -64,12 +70,15 @@ void check_texture(const MipChain& chain, const std::string& field) {
                                 " mip levels, expected " + std::to_string(expected_levels) +
                                 " (a full chain down to 1x1)");
   }
+  // Deferred: every level empty, and a texture_source to fill them.
+  const bool deferred = is_deferred(chain);
+  if (deferred && !may_defer) throw InputError(field, "mip level 0 has no texels");
   for (size_t k = 0; k < chain.levels.size(); ++k) {
     const TextureLevel& level = chain.levels[k];
     const int expected_width = std::max(1, width >> k);
     const int expected_height = std::max(1, height >> k);
-    if (level.width != expected_width || level.height != expected_height ||
-        level.texels.size() != static_cast<size_t>(expected_width) * expected_height) {
+    const size_t expected_texels = deferred ? 0 : static_cast<size_t>(expected_width) * expected_height;
+    if (level.width != expected_width || level.height != expected_height || level.texels.size() != expected_texels) {
       throw InputError(field, "mip level " + std::to_string(k) + " is " +
                                   size_text(level.width, level.height) + " with " +
                                   std::to_string(level.texels.size()) + " texels, expected " +
@@ -116,6 +125,66 @@ MipChain build_mip_chain(TextureLevel level0) {
   while (chain.levels.back().width > 1 || chain.levels.back().height > 1)
     chain.levels.push_back(box_downsample(chain.levels.back()));
   return chain;
+}
+
+MipChain deferred_mip_chain(int width, int height) {
+  MipChain chain;
+  for (int k = 0; k == 0 || (width >> (k - 1)) > 1 || (height >> (k - 1)) > 1; ++k)
+    chain.levels.push_back({std::max(1, width >> k), std::max(1, height >> k), {}});
+  return chain;
+}
+
+bool is_deferred(const MipChain& chain) { return !chain.levels.empty() && chain.levels.front().texels.empty(); }
+
+MipChain face_texture(const Scene& scene, size_t face) {
+  const MipChain& stored = scene.faces.at(face).texture;
+  if (!is_deferred(stored)) return stored;
+  if (!scene.texture_source) throw std::logic_error("face " + std::to_string(face) + " has a deferred texture and no source");
+  MipChain made = scene.texture_source(face);
+  bool same_sizes = made.levels.size() == stored.levels.size();
+  for (size_t k = 0; same_sizes && k < made.levels.size(); ++k)
+    same_sizes = made.levels[k].width == stored.levels[k].width && made.levels[k].height == stored.levels[k].height &&
+                 made.levels[k].texels.size() == static_cast<size_t>(made.levels[k].width) * made.levels[k].height;
+  if (!same_sizes) throw std::logic_error("texture_source made face " + std::to_string(face) + " at another size");
+  return made;
+}
+
+bool has_deferred_textures(const Scene& scene) {
+  return std::any_of(scene.faces.begin(), scene.faces.end(), [](const Face& f) { return is_deferred(f.texture); });
+}
+
+void materialize_textures(Scene& scene) {
+  if (!has_deferred_textures(scene)) return;
+  for_each_face_in_parallel(scene.faces.size(), [&](size_t f) {
+    if (is_deferred(scene.faces[f].texture)) scene.faces[f].texture = face_texture(scene, f);
+  });
+}
+
+void for_each_face_in_parallel(size_t count, const std::function<void(size_t face)>& work) {
+  std::atomic<size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto run_remaining = [&] {
+    try {
+      for (size_t f = next++; f < count; f = next++) work(f);
+    } catch (...) {
+      // Out of memory must reach the caller rather than terminate the process from a thread.
+      const std::lock_guard lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      next = count;
+    }
+  };
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());  // 0 if unknown
+  const unsigned helper_count = std::min(7u, cores - 1);
+  std::vector<std::thread> helpers;
+  try {
+    for (unsigned h = 0; h < helper_count && h < count; ++h) helpers.emplace_back(run_remaining);
+  } catch (const std::system_error&) {
+    // Fewer helpers than asked for: this thread does whatever they do not.
+  }
+  run_remaining();
+  for (std::thread& helper : helpers) helper.join();
+  if (failure) std::rethrow_exception(failure);
 }
 
 glm::vec3 face_point(const std::array<glm::vec3, 4>& corners, float u, float v) {
@@ -226,6 +295,14 @@ glm::vec3 Scene::face_normal(const Face& f) const {
 size_t Scene::texel_count() const {
   size_t count = 0;
   for (const Face& face : faces)
+    for (const TextureLevel& level : face.texture.levels)
+      count += static_cast<size_t>(level.width) * static_cast<size_t>(level.height);
+  return count;
+}
+
+size_t Scene::stored_texel_count() const {
+  size_t count = 0;
+  for (const Face& face : faces)
     for (const TextureLevel& level : face.texture.levels) count += level.texels.size();
   return count;
 }
@@ -294,7 +371,7 @@ void validate_scene(const Scene& scene) {
     const float area_measure = glm::length(diagonal_cross);
     if (!(area_measure > 0.0f) || !std::isfinite(area_measure))
       throw InputError(face_field + ".vertices", "the quad is degenerate (zero area)");
-    check_texture(face.texture, face_field + ".texture");
+    check_texture(face.texture, face_field + ".texture", static_cast<bool>(scene.texture_source));
     check_reflective_face(scene, face, face_field);
   }
   if (scene.environment) validate_environment(*scene.environment);

@@ -37,6 +37,12 @@ struct MipChain {
 // Builds the whole chain from level 0 (must be power-of-two sized).
 MipChain build_mip_chain(TextureLevel level0);
 
+// A chain that says only its levels' sizes (width x height down to 1x1) and holds no texels: the
+// texture of a face whose texels Scene::texture_source makes when they are needed.
+MipChain deferred_mip_chain(int width, int height);
+// Level 0 holds no texels: the chain is a deferred one (a built level 0 has at least one).
+bool is_deferred(const MipChain& chain);
+
 // The next level of a chain: each side above 1 halved, each texel the mean of its 2x2 (2x1, 1x2)
 // block.
 TextureLevel box_downsample(const TextureLevel& fine);
@@ -99,12 +105,32 @@ struct Scene {
   // Per-face displacement maps, read only by renders that ask for a displacement method
   // (docs/displacement.md); null for scenes without them.
   std::shared_ptr<const Displacement> displacement;
+  // Makes face f's whole chain (exactly what a stored one would hold) for the faces whose texture
+  // is deferred (is_deferred: sizes only). Generators asked to (GeneratorOptions::defer_textures)
+  // leave their textures to it, so that no float RGBA copy of every face ever exists: pack_scene
+  // makes each face's chain, packs it and drops it, and the packed copy is the only one (the
+  // float chains are 4x the packed RGBA8 bytes). Thread-safe; a copy of the scene shares it.
+  std::function<MipChain(size_t face)> texture_source;
 
   size_t triangle_count() const { return faces.size() * 2; }
   std::array<glm::vec3, 4> corners(const Face& f) const;
   glm::vec3 face_normal(const Face& f) const;  // unit normal of the quad (cross of diagonals)
-  size_t texel_count() const;                  // all levels of all faces
+  size_t texel_count() const;                  // all levels of all faces, deferred ones included
+  size_t stored_texel_count() const;           // the float RGBA texels held in memory (not deferred)
 };
+
+// Face f's chain: its stored one, or texture_source's for a deferred face (throws
+// std::logic_error when there is no source, or it makes a chain of other sizes).
+MipChain face_texture(const Scene& scene, size_t face);
+// Bakes every deferred face's texture into the scene (in parallel over faces): for the code that
+// reads other faces' texels (guard bands, references). A no-op for a scene without any.
+void materialize_textures(Scene& scene);
+bool has_deferred_textures(const Scene& scene);
+
+// Runs work(f) for every f in [0, count) on this thread and up to 7 helpers (one fewer than the
+// cores), faces handed out one at a time; the first exception thrown is rethrown here once all
+// have stopped. Nothing about the result may depend on which thread ran which face.
+void for_each_face_in_parallel(size_t count, const std::function<void(size_t face)>& work);
 
 // The camera of frame `frame` of `frames` of the scene's orbit. Throws InputError (field "frame")
 // when the scene has no orbit or frame is outside [0, frames).

@@ -1,16 +1,12 @@
 #include <seamcl/scene/scene_generators.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
-#include <exception>
 #include <functional>
 #include <map>
-#include <mutex>
+#include <memory>
 #include <random>
-#include <system_error>
-#include <thread>
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/scene/envmap_scene.h>
@@ -51,41 +47,39 @@ std::function<glm::vec4(size_t, glm::vec3)> albedo_function(TextureContent conte
   };
 }
 
+// Face f's chain baked from `albedo` at its texel centres.
+MipChain bake_face_chain(const std::array<glm::vec3, 4>& corners, TextureSize size,
+                         const std::function<glm::vec4(size_t, glm::vec3)>& albedo, size_t f) {
+  return build_mip_chain(bake_face_texture(corners, size.width, size.height, [&](glm::vec3 p) { return albedo(f, p); }));
+}
+
 // Texture contents for every face, in parallel, baked from scene.albedo: baking the paper
 // scene's ~9 million texels is most of its generation time, and faces are independent, so the
-// result does not depend on the number of threads or their timing.
-void bake_textures(Scene& scene, const std::vector<TextureSize>& sizes) {
-  auto paint_face = [&](size_t f) {
-    Face& face = scene.faces[f];
-    face.texture = build_mip_chain(bake_face_texture(scene.corners(face), sizes[f].width, sizes[f].height,
-                                                     [&](glm::vec3 p) { return scene.albedo(f, p); }));
-  };
-  // Faces are handed out one at a time because their sizes differ by up to 64x.
-  std::atomic<size_t> next_face{0};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  auto paint_remaining = [&] {
-    try {
-      for (size_t f = next_face++; f < scene.faces.size(); f = next_face++) paint_face(f);
-    } catch (...) {
-      // Out of memory must reach the caller rather than terminate the process from a thread.
-      const std::lock_guard lock(failure_mutex);
-      if (!failure) failure = std::current_exception();
-      next_face = scene.faces.size();
-    }
-  };
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());  // 0 if unknown
-  const unsigned helper_count = std::min(7u, cores - 1);
-  std::vector<std::thread> helpers;
-  try {
-    for (unsigned h = 0; h < helper_count && h < scene.faces.size(); ++h)
-      helpers.emplace_back(paint_remaining);
-  } catch (const std::system_error&) {
-    // Fewer helpers than asked for: this thread paints whatever they do not.
+// result does not depend on the number of threads or their timing. With defer, nothing is baked:
+// every face gets its sizes and scene.texture_source the same recipe (its own copy of the
+// corners and the albedo, so it stays right in any copy of the scene), baked when packed.
+void bake_textures(Scene& scene, const std::vector<TextureSize>& sizes, bool defer) {
+  if (defer) {
+    struct Recipe {
+      std::vector<std::array<glm::vec3, 4>> corners;
+      std::vector<TextureSize> sizes;
+      std::function<glm::vec4(size_t, glm::vec3)> albedo;
+    };
+    auto recipe = std::make_shared<Recipe>();
+    for (const Face& face : scene.faces) recipe->corners.push_back(scene.corners(face));
+    recipe->sizes = sizes;
+    recipe->albedo = scene.albedo;
+    for (size_t f = 0; f < scene.faces.size(); ++f)
+      scene.faces[f].texture = deferred_mip_chain(sizes[f].width, sizes[f].height);
+    scene.texture_source = [recipe = std::shared_ptr<const Recipe>(std::move(recipe))](size_t f) {
+      return bake_face_chain(recipe->corners.at(f), recipe->sizes.at(f), recipe->albedo, f);
+    };
+    return;
   }
-  paint_remaining();
-  for (std::thread& helper : helpers) helper.join();
-  if (failure) std::rethrow_exception(failure);
+  // Faces are handed out one at a time because their sizes differ by up to 64x.
+  for_each_face_in_parallel(scene.faces.size(), [&](size_t f) {
+    scene.faces[f].texture = bake_face_chain(scene.corners(scene.faces[f]), sizes[f], scene.albedo, f);
+  });
 }
 
 // The generator's textures: `sizes` per face, painted as the options say over `content`, the
@@ -93,7 +87,7 @@ void bake_textures(Scene& scene, const std::vector<TextureSize>& sizes) {
 void paint_textures(Scene& scene, const std::vector<TextureSize>& sizes, const GeneratorOptions& options,
                     TextureContent content = TextureContent::Surface) {
   scene.albedo = albedo_function(options.content.value_or(content), median_spacing(scene, sizes), options);
-  bake_textures(scene, sizes);
+  bake_textures(scene, sizes, options.defer_textures);
 }
 
 // A grid of nx x nz quads over [x0, x1] x [z0, z1] at height y, facing +y (counter-clockwise seen
@@ -144,24 +138,41 @@ void set_orbit_and_camera(Scene& scene, Orbit orbit, float fov_y_degrees) {
 }
 
 // Figure 1 of the paper: a torus on a ground plane, every face with its own texture of a size
-// drawn independently per axis from 16..128, so neighbouring faces rarely match.
+// drawn independently per axis from 16..128, so neighbouring faces rarely match. With
+// options.faces, the same scene subdivided further (or less), its textures scaled to keep about
+// the same texels; with options.texture_scale_log2, every texture side scaled by a power of two.
 Scene make_paper(const GeneratorOptions& options) {
   Scene scene;
   scene.name = "paper";
   constexpr float kMajorRadius = 2.0f;
   constexpr float kMinorRadius = 0.7f;
+  const double target = static_cast<double>(options.faces.value_or(kPaperFaces));
+  const double scale = std::sqrt(target / kPaperFaces);  // of the segment counts
+  auto segments = [&](int original) { return std::max(3, static_cast<int>(std::lround(original * scale))); };
+  // The area of each texture divided by 2^area_shift, split over the two sides (u takes the larger half).
+  const int area_shift = static_cast<int>(std::lround(std::log2(target / kPaperFaces)));
+  const int u_shift = area_shift >= 0 ? (area_shift + 1) / 2 : area_shift / 2;
+  const int v_shift = area_shift - u_shift;
+  const int texture_scale = options.texture_scale_log2.value_or(0);
+  auto scaled_side = [](int side, int log2_factor) {
+    const int scaled = log2_factor >= 0 ? side << log2_factor : side >> -log2_factor;
+    return std::clamp(scaled, 1, 4096);
+  };
   // Resting on the ground: the exact torus would touch y = 0; its polygonal version stays a few
   // thousandths above it.
   const glm::vec3 torus_center(0.0f, kMajorRadius + kMinorRadius, 0.0f);
-  add_torus(scene, torus_center, kMajorRadius, kMinorRadius, 50, 29);
-  add_ground_grid(scene, 32, 32, -8.0f, 8.0f, -8.0f, 8.0f, 0.0f);
+  add_torus(scene, torus_center, kMajorRadius, kMinorRadius, segments(50), segments(29));
+  // The ground takes what the torus leaves of the count (32 x 32 for the paper scene itself).
+  const int torus_faces = segments(50) * segments(29);
+  const int ground = std::max(3, static_cast<int>(std::lround(std::sqrt(std::max(target - torus_faces, 9.0)))));
+  add_ground_grid(scene, ground, ground, -8.0f, 8.0f, -8.0f, 8.0f, 0.0f);
 
   std::mt19937 random(20130805u);
   constexpr int kSides[] = {16, 32, 64, 128};
   std::vector<TextureSize> sizes(scene.faces.size());
   for (TextureSize& size : sizes) {
-    size.width = kSides[random() % 4];
-    size.height = kSides[random() % 4];
+    size.width = scaled_side(kSides[random() % 4], texture_scale - u_shift);
+    size.height = scaled_side(kSides[random() % 4], texture_scale - v_shift);
   }
   paint_textures(scene, sizes, options);
 
@@ -397,9 +408,30 @@ const std::vector<GeneratorInfo>& scene_generators() {
   return infos;
 }
 
+void check_paper_scaling(const std::string& scene, const GeneratorOptions& options, const std::string& path) {
+  const std::string prefix = path.empty() ? "" : path + ".";
+  if (options.faces) {
+    if (scene != "paper") throw InputError(prefix + "faces", "only the paper scene takes a face count, not '" + scene + "'");
+    if (*options.faces < kMinPaperFaces || *options.faces > kMaxPaperFaces) {
+      throw InputError(prefix + "faces", "must be in " + std::to_string(kMinPaperFaces) + ".." +
+                                             std::to_string(kMaxPaperFaces) + ", got " + std::to_string(*options.faces));
+    }
+  }
+  if (options.texture_scale_log2) {
+    if (scene != "paper")
+      throw InputError(prefix + "texture_scale_log2", "only the paper scene takes a texture scale, not '" + scene + "'");
+    if (*options.texture_scale_log2 < kMinTextureScaleLog2 || *options.texture_scale_log2 > kMaxTextureScaleLog2) {
+      throw InputError(prefix + "texture_scale_log2", "must be in " + std::to_string(kMinTextureScaleLog2) + ".." +
+                                                          std::to_string(kMaxTextureScaleLog2) + ", got " +
+                                                          std::to_string(*options.texture_scale_log2));
+    }
+  }
+}
+
 Scene generate_scene(const std::string& name, const GeneratorOptions& options) {
   for (const Generator& generator : generators()) {
     if (generator.info.name != name) continue;
+    check_paper_scaling(name, options);
     Scene scene = generator.make(options);
     validate_scene(scene);
     return scene;
@@ -434,6 +466,7 @@ void apply_generator_options(Scene& scene, const GeneratorOptions& options) {
     set_constant_textures(scene, glm::vec4(*options.constant_color, 1.0f));
   if (options.constant_color && scene.environment) scene.environment->constant = *options.constant_color;
   if (!options.tint) return;
+  materialize_textures(scene);  // tinting scales texels: a deferred scene's are baked first
   // The box filter is linear, so scaling every level equals re-filtering a scaled level 0.
   for (size_t f = 0; f < scene.faces.size(); ++f) {
     const glm::vec4 tint(face_tint(f), 1.0f);

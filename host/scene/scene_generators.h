@@ -28,7 +28,29 @@ struct GeneratorOptions {
   // its mirror sphere, glossy sphere and torus.
   std::optional<Environment> environment;
   std::optional<glm::vec3> roughness;
+  // Leave the generator's baked textures to Scene::texture_source (deferred_mip_chain sizes
+  // only): a render that packs the scene once never holds the float copy of every texture.
+  // The texels are the same either way.
+  bool defer_textures = false;
+  // paper only, for scaling measurements (seamcl bench --sweep). faces: about this many faces
+  // (kMinPaperFaces..kMaxPaperFaces; the torus and the ground subdivided in proportion, within 2%
+  // of it or 5 faces), each texture's area divided by the power of two nearest faces / 2,474 so that the
+  // scene keeps about the original's texels (sides stop at 1). texture_scale_log2: every texture
+  // side times 2^k (kMinTextureScaleLog2..kMaxTextureScaleLog2), after the face count's scaling.
+  // Unset (or 2,474 and 0): the paper scene itself.
+  std::optional<int> faces;
+  std::optional<int> texture_scale_log2;
 };
+
+inline constexpr int kPaperFaces = 2474;          // 50 x 29 torus quads and 32 x 32 ground quads
+inline constexpr int kMinPaperFaces = 100;
+inline constexpr int kMaxPaperFaces = 250000;     // about 100 MB of scene and packed tables
+inline constexpr int kMinTextureScaleLog2 = -4;   // sides 16..128 become 1..8
+inline constexpr int kMaxTextureScaleLog2 = 1;    // 4x the texels: about 150 MB packed RGBA8
+
+// InputError ("faces" / "texture_scale_log2", prefixed by `path` when not empty) for a value out
+// of its range or a scene other than paper.
+void check_paper_scaling(const std::string& scene, const GeneratorOptions& options, const std::string& path = {});
 
 struct GeneratorInfo {
   std::string name;

@@ -202,7 +202,8 @@ Environment read_environment(const json& value, const std::string& path) {
 }
 
 GeneratorOptions read_generator_options(const json& value, const std::string& path) {
-  const ObjectFields fields(value, path, {"tint", "constant_color", "content", "environment", "roughness"});
+  const ObjectFields fields(value, path,
+                            {"tint", "constant_color", "content", "environment", "roughness", "faces", "texture_scale_log2"});
   GeneratorOptions options;
   if (const json* content = fields.optional("content")) {
     const std::string name = read_string(*content, fields.path_of("content"));
@@ -227,6 +228,11 @@ GeneratorOptions read_generator_options(const json& value, const std::string& pa
     options.tint = read_bool(*tint, fields.path_of("tint"));
   if (const json* color = fields.optional("constant_color"))
     options.constant_color = read_color(*color, fields.path_of("constant_color"));
+  // The ranges are checked against the generator's name (check_paper_scaling), which the caller knows.
+  const int int_max = std::numeric_limits<int>::max(), int_min = std::numeric_limits<int>::min();
+  if (const json* faces = fields.optional("faces")) options.faces = read_int(*faces, fields.path_of("faces"), int_min, int_max);
+  if (const json* scale = fields.optional("texture_scale_log2"))
+    options.texture_scale_log2 = read_int(*scale, fields.path_of("texture_scale_log2"), int_min, int_max);
   return options;
 }
 
@@ -242,8 +248,10 @@ GeneratorRequest read_generator_request(const json& doc) {
   if (!is_generator_name(request.name))
     throw InputError("generator", "unknown generator '" + request.name +
                                       "' (known: " + known_generator_names() + ")");
-  if (const json* options = fields.optional("options"))
+  if (const json* options = fields.optional("options")) {
     request.options = read_generator_options(*options, "options");
+    check_paper_scaling(request.name, request.options, "options");
+  }
   return request;
 }
 
@@ -441,6 +449,7 @@ Scene realize(SceneSource source, const GeneratorOptions& extra) {
     options.tint = options.tint || extra.tint;
     if (extra.constant_color) options.constant_color = extra.constant_color;
     if (extra.content) options.content = extra.content;
+    options.defer_textures = options.defer_textures || extra.defer_textures;
     return generate_scene(request->name, options);
   }
   Scene scene = std::move(std::get<Scene>(source));

@@ -1,0 +1,169 @@
+// Host memory of a render (issue 14): generators that defer their textures to
+// Scene::texture_source pack to exactly the texels of baked ones, hold no float copy, and the
+// memory a render reports (render --json "memory") adds up to the faces' packed sizes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <seamcl/core/input_error.h>
+#include <seamcl/pipeline/packed_scene.h>
+#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene_generators.h>
+
+#include "core/srgb.h"
+#include "test_support.h"
+
+namespace {
+
+using namespace seamcl;
+
+Scene generated(const std::string& name, bool defer, bool tint = false) {
+  GeneratorOptions options;
+  options.defer_textures = defer;
+  options.tint = tint;
+  return generate_scene(name, options);
+}
+
+// Stored texels of every level of every face, counted here by halving the sides (not by the
+// library's own tables): what the packed texture must hold.
+size_t sum_of_face_texels(const Scene& scene, int band) {
+  size_t total = 0;
+  for (const Face& face : scene.faces) {
+    int w = face.texture.width(), h = face.texture.height();
+    for (;;) {
+      total += static_cast<size_t>(w + 2 * band) * static_cast<size_t>(h + 2 * band);
+      if (w == 1 && h == 1) break;
+      w = std::max(1, w / 2);
+      h = std::max(1, h / 2);
+    }
+  }
+  return total;
+}
+
+void expect_same_packing(const PackedScene& a, const PackedScene& b) {
+  EXPECT_EQ(a.level_offsets, b.level_offsets);
+  EXPECT_EQ(a.band_texels, b.band_texels);
+  ASSERT_EQ(a.texels8.size(), b.texels8.size());
+  ASSERT_EQ(a.texels32.size(), b.texels32.size());
+  EXPECT_TRUE(a.texels8 == b.texels8);
+  // Bit for bit: the same function at the same points, the same box filter.
+  EXPECT_TRUE(std::equal(a.texels32.begin(), a.texels32.end(), b.texels32.begin(),
+                         [](float x, float y) { return std::memcmp(&x, &y, sizeof x) == 0; }));
+  ASSERT_EQ(a.faces.size(), b.faces.size());
+  for (size_t f = 0; f < a.faces.size(); ++f) {
+    EXPECT_EQ(a.faces[f].width, b.faces[f].width);
+    EXPECT_EQ(a.faces[f].height, b.faces[f].height);
+    EXPECT_EQ(a.faces[f].level_count, b.faces[f].level_count);
+    EXPECT_EQ(a.faces[f].level_table, b.faces[f].level_table);
+  }
+}
+
+TEST(Memory, DeferredTexturesHoldNoTexelsAndPackToTheBakedOnesExactly) {
+  for (const char* name : {"quad2", "cube", "mixed", "closeup-corner"}) {
+    for (bool tint : {false, true}) {
+      SCOPED_TRACE(std::string(name) + (tint ? " tinted" : ""));
+      const Scene baked = generated(name, false, tint);
+      const Scene deferred = generated(name, true, tint);
+      EXPECT_GT(baked.stored_texel_count(), 0u);
+      EXPECT_EQ(deferred.stored_texel_count(), 0u);
+      EXPECT_EQ(deferred.texel_count(), baked.texel_count());
+      EXPECT_TRUE(has_deferred_textures(deferred));
+      EXPECT_FALSE(has_deferred_textures(baked));
+      for (TexelFormat format : {TexelFormat::Rgba8, TexelFormat::Rgba32f})
+        for (int band : {0, 2}) expect_same_packing(pack_scene(baked, format, band), pack_scene(deferred, format, band));
+      // Materialised, it is the baked scene.
+      Scene built = deferred;
+      materialize_textures(built);
+      EXPECT_FALSE(has_deferred_textures(built));
+      for (size_t f = 0; f < built.faces.size(); ++f)
+        for (size_t l = 0; l < built.faces[f].texture.levels.size(); ++l)
+          ASSERT_TRUE(built.faces[f].texture.levels[l].texels == baked.faces[f].texture.levels[l].texels);
+    }
+  }
+}
+
+TEST(Memory, ADeferredChainNeedsASourceOfTheRightSize) {
+  Scene scene = generated("quad2", true);
+  validate_scene(scene);  // deferred with a source: valid
+  Scene without = scene;
+  without.texture_source = nullptr;
+  try {
+    validate_scene(without);
+    FAIL() << "a deferred texture without a source was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "faces[0].texture");
+  }
+  Scene wrong = scene;
+  wrong.texture_source = [](size_t) { return build_mip_chain(TextureLevel{2, 2, std::vector<glm::vec4>(4)}); };
+  EXPECT_THROW(face_texture(wrong, 0), std::logic_error);
+  EXPECT_THROW(pack_scene(wrong), std::logic_error);
+  // A face given a built texture stops being deferred: its own texels are packed.
+  Scene replaced = scene;
+  replaced.faces[1].texture = build_mip_chain(TextureLevel{32, 16, std::vector<glm::vec4>(512, glm::vec4(0.5f))});
+  const PackedScene packed = pack_scene(replaced);
+  const PackedScene original = pack_scene(scene);
+  const size_t first = packed.level_offsets[packed.faces[1].level_table];
+  for (size_t t = first; t < packed.texels8.size(); ++t) ASSERT_EQ(packed.texels8[t], encode_srgb8(glm::vec4(0.5f)));
+  EXPECT_TRUE(std::equal(packed.texels8.begin(), packed.texels8.begin() + static_cast<std::ptrdiff_t>(first),
+                         original.texels8.begin()));
+}
+
+TEST(Memory, ReportedPackedBytesAreTheSumOfTheFacesPackedSizes) {
+  struct Case {
+    const char* scene;
+    TexelFormat format;
+    Method method;
+  };
+  for (const Case& c : {Case{"mixed", TexelFormat::Rgba8, Method::Discard}, Case{"mixed", TexelFormat::Rgba32f, Method::Traverse},
+                        Case{"cube", TexelFormat::Rgba8, Method::Guardband}, Case{"quad2", TexelFormat::Rgba8, Method::Discard}}) {
+    SCOPED_TRACE(std::string(c.scene) + " " + to_string(c.method));
+    const Scene scene = generated(c.scene, true);
+    Renderer renderer(seamcl_tests::shared_runtime());
+    renderer.load_scene(scene, c.format);
+    RenderOptions options;
+    options.width = 64;
+    options.height = 48;
+    options.msaa = 1;
+    options.method = c.method;
+    options.texels = c.format;
+    renderer.render(scene.camera, options);
+    const MeasuredMemory m = measure_memory(scene, renderer);
+    const int band = renderer.packed_scene().guard_band;
+    EXPECT_EQ(band, c.method == Method::Guardband ? sampler_params(options).guard_band : 0);
+    const size_t texel_bytes = c.format == TexelFormat::Rgba8 ? 4 : 16;
+    EXPECT_EQ(m.packed_texels, sum_of_face_texels(scene, band));
+    EXPECT_EQ(m.packed_texel_bytes, sum_of_face_texels(scene, band) * texel_bytes);
+    EXPECT_GT(m.host_packed_bytes, m.packed_texel_bytes);  // tables and positions on top
+    EXPECT_GE(m.device_bytes, m.packed_texel_bytes);
+    EXPECT_EQ(m.scene_float_texel_bytes, 0u);
+    EXPECT_EQ(m.renderer_float_texel_bytes, 0u);
+    EXPECT_GT(m.process.rss_bytes, 0u);
+    EXPECT_GE(m.process.peak_rss_bytes, m.process.rss_bytes);
+    const nlohmann::json json = to_json(m);
+    EXPECT_EQ(json.at("packed_texel_bytes").get<size_t>(), m.packed_texel_bytes);
+    EXPECT_EQ(json.at("peak_rss_bytes").get<size_t>(), m.process.peak_rss_bytes);
+  }
+  // A baked scene reports its float copies (16 bytes a texel of every level).
+  const Scene baked = generated("quad2", false);
+  Renderer renderer(seamcl_tests::shared_runtime());
+  renderer.load_scene(baked);
+  const MeasuredMemory m = measure_memory(baked, renderer);
+  EXPECT_EQ(m.scene_float_texel_bytes, sum_of_face_texels(baked, 0) * 16);
+  EXPECT_EQ(m.renderer_float_texel_bytes, sum_of_face_texels(baked, 0) * 16);
+}
+
+TEST(Memory, ProcessMemoryGrowsWithATouchedAllocation) {
+  const ProcessMemory before = process_memory();
+  ASSERT_GT(before.rss_bytes, 0u);
+  std::vector<char> block(64u << 20, 1);  // every page written
+  const ProcessMemory after = process_memory();
+  EXPECT_GE(after.rss_bytes, before.rss_bytes + (48u << 20)) << static_cast<int>(block[12345]);
+  EXPECT_GE(after.peak_rss_bytes, after.rss_bytes);
+}
+
+}  // namespace
