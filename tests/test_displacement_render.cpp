@@ -1,6 +1,7 @@
 // Displacement seen the honest way: crack pixels on a closed mesh whose inside is a flag, over an
 // orbit; the real Ptex displacement maps on plane.obj; the CLI, HTTP schema and error paths.
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -199,8 +200,11 @@ struct CliRun {
 };
 
 CliRun run_cli(const std::string& args) {
+  // Per process and call: CTest runs the tests of this file in parallel processes.
+  static int calls = 0;
   const fs::path dir = fs::temp_directory_path();
-  const std::string out = (dir / "seamcl_disp_out.txt").string(), err = (dir / "seamcl_disp_err.txt").string();
+  const std::string stem = "seamcl_disp_" + std::to_string(::getpid()) + "_" + std::to_string(++calls);
+  const std::string out = (dir / (stem + "_out.txt")).string(), err = (dir / (stem + "_err.txt")).string();
   const int status = std::system((std::string(SEAMCL_BINARY) + " " + args + " >" + out + " 2>" + err + " </dev/null").c_str());
   CliRun r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -212,6 +216,8 @@ CliRun run_cli(const std::string& args) {
   };
   r.out = slurp(out);
   r.err = slurp(err);
+  fs::remove(out);
+  fs::remove(err);
   return r;
 }
 
