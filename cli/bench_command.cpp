@@ -44,6 +44,7 @@ struct BenchArgs : MeasureArgs {
   bool no_errors = false;
   std::string shard = "1/1";  // part K of N of the orbit's frames (host/eval/shard.h)
   bool check_only = false;    // validate the options and the scene, render nothing
+  std::string seam_mask = "band";  // parse_seam_mask_kind: band (the committed results') or footprint (compare's)
   std::string sweep;          // scaling sweeps instead of the orbit (host/eval/scaling_sweep.h)
   int sweep_repeats = 5;
 };
@@ -135,12 +136,6 @@ class Progress {
   bool tty_, quiet_;
 };
 
-std::string join_names(const std::vector<std::string>& names) {
-  std::string out;
-  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
-  return out;
-}
-
 // --sweep: the scaling sweeps (one JSON, the chart's input: examples/scaling_chart.py).
 int run_sweep(const BenchArgs& args, const GlobalOptions& global) {
   const std::vector<SweepAxis> axes = parse_sweep(args.sweep);
@@ -189,6 +184,10 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
   if (with_errors) (void)reference_render_options(frame, ref_settings);  // size and settings checked now
   const Shard shard = parse_shard(args.shard);
   const FrameRange range = shard_frames(shard, frame.frames);
+  const std::optional<SeamMaskKind> mask_kind = parse_seam_mask_kind(args.seam_mask);
+  if (!mask_kind) {
+    throw InputError("seam_mask", "unknown mask '" + args.seam_mask + "' (known: " + join_names(seam_mask_kind_names()) + ")");
+  }
 
   GeneratorOptions generator_options;
   generator_options.tint = frame.tint;
@@ -260,8 +259,21 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
     RenderOptions frame_options = frame;
     frame_options.frame = k;
     const Camera camera = orbit_camera(scene, k, frames);
-    const std::vector<uint8_t> mask = seam_mask(render_face_map(base_renderer, camera, frame_options));
-    seam_pixels_per_frame.push_back(static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{1})));
+    // The seam pixels (0/1) per rate: one band for every rate, or each rate's footprint mask.
+    std::map<int, std::vector<uint8_t>> masks;
+    if (*mask_kind == SeamMaskKind::Band) {
+      const std::vector<uint8_t> band = seam_mask(render_face_map(base_renderer, camera, frame_options));
+      for (const MethodEntry& e : entries) masks[e.options.msaa] = band;
+    } else {
+      for (const MethodEntry& e : entries) {
+        if (masks.count(e.options.msaa)) continue;
+        RenderOptions mask_options = frame_options;
+        mask_options.msaa = e.options.msaa;
+        masks[e.options.msaa] = seam_pixels_only(footprint_seam_mask(base_renderer, camera, mask_options));
+      }
+    }
+    const std::vector<uint8_t>& first_mask = masks.begin()->second;  // the lowest rate's
+    seam_pixels_per_frame.push_back(static_cast<size_t>(std::count(first_mask.begin(), first_mask.end(), uint8_t{1})));
     std::optional<ReferenceImage> reference;
     if (with_errors && k % args.reference_frames == 0) {
       reference = reference_image(base_renderer, camera, frame_options, ref_settings);
@@ -282,6 +294,7 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
       Accum& a = acc[i];
       MethodEntry entry = a.entry;
       entry.options.frame = k;
+      const std::vector<uint8_t>& mask = masks.at(entry.options.msaa);
       EntryResult r = measure_entry(*a.renderer, camera, entry, 1, reference ? &reference->pixels : nullptr, &mask);
       a.ms.push_back(r.last.ms);
       a.nan_per_frame.push_back(count_nonfinite(r.last.pixels));
@@ -305,7 +318,7 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
               std::to_string(a.current.ms.total).substr(0, 6);
       if (!a.previous.empty()) {
         const std::vector<float> change = pixel_distances(a.current.pixels, a.previous);
-        const ErrorStats seam = error_stats(change, &mask);
+        const ErrorStats seam = error_stats(change, &masks.at(a.entry.options.msaa));
         if (seam.pixels > 0) a.temporal_seam.push_back(seam.mean);  // frames with no seam in view: skipped
         a.temporal_all.push_back(error_stats(change).mean);
         a.temporal_per_frame.push_back({{"frame", k},
@@ -314,6 +327,7 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
       }
     }
     for (DifferenceAccum& d : diffs) {
+      const std::vector<uint8_t>& mask = masks.at(d.msaa);
       d.pool.add(compare_images(acc[d.a].current.pixels, acc[d.b].current.pixels, &mask), mask);
     }
     for (Accum& a : acc) a.previous = std::move(a.current.pixels);
@@ -393,6 +407,7 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
                 {"errors", with_errors},
                 {"error_frames", error_frame_list},
                 {"order", "frame-major: every entry once per frame, start rotated by one each frame"},
+                {"seam_mask", to_string(*mask_kind)},
                 {"seam_radius", kSeamRadius},
                 {"seam_pixels_per_frame", seam_pixels_per_frame},
                 {"options", to_json(frame)},
@@ -456,6 +471,10 @@ Command add_bench_command(CLI::App& app) {
   cmd->add_option("--shard", args->shard,
                   "Run part K (1-based) of N: a contiguous block of the orbit's frames; `seamcl merge` combines "
                   "the parts' JSON into the unsharded run's [1/1]");
+  cmd->add_option("--seam-mask", args->seam_mask,
+                  "The seam pixels errors are pooled over: " + join_names(seam_mask_kind_names()) +
+                      " (footprint: each rate's pixels whose filter footprint crosses a shared edge, as compare "
+                      "measures; band: within 2 px of a face boundary, one mask for every rate) [band]");
   cmd->add_flag("--check", args->check_only, "Validate the options (and the scene) and exit without rendering");
   cmd->add_option("--sweep", args->sweep,
                   "Scaling sweeps instead of the orbit: a comma list of " + join_names(sweep_axis_names()) +

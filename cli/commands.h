@@ -4,10 +4,19 @@
 #pragma once
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 namespace seamcl::cli {
+
+// "a, b, c": the names an option accepts, for --help and error messages (", " between them);
+// "a,b,c" with separator "," is a default value the option itself parses back.
+inline std::string join_names(const std::vector<std::string>& names, const std::string& separator = ", ") {
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : separator) + name;
+  return out;
+}
 
 struct GlobalOptions {
   std::string device;  // --device, before the subcommand

@@ -181,13 +181,11 @@ int run(const CubeArgs& args, const GlobalOptions& global) {
 
 Command add_cube_command(CLI::App& app) {
   auto args = std::make_shared<CubeArgs>();
-  std::string all;
-  for (const std::string& name : cube_method_names()) all += (all.empty() ? "" : ",") + name;
-  args->cube_methods = all;
+  args->cube_methods = join_names(cube_method_names(), ",");
   CLI::App* command = app.add_subcommand(
       "cube-metrics", "Measure every cube-map seam method against the analytic environment, per cube size");
   command->add_option("--scene", args->scene, "A scene with an environment, built-in or a scene file (its environment may be an image) [envmap]");
-  command->add_option("--cube-methods", args->cube_methods, "Comma list of cube methods [" + all + "]");
+  command->add_option("--cube-methods", args->cube_methods, "Comma list of cube methods [" + args->cube_methods + "]");
   command->add_option("--cube-sizes", args->cube_sizes, "Comma list of cube face sizes, powers of two [16,64,256]");
   command->add_option("--size", args->size, "Image size WIDTHxHEIGHT [160x180]");
   command->add_option("--filter", args->filter, "Filter: bilinear, trilinear, aniso (ewa filters as aniso) [aniso]");

@@ -50,9 +50,8 @@ std::vector<DisplacementMethod> parse_methods(const std::string& text) {
   for (const std::string& name : split_list(text, "methods")) {
     const auto method = parse_displacement_method(name);
     if (!method) {
-      std::string known;
-      for (const std::string& n : displacement_method_names()) known += (known.empty() ? "" : ", ") + n;
-      throw InputError("methods", "unknown displacement method '" + name + "' (known: " + known + ")");
+      throw InputError("methods", "unknown displacement method '" + name + "' (known: " +
+                                      join_names(displacement_method_names()) + ")");
     }
     out.push_back(*method);
   }
@@ -85,6 +84,7 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
     throw InputError("scene", "'" + scene.name + "' has no displacement maps (the built-in 'displaced' scene has; an "
                                                  ".obj takes them with --displacement-map FILE.ptx)");
   }
+  check_tessellation_levels(scene, levels);  // the triangle bound of every level, before any render
   const bool closed = is_closed_mesh(scene);
   if (!args.images_dir.empty()) fs::create_directories(args.images_dir);
   auto progress = [&](const std::string& line) {
@@ -151,7 +151,7 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
 
 Command add_displacement_command(CLI::App& app) {
   auto args = std::make_shared<DisplacementArgs>();
-  for (const std::string& name : displacement_method_names()) args->methods += (args->methods.empty() ? "" : ",") + name;
+  args->methods = join_names(displacement_method_names(), ",");
   CLI::App* command = app.add_subcommand(
       "displacement-metrics",
       "Measure every displacement method at every tessellation level: exact gap, crack pixels over an orbit, time, extra bytes");

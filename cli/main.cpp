@@ -188,18 +188,13 @@ int main(int argc, char** argv) {
                      "Built-in scene name (see 'seamcl scenes'), a scene JSON file, an .obj mesh or a .ptx that holds its mesh [paper]");
   render->add_option("--texture", render_args.texture,
                      "A .ptx file of per-face textures for an .obj --scene (face i of the mesh takes face i of the file)");
-  auto listed = [](const std::vector<std::string>& names) {
-    std::string s;
-    for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
-    return s;
-  };
-  render->add_option("--method", render_args.method, "Seam method: " + listed(method_names()) + " [discard]");
-  render->add_option("--filter", render_args.filter, "Texture filter: " + listed(filter_names()) + " [aniso]");
+  render->add_option("--method", render_args.method, "Seam method: " + cli::join_names(method_names()) + " [discard]");
+  render->add_option("--filter", render_args.filter, "Texture filter: " + cli::join_names(filter_names()) + " [aniso]");
   render->add_option("--zero-coverage", render_args.zero_coverage,
                      "discard with every tap outside the face: clamp (a clamped lookup) or nan (the raw 0/0) [clamp]");
-  render->add_option("--texels", render_args.texels, "Texel storage: " + listed(texel_format_names()) + " [rgba8]");
+  render->add_option("--texels", render_args.texels, "Texel storage: " + cli::join_names(texel_format_names()) + " [rgba8]");
   render->add_option("--cube-method", render_args.cube_method,
-                     "Cube-map seam method of scenes with an environment (envmap): " + listed(cube_method_names()) +
+                     "Cube-map seam method of scenes with an environment (envmap): " + cli::join_names(cube_method_names()) +
                          " [cube-seamless]");
   render->add_option("--msaa", render_args.msaa, "Samples per pixel: 1, 2, 4, 8 or 16 [1]");
   render->add_option("--aniso", render_args.aniso, "Maximum anisotropy, 1..16 [16]");
@@ -211,7 +206,7 @@ int main(int argc, char** argv) {
   render->add_flag("--centroid", render_args.centroid, "Shade at the centroid of the covered samples (same as --shading centroid)");
   render->add_flag("--tint", render_args.tint, "Built-in scenes: tint each face a different base colour");
   render->add_option("--displacement-method", render_args.displacement_method,
-                     "Tessellate and displace with this seam method: " + listed(displacement_method_names()) + " [off]");
+                     "Tessellate and displace with this seam method: " + cli::join_names(displacement_method_names()) + " [off]");
   render->add_option("--tessellation", render_args.tessellation, "Displacement: each patch a (T+1)^2 grid, T 1..64 [8]");
   render->add_option("--displacement-level", render_args.displacement_level, "Displacement: the maps' level sampled, 0..16 [0]");
   render->add_option("--displacement-map", render_args.displacement_map,

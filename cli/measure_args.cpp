@@ -1,19 +1,11 @@
 #include "measure_args.h"
 
+#include "commands.h"
+
 #include <seamcl/core/input_error.h>
 #include <seamcl/pipeline/displacement_method.h>
 
 namespace seamcl::cli {
-namespace {
-
-std::string listed(const std::vector<std::string>& names) {
-  std::string s;
-  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
-  return s;
-}
-
-}  // namespace
-
 void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& default_methods) {
   a.methods = default_methods;
   command->add_option("--scene", a.scene, "Built-in scene name, a scene JSON file, an .obj mesh or a .ptx that holds its mesh [paper]");
@@ -27,7 +19,7 @@ void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& d
   command->add_option("--size", a.size, "Image size WIDTHxHEIGHT [480x540]");
   command->add_option("--shading", a.shading, "Where to shade: pixel, centroid or sample [pixel]");
   command->add_option("--displacement-method", a.displacement_method,
-                      "Tessellate and displace with this method: " + listed(displacement_method_names()) + " [off]");
+                      "Tessellate and displace with this method: " + join_names(displacement_method_names()) + " [off]");
   command->add_option("--tessellation", a.tessellation, "Displacement: each patch a (T+1)^2 grid, T 1..64 [8]");
   command->add_option("--displacement-level", a.displacement_level, "Displacement: the maps' level sampled, 0..16 [0]");
   command->add_flag("--tint", a.tint, "Built-in scenes: tint each face a different base colour");

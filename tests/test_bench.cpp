@@ -169,6 +169,43 @@ TEST_F(Bench, ErrorsMatchCompareOnTheSameFrame) {
   }
 }
 
+// --seam-mask footprint pools each rate's footprint mask, as compare measures one frame: bench's
+// per-frame seam error and seam pixels then equal compare's on the same frame, while the band mask
+// (the default) covers other pixels.
+TEST_F(Bench, FootprintSeamMaskMatchesCompare) {
+  const std::string common = "--scene quad2 --methods discard,clamp,black --msaa 1,4 --size 48x48 --frames 3";
+  const BenchProcess b = run_cli(*dir_, "bench " + common + " --seam-mask footprint --json");
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  const json bj = json::parse(b.out);
+  EXPECT_EQ(bj["seam_mask"], "footprint");
+  EXPECT_EQ(bench_json()["seam_mask"], "band");
+  const BenchProcess c = run_cli(*dir_, "compare " + common + " --frame 0 --repeat 1 --json");
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const json cj = json::parse(c.out);
+  int compared = 0;
+  for (const json& r : cj["results"]) {
+    SCOPED_TRACE(r["method"].get<std::string>() + " x" + std::to_string(r["msaa"].get<int>()));
+    const json& frame0 = result(bj, r["method"], r["msaa"])["error_per_frame"][0];
+    ASSERT_EQ(frame0["frame"], 0);
+    EXPECT_DOUBLE_EQ(frame0["seam_mean"].get<double>(), r["error"]["seam_mean"].get<double>());
+    EXPECT_GT(r["error"]["seam_pixels"].get<size_t>(), 0u);  // frame 0 has the shared edge in view
+    // seam_pixels_per_frame counts the lowest rate's mask.
+    if (r["msaa"] == 1) EXPECT_EQ(bj["seam_pixels_per_frame"][0], r["error"]["seam_pixels"]);
+    ++compared;
+  }
+  EXPECT_EQ(compared, 6);
+  // The controls stand apart over the footprint mask: black's seam error is far above discard's.
+  EXPECT_GT(result(bj, "black", 4)["error"]["seam_mean"].get<double>(),
+            2.0 * result(bj, "discard", 4)["error"]["seam_mean"].get<double>());
+  // The two masks are different pixel sets (the band is 5 px wide around every face boundary).
+  EXPECT_NE(bj["seam_pixels_per_frame"], bench_json()["seam_pixels_per_frame"]);
+
+  const BenchProcess bad = run_cli(*dir_, "bench " + common + " --seam-mask halo --json");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("seam_mask: unknown mask 'halo' (known: footprint, band)"), std::string::npos) << bad.err;
+  EXPECT_TRUE(bad.out.empty());
+}
+
 TEST_F(Bench, NoErrorsAndReferenceFrames) {
   const BenchProcess n = run_cli(*dir_, "bench --scene quad2 --methods discard --msaa 1 --size 48x48 --frames 3 "
                                         "--no-errors --json --no-cache");

@@ -147,7 +147,7 @@ TEST_F(BenchMerge, MergedPerFrameErrorsEqualTheUnshardedRunExactly) {
   const json w = whole(), m = merged();
   EXPECT_EQ(m["error_frames"], json::array({0, 2, 4}));
   for (const char* key : {"scene", "size", "frames", "reference_frames", "errors", "options", "error_frames",
-                          "seam_pixels_per_frame", "shard", "order", "seam_radius"}) {
+                          "seam_pixels_per_frame", "shard", "order", "seam_mask", "seam_radius"}) {
     EXPECT_EQ(m[key], w[key]) << key;
   }
   ASSERT_EQ(m["results"].size(), w["results"].size());

@@ -323,6 +323,27 @@ TEST(DisplacementMetricsCli, BadInputExitsTwoNamingTheField) {
   }
 }
 
+// The micro-triangle bound (patches * 2 * T^2) of every level, checked by displacement-metrics
+// before its first render (no asset has enough patches for T <= 64 to cross it, so the check is
+// held here on a scene's face count: paper's 2474 faces).
+TEST(DisplacementMetricsCli, TriangleBoundOfEveryLevelCheckedUpFront) {
+  const seamcl::Scene paper = seamcl::generate_scene("paper", {});
+  ASSERT_EQ(paper.faces.size(), 2474u);
+  EXPECT_NO_THROW(seamcl::check_tessellation_levels(paper, {1, 4, 16}));  // 2474 * 2 * 256 = 1,266,688
+  try {
+    seamcl::check_tessellation_levels(paper, {1, 4, 32});
+    FAIL() << "T = 32 on 2474 patches is over the bound";
+  } catch (const seamcl::InputError& e) {
+    EXPECT_EQ(e.field(), "tessellation");
+    EXPECT_NE(std::string(e.what()).find("2474 patches at T = 32 make 5066752 triangles, over the limit of " +
+                                         std::to_string(seamcl::kMaxTessellatedTriangles)),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(seamcl::check_tessellation_levels(paper, {0}), seamcl::InputError);
+  EXPECT_THROW(seamcl::check_tessellation_levels(paper, {65}), seamcl::InputError);
+}
+
 // compare takes the displacement options (their names as render's) and reports the displaced
 // frame's gap and cracks beside the seam methods' errors.
 TEST(DisplacementCompareCli, CompareMeasuresTheDisplacedFrame) {

@@ -368,7 +368,7 @@ json merge_bench_parts(const std::vector<BenchPart>& input) {
   }
 
   json out = json::object();
-  require_same(readers, tops, {"scene", "size", "frames", "reference_frames", "errors", "order", "seam_radius", "options"},
+  require_same(readers, tops, {"scene", "size", "frames", "reference_frames", "errors", "order", "seam_mask", "seam_radius", "options"},
                "", out);
   const json& errors_flag = out["errors"];
   if (!errors_flag.is_boolean()) readers[0].refuse("errors", "expected true or false");

@@ -167,6 +167,10 @@ nlohmann::json DisplacementReport::to_json() const {
   return out;
 }
 
+void check_tessellation_levels(const Scene& scene, const std::vector<int>& levels) {
+  for (int t : levels) check_tessellation(scene.faces.size(), t);
+}
+
 DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, const Camera& camera,
                                         const RenderOptions& options, int orbit_frames, int repeat) {
   if (!options.displacement) throw InputError("displacement_method", "is needed to measure displacement");

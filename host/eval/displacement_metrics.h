@@ -64,6 +64,10 @@ struct DisplacementReport {
   nlohmann::json to_json() const;
 };
 
+// Every level of a run checked before its first render: InputError("tessellation") for a T outside
+// 1..64 or one whose micro-triangles (faces * 2 * T^2) exceed the renderer's bound.
+void check_tessellation_levels(const Scene& scene, const std::vector<int>& levels);
+
 // Measures options.displacement (required) on `scene` at `camera`, or over `frames` frames of
 // its orbit when frames > 0: the gap from the device's tessellation, crack pixels from renders
 // of with_flag_shell(scene) (closed meshes only), time per frame from `repeat` renders of the

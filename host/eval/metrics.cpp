@@ -116,6 +116,37 @@ std::vector<uint8_t> footprint_seam_mask(Renderer& renderer, const Camera& camer
   return renderer.render(camera, options, true).seam_mask;
 }
 
+namespace {
+constexpr SeamMaskKind kSeamMaskKinds[] = {SeamMaskKind::Footprint, SeamMaskKind::Band};
+}  // namespace
+
+std::string to_string(SeamMaskKind kind) {
+  switch (kind) {
+    case SeamMaskKind::Footprint: return "footprint";
+    case SeamMaskKind::Band: return "band";
+  }
+  return "?";
+}
+
+std::optional<SeamMaskKind> parse_seam_mask_kind(std::string_view name) {
+  for (SeamMaskKind kind : kSeamMaskKinds) {
+    if (to_string(kind) == name) return kind;
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> seam_mask_kind_names() {
+  std::vector<std::string> names;
+  for (SeamMaskKind kind : kSeamMaskKinds) names.push_back(to_string(kind));
+  return names;
+}
+
+std::vector<uint8_t> seam_pixels_only(const std::vector<uint8_t>& mask) {
+  std::vector<uint8_t> seam(mask.size());
+  for (size_t i = 0; i < mask.size(); ++i) seam[i] = mask[i] == SEAMCL_MASK_SEAM ? 1 : 0;
+  return seam;
+}
+
 std::vector<float> pixel_distances(const std::vector<glm::vec4>& test, const std::vector<glm::vec4>& reference) {
   if (test.size() != reference.size()) {
     throw std::invalid_argument("pixel_distances: " + std::to_string(test.size()) + " test pixels vs " +
@@ -180,11 +211,9 @@ ImageErrors compare_images(const std::vector<glm::vec4>& test, const std::vector
   e.all = error_stats(e.distance);
   if (mask) {
     // Seam: value 1; off the seams: value 0; a footprint mask's boundary pixels (2) are neither.
-    std::vector<uint8_t> seam(mask->size()), off(mask->size());
-    for (size_t i = 0; i < mask->size(); ++i) {
-      seam[i] = (*mask)[i] == SEAMCL_MASK_SEAM ? 1 : 0;
-      off[i] = (*mask)[i] == SEAMCL_MASK_NONE ? 1 : 0;
-    }
+    const std::vector<uint8_t> seam = seam_pixels_only(*mask);
+    std::vector<uint8_t> off(mask->size());
+    for (size_t i = 0; i < mask->size(); ++i) off[i] = (*mask)[i] == SEAMCL_MASK_NONE ? 1 : 0;
     e.seam = error_stats(e.distance, &seam);
     e.off_seam = error_stats(e.distance, &off);
     const size_t covered = static_cast<size_t>(std::count(seam.begin(), seam.end(), uint8_t{1}));

@@ -25,6 +25,9 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -69,6 +72,16 @@ std::vector<uint8_t> seam_mask(const FaceMap& faces, int radius = kSeamRadius);
 // without guard bands) whatever options.method says; the rate, shading, filter and anisotropy are
 // the options'.
 std::vector<uint8_t> footprint_seam_mask(Renderer& renderer, const Camera& camera, RenderOptions options);
+
+// Which of the two masks above a measurement uses: `footprint` (footprint_seam_mask, per rate;
+// compare's) or `band` (seam_mask of the frame's face map, one for every rate).
+enum class SeamMaskKind { Footprint, Band };
+std::optional<SeamMaskKind> parse_seam_mask_kind(std::string_view name);
+std::string to_string(SeamMaskKind kind);
+std::vector<std::string> seam_mask_kind_names();
+
+// The seam pixels of a mask as 0/1: footprint_seam_mask's value 1 (SEAMCL_MASK_SEAM) only.
+std::vector<uint8_t> seam_pixels_only(const std::vector<uint8_t>& mask);
 
 struct ErrorStats {
   size_t pixels = 0;  // finite pixels counted (inside the mask, if any)

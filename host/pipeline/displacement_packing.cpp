@@ -149,11 +149,21 @@ size_t PackedDisplacement::method_bytes() const {
   }
 }
 
-PackedDisplacement pack_displacement(const Scene& scene, const DisplacementSettings& settings) {
-  if (settings.tessellation < 1 || settings.tessellation > SEAMCL_MAX_TESSELLATION) {
+void check_tessellation(size_t patches, int tessellation) {
+  if (tessellation < 1 || tessellation > SEAMCL_MAX_TESSELLATION) {
     throw InputError("tessellation", "must be in 1.." + std::to_string(SEAMCL_MAX_TESSELLATION) + ", got " +
-                                         std::to_string(settings.tessellation));
+                                         std::to_string(tessellation));
   }
+  const auto t = static_cast<size_t>(tessellation);
+  if (patches * 2 * t * t > kMaxTessellatedTriangles) {
+    throw InputError("tessellation", std::to_string(patches) + " patches at T = " + std::to_string(t) + " make " +
+                                         std::to_string(patches * 2 * t * t) + " triangles, over the limit of " +
+                                         std::to_string(kMaxTessellatedTriangles));
+  }
+}
+
+PackedDisplacement pack_displacement(const Scene& scene, const DisplacementSettings& settings) {
+  check_tessellation(scene.faces.size(), settings.tessellation);
   if (settings.level < 0 || settings.level > 16) {
     throw InputError("displacement_level", "must be in 0..16, got " + std::to_string(settings.level));
   }
@@ -164,12 +174,6 @@ PackedDisplacement pack_displacement(const Scene& scene, const DisplacementSetti
   }
   const Displacement& source = *scene.displacement;
   validate_displacement(source, scene.faces.size());
-  const auto t = static_cast<size_t>(settings.tessellation);
-  if (scene.faces.size() * 2 * t * t > kMaxTessellatedTriangles) {
-    throw InputError("tessellation", std::to_string(scene.faces.size()) + " patches at T = " + std::to_string(t) +
-                                         " make " + std::to_string(scene.faces.size() * 2 * t * t) +
-                                         " triangles, over the limit of " + std::to_string(kMaxTessellatedTriangles));
-  }
 
   PackedDisplacement out;
   out.params.tessellation = settings.tessellation;

@@ -31,6 +31,10 @@ struct DisplacementSettings {
 // bytes each, 2^21 of them need 1.4 GB; larger requests are refused.
 inline constexpr size_t kMaxTessellatedTriangles = size_t{1} << 21;
 
+// InputError("tessellation") for T outside 1..SEAMCL_MAX_TESSELLATION or patches * 2 * T^2 over
+// kMaxTessellatedTriangles.
+void check_tessellation(size_t patches, int tessellation);
+
 struct PackedDisplacement {
   std::vector<DisplacementPatch> patches;  // one per scene face
   std::vector<uint16_t> samples;           // every map at the chosen level
