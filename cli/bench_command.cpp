@@ -78,9 +78,13 @@ struct Pool {
     ++frames;
   }
   ImageErrors stats() const {
+    // As compare_images: seam over the value 1, off the seams over 0 (a footprint mask's boundary
+    // pixels, 2, are neither).
     ImageErrors e;
     e.all = error_stats(distance);
-    e.seam = error_stats(distance, &mask);
+    const std::vector<uint8_t> seam = seam_pixels_only(mask), off = off_seam_pixels_only(mask);
+    e.seam = error_stats(distance, &seam);
+    e.off_seam = error_stats(distance, &off);
     e.nan_pixels = nan_pixels;
     e.seam_nan_pixels = seam_nan_pixels;
     return e;
@@ -259,7 +263,7 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
     RenderOptions frame_options = frame;
     frame_options.frame = k;
     const Camera camera = orbit_camera(scene, k, frames);
-    // The seam pixels (0/1) per rate: one band for every rate, or each rate's footprint mask.
+    // The mask per rate: one band (0/1) for every rate, or each rate's footprint mask (0/1/2).
     std::map<int, std::vector<uint8_t>> masks;
     if (*mask_kind == SeamMaskKind::Band) {
       const std::vector<uint8_t> band = seam_mask(render_face_map(base_renderer, camera, frame_options));
@@ -269,11 +273,13 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
         if (masks.count(e.options.msaa)) continue;
         RenderOptions mask_options = frame_options;
         mask_options.msaa = e.options.msaa;
-        masks[e.options.msaa] = seam_pixels_only(footprint_seam_mask(base_renderer, camera, mask_options));
+        masks[e.options.msaa] = footprint_seam_mask(base_renderer, camera, mask_options);
       }
     }
-    const std::vector<uint8_t>& first_mask = masks.begin()->second;  // the lowest rate's
-    seam_pixels_per_frame.push_back(static_cast<size_t>(std::count(first_mask.begin(), first_mask.end(), uint8_t{1})));
+    std::map<int, std::vector<uint8_t>> seam_only;  // value 1 only, for error_stats
+    for (const auto& [rate, mask] : masks) seam_only[rate] = seam_pixels_only(mask);
+    const std::vector<uint8_t>& first_seam = seam_only.begin()->second;  // the lowest rate's
+    seam_pixels_per_frame.push_back(static_cast<size_t>(std::count(first_seam.begin(), first_seam.end(), uint8_t{1})));
     std::optional<ReferenceImage> reference;
     if (with_errors && k % args.reference_frames == 0) {
       reference = reference_image(base_renderer, camera, frame_options, ref_settings);
@@ -318,7 +324,7 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
               std::to_string(a.current.ms.total).substr(0, 6);
       if (!a.previous.empty()) {
         const std::vector<float> change = pixel_distances(a.current.pixels, a.previous);
-        const ErrorStats seam = error_stats(change, &masks.at(a.entry.options.msaa));
+        const ErrorStats seam = error_stats(change, &seam_only.at(a.entry.options.msaa));
         if (seam.pixels > 0) a.temporal_seam.push_back(seam.mean);  // frames with no seam in view: skipped
         a.temporal_all.push_back(error_stats(change).mean);
         a.temporal_per_frame.push_back({{"frame", k},

@@ -194,6 +194,12 @@ TEST_F(Bench, FootprintSeamMaskMatchesCompare) {
     ++compared;
   }
   EXPECT_EQ(compared, 6);
+  // Pooled over the mask's complement too (value 0: neither seam nor boundary), as compare splits it.
+  for (const json& r : bj["results"]) {
+    const json& e = r["error"];
+    EXPECT_GT(e["off_seam_pixels"].get<size_t>(), 0u);
+    EXPECT_LE(e["seam_pixels"].get<size_t>() + e["off_seam_pixels"].get<size_t>(), e["pixels"].get<size_t>());
+  }
   // The controls stand apart over the footprint mask: black's seam error is far above discard's.
   EXPECT_GT(result(bj, "black", 4)["error"]["seam_mean"].get<double>(),
             2.0 * result(bj, "discard", 4)["error"]["seam_mean"].get<double>());

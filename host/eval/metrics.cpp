@@ -147,6 +147,12 @@ std::vector<uint8_t> seam_pixels_only(const std::vector<uint8_t>& mask) {
   return seam;
 }
 
+std::vector<uint8_t> off_seam_pixels_only(const std::vector<uint8_t>& mask) {
+  std::vector<uint8_t> off(mask.size());
+  for (size_t i = 0; i < mask.size(); ++i) off[i] = mask[i] == SEAMCL_MASK_NONE ? 1 : 0;
+  return off;
+}
+
 std::vector<float> pixel_distances(const std::vector<glm::vec4>& test, const std::vector<glm::vec4>& reference) {
   if (test.size() != reference.size()) {
     throw std::invalid_argument("pixel_distances: " + std::to_string(test.size()) + " test pixels vs " +
@@ -212,8 +218,7 @@ ImageErrors compare_images(const std::vector<glm::vec4>& test, const std::vector
   if (mask) {
     // Seam: value 1; off the seams: value 0; a footprint mask's boundary pixels (2) are neither.
     const std::vector<uint8_t> seam = seam_pixels_only(*mask);
-    std::vector<uint8_t> off(mask->size());
-    for (size_t i = 0; i < mask->size(); ++i) off[i] = (*mask)[i] == SEAMCL_MASK_NONE ? 1 : 0;
+    const std::vector<uint8_t> off = off_seam_pixels_only(*mask);
     e.seam = error_stats(e.distance, &seam);
     e.off_seam = error_stats(e.distance, &off);
     const size_t covered = static_cast<size_t>(std::count(seam.begin(), seam.end(), uint8_t{1}));

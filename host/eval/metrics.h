@@ -82,6 +82,8 @@ std::vector<std::string> seam_mask_kind_names();
 
 // The seam pixels of a mask as 0/1: footprint_seam_mask's value 1 (SEAMCL_MASK_SEAM) only.
 std::vector<uint8_t> seam_pixels_only(const std::vector<uint8_t>& mask);
+// The pixels off every edge as 0/1: the mask's value 0 (SEAMCL_MASK_NONE).
+std::vector<uint8_t> off_seam_pixels_only(const std::vector<uint8_t>& mask);
 
 struct ErrorStats {
   size_t pixels = 0;  // finite pixels counted (inside the mask, if any)
