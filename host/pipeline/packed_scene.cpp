@@ -73,7 +73,10 @@ void pack_banded_deferred(const Scene& scene, PackedScene& out, const std::vecto
       if (is_deferred(window.faces[g].texture)) window.faces[g].texture = face_texture(scene, g);
     pack_face_texels(window, out, f, first_level[f]);
     for (uint32_t g : around)
-      if (last_reader[g] == f && is_deferred(scene.faces[g].texture)) window.faces[g].texture = scene.faces[g].texture;  // sizes only again
+      // Sizes only again. A new chain moved in, so the texels' storage is freed: copy-assigning
+      // the deferred chain would empty each level's vector but keep its capacity, and with it
+      // every face's floats until the end (which was guardband's peak).
+      if (last_reader[g] == f && is_deferred(scene.faces[g].texture)) window.faces[g].texture = MipChain(scene.faces[g].texture);
   }
 }
 
