@@ -579,7 +579,7 @@ json HttpServer::scenes_json() const {
 }
 
 json HttpServer::methods_json() const {
-  // Made on first use: it packs the default scene once per method, which the start need not wait for.
+  // Made on first use (from the default scene's sizes), which the start need not wait for.
   std::call_once(methods_once_, [this] { methods_cache_ = make_methods_json(); });
   return methods_cache_;
 }
@@ -591,15 +591,18 @@ json HttpServer::make_methods_json() const {
   const json default_json = to_json(defaults);
   const Scene& default_scene = *builtin_scene(defaults.scene, false);
   json methods = json::array();
+  // From the sizes (exactly what pack_scene stores, render_memory.h): nothing is baked or packed.
+  const SceneSizes default_sizes = scene_sizes(default_scene);
   for (const std::string& name : method_names()) {
     const Method method = *parse_method(name);
-    const PackedScene packed = pack_scene(default_scene, TexelFormat::Rgba8, method == Method::Guardband ? defaults.guard_band : 0);
+    const PackedTextureMemory packed =
+        packed_texture_memory(default_sizes, TexelFormat::Rgba8, method == Method::Guardband ? defaults.guard_band : 0);
     const size_t float_texel_bytes = 4 * sizeof(float);
     methods.push_back({{"name", name},
                        {"description", method_description(name)},
-                       {"texture_bytes", {{"rgba8", packed.texture_bytes()}, {"rgba32f", packed.texel_count() * float_texel_bytes}}},
-                       {"padding_bytes", {{"rgba8", packed.padding_bytes()}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
-                       {"adjacency_bytes", reads_adjacency(method) ? packed.adjacency_bytes() : 0}});
+                       {"texture_bytes", {{"rgba8", packed.texture_bytes}, {"rgba32f", packed.texels * float_texel_bytes}}},
+                       {"padding_bytes", {{"rgba8", packed.padding_bytes}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
+                       {"adjacency_bytes", reads_adjacency(method) ? packed.adjacency_bytes : 0}});
   }
   json scene_names = json::array();
   for (const GeneratorInfo& g : scene_generators()) scene_names.push_back(g.name);
@@ -652,6 +655,9 @@ std::shared_ptr<const Scene> HttpServer::builtin_scene(const std::string& name, 
   if (std::none_of(generators.begin(), generators.end(), [&](const GeneratorInfo& g) { return g.name == name; })) return nullptr;
   GeneratorOptions generator_options;
   generator_options.tint = tint;
+  // Deferred: a slot's Renderer packs each face from the generator, so no float copy of the
+  // scene's textures is held for the server's life (all of them together were about 700 MB).
+  generator_options.defer_textures = true;
   auto scene = std::make_shared<const Scene>(generate_scene(name, generator_options));
   scenes_[key] = scene;
   return scene;
@@ -660,6 +666,7 @@ std::shared_ptr<const Scene> HttpServer::builtin_scene(const std::string& name, 
 std::shared_ptr<const Scene> HttpServer::asset_scene(const RenderOptions& options) const {
   SceneSourceOptions source;
   source.generator.tint = options.tint;
+  source.generator.defer_textures = true;  // a .ptx's faces decoded while packed, not held as floats
   // A file's decoded texels (float RGBA) beyond the host budget are refused by the reader, before
   // they are allocated; a smaller asset is measured against the budgets like any scene.
   source.ptex_limits.max_texels = std::min<uint64_t>(source.ptex_limits.max_texels, options_.max_request_host_bytes / sizeof(glm::vec4));
