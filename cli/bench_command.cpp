@@ -197,6 +197,7 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
   generator_options.tint = frame.tint;
   SceneSourceOptions source;
   source.generator = generator_options;
+  source.generator.defer_textures = true;  // each Renderer packs face by face: no float copy of the textures
   const Scene scene = load_scene_source(frame.scene, frame.texture, source);
   if (args.check_only) {
     std::printf("bench options valid: %s, part %s: frames %d..%d of %d\n", scene.name.c_str(), to_string(shard).c_str(),

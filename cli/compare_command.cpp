@@ -96,6 +96,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
 
   SceneSourceOptions source;
   source.generator = generator_options;
+  source.generator.defer_textures = true;  // each Renderer packs face by face: no float copy of the textures
   const Scene scene = load_scene_source(frame.scene, frame.texture, source);
   const Camera camera = frame.frame ? orbit_camera(scene, *frame.frame, frame.frames) : scene.camera;
   if (!args.images_dir.empty()) fs::create_directories(args.images_dir);

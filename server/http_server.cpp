@@ -579,7 +579,7 @@ json HttpServer::scenes_json() const {
 }
 
 json HttpServer::methods_json() const {
-  // Made on first use: it packs the default scene once per method, which the start need not wait for.
+  // Made on first use (from the default scene's sizes), which the start need not wait for.
   std::call_once(methods_once_, [this] { methods_cache_ = make_methods_json(); });
   return methods_cache_;
 }
@@ -591,15 +591,18 @@ json HttpServer::make_methods_json() const {
   const json default_json = to_json(defaults);
   const Scene& default_scene = *builtin_scene(defaults.scene, false);
   json methods = json::array();
+  // From the sizes (exactly what pack_scene stores, render_memory.h): nothing is baked or packed.
+  const SceneSizes default_sizes = scene_sizes(default_scene);
   for (const std::string& name : method_names()) {
     const Method method = *parse_method(name);
-    const PackedScene packed = pack_scene(default_scene, TexelFormat::Rgba8, method == Method::Guardband ? defaults.guard_band : 0);
+    const PackedTextureMemory packed =
+        packed_texture_memory(default_sizes, TexelFormat::Rgba8, method == Method::Guardband ? defaults.guard_band : 0);
     const size_t float_texel_bytes = 4 * sizeof(float);
     methods.push_back({{"name", name},
                        {"description", method_description(name)},
-                       {"texture_bytes", {{"rgba8", packed.texture_bytes()}, {"rgba32f", packed.texel_count() * float_texel_bytes}}},
-                       {"padding_bytes", {{"rgba8", packed.padding_bytes()}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
-                       {"adjacency_bytes", reads_adjacency(method) ? packed.adjacency_bytes() : 0}});
+                       {"texture_bytes", {{"rgba8", packed.texture_bytes}, {"rgba32f", packed.texels * float_texel_bytes}}},
+                       {"padding_bytes", {{"rgba8", packed.padding_bytes}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
+                       {"adjacency_bytes", reads_adjacency(method) ? packed.adjacency_bytes : 0}});
   }
   json scene_names = json::array();
   for (const GeneratorInfo& g : scene_generators()) scene_names.push_back(g.name);
@@ -652,6 +655,9 @@ std::shared_ptr<const Scene> HttpServer::builtin_scene(const std::string& name, 
   if (std::none_of(generators.begin(), generators.end(), [&](const GeneratorInfo& g) { return g.name == name; })) return nullptr;
   GeneratorOptions generator_options;
   generator_options.tint = tint;
+  // Deferred: a slot's Renderer packs each face from the generator, so no float copy of the
+  // scene's textures is held for the server's life (all of them together were about 700 MB).
+  generator_options.defer_textures = true;
   auto scene = std::make_shared<const Scene>(generate_scene(name, generator_options));
   scenes_[key] = scene;
   return scene;
@@ -660,6 +666,7 @@ std::shared_ptr<const Scene> HttpServer::builtin_scene(const std::string& name, 
 std::shared_ptr<const Scene> HttpServer::asset_scene(const RenderOptions& options) const {
   SceneSourceOptions source;
   source.generator.tint = options.tint;
+  source.generator.defer_textures = true;  // a .ptx's faces decoded while packed, not held as floats
   // A file's decoded texels (float RGBA) beyond the host budget are refused by the reader, before
   // they are allocated; a smaller asset is measured against the budgets like any scene.
   source.ptex_limits.max_texels = std::min<uint64_t>(source.ptex_limits.max_texels, options_.max_request_host_bytes / sizeof(glm::vec4));
@@ -692,11 +699,13 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
     scene = found;
     key = scene_key(options.scene, options.tint);
   } else {
-    // Its structure first, on a copy whose valid texture sizes are shrunk to 1x1 (so nothing big
-    // is built), so that a malformed scene is a 400 whatever its size; then the size limits, from
-    // the JSON, before any texture is made.
+    // Its structure first, on a copy whose valid texture sizes are shrunk to 1x1 and whose
+    // generator bakes nothing (so nothing big is built), so that a malformed scene is a 400
+    // whatever its size; then the size limits, from the JSON, before any texture is made.
+    GeneratorOptions deferred;
+    deferred.defer_textures = true;
     try {
-      Scene shape = parse_scene_json(with_tiny_textures(inline_scene));
+      Scene shape = parse_scene_json(with_tiny_textures(inline_scene), {}, deferred);
       validate_scene(shape);
     } catch (const InputError& e) {
       throw InputError("scene." + e.field(), input_error_message(e));
@@ -724,12 +733,11 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
       }
     }
     try {
-      Scene parsed = parse_scene_json(inline_scene);
-      if (options.tint) {
-        GeneratorOptions generator_options;
-        generator_options.tint = true;
-        apply_generator_options(parsed, generator_options);
-      }
+      // A generator's textures deferred: the budgets are checked on the scene's sizes before any
+      // texel exists, and a render packs each face's texels straight from the generator.
+      GeneratorOptions generator_options = deferred;
+      generator_options.tint = options.tint;
+      Scene parsed = parse_scene_json(inline_scene, {}, generator_options);
       validate_scene(parsed);
       scene = std::make_shared<const Scene>(std::move(parsed));
     } catch (const InputError& e) {
@@ -754,6 +762,26 @@ void HttpServer::refuse_over_budget(size_t device_bytes, size_t host_bytes, cons
   }
 }
 
+void HttpServer::refuse_scene_over_budget(const Scene& scene, const RenderOptions& options, const json& inline_scene,
+                                          const std::string& key) const {
+  std::string field = inline_scene.is_null() ? (key.empty() ? "scene" : "texels") : "scene";
+  if (const auto given = inline_scene.is_object() ? inline_scene.find("options") : inline_scene.end();
+      !inline_scene.is_null() && given != inline_scene.end() && given->is_object()) {
+    for (const char* option : {"faces", "texture_scale_log2"})
+      if (given->contains(option)) {
+        field = std::string("scene.options.") + option;
+        break;
+      }
+  }
+  const SceneSizes sizes = scene_sizes(scene);
+  const RenderMemory memory = scene_render_memory(sizes, options);
+  // The request holds its own copy of an inline scene or asset on top of the Renderer's.
+  const size_t held = key.empty() ? scene_host_bytes(sizes) : 0;
+  refuse_over_budget(memory.device_bytes(), saturating_add(memory.host_bytes(), held), field,
+                     "the scene (" + std::to_string(sizes.faces.size()) + " faces, " +
+                         std::to_string(memory.textures.texels) + " packed texels)");
+}
+
 void HttpServer::handle_render(const json& request, httplib::Response& res) {
   const Clock::time_point start = Clock::now();
   if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
@@ -775,6 +803,7 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
                     "width x height x msaa = " + std::to_string(static_cast<long long>(options.width) * options.height * options.msaa) +
                         " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
   }
+  refuse_scene_over_budget(*scene, options, inline_scene, key);
   const SceneSizes sizes = scene_sizes(*scene);
   const RenderMemory memory = render_memory(sizes, options);
   const bool frame_drives = memory.frame_device_bytes() >= memory.scene_device_bytes();
@@ -919,6 +948,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
                           " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
     }
   }
+  refuse_scene_over_budget(*scene, frame, inline_scene, key);
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, entries, reference_settings);
   refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this compare");
   // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
@@ -1037,6 +1067,7 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
   const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key);
   const Camera camera = frame.frame ? orbit_camera(*scene, *frame.frame, frame.frames) : scene->camera;
   check_reference_limits(frame, settings, explicit_reference_msaa);
+  refuse_scene_over_budget(*scene, frame, inline_scene, key);
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, {}, settings);
   refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this reference");
 

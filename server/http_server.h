@@ -142,6 +142,11 @@ class HttpServer {
   std::shared_ptr<const Scene> resolve_scene(const nlohmann::json& inline_scene, RenderOptions& options,
                                              std::string& key) const;
   void refuse_over_budget(size_t device_bytes, size_t host_bytes, const std::string& field, const std::string& what) const;
+  // 413 when the scene alone (scene_render_memory: at 1x1, whatever the size asked) is over the
+  // budgets, naming the field that made it so: an inline scene's options.faces (or
+  // options.texture_scale_log2, or the scene), "texels" for a built-in, "scene" for an asset.
+  void refuse_scene_over_budget(const Scene& scene, const RenderOptions& options, const nlohmann::json& inline_scene,
+                                const std::string& key) const;
   nlohmann::json scenes_json() const;
   nlohmann::json assets_json() const;
   // An asset of the asset directory by options.scene and options.texture (400 without one).

@@ -1,14 +1,18 @@
 #!/usr/bin/env python3
 """Peak memory of `seamcl render --json` (issue 14): the "memory" block's peak RSS of the paper
-scene must stay under 350 MB, and under the runtime's floor (the peak of the two-face quad2
-render, measured here first) plus 2x the scene's packed texel bytes.
+scene must stay under 350 MB, and the peak of any render under the runtime's floor (the peak of
+the two-face quad2 render, measured here first) plus 2x the scene's packed texel bytes (with
+guard bands, the banded texels the render packed). --texture and --method render other scenes and
+methods (a .obj with its .ptx, guardband) against the same floor + 2x packed bound; --bound-mb 0
+drops the absolute bound.
 
 RSS is not a timing: for one binary and one scene it moves by a few MB between runs (PoCL's
 allocations, the kernel cache state), so the bounds are the issue's targets themselves and the
 measured figures are printed for the margin (when this test was written: paper 282 MB, 68 MB under
 350 MB; quad2 225 MB, so 42 MB under the floor + 2x packed).
 
-    tests/memory_peak_test.py --seamcl build/seamcl [--scene paper] [--bound-mb 350]
+    tests/memory_peak_test.py --seamcl build/seamcl [--scene paper] [--texture T.ptx] [--method M]
+                              [--bound-mb 350]
 """
 import argparse
 import json
@@ -16,11 +20,15 @@ import subprocess
 import sys
 
 
-def render_memory(seamcl, scene):
-    """The "memory" block of one `seamcl render --scene SCENE --json` (no image written)."""
-    done = subprocess.run([seamcl, "render", "--scene", scene, "--json"], capture_output=True, text=True, timeout=600)
-    if done.returncode != 0:
-        raise SystemExit(f"memory_peak_test: seamcl render --scene {scene} exited {done.returncode}: {done.stderr.strip()}")
+def render_memory(seamcl, scene, extra=()):
+    """The "memory" block of `seamcl render --scene SCENE [EXTRA] --json` (no image written), from
+    the second of two runs: the first fills PoCL's kernel cache if it is cold, and compiling a
+    program variant (LLVM) peaks 100-150 MB higher than the render itself, whatever the scene."""
+    command = [seamcl, "render", "--scene", scene, *extra, "--json"]
+    for _ in range(2):
+        done = subprocess.run(command, capture_output=True, text=True, timeout=600)
+        if done.returncode != 0:
+            raise SystemExit(f"memory_peak_test: {' '.join(command)} exited {done.returncode}: {done.stderr.strip()}")
     answer = json.loads(done.stdout)
     memory = answer.get("memory")
     for field in ("peak_rss_bytes", "packed_texel_bytes", "scene_float_texel_bytes", "renderer_float_texel_bytes"):
@@ -33,23 +41,32 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seamcl", required=True)
     parser.add_argument("--scene", default="paper")
-    parser.add_argument("--bound-mb", type=float, default=350.0, help="peak RSS bound of --scene in MB (10^6 bytes)")
+    parser.add_argument("--texture", help="the .ptx of an .obj --scene")
+    parser.add_argument("--method", help="seam method of the render (default: the CLI's)")
+    parser.add_argument("--bound-mb", type=float, default=350.0,
+                        help="peak RSS bound of --scene in MB (10^6 bytes); 0: none but floor + 2x packed")
     args = parser.parse_args()
 
+    extra = []
+    if args.texture:
+        extra += ["--texture", args.texture]
+    if args.method:
+        extra += ["--method", args.method]
     floor = render_memory(args.seamcl, "quad2")["peak_rss_bytes"]
-    memory = render_memory(args.seamcl, args.scene)
+    memory = render_memory(args.seamcl, args.scene, extra)
     peak, packed = memory["peak_rss_bytes"], memory["packed_texel_bytes"]
     mb = 1e6
     print(f"quad2 peak (runtime floor): {floor / mb:.1f} MB")
-    print(f"{args.scene}: peak {peak / mb:.1f} MB, packed texels {packed / mb:.1f} MB, "
-          f"floor + 2x packed {(floor + 2 * packed) / mb:.1f} MB, bound {args.bound_mb:.0f} MB")
+    print(f"{' '.join([args.scene] + extra)}: peak {peak / mb:.1f} MB, packed texels {packed / mb:.1f} MB, "
+          f"floor + 2x packed {(floor + 2 * packed) / mb:.1f} MB (margin {(floor + 2 * packed - peak) / mb:.1f} MB), "
+          f"bound {args.bound_mb:.0f} MB")
     failures = []
     if memory["scene_float_texel_bytes"] != 0 or memory["renderer_float_texel_bytes"] != 0:
         failures.append(f"float texture copies are held: scene {memory['scene_float_texel_bytes']} bytes, "
                         f"renderer {memory['renderer_float_texel_bytes']} bytes")
     if packed <= 0:
         failures.append("packed_texel_bytes is not positive")
-    if peak > args.bound_mb * mb:
+    if args.bound_mb > 0 and peak > args.bound_mb * mb:
         failures.append(f"peak RSS {peak / mb:.1f} MB is over {args.bound_mb:.0f} MB")
     if peak > floor + 2 * packed:
         failures.append(f"peak RSS {peak / mb:.1f} MB is over the floor + 2x packed, {(floor + 2 * packed) / mb:.1f} MB")

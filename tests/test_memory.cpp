@@ -9,13 +9,16 @@
 #include <string>
 #include <vector>
 
+#include <seamcl/assets/scene_source.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/eval/reference.h>
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 
 #include "core/srgb.h"
+#include "ptex_test_writer.h"
 #include "test_support.h"
 
 namespace {
@@ -165,5 +168,79 @@ TEST(Memory, ProcessMemoryGrowsWithATouchedAllocation) {
   EXPECT_GE(after.rss_bytes, before.rss_bytes + (48u << 20)) << static_cast<int>(block[12345]);
   EXPECT_GE(after.peak_rss_bytes, after.rss_bytes);
 }
+
+// Scenes from files (issue 14): a .obj with its .ptx, and a bare mesh's pattern, deferred as the
+// generators are: no float texel held, packed to exactly the eager scene's texels (with and
+// without guard bands, tinted or not), and the same reference cache key (the key hashes each
+// face's texels, made one face at a time for a deferred scene).
+TEST(Memory, AssetScenesDeferTheirTexturesAndPackAsTheEagerOnes) {
+  const std::string dir = seamcl_tests::ptex_assets_dir() + "/";
+  struct Case {
+    std::string mesh, texture;
+  };
+  for (const Case& c : {Case{"plane.obj", "rand_lo.ptx"}, Case{"ptex_test_object.obj", "cellnoise.ptx"}, Case{"plane.obj", ""}}) {
+    for (bool tint : {false, true}) {
+      SCOPED_TRACE(c.mesh + " " + c.texture + (tint ? " tinted" : ""));
+      SceneSourceOptions eager_options, deferred_options;
+      eager_options.generator.tint = deferred_options.generator.tint = tint;
+      deferred_options.generator.defer_textures = true;
+      const std::string texture = c.texture.empty() ? "" : dir + c.texture;
+      const Scene eager = load_scene_source(dir + c.mesh, texture, eager_options);
+      const Scene deferred = load_scene_source(dir + c.mesh, texture, deferred_options);
+      EXPECT_FALSE(has_deferred_textures(eager));
+      EXPECT_TRUE(has_deferred_textures(deferred));
+      EXPECT_EQ(deferred.stored_texel_count(), 0u);
+      EXPECT_EQ(deferred.texel_count(), eager.texel_count());
+      const std::vector<std::pair<TexelFormat, int>> packings = {{TexelFormat::Rgba8, 0}, {TexelFormat::Rgba8, 2}, {TexelFormat::Rgba32f, 0}};
+      for (const auto& [format, band] : packings) expect_same_packing(pack_scene(eager, format, band), pack_scene(deferred, format, band));
+      RenderOptions frame;
+      frame.width = 32;
+      frame.height = 24;
+      EXPECT_EQ(reference_cache_key(deferred, deferred.camera, frame, {}), reference_cache_key(eager, eager.camera, frame, {}));
+    }
+  }
+  // Another texture, another key: the deferred key hashes texels, not only sizes.
+  SceneSourceOptions deferred_options;
+  deferred_options.generator.defer_textures = true;
+  RenderOptions frame;
+  const Scene rand = load_scene_source(dir + "plane.obj", dir + "rand_lo.ptx", deferred_options);
+  const Scene wave = load_scene_source(dir + "plane.obj", dir + "wave_lo.ptx", deferred_options);
+  EXPECT_NE(reference_cache_key(rand, rand.camera, frame, {}), reference_cache_key(wave, rand.camera, frame, {}));
+}
+
+// The service's budget check (issue 14): the scene's own cost comes from its sizes, so a deferred
+// scene is refused before a texel is baked. What the scene alone costs does not depend on the
+// frame, and is the request at one pixel.
+TEST(Memory, SceneRenderMemoryComesFromTheSizesBeforeAnyTexelIsBaked) {
+  GeneratorOptions huge;
+  huge.defer_textures = true;
+  huge.faces = kMaxPaperFaces;
+  huge.texture_scale_log2 = kMaxTextureScaleLog2;
+  const ProcessMemory before = process_memory();
+  const Scene scene = generate_scene("paper", huge);
+  const ProcessMemory after = process_memory();
+  EXPECT_EQ(scene.stored_texel_count(), 0u);
+  const SceneSizes sizes = scene_sizes(scene);
+  RenderOptions small, large;
+  small.width = small.height = 64;
+  large.width = 1920;
+  large.height = 1080;
+  large.msaa = 16;
+  const RenderMemory at_small = scene_render_memory(sizes, small);
+  const RenderMemory at_large = scene_render_memory(sizes, large);
+  EXPECT_EQ(at_small.device_bytes(), at_large.device_bytes());
+  EXPECT_EQ(at_small.host_bytes(), at_large.host_bytes());
+  RenderOptions one_pixel = small;
+  one_pixel.width = one_pixel.height = one_pixel.msaa = 1;
+  EXPECT_EQ(at_small.device_bytes(), render_memory(sizes, one_pixel).device_bytes());
+  EXPECT_LE(at_small.device_bytes(), render_memory(sizes, small).device_bytes());
+  // About 4x paper's texels: with the request's own copy of the scene (as the service counts an
+  // inline one) over a 1 GiB budget in host bytes (float copies counted as the upper bound),
+  // while generating it held a small fraction of that.
+  EXPECT_GT(saturating_add(at_small.host_bytes(), scene_host_bytes(sizes)), size_t{1} << 30);
+  const size_t grown = after.rss_bytes > before.rss_bytes ? after.rss_bytes - before.rss_bytes : 0;
+  EXPECT_LT(grown, at_small.host_bytes() / 4) << "generating the deferred scene grew RSS by " << grown << " bytes";
+}
+
 
 }  // namespace

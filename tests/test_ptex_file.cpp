@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -472,6 +473,55 @@ TEST(Ptex, ReadFileNamesThePath) {
   const std::filesystem::path obj = ptex_assets_dir() + "/plane.obj";
   EXPECT_NE(expect_input_error([&] { read_ptex_file(obj.string()); }).find(obj.string() + ": header: not a Ptex file"),
             std::string::npos);
+}
+
+
+// Deferred (issue 14): the faces hold their sizes only and the source decodes each one to exactly
+// the chain an eager read stores; the whole file is still checked while parsing, so a file an
+// eager read refuses is refused the same way.
+TEST(Ptex, DeferredReadMakesEachFaceAsTheEagerReadAndRefusesTheSameFiles) {
+  for (const char* name : {"black", "rand_lo", "wave_lo", "cellnoise", "cube_text"}) {
+    SCOPED_TRACE(name);
+    const PtexFile& eager = sample(name);
+    const PtexFile deferred = read_ptex_file(ptex_assets_dir() + "/" + name + ".ptx", {}, true);
+    EXPECT_FALSE(eager.texture_source);
+    ASSERT_TRUE(deferred.texture_source);
+    ASSERT_EQ(deferred.textures.size(), eager.textures.size());
+    EXPECT_EQ(ptex_texel_count(deferred), ptex_texel_count(eager));
+    EXPECT_EQ(deferred.metadata, eager.metadata);
+    EXPECT_EQ(deferred.mesh.has_value(), eager.mesh.has_value());
+    for (size_t f = 0; f < eager.textures.size(); ++f) {
+      const MipChain& stored = deferred.textures[f];
+      ASSERT_TRUE(is_deferred(stored));
+      ASSERT_EQ(stored.levels.size(), eager.textures[f].levels.size());
+      const MipChain made = deferred.texture_source(f);
+      ASSERT_EQ(made.levels.size(), eager.textures[f].levels.size());
+      for (size_t l = 0; l < made.levels.size(); ++l) {
+        const TextureLevel& want = eager.textures[f].levels[l];
+        EXPECT_TRUE(stored.levels[l].texels.empty());
+        ASSERT_EQ(stored.levels[l].width, want.width);
+        ASSERT_EQ(stored.levels[l].height, want.height);
+        ASSERT_EQ(made.levels[l].width, want.width);
+        ASSERT_EQ(made.levels[l].height, want.height);
+        ASSERT_EQ(made.levels[l].texels.size(), want.texels.size());
+        ASSERT_EQ(std::memcmp(made.levels[l].texels.data(), want.texels.data(), want.texels.size() * sizeof(glm::vec4)), 0)
+            << "face " << f << " level " << l;
+      }
+    }
+  }
+  // A NaN in face 1's level 0: refused while parsing, deferred or not, with the same message.
+  PtexTestFile spec;
+  spec.data_type = 2;
+  spec.faces = {{1, 1, 0, {-1, -1, -1, -1}, 0, {0, 0x3c}}, {1, 1, 0, {-1, -1, -1, -1}, 0, {0, 0x3c}}};
+  std::vector<uint8_t> good, broken;
+  for (int t = 0; t < 4; ++t) put_u16(good, 0x3800);
+  for (int t = 0; t < 4; ++t) put_u16(broken, t == 3 ? uint16_t(0x7e00) : uint16_t(0x3800));
+  spec.levels = {{data_block(good, 4, 1, 2), data_block(broken, 4, 1, 2)}};
+  const std::vector<uint8_t> bytes = write_ptex(spec);
+  const std::string eager_message = parse_error(bytes);
+  const std::string deferred_message = expect_input_error([&] { parse_ptex(bytes, {}, true); });
+  EXPECT_NE(eager_message.find("face 1, level 0: texel (1, 1) channel 0 is nan"), std::string::npos) << eager_message;
+  EXPECT_EQ(deferred_message, eager_message);
 }
 
 }  // namespace

@@ -33,6 +33,7 @@
 #include <seamcl/eval/reference.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/packed_scene.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
@@ -871,6 +872,42 @@ TEST_F(Server, MalformedRequestsAreRefusedNamingTheField) {
 // Invalid UTF-8 in the path, decoded from %XX: the 404 answer echoed it into the JSON and its
 // dump threw inside cpp-httplib's error handler (std::terminate). Now: a 404 naming the path,
 // with the bytes replaced, and the server still answers.
+// An inline generator scene over the request-memory budget (issue 14): 413 naming the option
+// that made it so, with the estimate and the limit, decided from the scene's sizes before any
+// texel is baked. Baking this one (about 4x paper's texels at 250,000 faces) took 1.5 GB of peak
+// RSS; the peak (VmHWM, reset first through /proc/self/clear_refs) must stay far below that.
+TEST_F(Server, AnInlineSceneOverTheBudgetIsRefusedNamingItBeforeItIsBaked) {
+  httplib::Client c = client();
+  const std::string body =
+      R"({"scene": {"generator": "paper", "options": {"faces": 250000, "texture_scale_log2": 1}}, "size": "64x64"})";
+  bool peak_reset = false;
+  {
+    std::ofstream clear("/proc/self/clear_refs");
+    clear << "5" << std::flush;
+    peak_reset = static_cast<bool>(clear);
+  }
+  const ProcessMemory before = process_memory();
+  auto res = post_json(c, body);
+  const ProcessMemory after = process_memory();
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 413) << res->body;
+  const json answer = json::parse(res->body);
+  EXPECT_EQ(answer.at("field"), "scene.options.faces");
+  const std::string error = answer.at("error");
+  EXPECT_NE(error.find("the scene (2"), std::string::npos) << error;
+  EXPECT_NE(error.find(" MiB of "), std::string::npos) << error;
+  EXPECT_NE(error.find("memory, over this server's limit of 1024.0 MiB per request"), std::string::npos) << error;
+  // Without the face count, the texture scale is what makes it too big.
+  auto scaled = post_json(c, R"({"scene": {"generator": "paper", "options": {"texture_scale_log2": 1}}, "size": "64x64", "texels": "rgba32f"})");
+  ASSERT_TRUE(scaled);
+  ASSERT_EQ(scaled->status, 413) << scaled->body;
+  EXPECT_EQ(json::parse(scaled->body).at("field"), "scene.options.texture_scale_log2") << scaled->body;
+  if (peak_reset) {
+    const size_t grown = after.peak_rss_bytes > before.rss_bytes ? after.peak_rss_bytes - before.rss_bytes : 0;
+    EXPECT_LT(grown, size_t{400} << 20) << "the refused request raised the peak RSS by " << grown << " bytes";
+  }
+}
+
 TEST_F(Server, InvalidUtf8InThePathIsA404NotACrash) {
   std::string cut_inside_a_character = "/";
   for (int i = 0; i < 100; ++i) cut_inside_a_character += "%C3%A9";  // "é" x 100: 201 bytes decoded

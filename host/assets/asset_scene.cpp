@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <memory>
 
 #include <seamcl/assets/ptex_adjacency.h>
 #include <seamcl/core/input_error.h>
@@ -33,17 +34,32 @@ Scene scene_from_ptex(ObjMesh mesh, PtexFile ptex, const std::string& mesh_name,
   Scene scene = scene_of_mesh(std::move(mesh), mesh_name);
   check_ptex_adjacency(scene, ptex.faces, mesh_name, ptex_name, field);
   for (size_t f = 0; f < scene.faces.size(); ++f) scene.faces[f].texture = std::move(ptex.textures[f]);
+  scene.texture_source = std::move(ptex.texture_source);  // the deferred faces' (empty when none is)
   frame_camera(scene);
   validate_scene(scene);
   return scene;
 }
 
-Scene scene_from_mesh(ObjMesh mesh, int texture_size, const std::string& mesh_name) {
+Scene scene_from_mesh(ObjMesh mesh, int texture_size, const std::string& mesh_name, bool defer_textures) {
   if (texture_size < 1 || (texture_size & (texture_size - 1)) != 0)
     throw std::invalid_argument("scene_from_mesh: texture_size must be a power of two");
   Scene scene = scene_of_mesh(std::move(mesh), mesh_name);
-  for (Face& face : scene.faces)
-    face.texture = build_mip_chain(bake_face_texture(scene.corners(face), texture_size, texture_size, surface_pattern));
+  if (defer_textures) {
+    // The source keeps its own copy of the corners, so it stays right in any copy of the scene.
+    std::vector<std::array<glm::vec3, 4>> corners;
+    corners.reserve(scene.faces.size());
+    for (Face& face : scene.faces) {
+      corners.push_back(scene.corners(face));
+      face.texture = deferred_mip_chain(texture_size, texture_size);
+    }
+    scene.texture_source = [corners = std::make_shared<const std::vector<std::array<glm::vec3, 4>>>(std::move(corners)),
+                            texture_size](size_t f) {
+      return build_mip_chain(bake_face_texture(corners->at(f), texture_size, texture_size, surface_pattern));
+    };
+  } else {
+    for (Face& face : scene.faces)
+      face.texture = build_mip_chain(bake_face_texture(scene.corners(face), texture_size, texture_size, surface_pattern));
+  }
   frame_camera(scene);
   validate_scene(scene);
   return scene;

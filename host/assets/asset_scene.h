@@ -10,14 +10,15 @@
 
 namespace seamcl {
 
-// Face i of the mesh takes face i of the file. Throws InputError(field) when the face counts
+// Face i of the mesh takes face i of the file (a deferred file's texture_source becomes the scene's). Throws InputError(field) when the face counts
 // differ or the file's adjacency disagrees with the mesh's shared edges (check_ptex_adjacency).
 Scene scene_from_ptex(ObjMesh mesh, PtexFile ptex, const std::string& mesh_name, const std::string& ptex_name,
                       const std::string& field = "texture");
 
 // Every face the surface pattern (surface_pattern), baked at texture_size x texture_size texels
-// (a power of two): for a mesh without textures of its own.
-Scene scene_from_mesh(ObjMesh mesh, int texture_size, const std::string& mesh_name);
+// (a power of two): for a mesh without textures of its own. With defer_textures, baked by
+// Scene::texture_source when packed instead (the faces hold their sizes only).
+Scene scene_from_mesh(ObjMesh mesh, int texture_size, const std::string& mesh_name, bool defer_textures = false);
 
 // The mesh a .ptx carries in its metadata, as an ObjMesh; InputError(field) when it has none.
 ObjMesh ptex_mesh(const PtexFile& ptex, const std::string& ptex_name, const std::string& field = "scene");

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <new>
 #include <numeric>
 #include <sstream>
@@ -186,18 +187,37 @@ struct ChannelMap {
 
 class PtexDecoder {
  public:
-  PtexDecoder(std::span<const uint8_t> bytes, const PtexLimits& limits) : file_(bytes), limits_(limits) {}
+  // `owned`, when given, holds `bytes` and keeps them alive as long as the decoder (deferred textures).
+  PtexDecoder(std::span<const uint8_t> bytes, const PtexLimits& limits,
+              std::shared_ptr<const std::vector<uint8_t>> owned = nullptr)
+      : owned_(std::move(owned)), file_(bytes), limits_(limits) {}
 
   PtexFile decode() {
-    read_header();
-    read_face_info();
-    read_constant_data();
-    read_level_info();
-    check_no_edits();
-    read_metadata();
-    build_mesh();
+    read_structure();
     read_textures();
     return std::move(out_);
+  }
+
+  // The file's textures deferred: every face is decoded once here to check it (and dropped), and
+  // the returned file's texture_source decodes a face again when asked. `decoder` must own its bytes.
+  static PtexFile decode_deferred(std::shared_ptr<PtexDecoder> decoder) {
+    PtexDecoder& d = *decoder;
+    d.read_structure();
+    d.metadata_.clear();  // in out_ already, as text and mesh
+    d.out_.textures.resize(d.header_.faces);
+    for (uint32_t f = 0; f < d.header_.faces; ++f) {
+      const MipChain checked = d.face_chain(f);  // throws what an eager read would
+      d.out_.textures[f] = deferred_mip_chain(checked.width(), checked.height());
+    }
+    PtexFile out = d.out_;  // small now: face infos, sizes, metadata text, mesh
+    d.out_.textures.clear();
+    d.out_.metadata.clear();
+    d.out_.mesh.reset();
+    out.texture_source = [decoder = std::shared_ptr<const PtexDecoder>(std::move(decoder))](size_t face) {
+      if (face >= decoder->out_.faces.size()) throw std::out_of_range("ptex texture_source: face out of range");
+      return decoder->face_chain(static_cast<uint32_t>(face));
+    };
+    return out;
   }
 
  private:
@@ -211,12 +231,25 @@ class PtexDecoder {
     return file_.subspan(static_cast<size_t>(offset), static_cast<size_t>(size));
   }
 
-  std::vector<uint8_t> inflate_block(std::span<const uint8_t> in, uint64_t size, const std::string& what) {
+  // Everything but the texels: header, face infos, constant data, level tables, metadata, mesh.
+  void read_structure() {
+    read_header();
+    read_face_info();
+    read_constant_data();
+    read_level_info();
+    check_no_edits();
+    read_metadata();
+    build_mesh();
+  }
+
+  std::vector<uint8_t> inflate_block(std::span<const uint8_t> in, uint64_t size, const std::string& what) const {
     if (size > add_saturated(in.size() * kMaxInflateRatio, kInflateSlack))
       fail(what + ": a zlib block of " + str(in.size()) + " bytes cannot inflate to the " + str(size) +
            " bytes expected");
     std::vector<uint8_t> out(static_cast<size_t>(size));
-    if (std::string problem = inflater_.inflate_exact(in, out); !problem.empty()) fail(what + ": " + problem);
+    // One inflater per thread: a deferred file's faces are decoded by the packing threads at once.
+    thread_local Inflater inflater;
+    if (std::string problem = inflater.inflate_exact(in, out); !problem.empty()) fail(what + ": " + problem);
     return out;
   }
 
@@ -622,7 +655,7 @@ class PtexDecoder {
 
   // Decodes one face block (or tile) of 2^ulog2 x 2^vlog2 texels into `dest` at (x0, y0).
   void decode_block(std::span<const uint8_t> block, uint32_t encoding, int ulog2, int vlog2, TextureLevel& dest,
-                    int x0, int y0, bool tiles_allowed, const std::string& where) {
+                    int x0, int y0, bool tiles_allowed, const std::string& where) const {
     const int width = 1 << ulog2;
     const int height = 1 << vlog2;
     switch (encoding) {
@@ -696,7 +729,7 @@ class PtexDecoder {
   }
 
   // Level k of a face from its stored block: 2^(ulog2 - k) x 2^(vlog2 - k) texels.
-  TextureLevel stored_level(int k, uint32_t rank, const PtexFaceInfo& info, uint32_t face) {
+  TextureLevel stored_level(int k, uint32_t rank, const PtexFaceInfo& info, uint32_t face) const {
     const LevelInfo& level = levels_[k];
     const int ulog2 = info.ulog2 - k;
     const int vlog2 = info.vlog2 - k;
@@ -726,36 +759,40 @@ class PtexDecoder {
     }
   }
 
-  void read_textures() {
-    out_.textures.resize(header_.faces);
-    for (uint32_t f = 0; f < header_.faces; ++f) {
-      const PtexFaceInfo& info = out_.faces[f];
-      MipChain& chain = out_.textures[f];
-      const int levels = 1 + std::max(info.ulog2, info.vlog2);
-      chain.levels.reserve(levels);
-      for (int k = 0; k < levels; ++k) {
-        const int width = std::max(1, (1 << info.ulog2) >> k);
-        const int height = std::max(1, (1 << info.vlog2) >> k);
-        const uint32_t rank = reduction_rank_[f];
-        if (info.constant || (width == 1 && height == 1)) {
-          // Ptex's 1x1 level is the constant data: the average its writer stored, not a box
-          // filter of level 0 (which differs by rounding).
-          chain.levels.push_back(filled_level(width, height, constant_values_[f]));
-        } else if (k == 0) {
-          chain.levels.push_back(stored_level(0, f, info, f));
-        } else if (k < header_.levels && rank < levels_[k].faces) {
-          chain.levels.push_back(stored_level(k, rank, info, f));
-          unpremultiply(chain.levels.back(), f, k);
-        } else {
-          chain.levels.push_back(box_downsample(chain.levels.back()));
-        }
+  // Face f's whole chain, as PtexFile::textures describes it.
+  MipChain face_chain(uint32_t f) const {
+    const PtexFaceInfo& info = out_.faces[f];
+    MipChain chain;
+    const int levels = 1 + std::max(info.ulog2, info.vlog2);
+    chain.levels.reserve(levels);
+    for (int k = 0; k < levels; ++k) {
+      const int width = std::max(1, (1 << info.ulog2) >> k);
+      const int height = std::max(1, (1 << info.vlog2) >> k);
+      const uint32_t rank = reduction_rank_[f];
+      if (info.constant || (width == 1 && height == 1)) {
+        // Ptex's 1x1 level is the constant data: the average its writer stored, not a box
+        // filter of level 0 (which differs by rounding).
+        chain.levels.push_back(filled_level(width, height, constant_values_[f]));
+      } else if (k == 0) {
+        chain.levels.push_back(stored_level(0, f, info, f));
+      } else if (k < header_.levels && rank < levels_[k].faces) {
+        chain.levels.push_back(stored_level(k, rank, info, f));
+        unpremultiply(chain.levels.back(), f, k);
+      } else {
+        chain.levels.push_back(box_downsample(chain.levels.back()));
       }
     }
+    return chain;
   }
 
+  void read_textures() {
+    out_.textures.resize(header_.faces);
+    for (uint32_t f = 0; f < header_.faces; ++f) out_.textures[f] = face_chain(f);
+  }
+
+  std::shared_ptr<const std::vector<uint8_t>> owned_;  // the bytes file_ views, for a deferred file
   std::span<const uint8_t> file_;
   PtexLimits limits_;
-  Inflater inflater_;
   Header header_;
   int element_bytes_ = 1;
   int pixel_bytes_ = 1;
@@ -772,11 +809,13 @@ class PtexDecoder {
 
 }  // namespace
 
-PtexFile parse_ptex(std::span<const uint8_t> bytes, const PtexLimits& limits) {
-  return PtexDecoder(bytes, limits).decode();
+PtexFile parse_ptex(std::span<const uint8_t> bytes, const PtexLimits& limits, bool defer_textures) {
+  if (!defer_textures) return PtexDecoder(bytes, limits).decode();
+  auto owned = std::make_shared<const std::vector<uint8_t>>(bytes.begin(), bytes.end());
+  return PtexDecoder::decode_deferred(std::make_shared<PtexDecoder>(std::span<const uint8_t>(*owned), limits, owned));
 }
 
-PtexFile read_ptex_file(const std::string& path, const PtexLimits& limits) {
+PtexFile read_ptex_file(const std::string& path, const PtexLimits& limits, bool defer_textures) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw InputError("texture", path + ": cannot be read (" + std::strerror(errno) + ")");
   const std::streamoff size = in.tellg();
@@ -784,12 +823,14 @@ PtexFile read_ptex_file(const std::string& path, const PtexLimits& limits) {
   if (static_cast<uint64_t>(size) > limits.max_file_bytes)
     throw InputError("texture", path + ": " + str(uint64_t(size)) + " bytes, more than the limit of " +
                                     str(limits.max_file_bytes));
-  std::vector<uint8_t> bytes(static_cast<size_t>(size));
+  auto bytes = std::make_shared<std::vector<uint8_t>>(static_cast<size_t>(size));
   in.seekg(0);
-  if (!in.read(reinterpret_cast<char*>(bytes.data()), size))
+  if (!in.read(reinterpret_cast<char*>(bytes->data()), size))
     throw InputError("texture", path + ": cannot be read to its end");
   try {
-    return parse_ptex(bytes, limits);
+    if (!defer_textures) return parse_ptex(*bytes, limits);
+    const std::span<const uint8_t> view(*bytes);
+    return PtexDecoder::decode_deferred(std::make_shared<PtexDecoder>(view, limits, std::move(bytes)));
   } catch (const InputError& e) {
     // The message of parse_ptex's errors follows "texture: "; the path goes in front of it.
     const std::string message = std::string(e.what()).substr(e.field().size() + 2);
@@ -800,7 +841,7 @@ PtexFile read_ptex_file(const std::string& path, const PtexLimits& limits) {
 uint64_t ptex_texel_count(const PtexFile& file) {
   uint64_t texels = 0;
   for (const MipChain& chain : file.textures)
-    for (const TextureLevel& level : chain.levels) texels += level.texels.size();
+    for (const TextureLevel& level : chain.levels) texels += static_cast<uint64_t>(level.width) * level.height;
   return texels;
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <span>
@@ -48,7 +49,13 @@ struct PtexFile {
   // every level). Stored reductions are used as they are; missing ones are 2x2 (2x1, 1x2) box
   // filters of the level above; the 1x1 level is the file's constant data (Ptex's own 1x1 level).
   // Every chain passes validate_scene's checks.
+  // With defer_textures (parse_ptex, read_ptex_file) the chains hold their sizes only
+  // (deferred_mip_chain) and texture_source makes face f's chain, exactly what an eager read
+  // stores, from the file's bytes (kept, compressed as they are, by the source): so no float copy
+  // of every face exists (Scene::texture_source). Every face is still decoded once while parsing
+  // and dropped, so a malformed file is refused there as it is without deferral. Thread-safe.
   std::vector<MipChain> textures;
+  std::function<MipChain(size_t face)> texture_source;  // empty unless deferred
   std::map<std::string, std::string> metadata;  // values rendered as text, for display
                                                 // (long arrays shortened)
   std::optional<PtexMesh> mesh;
@@ -72,13 +79,14 @@ struct PtexLimits {
 // names the part at fault ("header: nchannels 1000 is not 1 to 4", "face 12, level 1: block of
 // 4000 bytes runs past the 300 bytes left in the level"), for every malformed, truncated or
 // unsupported input (triangle meshes, edits, more than 4 channels).
-PtexFile parse_ptex(std::span<const uint8_t> bytes, const PtexLimits& limits = {});
+PtexFile parse_ptex(std::span<const uint8_t> bytes, const PtexLimits& limits = {}, bool defer_textures = false);
 
 // Reads and parses a file; every error is InputError("texture", ...) whose message starts with
 // the path.
-PtexFile read_ptex_file(const std::string& path, const PtexLimits& limits = {});
+PtexFile read_ptex_file(const std::string& path, const PtexLimits& limits = {}, bool defer_textures = false);
 
-// Texels of all levels of all faces of a file's textures (16 bytes each as float RGBA).
+// Texels of all levels of all faces of a file's textures (16 bytes each as float RGBA), deferred
+// ones included.
 uint64_t ptex_texel_count(const PtexFile& file);
 
 }  // namespace seamcl

@@ -42,7 +42,8 @@ struct Loader {
   // The reader names every error "texture"; a .ptx given as the scene is the scene's.
   PtexFile read_ptex(const std::string& path, const std::string& field) const {
     try {
-      return read_ptex_file(path, options.ptex_limits);
+      // Deferred as the generators are when asked: the texels stay compressed until packed.
+      return read_ptex_file(path, options.ptex_limits, options.generator.defer_textures);
     } catch (const InputError& error) {
       if (error.field() == field) throw;
       throw InputError(field, message_of(error));
@@ -52,7 +53,8 @@ struct Loader {
   Scene mesh_scene(const std::string& mesh_path, const std::string& texture_path, const std::string& mesh_field,
                    const std::string& texture_field) const {
     ObjMesh mesh = read_obj_file(mesh_path, mesh_field);
-    if (texture_path.empty()) return scene_from_mesh(std::move(mesh), options.mesh_texture_size, mesh_path);
+    if (texture_path.empty())
+      return scene_from_mesh(std::move(mesh), options.mesh_texture_size, mesh_path, options.generator.defer_textures);
     if (asset_kind_of_path(texture_path) != AssetKind::Ptex)
       throw InputError(texture_field, "must be a .ptx file, got '" + texture_path + "'");
     return scene_from_ptex(std::move(mesh), read_ptex(texture_path, texture_field), mesh_path, texture_path,

@@ -33,7 +33,8 @@ using AssetPathResolver =
 std::string resolve_any_path(const std::string& name, const std::string& relative_to, const std::string& field);
 
 struct SceneSourceOptions {
-  GeneratorOptions generator;  // tint and a constant colour, on top of the scene's own textures
+  GeneratorOptions generator;  // tint and a constant colour, on top of the scene's own textures;
+                               // defer_textures also defers a .ptx's faces and a bare mesh's pattern
   PtexLimits ptex_limits;      // what a .ptx may make the reader allocate
   int mesh_texture_size = 64;  // texels per side of each face of a mesh without a .ptx
   AssetPathResolver resolve;   // empty: resolve_any_path

@@ -57,12 +57,15 @@ std::string scene_content_hash(const Scene& scene) {
   f.value(scene.positions.size());
   for (const glm::vec3& p : scene.positions) f.value(p);
   f.value(scene.faces.size());
-  for (const Face& face : scene.faces) {
+  for (size_t i = 0; i < scene.faces.size(); ++i) {
+    const Face& face = scene.faces[i];
     f.value(face.vertices);
     f.value(face.texture.levels.size());
     if (!face.texture.levels.empty()) {
-      // Level 0 determines the chain (build_mip_chain).
-      const TextureLevel& level = face.texture.levels.front();
+      // Level 0 determines the chain (build_mip_chain). A deferred face's is made and hashed
+      // (then dropped): the key of a scene is the same whether its textures are deferred or not.
+      const MipChain made = is_deferred(face.texture) ? face_texture(scene, i) : MipChain{};
+      const TextureLevel& level = (made.levels.empty() ? face.texture : made).levels.front();
       f.value(level.width);
       f.value(level.height);
       f.bytes(level.texels.data(), level.texels.size() * sizeof(glm::vec4));
@@ -615,7 +618,9 @@ Scene seamless_scene(const Scene& scene) {
   TextureLevel combined{W, H, std::vector<glm::vec4>(static_cast<size_t>(W) * static_cast<size_t>(H))};
   for (int r = 0; r < grid.rows; ++r)
     for (int c = 0; c < grid.columns; ++c) {
-      const TextureLevel& level = scene.faces[grid.faces[static_cast<size_t>(r * grid.columns + c)]].texture.levels.front();
+      const size_t f = grid.faces[static_cast<size_t>(r * grid.columns + c)];
+      const MipChain made = is_deferred(scene.faces[f].texture) ? face_texture(scene, f) : MipChain{};  // deferred: made here
+      const TextureLevel& level = (made.levels.empty() ? scene.faces[f].texture : made).levels.front();
       for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i)
           combined.texels[static_cast<size_t>(r * h + j) * static_cast<size_t>(W) + static_cast<size_t>(c * w + i)] =

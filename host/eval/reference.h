@@ -97,7 +97,8 @@ std::string default_cache_dir();
 RenderOptions reference_render_options(const RenderOptions& frame, const ReferenceSettings& settings);
 
 // Everything the reference depends on, as one canonical JSON string: a hash of the scene's
-// content (geometry, textures, light, background), the camera, the reference render options
+// content (geometry, textures, light, background; a deferred face's texels are made to be hashed,
+// one face at a time, so deferring a scene's textures does not change its key), the camera, the reference render options
 // (scene name, frame, frames, size, method, msaa, filter, aniso, texels, ...), the kernel
 // sources, the scale and the downsample filter.
 std::string reference_cache_key(const Scene& scene, const Camera& camera, const RenderOptions& frame,

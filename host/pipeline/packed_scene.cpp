@@ -48,9 +48,11 @@ void pack_face_texels(const Scene& scene, PackedScene& out, size_t f, size_t fir
 
 // Guard bands of a scene with deferred textures. A face's band reads the levels of the faces
 // across its edges and around its corners, all of which share a vertex with it; so the faces are
-// packed in order, each face's chain made just before the first face that reads it and dropped
-// after the last. Only that moving window of faces (about a ring of the mesh) holds float texels
-// at once, never the whole scene.
+// packed one after another, each face's chain made just before the first face that reads it and
+// dropped after the last. The order is breadth first over faces that share a vertex (each
+// connected part in turn), so that the faces holding float texels at once are a few rings of the
+// mesh around the packing front, however the file numbers its faces, never the whole scene. Each
+// face's band is written to its own range: the order changes nothing in the result.
 void pack_banded_deferred(const Scene& scene, PackedScene& out, const std::vector<size_t>& first_level) {
   const size_t count = scene.faces.size();
   std::vector<std::vector<uint32_t>> faces_at_vertex(scene.positions.size());
@@ -63,17 +65,35 @@ void pack_banded_deferred(const Scene& scene, PackedScene& out, const std::vecto
     around.erase(std::unique(around.begin(), around.end()), around.end());
     return around;
   };
-  std::vector<size_t> last_reader(count);
-  for (size_t f = 0; f < count; ++f)
-    for (uint32_t g : readers_of(f)) last_reader[g] = std::max(last_reader[g], f);
+  std::vector<uint32_t> order;
+  order.reserve(count);
+  std::vector<bool> queued(count, false);
+  for (size_t start = 0; start < count; ++start) {
+    if (queued[start]) continue;
+    queued[start] = true;
+    order.push_back(static_cast<uint32_t>(start));
+    for (size_t next = order.size() - 1; next < order.size(); ++next)
+      for (uint32_t g : readers_of(order[next]))
+        if (!queued[g]) {
+          queued[g] = true;
+          order.push_back(g);
+        }
+  }
+  std::vector<size_t> last_reader(count, 0);  // position in `order` of the last face reading each face
+  for (size_t k = 0; k < count; ++k)
+    for (uint32_t g : readers_of(order[k])) last_reader[g] = std::max(last_reader[g], k);
   Scene window = scene;  // deferred chains (sizes only) but for the faces in the window
-  for (size_t f = 0; f < count; ++f) {
+  for (size_t k = 0; k < count; ++k) {
+    const size_t f = order[k];
     const std::vector<uint32_t> around = readers_of(f);
     for (uint32_t g : around)
       if (is_deferred(window.faces[g].texture)) window.faces[g].texture = face_texture(scene, g);
     pack_face_texels(window, out, f, first_level[f]);
+    // Sizes only again. A new chain moved in, so the texels' storage is freed: copy-assigning
+    // the deferred chain would empty each level's vector but keep its capacity, and with it
+    // every face's floats until the end (which was guardband's peak).
     for (uint32_t g : around)
-      if (last_reader[g] == f && is_deferred(scene.faces[g].texture)) window.faces[g].texture = scene.faces[g].texture;  // sizes only again
+      if (last_reader[g] == k && is_deferred(scene.faces[g].texture)) window.faces[g].texture = MipChain(scene.faces[g].texture);
   }
 }
 

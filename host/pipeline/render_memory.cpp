@@ -153,6 +153,12 @@ RenderMemory render_memory(const Scene& scene, const RenderOptions& options) {
   return render_memory(scene_sizes(scene), options);
 }
 
+RenderMemory scene_render_memory(const SceneSizes& scene, const RenderOptions& options) {
+  RenderOptions smallest = options;
+  smallest.width = smallest.height = smallest.msaa = 1;
+  return render_memory(scene, smallest);
+}
+
 namespace {
 
 // "VmHWM:     123456 kB" -> bytes; 0 when the line is not there.

@@ -106,6 +106,12 @@ struct RenderMemory {
 RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options);
 RenderMemory render_memory(const Scene& scene, const RenderOptions& options);
 
+// What the scene alone makes a render of it cost, whatever frame is asked for: the request at 1x1
+// pixel without MSAA (the scene's arrays and packed textures, the setups and tile lists of its
+// triangles). A budget this is over is the scene's doing, not the size's; a service checks it on
+// SceneSizes from a deferred scene (GeneratorOptions::defer_textures) before anything is baked.
+RenderMemory scene_render_memory(const SceneSizes& scene, const RenderOptions& options);
+
 // a + b and a * b, at most SIZE_MAX: budgets must never wrap to a small number.
 size_t saturating_add(size_t a, size_t b);
 size_t saturating_mul(size_t a, size_t b);

@@ -466,13 +466,22 @@ void apply_generator_options(Scene& scene, const GeneratorOptions& options) {
     set_constant_textures(scene, glm::vec4(*options.constant_color, 1.0f));
   if (options.constant_color && scene.environment) scene.environment->constant = *options.constant_color;
   if (!options.tint) return;
-  materialize_textures(scene);  // tinting scales texels: a deferred scene's are baked first
   // The box filter is linear, so scaling every level equals re-filtering a scaled level 0.
-  for (size_t f = 0; f < scene.faces.size(); ++f) {
+  auto tint_chain = [](MipChain& chain, size_t f) {
     const glm::vec4 tint(face_tint(f), 1.0f);
-    for (TextureLevel& level : scene.faces[f].texture.levels)
+    for (TextureLevel& level : chain.levels)
       for (glm::vec4& texel : level.texels) texel *= tint;
+  };
+  // Deferred faces stay deferred: their source tints what it makes (a stored face has no texels
+  // to tint here and is tinted below).
+  if (scene.texture_source) {
+    scene.texture_source = [untinted = scene.texture_source, tint_chain](size_t f) {
+      MipChain chain = untinted(f);
+      tint_chain(chain, f);
+      return chain;
+    };
   }
+  for (size_t f = 0; f < scene.faces.size(); ++f) tint_chain(scene.faces[f].texture, f);
   if (scene.albedo) {
     scene.albedo = [untinted = scene.albedo](size_t face, glm::vec3 p) {
       return untinted(face, p) * glm::vec4(face_tint(face), 1.0f);

@@ -485,8 +485,8 @@ SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load
 
 }  // namespace
 
-Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_image) {
-  Scene scene = realize(read_document(doc, "scene", load_image), {});
+Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_image, const GeneratorOptions& options) {
+  Scene scene = realize(read_document(doc, "scene", load_image), options);
   // A document without a file behind it: nothing would read an environment's image files.
   if (scene.environment && scene.environment->files) {
     const EnvironmentFiles& files = *scene.environment->files;

@@ -18,8 +18,11 @@ namespace seamcl {
 using FaceImageLoader = std::function<TextureLevel(const std::string& name, const std::string& field)>;
 
 // Either a generator reference ({"generator": ..., "options": ...}) or an explicit scene.
-// The result has passed validate_scene.
-Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_image = {});
+// The result has passed validate_scene. `options` apply on top of the document's own as in
+// load_scene (defer_textures: a generator's textures are left to Scene::texture_source, so that
+// the scene's sizes, and what it will cost, are known before anything is baked).
+Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_image = {},
+                       const GeneratorOptions& options = {});
 
 // Reads and parses a scene file. An unreadable file or bad JSON syntax is InputError("scene", ...)
 // naming the path and the parse error; errors in the content keep their JSON path as the field.
