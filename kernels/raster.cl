@@ -22,19 +22,8 @@
  * global size (tiles_x, tiles_y * SEAMCL_TILE_SIZE); image sides <= 16384 (kMaxImageSide), so
  * fixed-point sample positions fit 32 bits and convert to float exactly. Twin: host/twins/raster.cpp. */
 
-/* D3D11 standard sample positions in 1/16 pixel from the pixel centre, y down; rows for 1, 2,
- * 4, 8 and 16 samples (row = log2(count)). */
-__constant char sample_offsets[5][SEAMCL_MAX_SAMPLES][2] = {
-    {{0, 0}},
-    {{4, 4}, {-4, -4}},
-    {{-2, -6}, {6, -2}, {-6, 2}, {2, 6}},
-    {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, 7}, {7, -7}},
-    {{1, 1}, {-1, -3}, {-3, 2}, {4, -1}, {-5, -2}, {2, 5}, {5, 3}, {3, -5},
-     {-2, 6}, {0, -7}, {-4, -6}, {-6, 4}, {-8, 0}, {7, -4}, {6, 7}, {-7, -8}}};
-
-SEAMCL_INLINE int sample_pattern_row(int sample_count) {
-  return sample_count == 1 ? 0 : sample_count == 2 ? 1 : sample_count == 4 ? 2 : sample_count == 8 ? 3 : 4;
-}
+/* The D3D11 sample pattern (sample_offsets, sample_pattern_row) is defined in triangle_setup.cl,
+ * whose cull reads it too. */
 
 /* Fixed-point position of sample s of pixel (x, y). */
 SEAMCL_INLINE long sample_fixed_x(int x, int row, int s) {
