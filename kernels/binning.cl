@@ -3,7 +3,11 @@
  *   bin_count  one work-item per input triangle, over its written slots (slot_counts, from
  *              setup): +1 on every tile a slot's triangle may cover;
  *   bin_scan   one work-item: exclusive prefix sum of the counts -> list offsets (and cursors);
- *   bin_fill   the same walk as bin_count: appends the slot index to each tile's list.
+ *   bin_fill   the same walk as bin_count: appends the slot index to each tile's list, and at the
+ *              same entry of tile_entry_rows the rows and columns of the tile that the slot's
+ *              box covers (tile-relative, 4 bits each: row_lo | row_hi << 4 | col_lo << 8 |
+ *              col_hi << 12), so raster skips the entry on its other rows without reading the
+ *              slot's record.
  * Most input triangles write one slot or none (culled), so walking triangles rather than all
  * SEAMCL_CLIP_SLOTS slots reads a few bytes for each culled one instead of six records.
  * A tile is skipped when one edge function is negative over all of its sample positions (the
@@ -12,6 +16,10 @@
  * broken by slot index). If the lists need more than bin_capacity entries, bin_fill drops the
  * rest and the host, seeing stats.bin_entries > capacity, grows the buffer and renders again.
  * Host guarantees: tile_counts zeroed before bin_count; slot_counts written for this frame. Twin: host/binning.cpp. */
+
+#if SEAMCL_TILE_SIZE != 16
+#error "tile_entry_rows packs tile-relative rows and columns in 4 bits each"
+#endif
 
 SEAMCL_INLINE int tile_may_be_covered(__global const TriangleSetup* s, int tile_x, int tile_y) {
   /* Fixed-point extent of every sample position inside the tile. */
@@ -58,7 +66,8 @@ __kernel void bin_scan(__constant FrameParams* frame, __global const uint* tile_
 }
 
 __kernel void bin_fill(__constant FrameParams* frame, __global const TriangleSetup* setups,
-                       __global const uint* slot_counts, __global uint* tile_cursors, __global uint* tile_lists) {
+                       __global const uint* slot_counts, __global uint* tile_cursors, __global uint* tile_lists,
+                       __global ushort* tile_entry_rows) {
   const int t = (int)get_global_id(0);
   if (t >= frame->input_triangles) return;
   const uint written = min(slot_counts[t], (uint)SEAMCL_CLIP_SLOTS);
@@ -70,7 +79,12 @@ __kernel void bin_fill(__constant FrameParams* frame, __global const TriangleSet
       for (int tx = s->bbox_min_x / SEAMCL_TILE_SIZE; tx <= s->bbox_max_x / SEAMCL_TILE_SIZE; ++tx) {
         if (!tile_may_be_covered(s, tx, ty)) continue;
         const uint entry = atomic_inc(&tile_cursors[ty * frame->tiles_x + tx]);
-        if (entry < frame->bin_capacity) tile_lists[entry] = slot;
+        if (entry >= frame->bin_capacity) continue;
+        tile_lists[entry] = slot;
+        const int x0 = tx * SEAMCL_TILE_SIZE, y0 = ty * SEAMCL_TILE_SIZE;
+        const int row_lo = max(s->bbox_min_y - y0, 0), row_hi = min(s->bbox_max_y - y0, SEAMCL_TILE_SIZE - 1);
+        const int col_lo = max(s->bbox_min_x - x0, 0), col_hi = min(s->bbox_max_x - x0, SEAMCL_TILE_SIZE - 1);
+        tile_entry_rows[entry] = (ushort)(row_lo | row_hi << 4 | col_lo << 8 | col_hi << 12);
       }
     }
   }

@@ -157,6 +157,19 @@ TEST(KernelVsTwin, EveryStageOnBuiltInAndRandomScenes) {
       running += counts[tile];
     }
     EXPECT_EQ(result.stats.bin_entries, running);
+    // Each entry's rows and columns: its slot's box clipped to the tile, tile-relative.
+    const std::vector<uint16_t> rows = renderer.read_tile_entry_rows();
+    ASSERT_EQ(rows.size(), lists.size());
+    for (size_t tile = 0; tile < counts.size(); ++tile) {
+      const int x0 = static_cast<int>(tile % frame.tiles_x) * SEAMCL_TILE_SIZE;
+      const int y0 = static_cast<int>(tile / frame.tiles_x) * SEAMCL_TILE_SIZE;
+      for (uint32_t entry = offsets[tile]; entry < offsets[tile] + counts[tile]; ++entry) {
+        const TriangleSetup& s = gpu_setups.at(lists[entry]);
+        const int expected = std::max(s.bbox_min_y - y0, 0) | std::min(s.bbox_max_y - y0, SEAMCL_TILE_SIZE - 1) << 4 |
+                             std::max(s.bbox_min_x - x0, 0) << 8 | std::min(s.bbox_max_x - x0, SEAMCL_TILE_SIZE - 1) << 12;
+        ASSERT_EQ(rows[entry], expected) << "tile " << tile << " entry " << entry;
+      }
+    }
 
     // Raster, from the GPU's setups: the same winner for every sample.
     const std::vector<uint32_t> gpu_winners = renderer.read_sample_triangles();

@@ -52,7 +52,8 @@ struct Renderer::Impl {
   std::vector<float> cube_host;
 
   // Frame buffers, grown on demand.
-  cl::Buffer frame_params, stats, setups, slot_counts, tile_counts, tile_offsets, tile_cursors, tile_lists, sample_triangle, image;
+  cl::Buffer frame_params, stats, setups, slot_counts, tile_counts, tile_offsets, tile_cursors, tile_lists, tile_entry_rows,
+      sample_triangle, image;
   cl::Buffer seam_mask;  // only once a render asks for the mask
   size_t setups_capacity = 0, slot_counts_capacity = 0, tiles_capacity = 0, samples_capacity = 0, pixels_capacity = 0, mask_capacity = 0;
   uint32_t bin_capacity = 0;         // tile-list entries the next frame asks for
@@ -135,7 +136,8 @@ struct Renderer::Impl {
   }
 
   void release_frame_buffers() {
-    setups = slot_counts = tile_counts = tile_offsets = tile_cursors = tile_lists = sample_triangle = image = seam_mask = cl::Buffer();
+    setups = slot_counts = tile_counts = tile_offsets = tile_cursors = tile_lists = tile_entry_rows = sample_triangle = image =
+        seam_mask = cl::Buffer();
     setups_capacity = slot_counts_capacity = tiles_capacity = samples_capacity = pixels_capacity = mask_capacity = 0;
     tile_lists_capacity = 0;
     // The tessellated vertices are sized by the request too (packed again on the next render).
@@ -189,6 +191,7 @@ struct Renderer::Impl {
     if (tile_lists() == nullptr || tile_lists_capacity < p.bin_capacity) {
       tile_lists_capacity = p.bin_capacity;
       tile_lists = cl::Buffer(context, CL_MEM_READ_WRITE, static_cast<size_t>(p.bin_capacity) * sizeof(cl_uint));
+      tile_entry_rows = cl::Buffer(context, CL_MEM_READ_WRITE, static_cast<size_t>(p.bin_capacity) * sizeof(cl_ushort));
     }
   }
 
@@ -250,6 +253,7 @@ struct Renderer::Impl {
       bin_fill_kernel.setArg(2, slot_counts);
       bin_fill_kernel.setArg(3, tile_cursors);
       bin_fill_kernel.setArg(4, tile_lists);
+      bin_fill_kernel.setArg(5, tile_entry_rows);
       queue.enqueueNDRangeKernel(bin_fill_kernel, cl::NullRange, cl::NDRange(round_up(input_triangles, kLinearGroup)), cl::NDRange(kLinearGroup), nullptr,
                                  next(ev.binning));
     }
@@ -260,7 +264,8 @@ struct Renderer::Impl {
     raster_kernel.setArg(2, tile_counts);
     raster_kernel.setArg(3, tile_offsets);
     raster_kernel.setArg(4, tile_lists);
-    raster_kernel.setArg(5, sample_triangle);
+    raster_kernel.setArg(5, tile_entry_rows);
+    raster_kernel.setArg(6, sample_triangle);
     // One work-item per tile row (kernels/raster.cl keeps a row in a 16-wide vector).
     queue.enqueueNDRangeKernel(raster_kernel, cl::NullRange,
                                cl::NDRange(static_cast<size_t>(p.tiles_x), static_cast<size_t>(p.tiles_y) * SEAMCL_TILE_SIZE),
@@ -308,7 +313,7 @@ void Renderer::load_scene(const Scene& scene, TexelFormat format) {
   impl_->pack_and_upload(format, 0);
   // Start the tile lists at a few entries per triangle slot; render() grows them when needed.
   impl_->bin_capacity = std::max<uint32_t>(impl_->bin_capacity, initial_tile_list_entries(scene.triangle_count()));
-  impl_->tile_lists = cl::Buffer();
+  impl_->tile_lists = impl_->tile_entry_rows = cl::Buffer();
 }
 
 void Renderer::set_device_byte_limit(size_t bytes) { impl_->device_byte_limit = bytes; }
@@ -329,7 +334,7 @@ size_t Renderer::device_bytes() const {
   for (const cl::Buffer* buffer :
        {&i.positions, &i.faces, &i.neighbors, &i.level_offsets, &i.texels, &i.reflective_faces, &i.cube_texels,
         &i.srgb_table, &i.frame_params, &i.stats,
-        &i.setups, &i.slot_counts, &i.tile_counts, &i.tile_offsets, &i.tile_cursors, &i.tile_lists, &i.sample_triangle, &i.image,
+        &i.setups, &i.slot_counts, &i.tile_counts, &i.tile_offsets, &i.tile_cursors, &i.tile_lists, &i.tile_entry_rows, &i.sample_triangle, &i.image,
         &i.seam_mask}) {
     if ((*buffer)() != nullptr) bytes += buffer->getInfo<CL_MEM_SIZE>();
   }
@@ -388,7 +393,9 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
       if (result.attempts >= 3) throw std::runtime_error("tile lists overflowed three times");
       const uint32_t grown = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{result.stats.bin_entries} * 5 / 4 + 1024, 1u << 31));
       if (impl_->device_byte_limit != 0) {
-        const size_t needed = device_bytes() - size_t{impl_->tile_lists_capacity} * sizeof(cl_uint) + size_t{grown} * sizeof(cl_uint);
+        // A list entry is a slot index and its rows (tile_entry_rows).
+        constexpr size_t entry_bytes = sizeof(cl_uint) + sizeof(cl_ushort);
+        const size_t needed = device_bytes() - size_t{impl_->tile_lists_capacity} * entry_bytes + size_t{grown} * entry_bytes;
         if (needed > impl_->device_byte_limit) {
           throw OverBudget("size", "this frame's tile lists (" + std::to_string(result.stats.bin_entries) + " entries)",
                            needed, impl_->device_byte_limit);
@@ -481,6 +488,12 @@ std::vector<uint32_t> Renderer::read_tile_lists() {
   FrameStats stats{};
   impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &stats);
   return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_lists, std::min(stats.bin_entries, impl_->bin_capacity));
+}
+std::vector<uint16_t> Renderer::read_tile_entry_rows() {
+  if (impl_->tile_entry_rows() == nullptr || impl_->last_params.width == 0) return {};  // released (or none yet)
+  FrameStats stats{};
+  impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &stats);
+  return read_buffer<uint16_t>(impl_->runtime.queue(), impl_->tile_entry_rows, std::min(stats.bin_entries, impl_->bin_capacity));
 }
 std::vector<uint32_t> Renderer::read_sample_triangles() {
   const FrameParams& p = impl_->last_params;
