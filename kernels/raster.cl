@@ -18,23 +18,14 @@
  * then follows the covered pixels, not pixels x samples.
  * Depths are computed only where a covered sample already has a triangle (overlapping front
  * faces), both from their planes with the twin's float steps: the eager z-buffer's result.
- * Host guarantees: bin lists built for this frame; bin_entries <= bin_capacity (else it re-runs);
+ * Each row skips, from tile_entry_rows alone, the list entries whose box misses it.
+ * Host guarantees: bin lists and tile_entry_rows built for this frame; bin_entries <= bin_capacity
+ * (else it re-runs);
  * global size (tiles_x, tiles_y * SEAMCL_TILE_SIZE); image sides <= 16384 (kMaxImageSide), so
  * fixed-point sample positions fit 32 bits and convert to float exactly. Twin: host/twins/raster.cpp. */
 
-/* D3D11 standard sample positions in 1/16 pixel from the pixel centre, y down; rows for 1, 2,
- * 4, 8 and 16 samples (row = log2(count)). */
-__constant char sample_offsets[5][SEAMCL_MAX_SAMPLES][2] = {
-    {{0, 0}},
-    {{4, 4}, {-4, -4}},
-    {{-2, -6}, {6, -2}, {-6, 2}, {2, 6}},
-    {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, 7}, {7, -7}},
-    {{1, 1}, {-1, -3}, {-3, 2}, {4, -1}, {-5, -2}, {2, 5}, {5, 3}, {3, -5},
-     {-2, 6}, {0, -7}, {-4, -6}, {-6, 4}, {-8, 0}, {7, -4}, {6, 7}, {-7, -8}}};
-
-SEAMCL_INLINE int sample_pattern_row(int sample_count) {
-  return sample_count == 1 ? 0 : sample_count == 2 ? 1 : sample_count == 4 ? 2 : sample_count == 8 ? 3 : 4;
-}
+/* The D3D11 sample pattern (sample_offsets, sample_pattern_row) is defined in triangle_setup.cl,
+ * whose cull reads it too. */
 
 /* Fixed-point position of sample s of pixel (x, y). */
 SEAMCL_INLINE long sample_fixed_x(int x, int row, int s) {
@@ -118,14 +109,20 @@ SEAMCL_INLINE void raster_take(__global const TriangleSetup* setups, uint slot, 
 
 /* Rows of one sample (or few): the vector runs over the row's 16 pixels, the loop over samples;
  * winners stored per sample [16 s + lane]. */
-SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, __global const uint* tile_lists, uint begin,
-                                       uint end, int x0, int y, int samples, int row, uint* best_slot) {
+SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, __global const uint* tile_lists,
+                                       __global const ushort* tile_entry_rows, uint begin, uint end, int x0, int y,
+                                       int samples, int row, uint* best_slot) {
   const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   const int16 x = x0 + lane;
   /* Fixed-point x of each lane's pixel centre; the row's y. */
   const int16 centre_x = x * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
   const int centre_y = y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
+  const uint tile_row = (uint)(y % SEAMCL_TILE_SIZE);
   for (uint entry = begin; entry < end; ++entry) {
+    /* Rows of the tile the entry's box covers (binning): most entries of a tile of small
+     * triangles miss this row, and are skipped without a read of their record. */
+    const uint rows = tile_entry_rows[entry];
+    if (tile_row < (rows & 15u) || tile_row > ((rows >> 4) & 15u)) continue;
     const uint slot = tile_lists[entry];
     __global const TriangleSetup* t = setups + slot;
     if (y < t->bbox_min_y || y > t->bbox_max_y || x0 + SEAMCL_TILE_SIZE - 1 < t->bbox_min_x || x0 > t->bbox_max_x) continue;
@@ -195,7 +192,8 @@ SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, __g
  * [16 lane + s]. A pixel whose sample box [-8, 7] / 16 lies inside all three edges is covered at
  * every sample, one outside an edge at none: only pixels an edge crosses test their samples. */
 SEAMCL_INLINE void raster_row_by_pixels(__global const TriangleSetup* setups, __global const uint* tile_lists,
-                                        uint begin, uint end, int x0, int y, int samples, int row, uint* best_slot) {
+                                        __global const ushort* tile_entry_rows, uint begin, uint end, int x0, int y,
+                                        int samples, int row, uint* best_slot) {
   int offset_x[SEAMCL_MAX_SAMPLES], offset_y[SEAMCL_MAX_SAMPLES];
   for (int s = 0; s < SEAMCL_MAX_SAMPLES; ++s) {
     offset_x[s] = s < samples ? sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16) : 0;
@@ -206,7 +204,12 @@ SEAMCL_INLINE void raster_row_by_pixels(__global const TriangleSetup* setups, __
   const int16 valid = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15) < samples;
   const int centre_y = y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
   const int16 py = centre_y + sample_y;
+  const uint tile_row = (uint)(y % SEAMCL_TILE_SIZE);
   for (uint entry = begin; entry < end; ++entry) {
+    /* Rows of the tile the entry's box covers (binning): most entries of a tile of small
+     * triangles miss this row, and are skipped without a read of their record. */
+    const uint rows = tile_entry_rows[entry];
+    if (tile_row < (rows & 15u) || tile_row > ((rows >> 4) & 15u)) continue;
     const uint slot = tile_lists[entry];
     __global const TriangleSetup* t = setups + slot;
     if (y < t->bbox_min_y || y > t->bbox_max_y || x0 + SEAMCL_TILE_SIZE - 1 < t->bbox_min_x || x0 > t->bbox_max_x) continue;
@@ -254,7 +257,8 @@ SEAMCL_INLINE void raster_row_by_pixels(__global const TriangleSetup* setups, __
 
 __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup* setups,
                      __global const uint* tile_counts, __global const uint* tile_offsets,
-                     __global const uint* tile_lists, __global uint* sample_triangle) {
+                     __global const uint* tile_lists, __global const ushort* tile_entry_rows,
+                     __global uint* sample_triangle) {
   const int tile_x = (int)get_global_id(0);
   const int y = (int)get_global_id(1);
   if (tile_x >= frame->tiles_x || y >= frame->height) return;
@@ -269,12 +273,12 @@ __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup
   uint best_slot[SEAMCL_MAX_SAMPLES * SEAMCL_TILE_SIZE];
   for (int i = 0; i < SEAMCL_MAX_SAMPLES; ++i) vstore16((uint16)(SEAMCL_NO_TRIANGLE), i, best_slot);
   if (samples < SEAMCL_RASTER_BY_PIXELS_FROM) {
-    raster_row_by_lanes(setups, tile_lists, begin, end, x0, y, samples, row, best_slot);
+    raster_row_by_lanes(setups, tile_lists, tile_entry_rows, begin, end, x0, y, samples, row, best_slot);
     for (int l = 0; l < lanes; ++l) {
       for (int s = 0; s < samples; ++s) out[l * samples + s] = best_slot[s * SEAMCL_TILE_SIZE + l];
     }
   } else {
-    raster_row_by_pixels(setups, tile_lists, begin, end, x0, y, samples, row, best_slot);
+    raster_row_by_pixels(setups, tile_lists, tile_entry_rows, begin, end, x0, y, samples, row, best_slot);
     for (int l = 0; l < lanes; ++l) {
       for (int s = 0; s < samples; ++s) out[l * samples + s] = best_slot[l * SEAMCL_TILE_SIZE + s];
     }

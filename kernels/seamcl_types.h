@@ -24,6 +24,7 @@ typedef float cl_float;
 #define SEAMCL_SUBPIXEL_ONE 256
 #define SEAMCL_MAX_SAMPLES 16
 #define SEAMCL_CLIP_SLOTS 6          /* a triangle clipped by 5 planes is a fan of at most 6 */
+#define SEAMCL_SETUP_GROUP 64        /* triangle_setup's work-group size (it sums visible slots per group) */
 #define SEAMCL_NO_TRIANGLE 0xffffffffu
 /* Seam mask (shade_resolve built with -DSEAMCL_SEAM_MASK=1): a footprint crosses an edge when a
  * filter puts more than this weight beyond it. Float rounding of weights that sum to 1 stays

@@ -1,12 +1,16 @@
 /* Stage 1: triangle setup. One work-item per input triangle t (face t/2; t even: quad corners
- * 0,1,2, t odd: 0,2,3), writing SEAMCL_CLIP_SLOTS TriangleSetup records at t*SEAMCL_CLIP_SLOTS.
+ * 0,1,2, t odd: 0,2,3), owning SEAMCL_CLIP_SLOTS TriangleSetup records at t*SEAMCL_CLIP_SLOTS.
  *
+ * slot_counts[t]: how many of t's slots were written (0 .. SEAMCL_CLIP_SLOTS; later ones hold
+ * stale data and count as empty): binning reads only those (the host fills it with
+ * SEAMCL_CLIP_SLOTS when tessellate.cl writes every slot instead).
  * Inputs: positions (world, xyz of float4), faces, frame (view_proj, image size, clip planes).
  * Steps: transform to clip space; clip against w >= near_w and the guard band |x| <= guard_x w,
  * |y| <= guard_y w (Sutherland-Hodgman; the host sizes the guard band so that snapped coordinates
  * and edge-function products fit in 64 bits); project to screen (pixels, y down); snap to
- * 1/SEAMCL_SUBPIXEL_ONE pixel; cull back faces (front = counter-clockwise in NDC, y up) and zero
- * area; build edge functions with the top-left rule and perspective-correct attribute planes.
+ * 1/SEAMCL_SUBPIXEL_ONE pixel; cull back faces (front = counter-clockwise in NDC, y up), zero
+ * area and triangles whose bounding box holds no sample position of the frame's pattern; build
+ * edge functions with the top-left rule and perspective-correct attribute planes.
  * A new vertex on an edge is always computed from the edge's inside end, so two triangles that
  * share the edge create bit-identical vertices: clipping keeps the mesh watertight.
  * Twin: host/triangle_setup.cpp. */
@@ -40,6 +44,41 @@ SEAMCL_INLINE ClipVertex clip_lerp(ClipVertex inside, ClipVertex outside, float 
 SEAMCL_INLINE long floor_div_subpixel(long value) {
   /* floor(value / SEAMCL_SUBPIXEL_ONE) for negative values too */
   return value >= 0 ? value / SEAMCL_SUBPIXEL_ONE : -((-value + SEAMCL_SUBPIXEL_ONE - 1) / SEAMCL_SUBPIXEL_ONE);
+}
+
+/* D3D11 standard sample positions in 1/16 pixel from the pixel centre, y down; rows for 1, 2,
+ * 4, 8 and 16 samples (row = log2(count)). */
+__constant char sample_offsets[5][SEAMCL_MAX_SAMPLES][2] = {
+    {{0, 0}},
+    {{4, 4}, {-4, -4}},
+    {{-2, -6}, {6, -2}, {-6, 2}, {2, 6}},
+    {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, 7}, {7, -7}},
+    {{1, 1}, {-1, -3}, {-3, 2}, {4, -1}, {-5, -2}, {2, 5}, {5, 3}, {3, -5},
+     {-2, 6}, {0, -7}, {-4, -6}, {-6, 4}, {-8, 0}, {7, -4}, {6, 7}, {-7, -8}}};
+
+SEAMCL_INLINE int sample_pattern_row(int sample_count) {
+  return sample_count == 1 ? 0 : sample_count == 2 ? 1 : sample_count == 4 ? 2 : sample_count == 8 ? 3 : 4;
+}
+
+
+/* Whether the fixed-point box [min_x, max_x] x [min_y, max_y] holds a sample position of the
+ * frame's pattern inside the image. A box is a product of ranges, so sample s lies in it at some
+ * pixel iff some column puts its x in [min_x, max_x] and some row its y in [min_y, max_y].
+ * A triangle whose box holds no sample covers none: setup culls it, so binning and raster never
+ * see it (most triangles smaller than a pixel, at one sample per pixel). */
+SEAMCL_INLINE int box_holds_sample(long min_x, long max_x, long min_y, long max_y, __constant FrameParams* frame) {
+  const int row = sample_pattern_row(frame->sample_count);
+  for (int s = 0; s < frame->sample_count; ++s) {
+    /* Sample s of pixel p is at p * ONE + centre: the first and last pixel inside the range. */
+    const long centre_x = SEAMCL_SUBPIXEL_ONE / 2 + sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16);
+    const long centre_y = SEAMCL_SUBPIXEL_ONE / 2 + sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
+    const long first_x = max(-floor_div_subpixel(centre_x - min_x), 0L);
+    const long last_x = min(floor_div_subpixel(max_x - centre_x), (long)frame->width - 1);
+    const long first_y = max(-floor_div_subpixel(centre_y - min_y), 0L);
+    const long last_y = min(floor_div_subpixel(max_y - centre_y), (long)frame->height - 1);
+    if (first_x <= last_x && first_y <= last_y) return 1;
+  }
+  return 0;
 }
 
 SEAMCL_INLINE TriangleSetup empty_setup(uint face) {
@@ -108,6 +147,7 @@ SEAMCL_INLINE TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, 
   s.bbox_min_y = (int)max(floor_div_subpixel(min_y - sample_span + SEAMCL_SUBPIXEL_ONE - 1), 0L);
   s.bbox_max_x = (int)min(floor_div_subpixel(max_x), (long)frame->width - 1);
   s.bbox_max_y = (int)min(floor_div_subpixel(max_y), (long)frame->height - 1);
+  if (!box_holds_sample(min_x, max_x, min_y, max_y, frame)) return empty_setup(face);
 
   /* Attribute planes over the snapped positions, relative to vertex 0 for precision. */
   const float scale = 1.0f / (float)SEAMCL_SUBPIXEL_ONE;
@@ -178,11 +218,10 @@ SEAMCL_INLINE uint clip_and_setup(ClipVertex* polygon, uint face_index, __consta
   return visible;
 }
 
-__kernel void triangle_setup(__constant FrameParams* frame, __global const float4* positions,
-                             __global const FaceGpu* faces, __global TriangleSetup* out,
-                             __global FrameStats* stats) {
-  const int t = (int)get_global_id(0);
-  if (t >= frame->input_triangles) return;
+/* Sets up input triangle t (all its slots and slot_counts[t]); returns its visible slots. */
+SEAMCL_INLINE uint setup_input_triangle(__constant FrameParams* frame, __global const float4* positions,
+                                        __global const FaceGpu* faces, __global TriangleSetup* out,
+                                        __global uint* slot_counts, int t) {
   const uint face_index = (uint)(t / 2);
   const FaceGpu face = faces[face_index];
   const int corner[3] = {0, (t & 1) ? 2 : 1, (t & 1) ? 3 : 2};
@@ -201,6 +240,40 @@ __kernel void triangle_setup(__constant FrameParams* frame, __global const float
     polygon[i].v = corner_v[corner[i]];
   }
 
-  const uint visible = clip_and_setup(polygon, face_index, frame, out + (size_t)t * SEAMCL_CLIP_SLOTS);
-  if (visible > 0) atomic_add(&stats->visible_triangles, visible);
+  /* Most triangles need no clipping: then the polygon stays the triangle and the fan is its one
+   * setup, as clip_and_setup would make it. Only a visible one is written: storing the empty
+   * slots was most of this stage's time (6 records of 112 bytes per triangle). */
+  int inside = 1;
+  for (int plane = 0; plane < 5; ++plane) {
+    for (int i = 0; i < 3; ++i) inside &= clip_distance(polygon[i], plane, frame) >= 0.0f;
+  }
+  __global TriangleSetup* slots = out + (size_t)t * SEAMCL_CLIP_SLOTS;
+  uint visible;
+  if (inside) {
+    const TriangleSetup s = setup_screen_triangle(polygon[0], polygon[1], polygon[2], face_index, frame);
+    visible = s.bbox_max_x >= s.bbox_min_x && s.bbox_max_y >= s.bbox_min_y;
+    if (visible) slots[0] = s;
+    slot_counts[t] = visible;
+  } else {
+    visible = clip_and_setup(polygon, face_index, frame, slots);
+    slot_counts[t] = SEAMCL_CLIP_SLOTS;
+  }
+  return visible;
+}
+
+__kernel __attribute__((reqd_work_group_size(SEAMCL_SETUP_GROUP, 1, 1)))
+void triangle_setup(__constant FrameParams* frame, __global const float4* positions, __global const FaceGpu* faces,
+                    __global TriangleSetup* out, __global uint* slot_counts, __global FrameStats* stats) {
+  /* Visible slots are summed per work-group, without atomics: a locked add per triangle waits
+   * for the triangle's record stores to drain, and cost a quarter of this stage. */
+  __local uint group_visible[SEAMCL_SETUP_GROUP];
+  const int t = (int)get_global_id(0);
+  group_visible[get_local_id(0)] =
+      t < frame->input_triangles ? setup_input_triangle(frame, positions, faces, out, slot_counts, t) : 0;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (get_local_id(0) == 0) {
+    uint sum = 0;
+    for (int i = 0; i < SEAMCL_SETUP_GROUP; ++i) sum += group_visible[i];
+    if (sum > 0) atomic_add(&stats->visible_triangles, sum);
+  }
 }

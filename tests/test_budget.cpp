@@ -142,8 +142,10 @@ TEST(Budget, SizesAloneGiveTheSameEstimateAsTheScene) {
   EXPECT_EQ(from_sizes.samples, 100u * 60u * 4u * 4u);
   EXPECT_EQ(from_sizes.image, 100u * 60u * 16u);
   EXPECT_EQ(from_sizes.tiles, 7u * 4u * 3u * 4u);
-  EXPECT_EQ(from_sizes.setups, 8u * SEAMCL_CLIP_SLOTS * sizeof(TriangleSetup));
-  EXPECT_EQ(from_sizes.tile_lists, (8u * 8u + 65536u) * 4u);
+  // Setups: the clip slots and a written-slot count (uint) per triangle. A list entry: the slot
+  // (uint) and its rows in the tile (ushort).
+  EXPECT_EQ(from_sizes.setups, 8u * SEAMCL_CLIP_SLOTS * sizeof(TriangleSetup) + 8u * sizeof(cl_uint));
+  EXPECT_EQ(from_sizes.tile_lists, (8u * 8u + 65536u) * (sizeof(cl_uint) + sizeof(cl_ushort)));
   EXPECT_GE(from_sizes.tile_lists_bound, from_sizes.tile_lists);
   EXPECT_EQ(from_sizes.host_image, 100u * 60u * 16u);
   // The band counts only for guardband.

@@ -89,16 +89,31 @@ std::vector<RasterCase> raster_cases() {
   return out;
 }
 
-// Every tile lists every slot (in reverse, so the list order is not the slot order).
+// Every tile lists every slot (in reverse, so the list order is not the slot order). Each entry's
+// rows are binning's (the box clipped to the tile) where the box meets the tile, else the whole
+// tile: the kernel's own box test must then reject it.
 std::vector<uint32_t> run_raster_kernel(const std::vector<TriangleSetup>& setups, const FrameParams& frame) {
   const cl::Context& context = shared_runtime().context();
   cl::CommandQueue& queue = shared_runtime().queue();
   const size_t tiles = static_cast<size_t>(frame.tiles_x) * frame.tiles_y;
   const uint32_t n = static_cast<uint32_t>(setups.size());
   std::vector<cl_uint> counts(tiles, n), offsets(tiles), lists;
+  std::vector<cl_ushort> rows;
   for (size_t tile = 0; tile < tiles; ++tile) {
     offsets[tile] = static_cast<cl_uint>(tile * n);
-    for (uint32_t k = 0; k < n; ++k) lists.push_back(n - 1 - k);
+    const int x0 = static_cast<int>(tile % frame.tiles_x) * SEAMCL_TILE_SIZE;
+    const int y0 = static_cast<int>(tile / frame.tiles_x) * SEAMCL_TILE_SIZE;
+    for (uint32_t k = 0; k < n; ++k) {
+      const TriangleSetup& s = setups[n - 1 - k];
+      lists.push_back(n - 1 - k);
+      const bool meets = s.bbox_min_x <= x0 + SEAMCL_TILE_SIZE - 1 && s.bbox_max_x >= x0 &&
+                         s.bbox_min_y <= y0 + SEAMCL_TILE_SIZE - 1 && s.bbox_max_y >= y0 && !setup_is_empty(s);
+      rows.push_back(meets ? static_cast<cl_ushort>(std::max(s.bbox_min_y - y0, 0) |
+                                                    std::min(s.bbox_max_y - y0, SEAMCL_TILE_SIZE - 1) << 4 |
+                                                    std::max(s.bbox_min_x - x0, 0) << 8 |
+                                                    std::min(s.bbox_max_x - x0, SEAMCL_TILE_SIZE - 1) << 12)
+                           : cl_ushort{0xF0F0});
+    }
   }
   auto input = [&](const void* data, size_t bytes) {
     return cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(data));
@@ -108,6 +123,7 @@ std::vector<uint32_t> run_raster_kernel(const std::vector<TriangleSetup>& setups
   cl::Buffer count_buffer = input(counts.data(), counts.size() * sizeof(cl_uint));
   cl::Buffer offset_buffer = input(offsets.data(), offsets.size() * sizeof(cl_uint));
   cl::Buffer list_buffer = input(lists.data(), lists.size() * sizeof(cl_uint));
+  cl::Buffer rows_buffer = input(rows.data(), rows.size() * sizeof(cl_ushort));
   const size_t samples = static_cast<size_t>(frame.width) * frame.height * frame.sample_count;
   cl::Buffer winners(context, CL_MEM_WRITE_ONLY, samples * sizeof(cl_uint));
   cl::Kernel kernel(shared_runtime().program(), "raster");
@@ -116,7 +132,8 @@ std::vector<uint32_t> run_raster_kernel(const std::vector<TriangleSetup>& setups
   kernel.setArg(2, count_buffer);
   kernel.setArg(3, offset_buffer);
   kernel.setArg(4, list_buffer);
-  kernel.setArg(5, winners);
+  kernel.setArg(5, rows_buffer);
+  kernel.setArg(6, winners);
   // The renderer's launch: one work-item per tile row.
   queue.enqueueNDRangeKernel(kernel, cl::NullRange,
                              cl::NDRange(static_cast<size_t>(frame.tiles_x), static_cast<size_t>(frame.tiles_y) * SEAMCL_TILE_SIZE),

@@ -130,16 +130,20 @@ RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options
   const size_t tess = options.displacement ? static_cast<size_t>(std::max(options.tessellation, 1)) : 1;
   const size_t slots = mul(mul(scene.triangle_count(), mul(tess, tess)), SEAMCL_CLIP_SLOTS);
   m.setups = device_array(slots, sizeof(TriangleSetup));
+  // and how many slots setup wrote per input triangle (Renderer's slot_counts, a uint each).
+  m.setups = add(m.setups, device_array(slots / SEAMCL_CLIP_SLOTS, sizeof(cl_uint)));
   if (options.displacement) m.setups = add(m.setups, mul(mul(faces, mul(tess + 1, tess + 1)), 32));
   m.tiles = mul(3 * sizeof(cl_uint), tile_count);
   const size_t initial_entries = initial_tile_list_entries(scene.triangle_count());
-  m.tile_lists = mul(initial_entries, sizeof(cl_uint));
+  // A list entry: the slot (uint) and its rows in the tile (Renderer's tile_entry_rows, a ushort).
+  constexpr size_t entry_bytes = sizeof(cl_uint) + sizeof(cl_ushort);
+  m.tile_lists = mul(initial_entries, entry_bytes);
   m.samples = device_array(mul(pixels, static_cast<size_t>(std::max(options.msaa, 1))), sizeof(cl_uint));
   m.image = device_array(pixels, sizeof(cl_float4));
   // Render grows the lists to bin_entries * 5/4 + 1024 (at most 2^31), and bin_entries is at most
   // one per slot per tile.
   const size_t grown_entries = std::min<size_t>(add(mul(mul(slots, tile_count) / 4 + 1, 5), 1024), size_t{1} << 31);
-  m.tile_lists_bound = mul(std::max(initial_entries, grown_entries), sizeof(cl_uint));
+  m.tile_lists_bound = mul(std::max(initial_entries, grown_entries), entry_bytes);
 
   m.host_scene = scene_host_bytes(scene);
   m.host_packed = add(add(mul(scene.vertices, sizeof(cl_float4)), mul(faces, sizeof(FaceGpu) + sizeof(FaceNeighbors))),

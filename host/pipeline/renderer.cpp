@@ -52,9 +52,10 @@ struct Renderer::Impl {
   std::vector<float> cube_host;
 
   // Frame buffers, grown on demand.
-  cl::Buffer frame_params, stats, setups, tile_counts, tile_offsets, tile_cursors, tile_lists, sample_triangle, image;
+  cl::Buffer frame_params, stats, setups, slot_counts, tile_counts, tile_offsets, tile_cursors, tile_lists, tile_entry_rows,
+      sample_triangle, image;
   cl::Buffer seam_mask;  // only once a render asks for the mask
-  size_t setups_capacity = 0, tiles_capacity = 0, samples_capacity = 0, pixels_capacity = 0, mask_capacity = 0;
+  size_t setups_capacity = 0, slot_counts_capacity = 0, tiles_capacity = 0, samples_capacity = 0, pixels_capacity = 0, mask_capacity = 0;
   uint32_t bin_capacity = 0;         // tile-list entries the next frame asks for
   uint32_t tile_lists_capacity = 0;  // entries allocated
   FrameParams last_params{};
@@ -135,8 +136,9 @@ struct Renderer::Impl {
   }
 
   void release_frame_buffers() {
-    setups = tile_counts = tile_offsets = tile_cursors = tile_lists = sample_triangle = image = seam_mask = cl::Buffer();
-    setups_capacity = tiles_capacity = samples_capacity = pixels_capacity = mask_capacity = 0;
+    setups = slot_counts = tile_counts = tile_offsets = tile_cursors = tile_lists = tile_entry_rows = sample_triangle = image =
+        seam_mask = cl::Buffer();
+    setups_capacity = slot_counts_capacity = tiles_capacity = samples_capacity = pixels_capacity = mask_capacity = 0;
     tile_lists_capacity = 0;
     // The tessellated vertices are sized by the request too (packed again on the next render).
     tessellation.release();
@@ -176,6 +178,7 @@ struct Renderer::Impl {
   void ensure_frame_buffers(const FrameParams& p) {
     const cl::Context& context = runtime.context();
     grow(setups, setups_capacity, static_cast<size_t>(p.input_triangles) * SEAMCL_CLIP_SLOTS, sizeof(TriangleSetup), context);
+    grow(slot_counts, slot_counts_capacity, static_cast<size_t>(p.input_triangles), sizeof(cl_uint), context);
     const size_t tiles = static_cast<size_t>(p.tiles_x) * p.tiles_y;
     if (tiles > tiles_capacity || tiles_capacity == 0) {
       tiles_capacity = tiles;
@@ -188,6 +191,7 @@ struct Renderer::Impl {
     if (tile_lists() == nullptr || tile_lists_capacity < p.bin_capacity) {
       tile_lists_capacity = p.bin_capacity;
       tile_lists = cl::Buffer(context, CL_MEM_READ_WRITE, static_cast<size_t>(p.bin_capacity) * sizeof(cl_uint));
+      tile_entry_rows = cl::Buffer(context, CL_MEM_READ_WRITE, static_cast<size_t>(p.bin_capacity) * sizeof(cl_ushort));
     }
   }
 
@@ -209,25 +213,32 @@ struct Renderer::Impl {
     const FrameStats zero_stats{};
     queue.enqueueWriteBuffer(stats, CL_FALSE, 0, sizeof(FrameStats), &zero_stats, nullptr, next(ev.setup));
 
-    const size_t slots = static_cast<size_t>(p.input_triangles) * SEAMCL_CLIP_SLOTS;
+    const size_t input_triangles = static_cast<size_t>(p.input_triangles);
     if (displaced) {
       tessellation.enqueue(program_key, frame_params, setups, stats, p.input_triangles, ev.tessellate, ev.setup);
+      // The tessellator writes every slot of a micro-triangle: binning reads them all.
+      if (input_triangles > 0) {
+        queue.enqueueFillBuffer(slot_counts, cl_uint{SEAMCL_CLIP_SLOTS}, 0, input_triangles * sizeof(cl_uint), nullptr,
+                                next(ev.setup));
+      }
     } else if (p.input_triangles > 0) {
       setup_kernel.setArg(0, frame_params);
       setup_kernel.setArg(1, positions);
       setup_kernel.setArg(2, faces);
       setup_kernel.setArg(3, setups);
-      setup_kernel.setArg(4, stats);
-      queue.enqueueNDRangeKernel(setup_kernel, cl::NullRange, cl::NDRange(round_up(static_cast<size_t>(p.input_triangles), kLinearGroup)),
-                                 cl::NDRange(kLinearGroup), nullptr, next(ev.setup));
+      setup_kernel.setArg(4, slot_counts);
+      setup_kernel.setArg(5, stats);
+      queue.enqueueNDRangeKernel(setup_kernel, cl::NullRange, cl::NDRange(round_up(input_triangles, SEAMCL_SETUP_GROUP)),
+                                 cl::NDRange(SEAMCL_SETUP_GROUP), nullptr, next(ev.setup));
     }
     const size_t tiles = static_cast<size_t>(p.tiles_x) * p.tiles_y;
     queue.enqueueFillBuffer(tile_counts, cl_uint{0}, 0, tiles * sizeof(cl_uint), nullptr, next(ev.binning));
-    if (slots > 0) {
+    if (input_triangles > 0) {
       bin_count_kernel.setArg(0, frame_params);
       bin_count_kernel.setArg(1, setups);
-      bin_count_kernel.setArg(2, tile_counts);
-      queue.enqueueNDRangeKernel(bin_count_kernel, cl::NullRange, cl::NDRange(round_up(slots, kLinearGroup)), cl::NDRange(kLinearGroup), nullptr,
+      bin_count_kernel.setArg(2, slot_counts);
+      bin_count_kernel.setArg(3, tile_counts);
+      queue.enqueueNDRangeKernel(bin_count_kernel, cl::NullRange, cl::NDRange(round_up(input_triangles, kLinearGroup)), cl::NDRange(kLinearGroup), nullptr,
                                  next(ev.binning));
     }
     bin_scan_kernel.setArg(0, frame_params);
@@ -236,12 +247,14 @@ struct Renderer::Impl {
     bin_scan_kernel.setArg(3, tile_cursors);
     bin_scan_kernel.setArg(4, stats);
     queue.enqueueNDRangeKernel(bin_scan_kernel, cl::NullRange, cl::NDRange(1), cl::NDRange(1), nullptr, next(ev.binning));
-    if (slots > 0) {
+    if (input_triangles > 0) {
       bin_fill_kernel.setArg(0, frame_params);
       bin_fill_kernel.setArg(1, setups);
-      bin_fill_kernel.setArg(2, tile_cursors);
-      bin_fill_kernel.setArg(3, tile_lists);
-      queue.enqueueNDRangeKernel(bin_fill_kernel, cl::NullRange, cl::NDRange(round_up(slots, kLinearGroup)), cl::NDRange(kLinearGroup), nullptr,
+      bin_fill_kernel.setArg(2, slot_counts);
+      bin_fill_kernel.setArg(3, tile_cursors);
+      bin_fill_kernel.setArg(4, tile_lists);
+      bin_fill_kernel.setArg(5, tile_entry_rows);
+      queue.enqueueNDRangeKernel(bin_fill_kernel, cl::NullRange, cl::NDRange(round_up(input_triangles, kLinearGroup)), cl::NDRange(kLinearGroup), nullptr,
                                  next(ev.binning));
     }
     const cl::NDRange tile_grid(static_cast<size_t>(p.tiles_x) * SEAMCL_TILE_SIZE, static_cast<size_t>(p.tiles_y) * SEAMCL_TILE_SIZE);
@@ -251,7 +264,8 @@ struct Renderer::Impl {
     raster_kernel.setArg(2, tile_counts);
     raster_kernel.setArg(3, tile_offsets);
     raster_kernel.setArg(4, tile_lists);
-    raster_kernel.setArg(5, sample_triangle);
+    raster_kernel.setArg(5, tile_entry_rows);
+    raster_kernel.setArg(6, sample_triangle);
     // One work-item per tile row (kernels/raster.cl keeps a row in a 16-wide vector).
     queue.enqueueNDRangeKernel(raster_kernel, cl::NullRange,
                                cl::NDRange(static_cast<size_t>(p.tiles_x), static_cast<size_t>(p.tiles_y) * SEAMCL_TILE_SIZE),
@@ -299,7 +313,7 @@ void Renderer::load_scene(const Scene& scene, TexelFormat format) {
   impl_->pack_and_upload(format, 0);
   // Start the tile lists at a few entries per triangle slot; render() grows them when needed.
   impl_->bin_capacity = std::max<uint32_t>(impl_->bin_capacity, initial_tile_list_entries(scene.triangle_count()));
-  impl_->tile_lists = cl::Buffer();
+  impl_->tile_lists = impl_->tile_entry_rows = cl::Buffer();
 }
 
 void Renderer::set_device_byte_limit(size_t bytes) { impl_->device_byte_limit = bytes; }
@@ -320,7 +334,7 @@ size_t Renderer::device_bytes() const {
   for (const cl::Buffer* buffer :
        {&i.positions, &i.faces, &i.neighbors, &i.level_offsets, &i.texels, &i.reflective_faces, &i.cube_texels,
         &i.srgb_table, &i.frame_params, &i.stats,
-        &i.setups, &i.tile_counts, &i.tile_offsets, &i.tile_cursors, &i.tile_lists, &i.sample_triangle, &i.image,
+        &i.setups, &i.slot_counts, &i.tile_counts, &i.tile_offsets, &i.tile_cursors, &i.tile_lists, &i.tile_entry_rows, &i.sample_triangle, &i.image,
         &i.seam_mask}) {
     if ((*buffer)() != nullptr) bytes += buffer->getInfo<CL_MEM_SIZE>();
   }
@@ -379,7 +393,9 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
       if (result.attempts >= 3) throw std::runtime_error("tile lists overflowed three times");
       const uint32_t grown = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{result.stats.bin_entries} * 5 / 4 + 1024, 1u << 31));
       if (impl_->device_byte_limit != 0) {
-        const size_t needed = device_bytes() - size_t{impl_->tile_lists_capacity} * sizeof(cl_uint) + size_t{grown} * sizeof(cl_uint);
+        // A list entry is a slot index and its rows (tile_entry_rows).
+        constexpr size_t entry_bytes = sizeof(cl_uint) + sizeof(cl_ushort);
+        const size_t needed = device_bytes() - size_t{impl_->tile_lists_capacity} * entry_bytes + size_t{grown} * entry_bytes;
         if (needed > impl_->device_byte_limit) {
           throw OverBudget("size", "this frame's tile lists (" + std::to_string(result.stats.bin_entries) + " entries)",
                            needed, impl_->device_byte_limit);
@@ -440,8 +456,24 @@ void Renderer::warm_up(const RenderOptions& options) {
 FrameParams Renderer::last_frame_params() const { return impl_->last_params; }
 
 std::vector<TriangleSetup> Renderer::read_setups() {
-  return read_buffer<TriangleSetup>(impl_->runtime.queue(), impl_->setups,
-                                    static_cast<size_t>(impl_->last_params.input_triangles) * SEAMCL_CLIP_SLOTS);
+  const size_t triangles = static_cast<size_t>(impl_->last_params.input_triangles);
+  std::vector<TriangleSetup> setups = read_buffer<TriangleSetup>(impl_->runtime.queue(), impl_->setups, triangles * SEAMCL_CLIP_SLOTS);
+  if (setups.empty()) return setups;
+  // Setup writes only a triangle's first slot_counts[t] slots (the rest hold stale data): fill the
+  // others with the empty record triangle_setup.cl's empty_setup makes, so every slot reads as before.
+  const std::vector<uint32_t> written = read_buffer<uint32_t>(impl_->runtime.queue(), impl_->slot_counts, triangles);
+  for (size_t t = 0; t < triangles; ++t) {
+    for (size_t k = std::min<size_t>(written[t], SEAMCL_CLIP_SLOTS); k < SEAMCL_CLIP_SLOTS; ++k) {
+      const uint32_t face = static_cast<uint32_t>(t / 2);
+      TriangleSetup& s = setups[t * SEAMCL_CLIP_SLOTS + k];
+      s = TriangleSetup{};
+      for (int i = 0; i < 3; ++i) s.edge_c[i] = -1;
+      s.bbox_max_x = -1;
+      s.bbox_max_y = -1;
+      s.face = face;
+    }
+  }
+  return setups;
 }
 std::vector<uint32_t> Renderer::read_tile_counts() {
   return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_counts,
@@ -456,6 +488,12 @@ std::vector<uint32_t> Renderer::read_tile_lists() {
   FrameStats stats{};
   impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &stats);
   return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_lists, std::min(stats.bin_entries, impl_->bin_capacity));
+}
+std::vector<uint16_t> Renderer::read_tile_entry_rows() {
+  if (impl_->tile_entry_rows() == nullptr || impl_->last_params.width == 0) return {};  // released (or none yet)
+  FrameStats stats{};
+  impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &stats);
+  return read_buffer<uint16_t>(impl_->runtime.queue(), impl_->tile_entry_rows, std::min(stats.bin_entries, impl_->bin_capacity));
 }
 std::vector<uint32_t> Renderer::read_sample_triangles() {
   const FrameParams& p = impl_->last_params;

@@ -109,6 +109,8 @@ class Renderer {
   std::vector<uint32_t> read_tile_counts();
   std::vector<uint32_t> read_tile_offsets();
   std::vector<uint32_t> read_tile_lists();
+  // Per tile-list entry: the tile's rows and columns its slot's box covers (kernels/binning.cl).
+  std::vector<uint16_t> read_tile_entry_rows();
   std::vector<uint32_t> read_sample_triangles();
 
  private:

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 
+#include "twins/sample_pattern.h"
+
 namespace seamcl {
 namespace {
 
@@ -43,7 +45,7 @@ TriangleSetup empty_setup(uint32_t face) {
   return s;
 }
 
-TriangleSetup setup_screen_triangle(std::array<ClipVertex, 3> c, uint32_t face, const FrameParams& f) {
+TriangleSetup setup_screen_triangle(std::array<ClipVertex, 3> c, uint32_t face, const FrameParams& f, bool cull_sampleless) {
   constexpr int64_t one = SEAMCL_SUBPIXEL_ONE;
   std::array<int64_t, 3> X{}, Y{};
   std::array<float, 3> inv_w{};
@@ -82,6 +84,7 @@ TriangleSetup setup_screen_triangle(std::array<ClipVertex, 3> c, uint32_t face, 
   s.bbox_min_y = static_cast<cl_int>(std::max<int64_t>(floor_div(min_y - span + one - 1, one), 0));
   s.bbox_max_x = static_cast<cl_int>(std::min<int64_t>(floor_div(max_x, one), f.width - 1));
   s.bbox_max_y = static_cast<cl_int>(std::min<int64_t>(floor_div(max_y, one), f.height - 1));
+  if (cull_sampleless && !box_holds_sample(min_x, max_x, min_y, max_y, f)) return empty_setup(face);
 
   const float scale = 1.0f / static_cast<float>(one);
   const float dx1 = static_cast<float>(X[1] - X[0]) * scale, dy1 = static_cast<float>(Y[1] - Y[0]) * scale;
@@ -105,7 +108,21 @@ TriangleSetup setup_screen_triangle(std::array<ClipVertex, 3> c, uint32_t face, 
 
 }  // namespace
 
-std::vector<TriangleSetup> setup_triangles_reference(const PackedScene& scene, const FrameParams& f) {
+bool box_holds_sample(int64_t min_x, int64_t max_x, int64_t min_y, int64_t max_y, const FrameParams& f) {
+  constexpr int64_t one = SEAMCL_SUBPIXEL_ONE;
+  for (const SampleOffset& o : sample_pattern(f.sample_count)) {
+    // Sample o of pixel p sits at p * one + centre; the first and last pixel that put it in range.
+    const int64_t centre_x = sample_fixed_x(0, o), centre_y = sample_fixed_y(0, o);
+    const int64_t first_x = std::max<int64_t>(-floor_div(centre_x - min_x, one), 0);
+    const int64_t last_x = std::min<int64_t>(floor_div(max_x - centre_x, one), f.width - 1);
+    const int64_t first_y = std::max<int64_t>(-floor_div(centre_y - min_y, one), 0);
+    const int64_t last_y = std::min<int64_t>(floor_div(max_y - centre_y, one), f.height - 1);
+    if (first_x <= last_x && first_y <= last_y) return true;
+  }
+  return false;
+}
+
+std::vector<TriangleSetup> setup_triangles_reference(const PackedScene& scene, const FrameParams& f, bool cull_sampleless) {
   std::vector<TriangleSetup> out;
   out.reserve(static_cast<size_t>(f.input_triangles) * SEAMCL_CLIP_SLOTS);
   constexpr float corner_u[4] = {0, 1, 1, 0};
@@ -142,7 +159,7 @@ std::vector<TriangleSetup> setup_triangles_reference(const PackedScene& scene, c
     // Fan triangulation into the fixed slots.
     for (int k = 0; k < SEAMCL_CLIP_SLOTS; ++k) {
       if (static_cast<size_t>(k + 2) < polygon.size()) {
-        out.push_back(setup_screen_triangle({polygon[0], polygon[k + 1], polygon[k + 2]}, face_index, f));
+        out.push_back(setup_screen_triangle({polygon[0], polygon[k + 1], polygon[k + 2]}, face_index, f, cull_sampleless));
       } else {
         out.push_back(empty_setup(face_index));
       }

@@ -1,6 +1,7 @@
 // Scalar twin of kernels/triangle_setup.cl: the same clipping, snapping, culling, edge functions
 // and attribute planes, one triangle at a time.
 #pragma once
+#include <cstdint>
 #include <vector>
 
 #include <seamcl/pipeline/gpu_types.h>
@@ -8,8 +9,15 @@
 
 namespace seamcl {
 
-// All SEAMCL_CLIP_SLOTS records of every input triangle, in the kernel's order.
-std::vector<TriangleSetup> setup_triangles_reference(const PackedScene& scene, const FrameParams& frame);
+// All SEAMCL_CLIP_SLOTS records of every input triangle, in the kernel's order. cull_sampleless
+// false keeps the triangles whose bounding box holds no sample (the kernel culls them), for the
+// test that they cover none.
+std::vector<TriangleSetup> setup_triangles_reference(const PackedScene& scene, const FrameParams& frame,
+                                                     bool cull_sampleless = true);
+
+// Whether the fixed-point box [min_x, max_x] x [min_y, max_y] holds a position of one of the
+// frame's samples (sample_count's pattern) in the image: setup culls triangles whose box holds none.
+bool box_holds_sample(int64_t min_x, int64_t max_x, int64_t min_y, int64_t max_y, const FrameParams& frame);
 
 inline bool setup_is_empty(const TriangleSetup& s) {
   return s.bbox_max_x < s.bbox_min_x || s.bbox_max_y < s.bbox_min_y;
