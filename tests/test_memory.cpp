@@ -161,12 +161,20 @@ TEST(Memory, ReportedPackedBytesAreTheSumOfTheFacesPackedSizes) {
 }
 
 TEST(Memory, ProcessMemoryGrowsWithATouchedAllocation) {
-  const ProcessMemory before = process_memory();
-  ASSERT_GT(before.rss_bytes, 0u);
-  std::vector<char> block(64u << 20, 1);  // every page written
-  const ProcessMemory after = process_memory();
-  EXPECT_GE(after.rss_bytes, before.rss_bytes + (48u << 20)) << static_cast<int>(block[12345]);
-  EXPECT_GE(after.peak_rss_bytes, after.rss_bytes);
+  // Other threads of this process (the runtime's, a server test's shutting down) may free memory
+  // between the two readings, so up to three tries: one that sees the growth is the reading
+  // working; none in three is a failure.
+  size_t best_growth = 0;
+  for (int attempt = 0; attempt < 3 && best_growth < (48u << 20); ++attempt) {
+    const ProcessMemory before = process_memory();
+    ASSERT_GT(before.rss_bytes, 0u);
+    std::vector<char> block(64u << 20, 1);  // every page written
+    const ProcessMemory after = process_memory();
+    EXPECT_GE(after.peak_rss_bytes, after.rss_bytes);
+    if (after.rss_bytes > before.rss_bytes) best_growth = std::max(best_growth, after.rss_bytes - before.rss_bytes);
+    EXPECT_EQ(block[12345], 1);
+  }
+  EXPECT_GE(best_growth, size_t{48} << 20);
 }
 
 // Scenes from files (issue 14): a .obj with its .ptx, and a bare mesh's pattern, deferred as the
