@@ -124,13 +124,13 @@ def main(argv=None):
                       file=sys.stderr)
                 return 2
         benches.append(bench)
-    spans = sorted((b["shard"]["first_frame"], b["shard"]["end_frame"]) for b in benches)
-    if any(later[0] < earlier[1] for earlier, later in zip(spans, spans[1:])):
-        print("orbit_claims: two parts cover the same frames", file=sys.stderr)
-        return 2
     try:
+        spans = sorted((b["shard"]["first_frame"], b["shard"]["end_frame"]) for b in benches)
+        if any(later[0] < earlier[1] for earlier, later in zip(spans, spans[1:])):
+            print("orbit_claims: two parts cover the same frames", file=sys.stderr)
+            return 2
         entries = entries_of(benches)
-    except (KeyError, TypeError, ValueError) as e:
+    except (KeyError, IndexError, TypeError, ValueError) as e:
         print(f"orbit_claims: {e}", file=sys.stderr)
         return 2
     analysis = study.analyse_run(entries)

@@ -65,7 +65,8 @@ SEAMCL_INLINE int sample_pattern_row(int sample_count) {
  * frame's pattern inside the image. A box is a product of ranges, so sample s lies in it at some
  * pixel iff some column puts its x in [min_x, max_x] and some row its y in [min_y, max_y].
  * A triangle whose box holds no sample covers none: setup culls it, so binning and raster never
- * see it (most triangles smaller than a pixel, at one sample per pixel). */
+ * see it. (Few are culled on paper at 99,037 faces, 85,305 -> 82,220 visible slots: most of
+ * setup's saving there comes from writing only the slots it fills.) */
 SEAMCL_INLINE int box_holds_sample(long min_x, long max_x, long min_y, long max_y, __constant FrameParams* frame) {
   const int row = sample_pattern_row(frame->sample_count);
   for (int s = 0; s < frame->sample_count; ++s) {

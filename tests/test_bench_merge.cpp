@@ -226,6 +226,17 @@ TEST_F(BenchMerge, RefusesPartsThatDoNotMakeOneBatch) {
   std::vector<BenchPart> other = parts;
   other[1].json["options"]["aniso"] = 4;
   EXPECT_EQ(field_of(other).rfind("options | options: part2.json: differs", 0), 0u) << field_of(other);
+  // Parts pooled over different seam masks; parts without the key (written before --seam-mask)
+  // pooled the band, so they merge with band parts only.
+  other = parts;
+  other[1].json["seam_mask"] = "footprint";
+  EXPECT_EQ(field_of(other).rfind("seam_mask | seam_mask: part2.json: differs", 0), 0u) << field_of(other);
+  other = parts;
+  for (BenchPart& p : other) p.json.erase("seam_mask");
+  EXPECT_EQ(field_of(other), "merged");
+  EXPECT_EQ(merge_bench_parts(other)["seam_mask"], "band");
+  other[0].json["seam_mask"] = "footprint";
+  EXPECT_EQ(field_of(other).rfind("seam_mask", 0), 0u) << field_of(other);
   // Another count of parts.
   other = parts;
   other[2].json["shard"]["count"] = 4;

@@ -869,9 +869,6 @@ TEST_F(Server, MalformedRequestsAreRefusedNamingTheField) {
   EXPECT_TRUE(decode(res->body, ".png", w, h) == library_image({{"scene", "quad2"}, {"size", "32x32"}}));
 }
 
-// Invalid UTF-8 in the path, decoded from %XX: the 404 answer echoed it into the JSON and its
-// dump threw inside cpp-httplib's error handler (std::terminate). Now: a 404 naming the path,
-// with the bytes replaced, and the server still answers.
 // An inline generator scene over the request-memory budget (issue 14): 413 naming the option
 // that made it so, with the estimate and the limit, decided from the scene's sizes before any
 // texel is baked. Baking this one (about 4x paper's texels at 250,000 faces) took 1.5 GB of peak
@@ -908,6 +905,9 @@ TEST_F(Server, AnInlineSceneOverTheBudgetIsRefusedNamingItBeforeItIsBaked) {
   }
 }
 
+// Invalid UTF-8 in the path, decoded from %XX: the 404 answer echoed it into the JSON and its
+// dump threw inside cpp-httplib's error handler (std::terminate). Now: a 404 naming the path,
+// with the bytes replaced, and the server still answers.
 TEST_F(Server, InvalidUtf8InThePathIsA404NotACrash) {
   std::string cut_inside_a_character = "/";
   for (int i = 0; i < 100; ++i) cut_inside_a_character += "%C3%A9";  // "é" x 100: 201 bytes decoded

@@ -368,8 +368,16 @@ json merge_bench_parts(const std::vector<BenchPart>& input) {
   }
 
   json out = json::object();
-  require_same(readers, tops, {"scene", "size", "frames", "reference_frames", "errors", "order", "seam_mask", "seam_radius", "options"},
+  require_same(readers, tops, {"scene", "size", "frames", "reference_frames", "errors", "order", "seam_radius", "options"},
                "", out);
+  // Parts written before bench had --seam-mask carry no seam_mask: they pooled the band.
+  const auto mask_of = [](const json& part) { return part.contains("seam_mask") ? part["seam_mask"] : json("band"); };
+  for (size_t i = 1; i < tops.size(); ++i) {
+    if (mask_of(*tops[i]) != mask_of(*tops[0])) {
+      readers[i].refuse("seam_mask", "differs from " + readers[0].name() + "'s: parts of different batches");
+    }
+  }
+  out["seam_mask"] = mask_of(*tops[0]);
   const json& errors_flag = out["errors"];
   if (!errors_flag.is_boolean()) readers[0].refuse("errors", "expected true or false");
   const bool with_errors = errors_flag.get<bool>();

@@ -168,7 +168,9 @@ nlohmann::json DisplacementReport::to_json() const {
 }
 
 void check_tessellation_levels(const Scene& scene, const std::vector<int>& levels) {
-  for (int t : levels) check_tessellation(scene.faces.size(), t);
+  // A closed mesh is also rendered with its flag shell (with_flag_shell: twice the faces).
+  const size_t patches = (is_closed_mesh(scene) ? 2 : 1) * scene.faces.size();
+  for (int t : levels) check_tessellation(patches, t);
 }
 
 DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, const Camera& camera,

@@ -65,7 +65,8 @@ struct DisplacementReport {
 };
 
 // Every level of a run checked before its first render: InputError("tessellation") for a T outside
-// 1..64 or one whose micro-triangles (faces * 2 * T^2) exceed the renderer's bound.
+// 1..64 or one whose micro-triangles (patches * 2 * T^2, the patches doubled for a closed mesh,
+// whose crack renders add the flag shell) exceed the renderer's bound.
 void check_tessellation_levels(const Scene& scene, const std::vector<int>& levels);
 
 // Measures options.displacement (required) on `scene` at `camera`, or over `frames` frames of

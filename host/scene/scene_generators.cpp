@@ -472,8 +472,8 @@ void apply_generator_options(Scene& scene, const GeneratorOptions& options) {
     for (TextureLevel& level : chain.levels)
       for (glm::vec4& texel : level.texels) texel *= tint;
   };
-  // Deferred faces stay deferred: their source tints what it makes (a stored face has no texels
-  // to tint here and is tinted below).
+  // Deferred faces stay deferred: their source tints what it makes (a deferred face has no
+  // texels to tint here; stored faces are tinted below).
   if (scene.texture_source) {
     scene.texture_source = [untinted = scene.texture_source, tint_chain](size_t f) {
       MipChain chain = untinted(f);
