@@ -88,7 +88,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   const std::vector<MethodEntry> entries = method_entries(base, methods, rates);
   if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
   const std::vector<ReferenceKind> kinds = reference_kinds(args.references);
-  const ReferenceSettings ref_settings = reference_settings(args);
+  ReferenceSettings ref_settings = reference_settings(args);
   (void)reference_render_options(frame, ref_settings);  // size and reference settings checked now
   GeneratorOptions generator_options;
   generator_options.tint = frame.tint;
@@ -99,6 +99,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   source.generator.defer_textures = true;  // each Renderer packs face by face: no float copy of the textures
   const Scene scene = load_scene_source(frame.scene, frame.texture, source);
   const Camera camera = frame.frame ? orbit_camera(scene, *frame.frame, frame.frames) : scene.camera;
+  if (ref_settings.use_cache) ref_settings.scene_hash = scene_content_hash(scene);  // once for every reference kind
   if (!args.images_dir.empty()) fs::create_directories(args.images_dir);
   auto progress = [&](const std::string& line) {
     if (!args.no_progress) std::fprintf(stderr, "compare: %s\n", line.c_str());

@@ -917,7 +917,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
     rest.erase("reference");
   }
   bool explicit_reference_msaa = false;
-  const ReferenceSettings reference_settings = take_reference_settings(rest, explicit_reference_msaa);
+  ReferenceSettings reference_settings = take_reference_settings(rest, explicit_reference_msaa);
   const json inline_scene = take_inline_scene(rest);
   // No size: the render default would be over this server's compare limit, so compare's own
   // default fits it. The answer says which size was used and where it came from.
@@ -969,6 +969,8 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
     Renderer renderer(runtime_);
     renderer.set_device_byte_limit(options_.max_request_device_bytes);
     renderer.load_scene(*scene, frame.texels);
+    // Hashed once for the lock's key and every reference kind's cache key (hashing bakes every face).
+    reference_settings.scene_hash = scene_content_hash(*scene);
     {
       const std::string cache_key = reference_cache_key(*scene, camera, frame, reference_settings);
       std::lock_guard lock(reference_locks_[std::hash<std::string>{}(cache_key) % reference_locks_.size()]);
@@ -1060,7 +1062,17 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
   }
   const ImageFormat format = take_image_format(rest);
   bool explicit_reference_msaa = false;
-  const ReferenceSettings settings = take_reference_settings(rest, explicit_reference_msaa);
+  ReferenceSettings settings = take_reference_settings(rest, explicit_reference_msaa);
+  if (rest.contains("reference")) {
+    const json& value = rest.at("reference");
+    if (!value.is_string()) throw InputError("reference", "must be a reference name, got " + echo(json_text(value)));
+    const ReferenceKind kind = parse_reference_kinds({value.get<std::string>()}).front();
+    if (kind != ReferenceKind::Paper && kind != ReferenceKind::Box) {
+      throw InputError("reference", "the " + to_string(kind) + " reference is not a downsampled render: /v1/compare measures against it");
+    }
+    settings.kind = kind;
+    rest.erase("reference");
+  }
   const json inline_scene = take_inline_scene(rest);
   RenderOptions frame = parse_render_options(rest);
   std::string key;
@@ -1081,6 +1093,7 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
     Renderer renderer(runtime_);
     renderer.set_device_byte_limit(options_.max_request_device_bytes);
     renderer.load_scene(*scene, frame.texels);
+    settings.scene_hash = scene_content_hash(*scene);  // once for the lock's key and the cache's
     const std::string cache_key = reference_cache_key(*scene, camera, frame, settings);
     std::lock_guard lock(reference_locks_[std::hash<std::string>{}(cache_key) % reference_locks_.size()]);
     reference = reference_image(renderer, camera, frame, settings);

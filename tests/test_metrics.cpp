@@ -417,6 +417,15 @@ TEST(Reference, CacheReturnsTheSamePixelsWithoutRendering) {
   EXPECT_NE(reference_cache_key(scene, moved, frame, s), reference_cache_key(scene, scene.camera, frame, s));
   const Scene tinted = generate_scene("quad2", {true, std::nullopt});
   EXPECT_NE(reference_cache_key(tinted, scene.camera, frame, s), reference_cache_key(scene, scene.camera, frame, s));
+  // A hash the caller computed once is the key's scene part: the same key as hashing here, and a
+  // cached entry found through it; another scene's hash is another key.
+  ReferenceSettings hashed = s;
+  hashed.scene_hash = scene_content_hash(scene);
+  EXPECT_EQ(reference_cache_key(scene, scene.camera, frame, hashed), reference_cache_key(scene, scene.camera, frame, s));
+  EXPECT_TRUE(reference_image(scene, scene.camera, frame, hashed, must_not_render).from_cache);
+  hashed.scene_hash = scene_content_hash(tinted);
+  EXPECT_NE(hashed.scene_hash, scene_content_hash(scene));
+  EXPECT_EQ(reference_cache_key(scene, scene.camera, frame, hashed), reference_cache_key(tinted, scene.camera, frame, s));
 
   // A corrupt entry is rendered again and rewritten.
   std::ofstream(first.cache_path, std::ios::binary | std::ios::trunc) << "not an exr";

@@ -18,6 +18,7 @@
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
+#include <seamcl/eval/reference.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/scene/scene_generators.h>
 #include "http_server.h"
@@ -94,6 +95,16 @@ TEST(OpenApi, EnumsAreTheParsersNames) {
   // compare's reference method is a method name too.
   const json reference_method = schema("CompareRequest").at("properties").at("reference_method");
   EXPECT_EQ(reference_method.at("enum").get<std::vector<std::string>>(), method_names());
+  // /v1/reference's kinds: the reference names that are downsampled renders, each one the parser
+  // takes, in its order.
+  const json reference = schema("ReferenceRequest").at("properties").at("reference");
+  std::vector<std::string> downsampled;
+  for (const std::string& name : reference_kind_names()) {
+    const ReferenceKind kind = *parse_reference_kind(name);
+    if (kind == ReferenceKind::Paper || kind == ReferenceKind::Box) downsampled.push_back(name);
+  }
+  EXPECT_EQ(reference.at("enum").get<std::vector<std::string>>(), downsampled);
+  EXPECT_EQ(reference.at("default"), to_string(ReferenceSettings{}.kind));
 }
 
 TEST(OpenApi, MsaaIsTheAllowedRates) {

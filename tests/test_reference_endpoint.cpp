@@ -48,6 +48,26 @@ TEST(ReferenceEndpoint, AnswersTheLibrarysReferenceAndRefusesWhatCompareRefuses)
   const ReferenceImage reference = reference_image(renderer, orbit_camera(scene, 3, 12), frame, settings);
   EXPECT_EQ(res->body, encode_image(ImageFormat::Png, reference.width, reference.height, reference.pixels));
 
+  // The box reference: the library's box downsample of the same 8x render, not the paper's (the
+  // scene's own camera: frame 3 of 12 sees no face, and both downsamples of an empty frame agree).
+  const auto box = client.Post("/v1/reference", R"({"scene": "quad2", "size": "40x24", "reference": "box"})", "application/json");
+  ASSERT_TRUE(box);
+  ASSERT_EQ(box->status, 200) << box->body;
+  const RenderOptions own_camera = parse_render_options({{"scene", "quad2"}, {"size", "40x24"}});
+  const ReferenceImage paper_reference = reference_image(renderer, scene.camera, own_camera, settings);
+  settings.kind = ReferenceKind::Box;
+  const ReferenceImage box_reference = reference_image(renderer, scene.camera, own_camera, settings);
+  EXPECT_EQ(box->body, encode_image(ImageFormat::Png, box_reference.width, box_reference.height, box_reference.pixels));
+  EXPECT_NE(box->body, encode_image(ImageFormat::Png, paper_reference.width, paper_reference.height, paper_reference.pixels));
+  EXPECT_EQ(json::parse(box->get_header_value("X-Seamcl-Reference")).at("name"), "box");
+  for (const char* refused : {R"("analytic")", R"("seamless")", R"("sharp")", "3"}) {
+    const auto answer = client.Post("/v1/reference", std::string(R"({"scene": "quad2", "size": "40x24", "reference": )") + refused + "}",
+                                    "application/json");
+    ASSERT_TRUE(answer);
+    EXPECT_EQ(answer->status, 400) << refused;
+    EXPECT_EQ(json::parse(answer->body).at("field"), "reference") << refused << ": " << answer->body;
+  }
+
   // Refusals name their field.
   const auto methods = client.Post("/v1/reference", R"({"scene": "quad2", "methods": "discard"})", "application/json");
   ASSERT_TRUE(methods);

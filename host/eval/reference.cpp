@@ -52,6 +52,8 @@ struct Fnv64 {
   }
 };
 
+}  // namespace
+
 std::string scene_content_hash(const Scene& scene) {
   Fnv64 f;
   f.value(scene.positions.size());
@@ -77,6 +79,8 @@ std::string scene_content_hash(const Scene& scene) {
   f.value(scene.background);
   return f.hex();
 }
+
+namespace {
 
 std::string text_hash(const std::string& text) {
   Fnv64 f;
@@ -320,7 +324,7 @@ std::string reference_cache_key(const Scene& scene, const Camera& camera, const 
   const json key = {
       {"version", SEAMCL_VERSION},
       {"kernels", text_hash(program_source())},
-      {"scene", scene_content_hash(scene)},
+      {"scene", settings.scene_hash.empty() ? scene_content_hash(scene) : settings.scene_hash},
       {"camera",
        {camera.eye.x, camera.eye.y, camera.eye.z, camera.target.x, camera.target.y, camera.target.z, camera.up.x,
         camera.up.y, camera.up.z, camera.fov_y_degrees}},

@@ -86,7 +86,16 @@ struct ReferenceSettings {
   // and this many entries. 0: unbounded. A 480x540 reference is about 4 MiB (zip float EXR).
   std::uintmax_t cache_max_bytes = kDefaultReferenceCacheBytes;
   size_t cache_max_entries = 0;
+  // scene_content_hash of the scene the references are of, when the caller has it. Hashing bakes
+  // every face's texels, so a caller keying several references of one scene (bench's reference
+  // frames, a request's key and its render) computes it once. Empty: computed for each key.
+  std::string scene_hash;
 };
+
+// A hash of everything in a scene that a render reads: geometry, level-0 texels (a deferred
+// face's are made to be hashed, one face at a time, so deferring does not change it), light and
+// background. Costs one bake of every face.
+std::string scene_content_hash(const Scene& scene);
 
 // $SEAMCL_CACHE_DIR, else $HOME/.cache/seamcl, else <temp>/seamcl-cache.
 std::string default_cache_dir();
@@ -96,9 +105,8 @@ std::string default_cache_dir();
 // too large, InputError("reference_method"/"reference_msaa", ...) for bad settings.
 RenderOptions reference_render_options(const RenderOptions& frame, const ReferenceSettings& settings);
 
-// Everything the reference depends on, as one canonical JSON string: a hash of the scene's
-// content (geometry, textures, light, background; a deferred face's texels are made to be hashed,
-// one face at a time, so deferring a scene's textures does not change its key), the camera, the reference render options
+// Everything the reference depends on, as one canonical JSON string: the scene's content hash
+// (settings.scene_hash, else scene_content_hash(scene)), the camera, the reference render options
 // (scene name, frame, frames, size, method, msaa, filter, aniso, texels, ...), the kernel
 // sources, the scale and the downsample filter.
 std::string reference_cache_key(const Scene& scene, const Camera& camera, const RenderOptions& frame,
