@@ -462,6 +462,15 @@ TEST(Assets, TheAssetDirectoryRefusesNamesThatLeaveItAndCachesWhatItLoads) {
   tinted.generator.tint = true;
   EXPECT_NE(assets.load("plane.obj", "maps/wave_lo.ptx", tinted), first);
   EXPECT_EQ(assets.cached_entries(), 2u);
+  // Deferred and baked are separate entries: neither is handed to a caller asking for the other.
+  SceneSourceOptions deferred;
+  deferred.generator.defer_textures = true;
+  const auto lazy = assets.load("plane.obj", "maps/wave_lo.ptx", deferred);
+  EXPECT_NE(lazy, first);
+  EXPECT_TRUE(has_deferred_textures(*lazy));
+  EXPECT_FALSE(has_deferred_textures(*assets.load("plane.obj", "maps/wave_lo.ptx", {})));
+  EXPECT_EQ(assets.load("plane.obj", "maps/wave_lo.ptx", deferred), lazy);
+  EXPECT_EQ(assets.cached_entries(), 3u);
   // Bounded: with room for nothing, nothing stays.
   AssetDirectory uncached(root.path().string(), {0, 4});
   uncached.load("plane.obj", "", {});

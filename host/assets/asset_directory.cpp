@@ -93,7 +93,10 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
   std::ostringstream key;
   key << resolve(scene, "", "scene") << "|" << file_stamp(resolve(scene, "", "scene")) << "|";
   if (!texture.empty()) key << resolve(texture, "", "texture") << "|" << file_stamp(resolve(texture, "", "texture"));
-  key << "|" << options.generator.tint << "|" << options.mesh_texture_size << "|" << options.ptex_limits.max_texels;
+  // Deferred or baked is part of the key: a caller that reads the stored texels must not be handed
+  // a deferred scene, nor one that packs face by face a baked one (its float copy of every face).
+  key << "|" << options.generator.tint << "|" << options.generator.defer_textures << "|" << options.mesh_texture_size
+      << "|" << options.ptex_limits.max_texels;
   if (options.generator.constant_color) {
     const glm::vec3 c = *options.generator.constant_color;
     key << "|" << c.r << "," << c.g << "," << c.b;
