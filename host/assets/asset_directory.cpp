@@ -112,7 +112,18 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
   }
   // Read outside the lock: a large file does not hold up requests for cached ones.
   auto loaded = std::make_shared<const Scene>(load_scene_source(scene, texture, options));
-  const size_t bytes = scene_host_bytes(scene_sizes(*loaded));
+  size_t bytes = scene_host_bytes(scene_sizes(*loaded));
+  // A deferred .ptx's texture_source keeps the whole file's bytes (its faces are decoded again
+  // while packing), metadata included: counted on top. (A .ptx named inside a scene file is not
+  // seen here; its faces' float texels are what scene_host_bytes counts for it.)
+  if (options.generator.defer_textures) {
+    for (const std::string* name : {&scene, &texture}) {
+      if (name->empty() || asset_kind_of_path(*name) != AssetKind::Ptex) continue;
+      std::error_code error;
+      const auto file_bytes = fs::file_size(resolve(*name, "", name == &scene ? "scene" : "texture"), error);
+      if (!error) bytes = saturating_add(bytes, static_cast<size_t>(file_bytes));
+    }
+  }
   std::lock_guard lock(mutex_);
   if (bytes > limits_.max_bytes || limits_.max_entries == 0) return loaded;
   entries_.push_front({key.str(), loaded, bytes});
