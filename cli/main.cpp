@@ -92,7 +92,9 @@ int run_render(const RenderArgs& args, const std::string& device) {
 
   ClRuntime runtime(device);
   Renderer renderer(runtime);
-  renderer.load_scene(scene, options.texels);
+  // Handed over, not copied: image faces' float chains exist once (scene() reads them back).
+  renderer.load_scene(std::move(scene), options.texels);
+  const Scene& loaded = renderer.scene();
   renderer.warm_up(options);
   std::vector<RenderResult> runs;
   for (int i = 0; i < args.repeat; ++i) runs.push_back(renderer.render(camera, options));
@@ -114,7 +116,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
                 {"runs", args.repeat},
                 {"kernel_build_ms", runtime.program_build_ms()},
                 {"scene_ms", scene_ms},
-                {"triangles", scene.triangle_count()},
+                {"triangles", loaded.triangle_count()},
                 {"visible_triangles", result.stats.visible_triangles},
                 {"fragments", result.stats.fragments},
                 {"texture_bytes", renderer.packed_scene().texture_bytes()},
@@ -123,18 +125,18 @@ int run_render(const RenderArgs& args, const std::string& device) {
                 {"bin_entries", result.stats.bin_entries}};
     if (options.displacement) {
       // The gap and crack pixels of this frame (docs/displacement.md), the times of the renders above.
-      DisplacementReport report = measure_displacement(runtime, scene, camera, options, args.crack_orbit, 0);
+      DisplacementReport report = measure_displacement(runtime, loaded, camera, options, args.crack_orbit, 0);
       report.frame_ms = stage_median(&StageTimes::total);
       report.tessellate_ms = stage_median(&StageTimes::tessellate);
       out["displacement"] = report.to_json();
       out["triangles"] = report.triangles;
     }
     if (!args.output.empty()) out["output"] = args.output;
-    out["memory"] = to_json(measure_memory(scene, renderer));  // peak over everything above
+    out["memory"] = to_json(measure_memory(renderer));  // peak over everything above
     std::cout << out.dump(2) << "\n";
   } else {
     std::printf("%s: %dx%d msaa %d, %.2f ms (setup %.2f, binning %.2f, raster %.2f, shade %.2f), %u fragments%s%s\n",
-                scene.name.c_str(), result.width, result.height, options.msaa, ms["total"].get<double>(),
+                loaded.name.c_str(), result.width, result.height, options.msaa, ms["total"].get<double>(),
                 ms["setup"].get<double>(), ms["binning"].get<double>(), ms["raster"].get<double>(),
                 ms["shade"].get<double>(), result.stats.fragments, args.output.empty() ? "" : " -> ",
                 args.output.c_str());

@@ -4,7 +4,9 @@ scene must stay under 350 MB, and the peak of any render under the runtime's flo
 the two-face quad2 render, measured here first) plus 2x the scene's packed texel bytes (with
 guard bands, the banded texels the render packed). --texture and --method render other scenes and
 methods (a .obj with its .ptx, guardband) against the same floor + 2x packed bound; --bound-mb 0
-drops the absolute bound.
+drops the absolute bound. Each --also "RENDER ARGS" is one more render (its own --scene and the
+rest; written --also="..." so that argparse takes it), held to the same floor + 2x packed
+bound only, against the floor measured once.
 
 RSS is not a timing: for one binary and one scene it moves by a few MB between runs (PoCL's
 allocations, the kernel cache state), so the bounds are the issue's targets themselves and the
@@ -12,10 +14,11 @@ measured figures are printed for the margin (when this test was written: paper 2
 350 MB; quad2 225 MB, so 42 MB under the floor + 2x packed).
 
     tests/memory_peak_test.py --seamcl build/seamcl [--scene paper] [--texture T.ptx] [--method M]
-                              [--bound-mb 350]
+                              [--bound-mb 350] [--also="--scene S --texture T --method M" ...]
 """
 import argparse
 import json
+import shlex
 import subprocess
 import sys
 
@@ -37,6 +40,28 @@ def render_memory(seamcl, scene, extra=()):
     return memory
 
 
+def check_case(seamcl, scene, extra, bound_mb, floor):
+    """The failures of one render against the floor + 2x packed bound (and bound_mb when > 0)."""
+    memory = render_memory(seamcl, scene, extra)
+    peak, packed = memory["peak_rss_bytes"], memory["packed_texel_bytes"]
+    mb = 1e6
+    print(f"{' '.join([scene] + extra)}: peak {peak / mb:.1f} MB, packed texels {packed / mb:.1f} MB, "
+          f"floor + 2x packed {(floor + 2 * packed) / mb:.1f} MB (margin {(floor + 2 * packed - peak) / mb:.1f} MB)"
+          + (f", bound {bound_mb:.0f} MB" if bound_mb > 0 else ""))
+    failures = []
+    where = " ".join([scene] + extra)
+    if memory["scene_float_texel_bytes"] != 0 or memory["renderer_float_texel_bytes"] != 0:
+        failures.append(f"{where}: float texture copies are held: scene {memory['scene_float_texel_bytes']} bytes, "
+                        f"renderer {memory['renderer_float_texel_bytes']} bytes")
+    if packed <= 0:
+        failures.append(f"{where}: packed_texel_bytes is not positive")
+    if bound_mb > 0 and peak > bound_mb * mb:
+        failures.append(f"{where}: peak RSS {peak / mb:.1f} MB is over {bound_mb:.0f} MB")
+    if peak > floor + 2 * packed:
+        failures.append(f"{where}: peak RSS {peak / mb:.1f} MB is over the floor + 2x packed, {(floor + 2 * packed) / mb:.1f} MB")
+    return failures
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seamcl", required=True)
@@ -45,6 +70,8 @@ def main():
     parser.add_argument("--method", help="seam method of the render (default: the CLI's)")
     parser.add_argument("--bound-mb", type=float, default=350.0,
                         help="peak RSS bound of --scene in MB (10^6 bytes); 0: none but floor + 2x packed")
+    parser.add_argument("--also", action="append", default=[], metavar="RENDER_ARGS",
+                        help="another render's arguments (with its --scene), held to floor + 2x packed")
     args = parser.parse_args()
 
     extra = []
@@ -53,23 +80,18 @@ def main():
     if args.method:
         extra += ["--method", args.method]
     floor = render_memory(args.seamcl, "quad2")["peak_rss_bytes"]
-    memory = render_memory(args.seamcl, args.scene, extra)
-    peak, packed = memory["peak_rss_bytes"], memory["packed_texel_bytes"]
     mb = 1e6
     print(f"quad2 peak (runtime floor): {floor / mb:.1f} MB")
-    print(f"{' '.join([args.scene] + extra)}: peak {peak / mb:.1f} MB, packed texels {packed / mb:.1f} MB, "
-          f"floor + 2x packed {(floor + 2 * packed) / mb:.1f} MB (margin {(floor + 2 * packed - peak) / mb:.1f} MB), "
-          f"bound {args.bound_mb:.0f} MB")
     failures = []
-    if memory["scene_float_texel_bytes"] != 0 or memory["renderer_float_texel_bytes"] != 0:
-        failures.append(f"float texture copies are held: scene {memory['scene_float_texel_bytes']} bytes, "
-                        f"renderer {memory['renderer_float_texel_bytes']} bytes")
-    if packed <= 0:
-        failures.append("packed_texel_bytes is not positive")
-    if args.bound_mb > 0 and peak > args.bound_mb * mb:
-        failures.append(f"peak RSS {peak / mb:.1f} MB is over {args.bound_mb:.0f} MB")
-    if peak > floor + 2 * packed:
-        failures.append(f"peak RSS {peak / mb:.1f} MB is over the floor + 2x packed, {(floor + 2 * packed) / mb:.1f} MB")
+    cases = [(args.scene, extra, args.bound_mb)]
+    for also in args.also:
+        words = shlex.split(also)
+        if "--scene" not in words or words.index("--scene") + 1 >= len(words):
+            raise SystemExit(f"memory_peak_test: --also {also!r} names no --scene")
+        at = words.index("--scene")
+        cases.append((words[at + 1], words[:at] + words[at + 2:], 0.0))
+    for scene, render_args, bound_mb in cases:
+        failures += check_case(args.seamcl, scene, render_args, bound_mb, floor)
     for failure in failures:
         print(f"memory_peak_test: {failure}", file=sys.stderr)
     return 1 if failures else 0

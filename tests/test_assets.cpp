@@ -23,6 +23,7 @@
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/io/image_io.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/pipeline/texture_lookups.h>
 #include <seamcl/scene/scene_generators.h>
@@ -462,6 +463,19 @@ TEST(Assets, TheAssetDirectoryRefusesNamesThatLeaveItAndCachesWhatItLoads) {
   tinted.generator.tint = true;
   EXPECT_NE(assets.load("plane.obj", "maps/wave_lo.ptx", tinted), first);
   EXPECT_EQ(assets.cached_entries(), 2u);
+  // Deferred and baked are separate entries: neither is handed to a caller asking for the other.
+  SceneSourceOptions deferred;
+  deferred.generator.defer_textures = true;
+  const size_t eager_bytes = assets.cached_bytes();
+  const auto lazy = assets.load("plane.obj", "maps/wave_lo.ptx", deferred);
+  EXPECT_NE(lazy, first);
+  // The deferred scene's source keeps the .ptx's bytes: the cache counts them.
+  EXPECT_EQ(assets.cached_bytes(), eager_bytes + scene_host_bytes(scene_sizes(*lazy)) +
+                                       static_cast<size_t>(fs::file_size(root.path() / "maps" / "wave_lo.ptx")));
+  EXPECT_TRUE(has_deferred_textures(*lazy));
+  EXPECT_FALSE(has_deferred_textures(*assets.load("plane.obj", "maps/wave_lo.ptx", {})));
+  EXPECT_EQ(assets.load("plane.obj", "maps/wave_lo.ptx", deferred), lazy);
+  EXPECT_EQ(assets.cached_entries(), 3u);
   // Bounded: with room for nothing, nothing stays.
   AssetDirectory uncached(root.path().string(), {0, 4});
   uncached.load("plane.obj", "", {});

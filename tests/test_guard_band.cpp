@@ -7,7 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <cstring>
+#include <memory>
 #include <random>
 #include <set>
 
@@ -265,4 +268,97 @@ TEST(GuardBand, CornerBandsAtEveryValenceAndAtBoundaries) {
   }
   EXPECT_EQ(valences_seen, (std::set<int>{0, 3, 4, 5}));
   EXPECT_GT(boundary_corners, 0u);
+}
+
+namespace {
+
+// The same scene with every texture deferred to a source that hands out the baked chains, and
+// counts how often each face's chain is made.
+Scene deferred_copy(const Scene& baked, std::shared_ptr<std::vector<std::atomic<int>>> made = nullptr) {
+  Scene deferred = baked;
+  for (Face& face : deferred.faces) face.texture = deferred_mip_chain(face.texture.width(), face.texture.height());
+  auto chains = std::make_shared<std::vector<MipChain>>();
+  for (const Face& face : baked.faces) chains->push_back(face.texture);
+  deferred.texture_source = [chains, made](size_t f) {
+    if (made) ++(*made)[f];
+    return (*chains)[f];
+  };
+  return deferred;
+}
+
+}  // namespace
+
+TEST(GuardBand, DeferredScenesBandFromEdgeStripsToTheBakedBits) {
+  // Packing a deferred scene keeps only the strips of its faces that bands read: the bands must
+  // come out bit for bit as from the whole chains, at every valence, at boundaries, beside
+  // anisotropic, finer and coarser neighbours and turned faces, for narrow and wide bands, and
+  // each face's chain must be made once.
+  Scene prism = seamcl_tests::split_pentagonal_prism();
+  Scene box = seamcl_tests::subdivided_cube(2);
+  box.faces.erase(box.faces.begin() + 4, box.faces.begin() + 8);
+  Scene cube = seamcl_tests::subdivided_cube(3);
+  std::vector<Scene> scenes;
+  for (Scene* scene : {&prism, &box, &cube}) {
+    seamcl_tests::set_textures(*scene, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+    scenes.push_back(*scene);
+  }
+  scenes.push_back(seamcl_tests::turn_face(seamcl_tests::turn_face(cube, 4, 1, false), 10, 3, false));
+  for (const Scene& baked : scenes) {
+    for (int band : {1, 4, kMaxGuardBand}) {
+      for (TexelFormat format : {TexelFormat::Rgba8, TexelFormat::Rgba32f}) {
+        SCOPED_TRACE(baked.name + " band " + std::to_string(band) + " " + to_string(format));
+        auto made = std::make_shared<std::vector<std::atomic<int>>>(baked.faces.size());
+        const Scene deferred = deferred_copy(baked, made);
+        const PackedScene expected = pack_scene(baked, format, band);
+        const PackedScene packed = pack_scene(deferred, format, band);
+        EXPECT_EQ(packed.level_offsets, expected.level_offsets);
+        EXPECT_TRUE(packed.texels8 == expected.texels8);
+        ASSERT_EQ(packed.texels32.size(), expected.texels32.size());
+        EXPECT_EQ(std::memcmp(packed.texels32.data(), expected.texels32.data(), packed.texels32.size() * sizeof(float)), 0);
+        for (size_t f = 0; f < made->size(); ++f) EXPECT_EQ((*made)[f].load(), 1) << "face " << f;
+      }
+    }
+  }
+}
+
+TEST(GuardBand, BandsReadStripsAboutABandDeepAtEqualDensity) {
+  // A closed cube of 64x64 faces: at level 0 the bands of 4 read 4 texels deep into each
+  // neighbour (the band's texels are the neighbour's own); the coarsest levels are read whole.
+  // The strips hold those texels exactly as the chain does, and far fewer of them.
+  constexpr int band = 4;
+  Scene cube = seamcl_tests::subdivided_cube(2);
+  seamcl_tests::set_textures(cube, {{64, 64}}, seamcl_tests::distinct_texel);
+  const std::vector<std::vector<int>> depths = band_read_depths(cube, build_adjacency(cube), band);
+  ASSERT_EQ(depths.size(), cube.faces.size());
+  size_t chain_texels = 0;
+  for (const TextureLevel& level : cube.faces[0].texture.levels) chain_texels += level.texels.size();
+  for (size_t f = 0; f < cube.faces.size(); ++f) {
+    SCOPED_TRACE("face " + std::to_string(f));
+    const MipChain& chain = cube.faces[f].texture;
+    ASSERT_EQ(depths[f].size(), chain.levels.size());
+    EXPECT_EQ(depths[f][0], band);
+    EXPECT_EQ(depths[f][1], band);
+    EXPECT_GE(2 * depths[f].back(), 1);  // the 1x1 level is read
+    const EdgeStrips strips(chain, depths[f]);
+    EXPECT_LT(strips.texel_count() * 3, chain_texels);
+    for (size_t l = 0; l < chain.levels.size(); ++l) {
+      const TextureLevel& level = chain.levels[l];
+      for (int j = 0; j < level.height; ++j) {
+        for (int i = 0; i < level.width; ++i) {
+          const int from_edge = std::min(std::min(i, level.width - 1 - i), std::min(j, level.height - 1 - j));
+          if (from_edge < depths[f][l]) {
+            ASSERT_EQ(strips.at(l, i, j), level.at(i, j)) << "level " << l << " texel " << i << "," << j;
+          } else {
+            EXPECT_THROW(strips.at(l, i, j), std::logic_error) << "level " << l << " texel " << i << "," << j;
+          }
+        }
+      }
+    }
+    EXPECT_THROW(strips.at(0, 64, 0), std::logic_error);
+  }
+  // Anisotropic faces read deeper: a 4x64 face beside a 64x64 one, sharing its long edge, has
+  // band texels a quarter of the face deep, which reach 16 texels into the square neighbour.
+  Scene pair = two_quads(4, 64);
+  seamcl_tests::set_textures(pair, {{4, 64}, {64, 64}}, seamcl_tests::distinct_texel);
+  EXPECT_EQ(band_read_depths(pair, build_adjacency(pair), 1)[1][0], 16);
 }

@@ -160,6 +160,29 @@ TEST(Memory, ReportedPackedBytesAreTheSumOfTheFacesPackedSizes) {
   EXPECT_EQ(m.renderer_float_texel_bytes, sum_of_face_texels(baked, 0) * 16);
 }
 
+TEST(Memory, LoadSceneTakesAHandedOverSceneWithoutACopy) {
+  // A scene handed over (load_scene(Scene&&)) is the Renderer's only copy: its float texels are
+  // counted once, scene() gives back what was handed over, and it packs as a copied one does.
+  const Scene baked = generated("quad2", false);
+  Renderer copied(seamcl_tests::shared_runtime());
+  copied.load_scene(baked);
+  Scene handed = baked;
+  const glm::vec4* texels = handed.faces[0].texture.levels[0].texels.data();
+  Renderer taken(seamcl_tests::shared_runtime());
+  taken.load_scene(std::move(handed));
+  EXPECT_EQ(taken.scene().faces[0].texture.levels[0].texels.data(), texels);  // moved, not copied
+  EXPECT_EQ(taken.scene().stored_texel_count(), baked.stored_texel_count());
+  EXPECT_TRUE(taken.packed_scene().texels8 == copied.packed_scene().texels8);
+  const MeasuredMemory m = measure_memory(taken);
+  EXPECT_EQ(m.scene_float_texel_bytes, 0u);
+  EXPECT_EQ(m.renderer_float_texel_bytes, sum_of_face_texels(baked, 0) * 16);
+  // An invalid scene is refused before anything is taken over.
+  Scene broken = baked;
+  broken.faces[0].vertices[0] = 1000;
+  EXPECT_THROW(taken.load_scene(std::move(broken)), InputError);
+  EXPECT_TRUE(taken.has_scene());
+}
+
 TEST(Memory, ProcessMemoryGrowsWithATouchedAllocation) {
   // Other threads of this process (the runtime's, a server test's shutting down) may free memory
   // between the two readings, so up to three tries: one that sees the growth is the reading

@@ -93,7 +93,10 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
   std::ostringstream key;
   key << resolve(scene, "", "scene") << "|" << file_stamp(resolve(scene, "", "scene")) << "|";
   if (!texture.empty()) key << resolve(texture, "", "texture") << "|" << file_stamp(resolve(texture, "", "texture"));
-  key << "|" << options.generator.tint << "|" << options.mesh_texture_size << "|" << options.ptex_limits.max_texels;
+  // Deferred or baked is part of the key: a caller that reads the stored texels must not be handed
+  // a deferred scene, nor one that packs face by face a baked one (its float copy of every face).
+  key << "|" << options.generator.tint << "|" << options.generator.defer_textures << "|" << options.mesh_texture_size
+      << "|" << options.ptex_limits.max_texels;
   if (options.generator.constant_color) {
     const glm::vec3 c = *options.generator.constant_color;
     key << "|" << c.r << "," << c.g << "," << c.b;
@@ -109,7 +112,18 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
   }
   // Read outside the lock: a large file does not hold up requests for cached ones.
   auto loaded = std::make_shared<const Scene>(load_scene_source(scene, texture, options));
-  const size_t bytes = scene_host_bytes(scene_sizes(*loaded));
+  size_t bytes = scene_host_bytes(scene_sizes(*loaded));
+  // A deferred .ptx's texture_source keeps the whole file's bytes (its faces are decoded again
+  // while packing), metadata included: counted on top. (A .ptx named inside a scene file is not
+  // seen here; its faces' float texels are what scene_host_bytes counts for it.)
+  if (options.generator.defer_textures) {
+    for (const std::string* name : {&scene, &texture}) {
+      if (name->empty() || asset_kind_of_path(*name) != AssetKind::Ptex) continue;
+      std::error_code error;
+      const auto file_bytes = fs::file_size(resolve(*name, "", name == &scene ? "scene" : "texture"), error);
+      if (!error) bytes = saturating_add(bytes, static_cast<size_t>(file_bytes));
+    }
+  }
   std::lock_guard lock(mutex_);
   if (bytes > limits_.max_bytes || limits_.max_entries == 0) return loaded;
   entries_.push_front({key.str(), loaded, bytes});

@@ -9,11 +9,24 @@
 
 #include <algorithm>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
 namespace seamcl {
 namespace {
+
+void store_texel(PackedScene& out, size_t at, const glm::vec4& texel) {
+  if (out.format == TexelFormat::Rgba8) {
+    out.texels8[at] = encode_srgb8(texel);
+  } else {
+    float* stored = &out.texels32[4 * at];
+    stored[0] = texel.r;
+    stored[1] = texel.g;
+    stored[2] = texel.b;
+    stored[3] = texel.a;
+  }
+}
 
 // Writes face f's levels (banded when guard_band > 0) at their offsets in `out`'s texels.
 void pack_face_texels(const Scene& scene, PackedScene& out, size_t f, size_t first_level) {
@@ -32,27 +45,51 @@ void pack_face_texels(const Scene& scene, PackedScene& out, size_t f, size_t fir
                              " holds other than its size's texels");
     }
     size_t at = out.level_offsets[first_level + l];
-    for (const glm::vec4& texel : level.texels) {
-      if (out.format == TexelFormat::Rgba8) {
-        out.texels8[at++] = encode_srgb8(texel);
-      } else {
-        float* stored = &out.texels32[4 * at++];
-        stored[0] = texel.r;
-        stored[1] = texel.g;
-        stored[2] = texel.b;
-        stored[3] = texel.a;
-      }
-    }
+    for (const glm::vec4& texel : level.texels) store_texel(out, at++, texel);
   }
 }
 
+// Face f's own texels into the middle of its banded levels (the bands are written apart).
+void pack_own_texels(const MipChain& chain, PackedScene& out, size_t f, size_t first_level) {
+  const int band = out.guard_band;
+  for (size_t l = 0; l < chain.levels.size(); ++l) {
+    const TextureLevel& level = chain.levels[l];
+    if (level.texels.size() != static_cast<size_t>(level.width) * static_cast<size_t>(level.height))
+      throw std::logic_error("pack_scene: face " + std::to_string(f) + " level " + std::to_string(l) +
+                             " holds other than its size's texels");
+    const size_t stored_width = static_cast<size_t>(level.width + 2 * band);
+    const size_t first = out.level_offsets[first_level + l];
+    for (int j = 0; j < level.height; ++j)
+      for (int i = 0; i < level.width; ++i)
+        store_texel(out, first + static_cast<size_t>(j + band) * stored_width + static_cast<size_t>(i + band), level.at(i, j));
+  }
+}
+
+// The strips of the faces in the packing window, by face: what the bands being packed read.
+class WindowStrips final : public BandTexels {
+ public:
+  explicit WindowStrips(size_t faces) : strips_(faces) {}
+  bool holds(size_t face) const { return strips_[face] != nullptr; }
+  void hold(size_t face, std::unique_ptr<EdgeStrips> strips) { strips_[face] = std::move(strips); }
+  void drop(size_t face) { strips_[face].reset(); }
+  const glm::vec4& at(uint32_t face, size_t level, int i, int j) const override {
+    if (!strips_[face]) throw std::logic_error("pack_scene: a band read face " + std::to_string(face) + " outside the window");
+    return strips_[face]->at(level, i, j);
+  }
+
+ private:
+  std::vector<std::unique_ptr<EdgeStrips>> strips_;
+};
+
 // Guard bands of a scene with deferred textures. A face's band reads the levels of the faces
-// across its edges and around its corners, all of which share a vertex with it; so the faces are
-// packed one after another, each face's chain made just before the first face that reads it and
-// dropped after the last. The order is breadth first over faces that share a vertex (each
-// connected part in turn), so that the faces holding float texels at once are a few rings of the
-// mesh around the packing front, however the file numbers its faces, never the whole scene. Each
-// face's band is written to its own range: the order changes nothing in the result.
+// across its edges and around its corners, all of which share a vertex with it, and of those only
+// strips along their edges (band_read_depths). So the faces are visited one after another; the
+// first time the window reaches a face its chain is made, its own texels are packed, the strips
+// its neighbours' bands read are kept and the chain is dropped; the strips go once the last face
+// reading them is banded. The order is breadth first over faces that share a vertex (each
+// connected part in turn), so that the strips held at once are those of a few rings of the mesh
+// around the packing front, however the file numbers its faces, and no more than one face's
+// chain exists at a time. Each texel is written to its own place: the order changes no result.
 void pack_banded_deferred(const Scene& scene, PackedScene& out, const std::vector<size_t>& first_level) {
   const size_t count = scene.faces.size();
   std::vector<std::vector<uint32_t>> faces_at_vertex(scene.positions.size());
@@ -82,18 +119,31 @@ void pack_banded_deferred(const Scene& scene, PackedScene& out, const std::vecto
   std::vector<size_t> last_reader(count, 0);  // position in `order` of the last face reading each face
   for (size_t k = 0; k < count; ++k)
     for (uint32_t g : readers_of(order[k])) last_reader[g] = std::max(last_reader[g], k);
-  Scene window = scene;  // deferred chains (sizes only) but for the faces in the window
+  const std::vector<std::vector<int>> depths = band_read_depths(scene, out.neighbors, out.guard_band);
+  WindowStrips window(count);
+  std::vector<bool> packed_own(count, false);
   for (size_t k = 0; k < count; ++k) {
-    const size_t f = order[k];
+    const uint32_t f = order[k];
     const std::vector<uint32_t> around = readers_of(f);
+    for (uint32_t g : around) {
+      if (packed_own[g]) continue;
+      const MipChain made = is_deferred(scene.faces[g].texture) ? face_texture(scene, g) : MipChain{};
+      const MipChain& chain = made.levels.empty() ? scene.faces[g].texture : made;
+      pack_own_texels(chain, out, g, first_level[g]);
+      window.hold(g, std::make_unique<EdgeStrips>(chain, depths[g]));
+      packed_own[g] = true;
+    }
+    const size_t band = static_cast<size_t>(out.guard_band);
+    for (size_t l = 0; l < scene.faces[f].texture.levels.size(); ++l) {
+      const size_t stored_width = static_cast<size_t>(scene.faces[f].texture.levels[l].width) + 2 * band;
+      const size_t first = out.level_offsets[first_level[f] + l];
+      for_each_band_texel(scene, out.neighbors, f, static_cast<int>(l), out.guard_band, window,
+                          [&](int si, int sj, const glm::vec4& texel) {
+                            store_texel(out, first + static_cast<size_t>(sj) * stored_width + static_cast<size_t>(si), texel);
+                          });
+    }
     for (uint32_t g : around)
-      if (is_deferred(window.faces[g].texture)) window.faces[g].texture = face_texture(scene, g);
-    pack_face_texels(window, out, f, first_level[f]);
-    // Sizes only again. A new chain moved in, so the texels' storage is freed: copy-assigning
-    // the deferred chain would empty each level's vector but keep its capacity, and with it
-    // every face's floats until the end (which was guardband's peak).
-    for (uint32_t g : around)
-      if (last_reader[g] == k && is_deferred(scene.faces[g].texture)) window.faces[g].texture = MipChain(scene.faces[g].texture);
+      if (last_reader[g] == k) window.drop(g);
   }
 }
 

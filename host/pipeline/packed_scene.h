@@ -36,8 +36,9 @@ inline constexpr int kMaxGuardBand = 16;
 
 // With guard_band > 0 every level is stored with that many band texels each side (guard_band.h).
 // Faces are packed in parallel. A deferred face's chain (Scene::texture_source) is made while
-// it is packed and dropped right after (with guard bands, kept while its neighbours are packed),
-// so that packing never holds the float copy of every texture: the packed texels are what stays.
+// it is packed and dropped right after (with guard bands, only the strips along its edges that
+// its neighbours' bands read are kept while those are packed), so that packing never holds the
+// float copy of every texture: the packed texels are what stays.
 PackedScene pack_scene(const Scene& scene, TexelFormat format = TexelFormat::Rgba8, int guard_band = 0);
 
 }  // namespace seamcl

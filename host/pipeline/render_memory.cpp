@@ -213,6 +213,8 @@ MeasuredMemory measure_memory(const Scene& caller_scene, const Renderer& rendere
   return m;
 }
 
+MeasuredMemory measure_memory(const Renderer& renderer) { return measure_memory(Scene{}, renderer); }
+
 nlohmann::json to_json(const MeasuredMemory& m) {
   return {{"peak_rss_bytes", m.process.peak_rss_bytes},
           {"rss_bytes", m.process.rss_bytes},

@@ -146,6 +146,8 @@ struct MeasuredMemory {
 
 // Reads the process's memory now; the packed and device figures of the renderer's loaded scene.
 MeasuredMemory measure_memory(const Scene& caller_scene, const Renderer& renderer);
+// For a caller that holds no scene of its own (it handed it over: Renderer::load_scene(Scene&&)).
+MeasuredMemory measure_memory(const Renderer& renderer);
 // {"peak_rss_bytes", "rss_bytes", "packed_texels", "packed_texel_bytes", "host_packed_bytes",
 //  "device_bytes", "scene_float_texel_bytes", "renderer_float_texel_bytes"}
 nlohmann::json to_json(const MeasuredMemory& memory);

@@ -5,6 +5,7 @@
 #include <optional>
 #include <cassert>
 #include <stdexcept>
+#include <utility>
 
 #include <seamcl/pipeline/render_memory.h>
 #include <seamcl/core/input_error.h>
@@ -313,6 +314,16 @@ void Renderer::load_scene(const Scene& scene, TexelFormat format) {
   impl_->pack_and_upload(format, 0);
   // Start the tile lists at a few entries per triangle slot; render() grows them when needed.
   impl_->bin_capacity = std::max<uint32_t>(impl_->bin_capacity, initial_tile_list_entries(scene.triangle_count()));
+  impl_->tile_lists = impl_->tile_entry_rows = cl::Buffer();
+}
+
+void Renderer::load_scene(Scene&& scene, TexelFormat format) {
+  validate_scene(scene);
+  impl_->release_scene_buffers();
+  impl_->scene.reset();
+  impl_->scene = std::make_unique<Scene>(std::move(scene));
+  impl_->pack_and_upload(format, 0);
+  impl_->bin_capacity = std::max<uint32_t>(impl_->bin_capacity, initial_tile_list_entries(impl_->scene->triangle_count()));
   impl_->tile_lists = impl_->tile_entry_rows = cl::Buffer();
 }
 

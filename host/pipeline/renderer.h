@@ -60,6 +60,9 @@ class Renderer {
   // Packs and uploads the scene (validated first). Later renders use it until the next call; a
   // render asking for another texel format packs it again.
   void load_scene(const Scene& scene, TexelFormat format = TexelFormat::Rgba8);
+  // The same, taking the scene over instead of copying it: a caller that does not need its scene
+  // again (scene() gives it back) holds no second copy of its float texels (image faces).
+  void load_scene(Scene&& scene, TexelFormat format = TexelFormat::Rgba8);
   const Scene& scene() const;
   const PackedScene& packed_scene() const;
   // The cube map of the last render's cube method as uploaded (pack_cube_texels), for the twins;
