@@ -3,7 +3,8 @@
  *   bin_count  one work-item per input triangle, over its written slots (slot_counts, from
  *              setup): +1 on every tile a slot's triangle may cover;
  *   bin_scan   one work-item: exclusive prefix sum of the counts -> list offsets (and cursors);
- *   bin_fill   the same walk as bin_count: appends the slot index to each tile's list, and at the
+ *   bin_fill   the same walk as bin_count: appends the slot index (k * input_triangles + t, the
+ *              record's index) to each tile's list, and at the
  *              same entry of tile_entry_rows the rows and columns of the tile that the slot's
  *              box covers (tile-relative, 4 bits each: row_lo | row_hi << 4 | col_lo << 8 |
  *              col_hi << 12), so raster skips the entry on its other rows without reading the
@@ -42,7 +43,7 @@ __kernel void bin_count(__constant FrameParams* frame, __global const TriangleSe
   if (t >= frame->input_triangles) return;
   const uint written = min(slot_counts[t], (uint)SEAMCL_CLIP_SLOTS);
   for (uint k = 0; k < written; ++k) {
-    __global const TriangleSetup* s = setups + (size_t)t * SEAMCL_CLIP_SLOTS + k;
+    __global const TriangleSetup* s = setups + (size_t)k * (size_t)frame->input_triangles + t;
     if (s->bbox_max_x < s->bbox_min_x || s->bbox_max_y < s->bbox_min_y) continue;
     for (int ty = s->bbox_min_y / SEAMCL_TILE_SIZE; ty <= s->bbox_max_y / SEAMCL_TILE_SIZE; ++ty) {
       for (int tx = s->bbox_min_x / SEAMCL_TILE_SIZE; tx <= s->bbox_max_x / SEAMCL_TILE_SIZE; ++tx) {
@@ -72,7 +73,7 @@ __kernel void bin_fill(__constant FrameParams* frame, __global const TriangleSet
   if (t >= frame->input_triangles) return;
   const uint written = min(slot_counts[t], (uint)SEAMCL_CLIP_SLOTS);
   for (uint k = 0; k < written; ++k) {
-    const uint slot = (uint)t * SEAMCL_CLIP_SLOTS + k;
+    const uint slot = k * (uint)frame->input_triangles + (uint)t;
     __global const TriangleSetup* s = setups + slot;
     if (s->bbox_max_x < s->bbox_min_x || s->bbox_max_y < s->bbox_min_y) continue;
     for (int ty = s->bbox_min_y / SEAMCL_TILE_SIZE; ty <= s->bbox_max_y / SEAMCL_TILE_SIZE; ++ty) {

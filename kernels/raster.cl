@@ -5,8 +5,8 @@
  * For each sample of the pixel (D3D11 standard positions, below), a triangle covers it iff all
  * three edge functions are >= 0 at the sample's fixed-point position (top-left rule folded into
  * edge_c by setup). Depth is 1/w from the plane: nearer is larger. The sample keeps the covering
- * triangle of largest 1/w, ties going to the lower slot index, so the result does not depend on
- * the order of the tile list. Output: sample_triangle[(y * width + x) * sample_count + s], the
+ * triangle of largest 1/w, ties going to the earlier input triangle (then fan slot), so the
+ * result does not depend on the order of the tile list. Output: sample_triangle[(y * width + x) * sample_count + s], the
  * winning slot or SEAMCL_NO_TRIANGLE.
  * Edge functions are affine: E at a sample is E at a pixel centre (64-bit) plus a * dx + b * dy
  * for the sample's small offset. With |offsets| < 2^29 the centre value clamped to +-2^29, plus
@@ -79,14 +79,24 @@ SEAMCL_INLINE int raster_plane_is_tame(__global const TriangleSetup* t) {
   return bound < 0x1p100f; /* false for NaN and infinite coefficients */
 }
 
+/* Whether slot a comes before slot b in the tie order: input triangle, then fan slot (the order
+ * of t * SEAMCL_CLIP_SLOTS + k, which the twin compares). Records are slot-major, slot = k *
+ * triangles + t (triangles: the frame's input triangles), so the slot numbers themselves are not in
+ * that order. Only equal depths ask. */
+SEAMCL_INLINE int raster_slot_precedes(uint a, uint b, uint triangles) {
+  if (triangles == 0) return a < b; /* no input triangles: no slots either (never a zero divisor) */
+  const uint ta = a % triangles, tb = b % triangles;
+  return ta < tb || (ta == tb && a < b);
+}
+
 /* One sample of the row: the lanes in `covered` (-1) take `slot` where they have no triangle yet,
- * or where it is nearer than theirs (or as near and of lower slot). Depths are computed only for
+ * or where it is nearer than theirs (or as near and earlier in the tie order, raster_slot_precedes). Depths are computed only for
  * such contests (overlapping front faces: rare, as back faces are culled), both from their planes
  * with the same steps, so the result is the eager z-buffer's (whose empty samples hold -infinity:
  * a plane that is not tame contests them too, and its NaN depths never win).
  * (px, py): the lanes' fixed-point positions. */
-SEAMCL_INLINE void raster_take(__global const TriangleSetup* setups, uint slot, int tame, int16 covered, int16 px,
-                               int16 py, uint* best_slot) {
+SEAMCL_INLINE void raster_take(__global const TriangleSetup* setups, uint triangles, uint slot, int tame, int16 covered,
+                               int16 px, int16 py, uint* best_slot) {
   const uint16 old_slot = vload16(0, best_slot);
   const int16 empty = old_slot == (uint16)SEAMCL_NO_TRIANGLE;
   int16 contested = covered & ~empty;
@@ -99,7 +109,8 @@ SEAMCL_INLINE void raster_take(__global const TriangleSetup* setups, uint slot, 
       const uint other = raster_min_lane(select((uint16)SEAMCL_NO_TRIANGLE, old_slot, contested));
       const int16 held = contested & (old_slot == other);
       const float16 other_depth = raster_depth(setups + other, px, py);
-      const int16 lower_slot = (int16)(slot < other ? -1 : 0); /* a scalar comparison gives 1, not -1 */
+      /* a scalar comparison gives 1, not -1 */
+      const int16 lower_slot = (int16)(raster_slot_precedes(slot, other, triangles) ? -1 : 0);
       takes |= held & ((depth > other_depth) | ((depth == other_depth) & lower_slot));
       contested &= ~held;
     }
@@ -109,7 +120,7 @@ SEAMCL_INLINE void raster_take(__global const TriangleSetup* setups, uint slot, 
 
 /* Rows of one sample (or few): the vector runs over the row's 16 pixels, the loop over samples;
  * winners stored per sample [16 s + lane]. */
-SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, __global const uint* tile_lists,
+SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, uint triangles, __global const uint* tile_lists,
                                        __global const ushort* tile_entry_rows, uint begin, uint end, int x0, int y,
                                        int samples, int row, uint* best_slot) {
   const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -164,7 +175,7 @@ SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, __g
           covered |= partial & (any_negative >= 0);
           if (!raster_any(covered)) continue;
         }
-        raster_take(setups, slot, tame, covered, centre_x + ox, (int16)(centre_y + oy), best_slot + s * SEAMCL_TILE_SIZE);
+        raster_take(setups, triangles, slot, tame, covered, centre_x + ox, (int16)(centre_y + oy), best_slot + s * SEAMCL_TILE_SIZE);
       }
     } else {
       long16 e[3];
@@ -178,7 +189,7 @@ SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, __g
                                (e[2] + (t->edge_a[2] * ox + t->edge_b[2] * oy));
         const int16 covered = in_box & convert_int16(any_negative >= 0);
         if (!raster_any(covered)) continue;
-        raster_take(setups, slot, tame, covered, centre_x + (int)ox, (int16)(centre_y + (int)oy), best_slot + s * SEAMCL_TILE_SIZE);
+        raster_take(setups, triangles, slot, tame, covered, centre_x + (int)ox, (int16)(centre_y + (int)oy), best_slot + s * SEAMCL_TILE_SIZE);
       }
     }
   }
@@ -191,7 +202,7 @@ SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, __g
  * loop over the pixels of the row inside the triangle's box; winners stored per pixel
  * [16 lane + s]. A pixel whose sample box [-8, 7] / 16 lies inside all three edges is covered at
  * every sample, one outside an edge at none: only pixels an edge crosses test their samples. */
-SEAMCL_INLINE void raster_row_by_pixels(__global const TriangleSetup* setups, __global const uint* tile_lists,
+SEAMCL_INLINE void raster_row_by_pixels(__global const TriangleSetup* setups, uint triangles, __global const uint* tile_lists,
                                         __global const ushort* tile_entry_rows, uint begin, uint end, int x0, int y,
                                         int samples, int row, uint* best_slot) {
   int offset_x[SEAMCL_MAX_SAMPLES], offset_y[SEAMCL_MAX_SAMPLES];
@@ -247,7 +258,7 @@ SEAMCL_INLINE void raster_row_by_pixels(__global const TriangleSetup* setups, __
         if (!raster_any(covered)) continue;
       }
       const int centre_x = (x0 + l) * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
-      raster_take(setups, slot, tame, covered, centre_x + sample_x, py, best_slot + l * SEAMCL_TILE_SIZE);
+      raster_take(setups, triangles, slot, tame, covered, centre_x + sample_x, py, best_slot + l * SEAMCL_TILE_SIZE);
     }
   }
 }
@@ -273,12 +284,12 @@ __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup
   uint best_slot[SEAMCL_MAX_SAMPLES * SEAMCL_TILE_SIZE];
   for (int i = 0; i < SEAMCL_MAX_SAMPLES; ++i) vstore16((uint16)(SEAMCL_NO_TRIANGLE), i, best_slot);
   if (samples < SEAMCL_RASTER_BY_PIXELS_FROM) {
-    raster_row_by_lanes(setups, tile_lists, tile_entry_rows, begin, end, x0, y, samples, row, best_slot);
+    raster_row_by_lanes(setups, (uint)frame->input_triangles, tile_lists, tile_entry_rows, begin, end, x0, y, samples, row, best_slot);
     for (int l = 0; l < lanes; ++l) {
       for (int s = 0; s < samples; ++s) out[l * samples + s] = best_slot[s * SEAMCL_TILE_SIZE + l];
     }
   } else {
-    raster_row_by_pixels(setups, tile_lists, tile_entry_rows, begin, end, x0, y, samples, row, best_slot);
+    raster_row_by_pixels(setups, (uint)frame->input_triangles, tile_lists, tile_entry_rows, begin, end, x0, y, samples, row, best_slot);
     for (int l = 0; l < lanes; ++l) {
       for (int s = 0; s < samples; ++s) out[l * samples + s] = best_slot[l * SEAMCL_TILE_SIZE + s];
     }

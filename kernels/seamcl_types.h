@@ -171,7 +171,11 @@ typedef struct {
   cl_int reflective;        /* index into the ReflectiveFace table; -1: a diffuse, textured face */
 } FaceGpu;
 
-/* Output of triangle setup, one per clip slot (input triangle * SEAMCL_CLIP_SLOTS + k).
+/* Output of triangle setup, one per clip slot: slot k of input triangle t at index
+ * k * input_triangles + t (slot-major: the records of unclipped triangles, slot 0, lie dense and in
+ * input order, so setup's stores and later stages' reads share cache lines and pages). Tile lists
+ * and sample winners hold these indices; the tie order (raster) and the host's read-backs use input
+ * order, t * SEAMCL_CLIP_SLOTS + k.
  * Edge functions over fixed-point positions P (SEAMCL_SUBPIXEL_BITS fraction bits):
  *   E_i(P) = edge_a[i] * P.x + edge_b[i] * P.y + edge_c[i]
  * with the top-left rule folded into edge_c (non-top-left edges are biased by -1), so a sample

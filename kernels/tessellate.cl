@@ -261,6 +261,6 @@ __kernel void tessellated_setup(__constant FrameParams* frame, __constant Tessel
     polygon[k].u = tv.u;
     polygon[k].v = tv.v;
   }
-  const uint visible = clip_and_setup(polygon, (uint)patch, frame, out + (size_t)tri * SEAMCL_CLIP_SLOTS);
+  const uint visible = clip_and_setup(polygon, (uint)patch, frame, out + tri, (size_t)frame->input_triangles);
   if (visible > 0) atomic_add(&stats->visible_triangles, visible);
 }

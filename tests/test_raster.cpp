@@ -91,7 +91,8 @@ std::vector<RasterCase> raster_cases() {
 
 // Every tile lists every slot (in reverse, so the list order is not the slot order). Each entry's
 // rows are binning's (the box clipped to the tile) where the box meets the tile, else the whole
-// tile: the kernel's own box test must then reject it.
+// tile: the kernel's own box test must then reject it. `setups` and the winners returned are in
+// the device's slot numbering (slot-major: k * frame.input_triangles + t).
 std::vector<uint32_t> run_raster_kernel(const std::vector<TriangleSetup>& setups, const FrameParams& frame) {
   const cl::Context& context = shared_runtime().context();
   cl::CommandQueue& queue = shared_runtime().queue();
@@ -155,6 +156,7 @@ TEST(Raster, KernelMatchesTwinOnLongEdgesOverlapsAndOddPlanesAtEveryRate) {
       frame.tiles_x = (kWidth + SEAMCL_TILE_SIZE - 1) / SEAMCL_TILE_SIZE;
       frame.tiles_y = (kHeight + SEAMCL_TILE_SIZE - 1) / SEAMCL_TILE_SIZE;
       frame.sample_count = samples;
+      frame.input_triangles = static_cast<cl_int>(c.setups.size());  // every record is slot 0 of its triangle
       frame.bin_capacity = static_cast<cl_uint>(c.setups.size()) * frame.tiles_x * frame.tiles_y;
       const std::vector<uint32_t> twin = raster_reference(c.setups, frame);
       const std::vector<uint32_t> kernel = run_raster_kernel(c.setups, frame);
@@ -188,4 +190,65 @@ TEST(Raster, KernelMatchesTwinOnLongEdgesOverlapsAndOddPlanesAtEveryRate) {
     for (int i = 0; i < 3; ++i) longest = std::max<int64_t>(longest, std::abs(int64_t{t.edge_a[i]}) + std::abs(int64_t{t.edge_b[i]}));
   }
   EXPECT_GE(longest, int64_t{1} << 22);
+}
+
+TEST(Raster, TiesFollowInputOrderWithSlotMajorRecords) {
+  // The device keeps slot k of input triangle t at k * triangles + t, so slot numbers do not run
+  // in input order (t, then k), which the twin's tie rule follows. The case with equal depths,
+  // laid out as input triangles of SEAMCL_CLIP_SLOTS slots each, placed slot-major for the kernel:
+  // its winners, translated back, must be the twin's, and some ties must be decided by the order
+  // (a later input triangle on a lower slot number).
+  const RasterCase c = raster_cases()[2];
+  const uint32_t triangles = static_cast<uint32_t>((c.setups.size() + SEAMCL_CLIP_SLOTS - 1) / SEAMCL_CLIP_SLOTS);
+  std::vector<TriangleSetup> input_order(static_cast<size_t>(triangles) * SEAMCL_CLIP_SLOTS);
+  for (TriangleSetup& s : input_order) s.bbox_max_x = s.bbox_max_y = -1;  // padding: empty slots
+  std::copy(c.setups.begin(), c.setups.end(), input_order.begin());
+  std::vector<TriangleSetup> slot_major(input_order.size());
+  for (uint32_t t = 0; t < triangles; ++t) {
+    for (uint32_t k = 0; k < SEAMCL_CLIP_SLOTS; ++k) slot_major[k * triangles + t] = input_order[t * SEAMCL_CLIP_SLOTS + k];
+  }
+  for (const int samples : {1, 4, 16}) {
+    SCOPED_TRACE(std::to_string(samples) + " samples");
+    FrameParams frame{};
+    frame.width = kWidth;
+    frame.height = kHeight;
+    frame.tiles_x = (kWidth + SEAMCL_TILE_SIZE - 1) / SEAMCL_TILE_SIZE;
+    frame.tiles_y = (kHeight + SEAMCL_TILE_SIZE - 1) / SEAMCL_TILE_SIZE;
+    frame.sample_count = samples;
+    frame.input_triangles = static_cast<cl_int>(triangles);
+    frame.bin_capacity = static_cast<cl_uint>(slot_major.size()) * frame.tiles_x * frame.tiles_y;
+    const std::vector<uint32_t> twin = raster_reference(input_order, frame);
+    std::vector<uint32_t> kernel = run_raster_kernel(slot_major, frame);
+    for (uint32_t& slot : kernel) {
+      if (slot != SEAMCL_NO_TRIANGLE) slot = (slot % triangles) * SEAMCL_CLIP_SLOTS + slot / triangles;
+    }
+    ASSERT_EQ(kernel.size(), twin.size());
+    size_t mismatches = 0, order_decides = 0;
+    const std::vector<SampleOffset>& pattern = sample_pattern(samples);
+    for (size_t i = 0; i < twin.size(); ++i) {
+      mismatches += kernel[i] != twin[i];
+      if (twin[i] == SEAMCL_NO_TRIANGLE) continue;
+      // Another slot as near at this sample whose slot-major number is lower, yet it loses.
+      const size_t pixel = i / samples;
+      const int x = static_cast<int>(pixel % kWidth), y = static_cast<int>(pixel / kWidth);
+      const SampleOffset& o = pattern[i % samples];
+      const TriangleSetup& w = input_order[twin[i]];
+      const float depth = plane_inv_w(w, static_cast<float>(sample_fixed_x(x, o)) / SEAMCL_SUBPIXEL_ONE,
+                                      static_cast<float>(sample_fixed_y(y, o)) / SEAMCL_SUBPIXEL_ONE);
+      const uint32_t winner_device = (twin[i] % SEAMCL_CLIP_SLOTS) * triangles + twin[i] / SEAMCL_CLIP_SLOTS;
+      for (uint32_t other = 0; other < input_order.size(); ++other) {
+        const TriangleSetup& t = input_order[other];
+        if (other == twin[i] || setup_is_empty(t) || x < t.bbox_min_x || x > t.bbox_max_x || y < t.bbox_min_y ||
+            y > t.bbox_max_y || !setup_covers(t, sample_fixed_x(x, o), sample_fixed_y(y, o))) {
+          continue;
+        }
+        const float other_depth = plane_inv_w(t, static_cast<float>(sample_fixed_x(x, o)) / SEAMCL_SUBPIXEL_ONE,
+                                              static_cast<float>(sample_fixed_y(y, o)) / SEAMCL_SUBPIXEL_ONE);
+        const uint32_t other_device = (other % SEAMCL_CLIP_SLOTS) * triangles + other / SEAMCL_CLIP_SLOTS;
+        order_decides += other_depth == depth && other_device < winner_device;
+      }
+    }
+    EXPECT_EQ(mismatches, 0u);
+    EXPECT_GT(order_decides, 0u) << "no tie where slot-major numbers and input order disagree";
+  }
 }

@@ -466,22 +466,40 @@ void Renderer::warm_up(const RenderOptions& options) {
 
 FrameParams Renderer::last_frame_params() const { return impl_->last_params; }
 
+namespace {
+
+// The read-backs below return setups and slot numbers in input order (slot t * SEAMCL_CLIP_SLOTS
+// + k, as the twins number them), though the device keeps its records slot-major (k * input
+// triangles + t; kernels/seamcl_types.h). This maps a device slot number to input order.
+uint32_t input_order_slot(uint32_t slot, uint32_t triangles) {
+  if (slot == SEAMCL_NO_TRIANGLE || triangles == 0) return slot;
+  return (slot % triangles) * SEAMCL_CLIP_SLOTS + slot / triangles;
+}
+
+}  // namespace
+
 std::vector<TriangleSetup> Renderer::read_setups() {
   const size_t triangles = static_cast<size_t>(impl_->last_params.input_triangles);
-  std::vector<TriangleSetup> setups = read_buffer<TriangleSetup>(impl_->runtime.queue(), impl_->setups, triangles * SEAMCL_CLIP_SLOTS);
-  if (setups.empty()) return setups;
+  const std::vector<TriangleSetup> slot_major =
+      read_buffer<TriangleSetup>(impl_->runtime.queue(), impl_->setups, triangles * SEAMCL_CLIP_SLOTS);
+  if (slot_major.empty()) return {};
   // Setup writes only a triangle's first slot_counts[t] slots (the rest hold stale data): fill the
   // others with the empty record triangle_setup.cl's empty_setup makes, so every slot reads as before.
   const std::vector<uint32_t> written = read_buffer<uint32_t>(impl_->runtime.queue(), impl_->slot_counts, triangles);
+  std::vector<TriangleSetup> setups(slot_major.size());
   for (size_t t = 0; t < triangles; ++t) {
-    for (size_t k = std::min<size_t>(written[t], SEAMCL_CLIP_SLOTS); k < SEAMCL_CLIP_SLOTS; ++k) {
-      const uint32_t face = static_cast<uint32_t>(t / 2);
+    const size_t filled = std::min<size_t>(written[t], SEAMCL_CLIP_SLOTS);
+    for (size_t k = 0; k < SEAMCL_CLIP_SLOTS; ++k) {
       TriangleSetup& s = setups[t * SEAMCL_CLIP_SLOTS + k];
+      if (k < filled) {
+        s = slot_major[k * triangles + t];
+        continue;
+      }
       s = TriangleSetup{};
       for (int i = 0; i < 3; ++i) s.edge_c[i] = -1;
       s.bbox_max_x = -1;
       s.bbox_max_y = -1;
-      s.face = face;
+      s.face = static_cast<uint32_t>(t / 2);
     }
   }
   return setups;
@@ -498,7 +516,11 @@ std::vector<uint32_t> Renderer::read_tile_lists() {
   if (impl_->tile_lists() == nullptr || impl_->last_params.width == 0) return {};  // released (or none yet)
   FrameStats stats{};
   impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &stats);
-  return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_lists, std::min(stats.bin_entries, impl_->bin_capacity));
+  std::vector<uint32_t> lists =
+      read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_lists, std::min(stats.bin_entries, impl_->bin_capacity));
+  const uint32_t triangles = static_cast<uint32_t>(impl_->last_params.input_triangles);
+  for (uint32_t& slot : lists) slot = input_order_slot(slot, triangles);
+  return lists;
 }
 std::vector<uint16_t> Renderer::read_tile_entry_rows() {
   if (impl_->tile_entry_rows() == nullptr || impl_->last_params.width == 0) return {};  // released (or none yet)
@@ -508,8 +530,10 @@ std::vector<uint16_t> Renderer::read_tile_entry_rows() {
 }
 std::vector<uint32_t> Renderer::read_sample_triangles() {
   const FrameParams& p = impl_->last_params;
-  return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->sample_triangle,
-                               static_cast<size_t>(p.width) * p.height * p.sample_count);
+  std::vector<uint32_t> winners = read_buffer<uint32_t>(impl_->runtime.queue(), impl_->sample_triangle,
+                                                       static_cast<size_t>(p.width) * p.height * p.sample_count);
+  for (uint32_t& slot : winners) slot = input_order_slot(slot, static_cast<uint32_t>(p.input_triangles));
+  return winners;
 }
 
 }  // namespace seamcl
