@@ -69,6 +69,13 @@
 #define SEAMCL_TRAVERSE_EARLY_OUT 1
 #endif
 
+/* How far past a face's edge (or its guard band's), in texels of the level read, a bilinear
+ * probe can still weigh a texel inside: a tap weighs something only while the point lies less
+ * than half a texel past the texel's edge; the 1/16 texel more absorbs the rounding of the probes'
+ * positions (summed step by step) and of u * width - 0.5 (the value the filter floors). Twin:
+ * kTapReachTexels in host/twins/texture_sample.cpp. */
+#define TAP_REACH_TEXELS 0.5625f
+
 #if SEAMCL_TEXELS_F32
 #define TEXEL_BUFFER __global const float*
 #else
@@ -241,16 +248,16 @@ SEAMCL_INLINE int coarser_level(const FaceGpu* face, float lod) {
  * spread no further than (half_u, half_v) (uv) from it, can put weight on a texel inside the face.
  * A bilinear tap weighs something only while the point lies less than half a texel of its level
  * past the texel's edge (or the guard band's, which border addressing reads as inside); the test
- * allows a whole texel and half a probe step more than the spread, which absorbs the rounding of
- * the probes' positions. Conservative: a lookup it rules out adds exactly nothing, so skipping it
+ * allows TAP_REACH_TEXELS (half a texel and a sixteenth) and half a probe step more than the
+ * spread, which absorbs the rounding of the probes' positions. Conservative: a lookup it rules out adds exactly nothing, so skipping it
  * changes no bit. A NaN anywhere reads as "may reach". */
 SEAMCL_INLINE int probe_reaches_face(float u, float v, float reach_u, float reach_v) {
   return !(u + reach_u <= 0.0f || u - reach_u >= 1.0f || v + reach_v <= 0.0f || v - reach_v >= 1.0f);
 }
 
 SEAMCL_INLINE int probes_reach_face(const FaceGpu* face, int level, float u, float v, float half_u, float half_v) {
-  return probe_reaches_face(u, v, half_u + (1.0f + (float)GUARD) / (float)max(face->width >> level, 1),
-                            half_v + (1.0f + (float)GUARD) / (float)max(face->height >> level, 1));
+  return probe_reaches_face(u, v, half_u + (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->width >> level, 1),
+                            half_v + (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->height >> level, 1));
 }
 
 /* The line of trilinear probes an aniso lookup takes, computed once so that the reach test of
@@ -297,8 +304,8 @@ SEAMCL_INLINE void accumulate_probes(FilterSum* sum, const FaceGpu* face, __glob
   float pu = p.first_u;
   float pv = p.first_v;
   const int level = coarser_level(face, p.lod);
-  const float reach_u = (1.0f + (float)GUARD) / (float)max(face->width >> level, 1);
-  const float reach_v = (1.0f + (float)GUARD) / (float)max(face->height >> level, 1);
+  const float reach_u = (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->width >> level, 1);
+  const float reach_v = (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->height >> level, 1);
   for (int i = 0; i < p.probes; ++i) {
     if (!SEAMCL_TRAVERSE_EARLY_OUT || address != SEAMCL_ADDRESS_BORDER || probe_reaches_face(pu, pv, reach_u, reach_v)) {
       accumulate_trilinear(sum, face, level_offsets, texels, srgb_to_linear, pu, pv, p.lod, p.weight, address);
@@ -455,7 +462,8 @@ SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, int 
                          : filter == SEAMCL_FILTER_EWA ? (1.0f + max_side / min_side) * axes
                                                        : 0.0f;
   const float spread_v = filter == SEAMCL_FILTER_ANISO ? 0.5f * fmax(fabs(dvdx), fabs(dvdy)) : spread_u;
-  const float texel_reach = texel_sides * (1.0f + (float)GUARD);
+  /* EWA's ellipse is widened by about a texel: it keeps the whole texel of before. */
+  const float texel_reach = texel_sides * ((filter == SEAMCL_FILTER_EWA ? 1.0f : TAP_REACH_TEXELS) + (float)GUARD);
   const float counted_u = distance_u > 2.0f ? 2.0f : distance_u;
   const float counted_v = distance_v > 2.0f ? 2.0f : distance_v;
   return !(counted_u * min_side >= spread_u * min_side + texel_reach ||

@@ -12,6 +12,15 @@ namespace seamcl {
 
 namespace {
 
+// How far past a face's edge (or its guard band's), in texels of the level read, a bilinear probe
+// can still weigh a texel inside. A tap at texel i weighs something only while the point's texel
+// coordinate x = u * width - 0.5 lies in (i - 1, i + 1): the point less than half a texel past
+// the texel's edge. At exactly half a texel x = -1, fx = 0, and the weight derived as
+// fy - ((1 - fx) - (1 - fx)(1 - fy)) can still round to a few ulps, so the bound is kept
+// strict; the 1/16 texel more absorbs that, the probes' positions summed step by step and the
+// rounding of u * width - 0.5. The kernel's TAP_REACH_TEXELS.
+constexpr float kTapReachTexels = 0.5625f;
+
 struct Level {
   uint32_t offset;    // first stored texel (the band's corner with a guard band)
   int width, height;  // the face's texels
@@ -142,8 +151,8 @@ int coarser_level(const FaceGpu& face, float lod) {
 }
 
 // Whether a bilinear probe at (u, v) can weigh a texel inside the face (border address mode),
-// `reach` being a texel of the level it reads: a tap weighs something only while the point lies
-// less than half a texel past the texel's edge; the other half absorbs rounding. NaN: may reach.
+// `reach` being kTapReachTexels texels of the level it reads: a tap weighs something only while the point lies
+// less than half a texel past the texel's edge; kTapReachTexels keeps a sixteenth more for rounding. NaN: may reach.
 bool probe_reaches_face(float u, float v, float reach_u, float reach_v) {
   return !(u + reach_u <= 0.0f || u - reach_u >= 1.0f || v + reach_v <= 0.0f || v - reach_v >= 1.0f);
 }
@@ -151,7 +160,7 @@ bool probe_reaches_face(float u, float v, float reach_u, float reach_v) {
 // The same for probes on `level` centred at (u, v) and spread no further than (half_u, half_v).
 // The band's texels (`pad` each side) count as inside.
 bool probes_reach_face(const FaceGpu& face, int pad, int level, float u, float v, float half_u, float half_v) {
-  const float texels = 1.0f + static_cast<float>(pad);
+  const float texels = kTapReachTexels + static_cast<float>(pad);
   return probe_reaches_face(u, v, half_u + texels / static_cast<float>(std::max(face.width >> level, 1)),
                             half_v + texels / static_cast<float>(std::max(face.height >> level, 1)));
 }
@@ -161,7 +170,7 @@ bool probes_reach_face(const FaceGpu& face, int pad, int level, float u, float v
 void accumulate_probes(FilterSum& sum, const TextureView& tex, const FaceGpu& face, const AnisoProbes& p, int address) {
   float pu = p.first_u, pv = p.first_v;
   const int level = coarser_level(face, p.lod);
-  const float texels = 1.0f + static_cast<float>(tex.guard_band);
+  const float texels = kTapReachTexels + static_cast<float>(tex.guard_band);
   const float reach_u = texels / static_cast<float>(std::max(face.width >> level, 1));
   const float reach_v = texels / static_cast<float>(std::max(face.height >> level, 1));
   for (int i = 0; i < p.probes; ++i) {
@@ -309,7 +318,7 @@ bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, in
   const float shortest = std::fmin(axis_x, axis_y);
   const float min_side = static_cast<float>(std::min(other.width, other.height));
   const float max_side = static_cast<float>(std::max(other.width, other.height));
-  // A tap weighs something only within one texel of its probe. The coarsest texel the other
+  // A tap weighs something only within half a texel of its probe (kTapReachTexels). The coarsest texel the other
   // face's filter can weigh (uv): bilinear reads level 0; the others a trilinear pair at lod (at
   // least 0) and the next level, whose texels are up to twice 2^lod level-0 texels (2.01:
   // approx_log2's error); none is longer than the face. Trilinear's lod is log2 of the longer
@@ -331,7 +340,9 @@ bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, in
                                                        : 0.0f;
   const float spread_v = filter == SEAMCL_FILTER_ANISO ? 0.5f * std::fmax(std::fabs(dvdx), std::fabs(dvdy)) : spread_u;
   // A guard band's texels read as inside too.
-  const float texel_reach = texel_sides * (1.0f + static_cast<float>(guard_band));
+  // EWA's ellipse is widened by about a texel (the + 1 of accumulate_ewa_level): it keeps a whole one.
+  const float texel_reach =
+      texel_sides * ((filter == SEAMCL_FILTER_EWA ? 1.0f : kTapReachTexels) + static_cast<float>(guard_band));
   // EWA pulls a centre more than two face widths out back to two widths: count no distance
   // beyond 2. A NaN distance is never skipped.
   const float counted_u = distance_u > 2.0f ? 2.0f : distance_u;
