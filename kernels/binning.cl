@@ -14,7 +14,7 @@
  * A tile is skipped when one edge function is negative over all of its sample positions (the
  * standard corner test), so long thin triangles do not fill their whole bounding box.
  * List order inside a tile depends on atomics; raster does not depend on it (ties in depth are
- * broken by slot index). If the lists need more than bin_capacity entries, bin_fill drops the
+ * broken by input order, raster_slot_precedes). If the lists need more than bin_capacity entries, bin_fill drops the
  * rest and the host, seeing stats.bin_entries > capacity, grows the buffer and renders again.
  * Host guarantees: tile_counts zeroed before bin_count; slot_counts written for this frame. Twin: host/binning.cpp. */
 

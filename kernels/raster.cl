@@ -82,7 +82,7 @@ SEAMCL_INLINE int raster_plane_is_tame(__global const TriangleSetup* t) {
 /* Whether slot a comes before slot b in the tie order: input triangle, then fan slot (the order
  * of t * SEAMCL_CLIP_SLOTS + k, which the twin compares). Records are slot-major, slot = k *
  * triangles + t (triangles: the frame's input triangles), so the slot numbers themselves are not in
- * that order. Only equal depths ask. */
+ * that order. Asked for every contested lane; its result counts only where the depths are equal. */
 SEAMCL_INLINE int raster_slot_precedes(uint a, uint b, uint triangles) {
   if (triangles == 0) return a < b; /* no input triangles: no slots either (never a zero divisor) */
   const uint ta = a % triangles, tb = b % triangles;

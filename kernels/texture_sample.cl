@@ -71,8 +71,9 @@
 
 /* How far past a face's edge (or its guard band's), in texels of the level read, a bilinear
  * probe can still weigh a texel inside: a tap weighs something only while the point lies less
- * than half a texel past the texel's edge; the 1/16 texel more absorbs the rounding of the probes'
- * positions (summed step by step) and of u * width - 0.5 (the value the filter floors). Twin:
+ * than half a texel past the texel's edge; the 1/16 texel more absorbs the rounding of u * width - 0.5
+ * (the value the filter floors) and, for probes_reach_face's whole-line test, of the probes'
+ * positions summed step by step (the per-probe skip tests the very position it samples). Twin:
  * kTapReachTexels in host/twins/texture_sample.cpp. */
 #define TAP_REACH_TEXELS 0.5625f
 

@@ -1065,12 +1065,13 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
   ReferenceSettings settings = take_reference_settings(rest, explicit_reference_msaa);
   if (rest.contains("reference")) {
     const json& value = rest.at("reference");
-    if (!value.is_string()) throw InputError("reference", "must be a reference name, got " + echo(json_text(value)));
-    const ReferenceKind kind = parse_reference_kinds({value.get<std::string>()}).front();
-    if (kind != ReferenceKind::Paper && kind != ReferenceKind::Box) {
-      throw InputError("reference", "the " + to_string(kind) + " reference is not a downsampled render: /v1/compare measures against it");
+    const std::optional<ReferenceKind> kind =
+        value.is_string() ? parse_reference_kind(value.get<std::string>()) : std::nullopt;
+    if (kind == ReferenceKind::Analytic || kind == ReferenceKind::Seamless) {
+      throw InputError("reference", "the " + to_string(*kind) + " reference is not a downsampled render: /v1/compare measures against it");
     }
-    settings.kind = kind;
+    if (!kind) throw InputError("reference", "must be paper or box, got " + echo(json_text(value)));
+    settings.kind = *kind;
     rest.erase("reference");
   }
   const json inline_scene = take_inline_scene(rest);

@@ -181,6 +181,10 @@ TEST(Memory, LoadSceneTakesAHandedOverSceneWithoutACopy) {
   broken.faces[0].vertices[0] = 1000;
   EXPECT_THROW(taken.load_scene(std::move(broken)), InputError);
   EXPECT_TRUE(taken.has_scene());
+  EXPECT_EQ(taken.scene().faces[0].vertices, baked.faces[0].vertices);  // the old scene kept
+  ASSERT_EQ(broken.faces.size(), baked.faces.size());  // and the refused one left with the caller
+  EXPECT_EQ(broken.faces[0].vertices[0], 1000);
+  EXPECT_EQ(broken.faces[0].texture.levels[0].texels, baked.faces[0].texture.levels[0].texels);
 }
 
 TEST(Memory, ProcessMemoryGrowsWithATouchedAllocation) {

@@ -86,7 +86,8 @@ struct ReferenceSettings {
   // and this many entries. 0: unbounded. A 480x540 reference is about 4 MiB (zip float EXR).
   std::uintmax_t cache_max_bytes = kDefaultReferenceCacheBytes;
   size_t cache_max_entries = 0;
-  // scene_content_hash of the scene the references are of, when the caller has it. Hashing bakes
+  // scene_content_hash of the scene the references are of, when the caller has it; trusted as
+  // given, so it must be that scene's (a settings object reused for another scene must clear it). Hashing bakes
   // every face's texels, so a caller keying several references of one scene (bench's reference
   // frames, a request's key and its render) computes it once. Empty: computed for each key.
   std::string scene_hash;

@@ -110,6 +110,20 @@ struct Renderer::Impl {
     uploaded = true;
   }
 
+  // load_scene: the old scene and its buffers go before make_scene makes the new copy, so a
+  // reload never holds two scenes.
+  template <typename MakeScene>
+  void replace_scene(const Scene& checked, TexelFormat format, MakeScene make_scene) {
+    validate_scene(checked);
+    release_scene_buffers();
+    scene.reset();
+    scene = make_scene();
+    pack_and_upload(format, 0);
+    // Start the tile lists at a few entries per triangle slot; render() grows them when needed.
+    bin_capacity = std::max<uint32_t>(bin_capacity, initial_tile_list_entries(scene->triangle_count()));
+    tile_lists = tile_entry_rows = cl::Buffer();
+  }
+
   void release_scene_buffers() {
     uploaded = false;
     // The buffers first: the texel buffer may be the packed array itself (upload_shared).
@@ -307,24 +321,11 @@ Renderer::Renderer(ClRuntime& runtime) : impl_(std::make_unique<Impl>(runtime)) 
 Renderer::~Renderer() = default;
 
 void Renderer::load_scene(const Scene& scene, TexelFormat format) {
-  validate_scene(scene);
-  impl_->release_scene_buffers();
-  impl_->scene.reset();  // the old copy goes before the new one is made
-  impl_->scene = std::make_unique<Scene>(scene);
-  impl_->pack_and_upload(format, 0);
-  // Start the tile lists at a few entries per triangle slot; render() grows them when needed.
-  impl_->bin_capacity = std::max<uint32_t>(impl_->bin_capacity, initial_tile_list_entries(scene.triangle_count()));
-  impl_->tile_lists = impl_->tile_entry_rows = cl::Buffer();
+  impl_->replace_scene(scene, format, [&] { return std::make_unique<Scene>(scene); });
 }
 
 void Renderer::load_scene(Scene&& scene, TexelFormat format) {
-  validate_scene(scene);
-  impl_->release_scene_buffers();
-  impl_->scene.reset();
-  impl_->scene = std::make_unique<Scene>(std::move(scene));
-  impl_->pack_and_upload(format, 0);
-  impl_->bin_capacity = std::max<uint32_t>(impl_->bin_capacity, initial_tile_list_entries(impl_->scene->triangle_count()));
-  impl_->tile_lists = impl_->tile_entry_rows = cl::Buffer();
+  impl_->replace_scene(scene, format, [&] { return std::make_unique<Scene>(std::move(scene)); });
 }
 
 void Renderer::set_device_byte_limit(size_t bytes) { impl_->device_byte_limit = bytes; }

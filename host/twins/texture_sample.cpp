@@ -17,8 +17,8 @@ namespace {
 // coordinate x = u * width - 0.5 lies in (i - 1, i + 1): the point less than half a texel past
 // the texel's edge. At exactly half a texel x = -1, fx = 0, and the weight derived as
 // fy - ((1 - fx) - (1 - fx)(1 - fy)) can still round to a few ulps, so the bound is kept
-// strict; the 1/16 texel more absorbs that, the probes' positions summed step by step and the
-// rounding of u * width - 0.5. The kernel's TAP_REACH_TEXELS.
+// strict; the 1/16 texel more absorbs that, the rounding of u * width - 0.5 and, for the
+// whole-line test, the probes' positions summed step by step. The kernel's TAP_REACH_TEXELS.
 constexpr float kTapReachTexels = 0.5625f;
 
 struct Level {

@@ -9,7 +9,8 @@
 
 namespace seamcl {
 
-// All SEAMCL_CLIP_SLOTS records of every input triangle, in the kernel's order. cull_sampleless
+// All SEAMCL_CLIP_SLOTS records of every input triangle in input order (record t * SEAMCL_CLIP_SLOTS
+// + k), the order Renderer::read_setups returns; the device stores them slot-major. cull_sampleless
 // false keeps the triangles whose bounding box holds no sample (the kernel culls them), for the
 // test that they cover none.
 std::vector<TriangleSetup> setup_triangles_reference(const PackedScene& scene, const FrameParams& frame,
