@@ -6,7 +6,10 @@ guard bands, the banded texels the render packed). --texture and --method render
 methods (a .obj with its .ptx, guardband) against the same floor + 2x packed bound; --bound-mb 0
 drops the absolute bound. Each --also "RENDER ARGS" is one more render (its own --scene and the
 rest; written --also="..." so that argparse takes it), held to the same floor + 2x packed
-bound only, against the floor measured once.
+bound only, against the floor measured once. --image-cube SIDE renders a scene file of six
+SIDE x SIDE PNG faces (written by this script into a temporary directory: noise, so that the files
+are as large as such images get), with the default method and with guardband, against the same
+bound.
 
 RSS is not a timing: for one binary and one scene it moves by a few MB between runs (PoCL's
 allocations, the kernel cache state), so the bounds are the issue's targets themselves and the
@@ -18,9 +21,14 @@ measured figures are printed for the margin (when this test was written: paper 2
 """
 import argparse
 import json
+import os
+import random
 import shlex
+import struct
 import subprocess
 import sys
+import tempfile
+import zlib
 
 
 def render_memory(seamcl, scene, extra=()):
@@ -38,6 +46,35 @@ def render_memory(seamcl, scene, extra=()):
         if not isinstance(memory, dict) or not isinstance(memory.get(field), int):
             raise SystemExit(f"memory_peak_test: render --scene {scene} --json has no memory.{field}")
     return memory
+
+
+def write_png(path, side, seed):
+    """A side x side 8-bit RGB PNG of seeded noise (PNG's chunks written here: no imaging library)."""
+    rows = random.Random(seed)
+    raw = b"".join(b"\0" + rows.randbytes(3 * side) for _ in range(side))  # filter byte 0 per row
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+    with open(path, "wb") as out:
+        out.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", side, side, 8, 2, 0, 0, 0))
+                  + chunk(b"IDAT", zlib.compress(raw, 1)) + chunk(b"IEND", b""))
+
+
+def write_image_cube(directory, side):
+    """A scene file of a cube whose six faces show six side x side PNG files beside it; its path."""
+    quads = [[4, 5, 6, 7], [1, 0, 3, 2], [5, 1, 2, 6], [0, 4, 7, 3], [7, 6, 2, 3], [0, 1, 5, 4]]
+    faces = []
+    for face, quad in enumerate(quads):
+        write_png(os.path.join(directory, f"f{face}.png"), side, face)
+        faces.append({"vertices": quad, "texture": {"image": f"f{face}.png"}})
+    scene = {"name": "image_cube", "faces": faces,
+             "positions": [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]],
+             "camera": {"eye": [3, 2.5, 4], "target": [0, 0, 0], "fov_y_degrees": 40}}
+    path = os.path.join(directory, "cube.json")
+    with open(path, "w") as out:
+        json.dump(scene, out)
+    return path
 
 
 def check_case(seamcl, scene, extra, bound_mb, floor):
@@ -72,7 +109,11 @@ def main():
                         help="peak RSS bound of --scene in MB (10^6 bytes); 0: none but floor + 2x packed")
     parser.add_argument("--also", action="append", default=[], metavar="RENDER_ARGS",
                         help="another render's arguments (with its --scene), held to floor + 2x packed")
+    parser.add_argument("--image-cube", type=int, default=0, metavar="SIDE",
+                        help="also a scene file of six SIDE x SIDE PNG faces, plain and guardband (0: none)")
     args = parser.parse_args()
+    if args.image_cube and (args.image_cube < 1 or args.image_cube & (args.image_cube - 1)):
+        parser.error("--image-cube must be a power of two")
 
     extra = []
     if args.texture:
@@ -90,8 +131,12 @@ def main():
             raise SystemExit(f"memory_peak_test: --also {also!r} names no --scene")
         at = words.index("--scene")
         cases.append((words[at + 1], words[:at] + words[at + 2:], 0.0))
-    for scene, render_args, bound_mb in cases:
-        failures += check_case(args.seamcl, scene, render_args, bound_mb, floor)
+    with tempfile.TemporaryDirectory(prefix="seamcl_memory_") as directory:
+        if args.image_cube:
+            cube = write_image_cube(directory, args.image_cube)
+            cases += [(cube, [], 0.0), (cube, ["--method", "guardband"], 0.0)]
+        for scene, render_args, bound_mb in cases:
+            failures += check_case(args.seamcl, scene, render_args, bound_mb, floor)
     for failure in failures:
         print(f"memory_peak_test: {failure}", file=sys.stderr)
     return 1 if failures else 0

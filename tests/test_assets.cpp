@@ -5,10 +5,13 @@
 // across cube_text's rotated neighbours, no NaN with any method at 1x and 8x.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -423,6 +426,149 @@ TEST(Assets, ImageFacesAreReadUprightRelativeToTheSceneFile) {
   nlohmann::json both = scene_with("tiles/tile.exr");
   both["faces"][0]["texture"]["width"] = 4;
   input_error([&] { parse_scene_json(both); }, "faces[0].texture.width");
+}
+
+// A scene file of one face per image, on the faces of a unit cube (six at most), camera outside.
+nlohmann::json image_cube_scene(const std::vector<std::string>& images) {
+  const std::vector<std::array<int, 4>> quads{{4, 5, 6, 7}, {1, 0, 3, 2}, {5, 1, 2, 6}, {0, 4, 7, 3}, {7, 6, 2, 3}, {0, 1, 5, 4}};
+  nlohmann::json faces = nlohmann::json::array();
+  for (size_t f = 0; f < images.size(); ++f) faces.push_back({{"vertices", quads[f]}, {"texture", {{"image", images[f]}}}});
+  return {{"positions", {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}}},
+          {"faces", faces},
+          {"camera", {{"eye", {3, 2.5, 4}}, {"target", {0, 0, 0}}, {"fov_y_degrees", 40}}}};
+}
+
+// Pixels that differ from texel to texel and from image to image (seed), in [0, 1].
+std::vector<glm::vec4> varied_pixels(int width, int height, int seed) {
+  std::vector<glm::vec4> pixels;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      pixels.emplace_back(static_cast<float>((x * 7 + y * 3 + seed * 5) % 17) / 16.0f,
+                          static_cast<float>((x + 11 * y + seed) % 13) / 12.0f, static_cast<float>(seed % 6) / 5.0f, 1.0f);
+  return pixels;
+}
+
+SceneSourceOptions deferring(bool tint = false) {
+  SceneSourceOptions options;
+  options.generator.defer_textures = true;
+  options.generator.tint = tint;
+  return options;
+}
+
+bool same_chains(const MipChain& a, const MipChain& b) {
+  if (a.levels.size() != b.levels.size()) return false;
+  for (size_t k = 0; k < a.levels.size(); ++k)
+    if (a.levels[k].width != b.levels[k].width || a.levels[k].height != b.levels[k].height ||
+        a.levels[k].texels != b.levels[k].texels)
+      return false;
+  return true;
+}
+
+TEST(Assets, DeferredImageFacesHoldSizesOnlyAndMakeTheEagerTexels) {
+  TempDir dir;
+  // PNG (sRGB, 8 bits), EXR (linear half) and grey faces of different, non-square sizes.
+  write_image((dir.path() / "a.png").string(), 16, 8, varied_pixels(16, 8, 1));
+  write_image((dir.path() / "b.exr").string(), 4, 32, varied_pixels(4, 32, 2));
+  write_image((dir.path() / "c.png").string(), 8, 8, varied_pixels(8, 8, 3));
+  nlohmann::json doc = image_cube_scene({"a.png", "b.exr", "c.png"});
+  doc["faces"].push_back({{"vertices", {0, 1, 5, 4}}, {"texture", {{"width", 8}, {"height", 4}}}});
+  const std::string file = dir.write("mixed.json", doc.dump());
+  for (const bool tint : {false, true}) {
+    SceneSourceOptions eager_options;
+    eager_options.generator.tint = tint;
+    const Scene eager = load_scene_source(file, "", eager_options);
+    const Scene deferred = load_scene_source(file, "", deferring(tint));
+    ASSERT_FALSE(has_deferred_textures(eager));
+    ASSERT_EQ(deferred.faces.size(), 4u);
+    EXPECT_EQ(deferred.stored_texel_count(), 0u) << "a deferred scene file holds no float texels";
+    EXPECT_EQ(deferred.texel_count(), eager.texel_count());
+    for (size_t f = 0; f < deferred.faces.size(); ++f) {
+      EXPECT_TRUE(is_deferred(deferred.faces[f].texture)) << f;
+      EXPECT_EQ(deferred.faces[f].texture.width(), eager.faces[f].texture.width()) << f;
+      EXPECT_EQ(deferred.faces[f].texture.height(), eager.faces[f].texture.height()) << f;
+      EXPECT_TRUE(same_chains(face_texture(deferred, f), eager.faces[f].texture)) << "face " << f << " tint " << tint;
+    }
+    // Packed alike, so rendered alike.
+    const RenderOptions options = parse_render_options({{"method", "traverse"}, {"msaa", 4}, {"size", "48x40"}});
+    Renderer from_eager(shared_runtime()), from_deferred(shared_runtime());
+    from_eager.load_scene(eager);
+    from_deferred.load_scene(deferred);
+    EXPECT_EQ(from_eager.render(eager.camera, options).pixels, from_deferred.render(deferred.camera, options).pixels);
+  }
+  // No analytic content for image faces: their texels are the only statement of it.
+  EXPECT_FALSE(load_scene_source(file).albedo);
+  EXPECT_FALSE(load_scene_source(file, "", deferring()).albedo);
+}
+
+TEST(Assets, AnImageFaceThatChangedOrWentBeforeItIsPackedIsAnInputError) {
+  TempDir dir;
+  const std::string image = (dir.path() / "face.png").string();
+  const std::string file = dir.write("one.json", image_cube_scene({"face.png"}).dump());
+  auto fresh = [&] {
+    write_image(image, 8, 8, varied_pixels(8, 8, 4));
+    return load_scene_source(file, "", deferring());
+  };
+  const std::string field = "faces[0].texture.image";
+
+  // Rewritten with other pixels of the same size: refused, not shown.
+  Scene scene = fresh();
+  write_image(image, 8, 8, varied_pixels(8, 8, 5));
+  fs::last_write_time(image, fs::last_write_time(image) + std::chrono::seconds(2));
+  EXPECT_NE(input_error([&] { face_texture(scene, 0); }, field).find("changed since the scene was read"), std::string::npos);
+  Renderer renderer(shared_runtime());
+  EXPECT_NE(input_error([&] { renderer.load_scene(scene); }, field).find("face.png"), std::string::npos);
+
+  // Only touched (same bytes, later time): refused as well; the stamp is all that is compared.
+  scene = fresh();
+  fs::last_write_time(image, fs::last_write_time(image) + std::chrono::seconds(2));
+  EXPECT_NE(input_error([&] { face_texture(scene, 0); }, field).find("modified again"), std::string::npos);
+
+  // Another size.
+  scene = fresh();
+  write_image(image, 16, 8, varied_pixels(16, 8, 4));
+  EXPECT_NE(input_error([&] { face_texture(scene, 0); }, field).find("changed since"), std::string::npos);
+
+  // Gone.
+  scene = fresh();
+  fs::remove(image);
+  EXPECT_NE(input_error([&] { face_texture(scene, 0); }, field).find("is gone"), std::string::npos);
+  EXPECT_NE(input_error([&] { Renderer(shared_runtime()).load_scene(std::move(scene)); }, field).find("is gone"),
+            std::string::npos);
+
+  // Unchanged: made as often as asked, the same each time.
+  scene = fresh();
+  EXPECT_TRUE(same_chains(face_texture(scene, 0), face_texture(scene, 0)));
+}
+
+TEST(Assets, ImageFacesWithBadPixelsAreRefusedWhenParsedOrWhenDeferredWhenMade) {
+  TempDir dir;
+  // A PNG whose header is whole and whose pixel data is cut off: its size is readable, its pixels not.
+  write_image((dir.path() / "whole.png").string(), 64, 64, varied_pixels(64, 64, 6));
+  {
+    std::ifstream in(dir.path() / "whole.png", std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const size_t data = bytes.find("IDAT");  // the first chunk of pixel data: cut 16 bytes into it
+    ASSERT_NE(data, std::string::npos);
+    ASSERT_GT(bytes.size(), data + 100);
+    dir.write("cut.png", bytes.substr(0, data + 20));
+  }
+  const std::string cut = dir.write("cut.json", image_cube_scene({"cut.png"}).dump());
+  input_error([&] { load_scene_source(cut); }, "faces[0].texture.image");
+  const Scene deferred = load_scene_source(cut, "", deferring());
+  input_error([&] { face_texture(deferred, 0); }, "faces[0].texture.image");
+  input_error([&] { Renderer(shared_runtime()).load_scene(deferred); }, "faces[0].texture.image");
+
+  // A NaN texel: refused by validate_scene when baked at once, by the source when deferred, with
+  // the same field and message.
+  std::vector<glm::vec4> pixels = varied_pixels(4, 4, 7);
+  pixels[5].g = std::nanf("");
+  write_image((dir.path() / "nan.exr").string(), 4, 4, pixels);
+  const std::string nan = dir.write("nan.json", image_cube_scene({"nan.exr"}).dump());
+  const std::string eager_message = input_error([&] { load_scene_source(nan); }, "faces[0].texture");
+  EXPECT_NE(eager_message.find("mip level 0 has a non-finite texel"), std::string::npos) << eager_message;
+  const Scene with_nan = load_scene_source(nan, "", deferring());
+  EXPECT_EQ(input_error([&] { face_texture(with_nan, 0); }, "faces[0].texture"), eager_message.substr(0, eager_message.find(" (in '")));
+  input_error([&] { Renderer(shared_runtime()).load_scene(with_nan); }, "faces[0].texture");
 }
 
 TEST(Assets, TheAssetDirectoryRefusesNamesThatLeaveItAndCachesWhatItLoads) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <memory>
 #include <sstream>
 
 #include <seamcl/core/input_error.h>
@@ -87,8 +88,13 @@ std::string AssetDirectory::resolve(const std::string& name, const std::string& 
 
 std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, const std::string& texture,
                                                   SceneSourceOptions options) {
-  options.resolve = [this](const std::string& name, const std::string& relative_to, const std::string& field) {
-    return resolve(name, relative_to, field);
+  // Every file the load resolves, stamped when resolved (before it is read), so that a file
+  // changed while or after it is read makes the entry stale rather than the stamp new.
+  auto files = std::make_shared<std::vector<std::pair<std::string, std::string>>>();
+  options.resolve = [this, files](const std::string& name, const std::string& relative_to, const std::string& field) {
+    std::string path = resolve(name, relative_to, field);
+    files->emplace_back(path, file_stamp(path));
+    return path;
   };
   std::ostringstream key;
   key << resolve(scene, "", "scene") << "|" << file_stamp(resolve(scene, "", "scene")) << "|";
@@ -104,29 +110,28 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
   {
     std::lock_guard lock(mutex_);
     const auto found = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.key == key.str(); });
-    if (found != entries_.end()) {
+    const bool fresh = found != entries_.end() && std::all_of(found->files.begin(), found->files.end(), [](const auto& file) {
+                         return file_stamp(file.first) == file.second;
+                       });
+    if (fresh) {
       entries_.splice(entries_.begin(), entries_, found);
       return found->scene;
+    }
+    if (found != entries_.end()) {  // a file it read has changed since: loaded again below
+      bytes_ -= found->bytes;
+      entries_.erase(found);
     }
     ++loads_;
   }
   // Read outside the lock: a large file does not hold up requests for cached ones.
   auto loaded = std::make_shared<const Scene>(load_scene_source(scene, texture, options));
   size_t bytes = scene_host_bytes(scene_sizes(*loaded));
-  // A deferred .ptx's texture_source keeps the whole file's bytes (its faces are decoded again
-  // while packing), metadata included: counted on top. (A .ptx named inside a scene file is not
-  // seen here; its faces' float texels are what scene_host_bytes counts for it.)
-  if (options.generator.defer_textures) {
-    for (const std::string* name : {&scene, &texture}) {
-      if (name->empty() || asset_kind_of_path(*name) != AssetKind::Ptex) continue;
-      std::error_code error;
-      const auto file_bytes = fs::file_size(resolve(*name, "", name == &scene ? "scene" : "texture"), error);
-      if (!error) bytes = saturating_add(bytes, static_cast<size_t>(file_bytes));
-    }
-  }
+  // What its texture_source keeps to make the faces from (a deferred .ptx's whole file, metadata
+  // included, also one named inside a scene file): counted on top.
+  bytes = saturating_add(bytes, loaded->texture_source_bytes);
   std::lock_guard lock(mutex_);
   if (bytes > limits_.max_bytes || limits_.max_entries == 0) return loaded;
-  entries_.push_front({key.str(), loaded, bytes});
+  entries_.push_front({key.str(), loaded, bytes, std::move(*files)});
   bytes_ += bytes;
   while (entries_.size() > limits_.max_entries || bytes_ > limits_.max_bytes) {
     bytes_ -= entries_.back().bytes;

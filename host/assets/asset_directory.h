@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <seamcl/assets/scene_source.h>
@@ -47,9 +48,10 @@ class AssetDirectory {
   std::string resolve(const std::string& name, const std::string& relative_to, const std::string& field) const;
 
   // load_scene_source with every name resolved here; from the cache when the same names with the
-  // same options were loaded before and the scene and texture files have the same size and
-  // modification time (files named inside a scene file are not checked: they are seen again once
-  // the entry leaves the cache).
+  // same options were loaded before and every file the load resolved (the scene and texture, and
+  // the files a scene file names: meshes, .ptx, face and environment images) still has the size
+  // and modification time it had when it was resolved; otherwise loaded again. (A deferred image
+  // face reads its file when packed: a cached scene must not name a file changed since.)
   std::shared_ptr<const Scene> load(const std::string& scene, const std::string& texture, SceneSourceOptions options);
 
   size_t cached_entries() const;
@@ -61,6 +63,7 @@ class AssetDirectory {
     std::string key;
     std::shared_ptr<const Scene> scene;
     size_t bytes = 0;
+    std::vector<std::pair<std::string, std::string>> files;  // every path the load resolved, and its stamp then
   };
 
   std::string root_;  // canonical

@@ -210,6 +210,7 @@ class PtexDecoder {
       d.out_.textures[f] = deferred_mip_chain(checked.width(), checked.height());
     }
     PtexFile out = d.out_;  // small now: face infos, sizes, metadata text, mesh
+    out.texture_source_bytes = d.file_.size();
     d.out_.textures.clear();
     d.out_.metadata.clear();
     d.out_.mesh.reset();

@@ -56,6 +56,7 @@ struct PtexFile {
   // and dropped, so a malformed file is refused there as it is without deferral. Thread-safe.
   std::vector<MipChain> textures;
   std::function<MipChain(size_t face)> texture_source;  // empty unless deferred
+  uint64_t texture_source_bytes = 0;                     // what it keeps: the file's bytes (0 unless deferred)
   std::map<std::string, std::string> metadata;  // values rendered as text, for display
                                                 // (long arrays shortened)
   std::optional<PtexMesh> mesh;

@@ -117,8 +117,12 @@ struct Loader {
       // Generators and explicit scenes: host/scene's reader (which reports syntax errors itself),
       // with image faces read here, relative to the file.
       const std::string directory = fs::path(path).parent_path().string();
+      // Only the header is read here; the pixels when the face is baked (at once, or for a
+      // deferred scene when it is packed: the file must not have changed by then).
       const FaceImageLoader load_image = [this, directory](const std::string& name, const std::string& field) {
-        return read_face_image(resolve(name, directory, field), field);
+        FaceImageFile file = open_face_image(resolve(name, directory, field), field);
+        const int width = file.width, height = file.height;
+        return FaceImage{width, height, [file = std::move(file)] { return read_face_image(file); }};
       };
       Scene scene = load_scene(path, options.generator, load_image);
       if (scene.environment) load_environment_files(*scene.environment, directory, resolve);

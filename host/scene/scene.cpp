@@ -267,6 +267,9 @@ glm::vec4 detail_pattern(glm::vec3 p, float texel_spacing) {
 
 void set_constant_textures(Scene& scene, glm::vec4 color) {
   scene.albedo = [color](size_t, glm::vec3) { return color; };
+  // No face is deferred afterwards: what made them (a .ptx's bytes, say) is no longer needed.
+  scene.texture_source = {};
+  scene.texture_source_bytes = 0;
   for (Face& face : scene.faces) {
     const int width = face.texture.width();
     const int height = face.texture.height();

@@ -106,11 +106,15 @@ struct Scene {
   // (docs/displacement.md); null for scenes without them.
   std::shared_ptr<const Displacement> displacement;
   // Makes face f's whole chain (exactly what a stored one would hold) for the faces whose texture
-  // is deferred (is_deferred: sizes only). Generators, .ptx files and bare meshes' patterns asked
-  // to (GeneratorOptions::defer_textures) leave their textures to it, so that no float RGBA copy of every face ever exists: pack_scene
+  // is deferred (is_deferred: sizes only). Generators, .ptx files, bare meshes' patterns and
+  // explicit scene files (image faces read again from their files) asked to
+  // (GeneratorOptions::defer_textures) leave their textures to it, so that no float RGBA copy of every face ever exists: pack_scene
   // makes each face's chain, packs it and drops it, and the packed copy is the only one (the
   // float chains are 4x the packed RGBA8 bytes). Thread-safe; a copy of the scene shares it.
   std::function<MipChain(size_t face)> texture_source;
+  // The bytes texture_source keeps to make the faces from (a deferred .ptx's whole file): memory
+  // a scene holds beyond its Face records, shared by its copies, for budgets to count.
+  size_t texture_source_bytes = 0;
 
   size_t triangle_count() const { return faces.size() * 2; }
   std::array<glm::vec3, 4> corners(const Face& f) const;

@@ -74,6 +74,7 @@ void bake_textures(Scene& scene, const std::vector<TextureSize>& sizes, bool def
     scene.texture_source = [recipe = std::shared_ptr<const Recipe>(std::move(recipe))](size_t f) {
       return bake_face_chain(recipe->corners.at(f), recipe->sizes.at(f), recipe->albedo, f);
     };
+    scene.texture_source_bytes = 0;  // whatever made the faces before is dropped
     return;
   }
   // Faces are handed out one at a time because their sizes differ by up to 64x.

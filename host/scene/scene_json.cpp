@@ -1,12 +1,14 @@
 #include <seamcl/scene/scene_json.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <limits>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string_view>
 #include <variant>
@@ -264,6 +266,36 @@ struct TexturePlan {
   std::string image;  // a file whose pixels are level 0 (its size is the texture's)
 };
 
+// Everything that makes one face's chain, apart from the scene: the same recipe bakes a face at
+// once or, deferred, when it is packed, so both give the same texels.
+struct FaceRecipe {
+  TexturePlan plan;
+  std::array<glm::vec3, 4> corners{};
+  std::function<TextureLevel()> read_image;  // image faces: the loader's reader
+  std::string field;                         // faces[f].texture
+};
+
+MipChain make_face_chain(const FaceRecipe& recipe) {
+  const TexturePlan& plan = recipe.plan;
+  if (recipe.read_image) return build_mip_chain(recipe.read_image());
+  const glm::vec4 color(plan.color, 1.0f);
+  TextureLevel level0 =
+      plan.constant ? TextureLevel{plan.width, plan.height,
+                                   std::vector<glm::vec4>(static_cast<size_t>(plan.width) * plan.height, color)}
+                    : bake_face_texture(recipe.corners, plan.width, plan.height,
+                                        [&color](glm::vec3 p) { return surface_pattern(p) * color; });
+  return build_mip_chain(std::move(level0));
+}
+
+// What validate_scene checks of a stored chain's texels, for a deferred one when it is made: an
+// image may hold NaN or infinity, and large finite values may overflow in the box filter.
+void check_finite_texels(const MipChain& chain, const std::string& field) {
+  for (size_t k = 0; k < chain.levels.size(); ++k)
+    for (const glm::vec4& t : chain.levels[k].texels)
+      if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z) || !std::isfinite(t.w))
+        throw InputError(field, "mip level " + std::to_string(k) + " has a non-finite texel");
+}
+
 TexturePlan read_texture(const json& value, const std::string& path) {
   const ObjectFields fields(value, path, {"width", "height", "content", "color", "image"});
   TexturePlan plan;
@@ -337,7 +369,10 @@ Light read_light(const json& value) {
   return light;
 }
 
-Scene read_explicit_scene(const json& doc, const std::string& default_name, const FaceImageLoader& load_image) {
+// defer: every face's texture is left to scene.texture_source (deferred_mip_chain), image faces
+// sized from their headers.
+Scene read_explicit_scene(const json& doc, const std::string& default_name, const FaceImageLoader& load_image,
+                          bool defer) {
   const ObjectFields fields(
       doc, "", {"name", "positions", "faces", "camera", "orbit", "light", "background", "environment", "normals"});
   Scene scene;
@@ -403,44 +438,56 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name, cons
     }
   }
 
-  // Textures last: baking is the expensive part, so a document is checked in full first.
+  // Textures last: baking is the expensive part, so a document is checked in full first. Image
+  // faces are sized from their files' headers here; their pixels are read when baked.
+  std::vector<FaceRecipe> recipes;
   for (size_t f = 0; f < scene.faces.size(); ++f) {
-    const TexturePlan& plan = plans[f];
-    if (!plan.image.empty()) {
-      const std::string image_path = element_path("faces", f) + ".texture.image";
-      TextureLevel level0 = load_image(plan.image, image_path);
-      total_texels += level0.texels.size();
+    FaceRecipe recipe{plans[f], scene.corners(scene.faces[f]), {}, element_path("faces", f) + ".texture"};
+    if (!recipe.plan.image.empty()) {
+      const std::string image_path = recipe.field + ".image";
+      FaceImage image = load_image(recipe.plan.image, image_path);
+      recipe.plan.width = image.width;
+      recipe.plan.height = image.height;
+      recipe.read_image = std::move(image.read);
+      total_texels += static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
       if (total_texels > kMaxSceneTexels)
         throw InputError(image_path, "the scene's textures exceed " + std::to_string(kMaxSceneTexels) + " texels in all");
-      scene.faces[f].texture = build_mip_chain(std::move(level0));
-      continue;
     }
-    const glm::vec4 color(plan.color, 1.0f);
-    TextureLevel level0 =
-        plan.constant
-            ? TextureLevel{plan.width, plan.height,
-                           std::vector<glm::vec4>(static_cast<size_t>(plan.width) * plan.height,
-                                                  color)}
-            : bake_face_texture(scene.corners(scene.faces[f]), plan.width, plan.height,
-                                [&color](glm::vec3 p) { return surface_pattern(p) * color; });
-    scene.faces[f].texture = build_mip_chain(std::move(level0));
+    recipes.push_back(std::move(recipe));
   }
-  // The same content as a function, for the analytic reference.
+  if (defer) {
+    for (size_t f = 0; f < scene.faces.size(); ++f)
+      scene.faces[f].texture = deferred_mip_chain(recipes[f].plan.width, recipes[f].plan.height);
+    scene.texture_source = [recipes = std::make_shared<const std::vector<FaceRecipe>>(recipes)](size_t f) {
+      const FaceRecipe& recipe = recipes->at(f);
+      MipChain chain = make_face_chain(recipe);
+      check_finite_texels(chain, recipe.field);
+      return chain;
+    };
+  } else {
+    for (size_t f = 0; f < scene.faces.size(); ++f) scene.faces[f].texture = make_face_chain(recipes[f]);
+  }
+  // The same content as a function, for the analytic reference; none when an image paints a face
+  // (its texels are the only statement of its content).
+  const bool any_image = std::any_of(plans.begin(), plans.end(), [](const TexturePlan& p) { return !p.image.empty(); });
   std::vector<std::pair<bool, glm::vec4>> contents;
   for (const TexturePlan& plan : plans) contents.emplace_back(plan.constant, glm::vec4(plan.color, 1.0f));
-  scene.albedo = [contents](size_t face, glm::vec3 p) {
-    const auto& [constant, color] = contents[face];
-    return constant ? color : surface_pattern(p) * color;
-  };
+  if (!any_image) {
+    scene.albedo = [contents](size_t face, glm::vec3 p) {
+      const auto& [constant, color] = contents[face];
+      return constant ? color : surface_pattern(p) * color;
+    };
+  }
   validate_scene(scene);
   return scene;
 }
 
 using SceneSource = std::variant<GeneratorRequest, Scene>;
 
-SceneSource read_document(const json& doc, const std::string& default_name, const FaceImageLoader& load_image) {
+SceneSource read_document(const json& doc, const std::string& default_name, const FaceImageLoader& load_image,
+                          bool defer) {
   if (doc.is_object() && doc.contains("generator")) return read_generator_request(doc);
-  return read_explicit_scene(doc, default_name, load_image);
+  return read_explicit_scene(doc, default_name, load_image, defer);
 }
 
 Scene realize(SceneSource source, const GeneratorOptions& extra) {
@@ -462,7 +509,7 @@ std::string message_of(const InputError& error) {
   return std::string(error.what()).substr(error.field().size() + 2);
 }
 
-SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load_image) {
+SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load_image, bool defer) {
   std::error_code error_code;
   if (!std::filesystem::exists(path, error_code))
     throw InputError("scene", "cannot read scene file '" + path + "': no such file");
@@ -477,7 +524,7 @@ SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load
     throw InputError("scene", "scene file '" + path + "' is not valid JSON: " + error.what());
   }
   try {
-    return read_document(doc, std::filesystem::path(path).stem().string(), load_image);
+    return read_document(doc, std::filesystem::path(path).stem().string(), load_image, defer);
   } catch (const InputError& error) {
     throw InputError(error.field(), message_of(error) + " (in '" + path + "')");
   }
@@ -486,7 +533,7 @@ SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load
 }  // namespace
 
 Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_image, const GeneratorOptions& options) {
-  Scene scene = realize(read_document(doc, "scene", load_image), options);
+  Scene scene = realize(read_document(doc, "scene", load_image, options.defer_textures), options);
   // A document without a file behind it: nothing would read an environment's image files.
   if (scene.environment && scene.environment->files) {
     const EnvironmentFiles& files = *scene.environment->files;
@@ -497,14 +544,14 @@ Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_im
 }
 
 Scene load_scene_file(const std::string& path, const FaceImageLoader& load_image) {
-  return realize(read_scene_file(path, load_image), {});
+  return realize(read_scene_file(path, load_image, false), {});
 }
 
 Scene load_scene(const std::string& name_or_path, const GeneratorOptions& options, const FaceImageLoader& load_image) {
   if (is_generator_name(name_or_path)) return generate_scene(name_or_path, options);
   std::error_code ignored;
   if (name_or_path.ends_with(".json") || std::filesystem::exists(name_or_path, ignored))
-    return realize(read_scene_file(name_or_path, load_image), options);
+    return realize(read_scene_file(name_or_path, load_image, options.defer_textures), options);
   throw InputError("scene", "unknown scene '" + name_or_path + "' (known: " +
                                 known_generator_names() + "; or the path of a .json scene file)");
 }

@@ -11,16 +11,28 @@
 
 namespace seamcl {
 
-// Reads the image a face names ("texture": {"image": NAME}) as level 0 of its texture. `field` is
-// the JSON path to name in errors (faces[3].texture.image). host/scene reads no image files
-// itself: host/assets supplies this (seamcl::load_scene_source), and without one an image face is
-// an InputError, so an inline scene (the HTTP service) can name no file.
-using FaceImageLoader = std::function<TextureLevel(const std::string& name, const std::string& field)>;
+// A face's image as the loader found it while the scene was read: its size (from the file's
+// header; powers of two) and how to read its pixels as level 0 (width x height texels), at once
+// or, for a deferred scene, each time the face's texture is made (Scene::texture_source).
+struct FaceImage {
+  int width = 0;
+  int height = 0;
+  std::function<TextureLevel()> read;  // throws InputError naming the field (the file changed, went)
+};
+
+// Looks up the image a face names ("texture": {"image": NAME}): refuses a missing or bad file
+// from its header, reading no pixels. `field` is the JSON path to name in errors
+// (faces[3].texture.image). host/scene reads no image files itself: host/assets supplies this
+// (seamcl::load_scene_source), and without one an image face is an InputError, so an inline scene
+// (the HTTP service) can name no file.
+using FaceImageLoader = std::function<FaceImage(const std::string& name, const std::string& field)>;
 
 // Either a generator reference ({"generator": ..., "options": ...}) or an explicit scene.
 // The result has passed validate_scene. `options` apply on top of the document's own as in
-// load_scene (defer_textures: a generator's textures are left to Scene::texture_source, so that
-// the scene's sizes, and what it will cost, are known before anything is baked).
+// load_scene (defer_textures: a generator's textures, and every face's of an explicit scene,
+// images included, are left to Scene::texture_source, so that the scene's sizes, and what it will
+// cost, are known before anything is baked or decoded; a face's errors found only then, such as
+// an image file that changed since, are InputErrors naming the face's field).
 Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_image = {},
                        const GeneratorOptions& options = {});
 
