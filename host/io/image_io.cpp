@@ -1,5 +1,6 @@
 #include <seamcl/io/image_io.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -97,26 +98,26 @@ std::string encode_image(ImageFormat format, int width, int height, const std::v
 std::vector<glm::vec4> read_image(const std::string& path, int& width, int& height) {
   OIIO::ImageBuf input(path);
   if (!input.read(0, 0, true, OIIO::TypeDesc::FLOAT)) throw std::runtime_error("cannot read " + path + ": " + input.geterror());
-  OIIO::ImageBuf linear = input;
+  // Converted in place and copied once, straight into the RGBA result: a large face or
+  // environment image is decoded with its float pixels held twice at most, not four times.
   const std::string colorspace = input.spec().get_string_attribute("oiio:ColorSpace");
   if (colorspace == "sRGB") {
-    if (!OIIO::ImageBufAlgo::colorconvert(linear, input, "sRGB", "linear")) {
-      throw std::runtime_error("cannot convert " + path + " to linear: " + linear.geterror());
+    if (!OIIO::ImageBufAlgo::colorconvert(input, input, "sRGB", "linear")) {
+      throw std::runtime_error("cannot convert " + path + " to linear: " + input.geterror());
     }
   }
-  width = linear.spec().width;
-  height = linear.spec().height;
-  const int channels = linear.spec().nchannels;
-  std::vector<float> values(static_cast<size_t>(width) * height * channels);
-  linear.get_pixels(OIIO::ROI(0, width, 0, height, 0, 1, 0, channels), OIIO::TypeDesc::FLOAT, values.data());
+  width = input.spec().width;
+  height = input.spec().height;
+  const int channels = input.spec().nchannels;
   std::vector<glm::vec4> pixels(static_cast<size_t>(width) * height, glm::vec4(0, 0, 0, 1));
-  for (size_t i = 0; i < pixels.size(); ++i) {
-    if (channels <= 2) {
-      pixels[i] = glm::vec4(glm::vec3(values[i * channels]), channels == 2 ? values[i * channels + 1] : 1.0f);
-      continue;
-    }
-    for (int c = 0; c < std::min(channels, 4); ++c) pixels[i][c] = values[i * channels + c];
-  }
+  // Channels 0..3 into x, y, z, w of each pixel (the rest keep 0, 0, 0, 1) ...
+  const OIIO::stride_t pixel_stride = sizeof(glm::vec4);
+  if (!input.get_pixels(OIIO::ROI(0, width, 0, height, 0, 1, 0, std::min(channels, 4)), OIIO::TypeDesc::FLOAT,
+                        pixels.data(), pixel_stride, pixel_stride * width))
+    throw std::runtime_error("cannot read " + path + ": " + input.geterror());
+  // ... and grey (with alpha in y) spread to RGB.
+  if (channels <= 2)
+    for (glm::vec4& p : pixels) p = glm::vec4(glm::vec3(p.x), channels == 2 ? p.y : 1.0f);
   return pixels;
 }
 

@@ -6,6 +6,7 @@
 #include "pipeline/adjacency.h"
 #include "pipeline/guard_band.h"
 #include "pipeline/reflective_face.h"
+#include "scene/budgeted_faces.h"
 
 #include <algorithm>
 #include <limits>
@@ -199,7 +200,11 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
   if (guard_band > 0 && has_deferred_textures(scene)) {
     pack_banded_deferred(scene, out, first_level);
   } else {
-    for_each_face_in_parallel(scene.faces.size(), [&](size_t f) { pack_face_texels(scene, out, f, first_level[f]); });
+    // Deferred faces' float chains in flight together at most the packed bytes (one at a time when
+    // larger): the peak stays within the packed copy + as much again.
+    for_each_face_in_budget(
+        scene.faces.size(), [&](size_t f) { pack_face_texels(scene, out, f, first_level[f]); },
+        [&](size_t f) { return texture_making_bytes(scene, f); }, out.texture_bytes());
   }
   return out;
 }

@@ -1,0 +1,50 @@
+#include "scene/budgeted_faces.h"
+
+#include <condition_variable>
+#include <mutex>
+
+namespace seamcl {
+
+void for_each_face_in_budget(size_t count, const std::function<void(size_t face)>& work,
+                             const std::function<size_t(size_t face)>& weight, size_t budget) {
+  std::mutex mutex;
+  std::condition_variable room;
+  size_t running_weight = 0, running = 0;  // of the faces between their wait and their end
+  // Gives a face's weight back when its work ends, also by an exception.
+  struct Leave {
+    std::mutex& mutex;
+    std::condition_variable& room;
+    size_t& running_weight;
+    size_t& running;
+    size_t weight;
+    ~Leave() {
+      {
+        const std::lock_guard lock(mutex);
+        running_weight -= weight;
+        --running;
+      }
+      room.notify_all();
+    }
+  };
+  for_each_face_in_parallel(count, [&](size_t f) {
+    const size_t w = weight(f);
+    {
+      std::unique_lock lock(mutex);
+      room.wait(lock, [&] { return running == 0 || (w <= budget && running_weight <= budget - w); });
+      running_weight += w;
+      ++running;
+    }
+    const Leave leave{mutex, room, running_weight, running, w};
+    work(f);
+  });
+}
+
+size_t texture_making_bytes(const Scene& scene, size_t face) {
+  const MipChain& chain = scene.faces.at(face).texture;
+  if (!is_deferred(chain)) return 0;
+  size_t texels = 0;
+  for (const TextureLevel& level : chain.levels) texels += static_cast<size_t>(level.width) * static_cast<size_t>(level.height);
+  return texels * sizeof(glm::vec4);
+}
+
+}  // namespace seamcl

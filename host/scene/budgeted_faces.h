@@ -1,0 +1,23 @@
+// Per-face work in parallel within a memory budget: packing a deferred scene makes each face's
+// float chain while the packed copy already exists, so how many chains are in flight at once
+// decides the peak (host/pipeline/packed_scene.cpp).
+#pragma once
+#include <cstddef>
+#include <functional>
+
+#include <seamcl/scene/scene.h>
+
+namespace seamcl {
+
+// As for_each_face_in_parallel, but a face starts only while the `weight`s of the faces running,
+// its own included, sum to at most `budget`, or when none is running (a face heavier than the
+// budget runs alone): what the running faces hold together stays within the budget, or within
+// the one heaviest face. The first exception is rethrown once all have stopped, as there.
+void for_each_face_in_budget(size_t count, const std::function<void(size_t face)>& work,
+                             const std::function<size_t(size_t face)>& weight, size_t budget);
+
+// The float RGBA bytes of face f's chain while it is made: every level's texels for a deferred
+// face, 0 for a stored one (read where it is).
+size_t texture_making_bytes(const Scene& scene, size_t face);
+
+}  // namespace seamcl
