@@ -10,6 +10,10 @@
 
 #include <sys/resource.h>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -181,6 +185,12 @@ size_t status_kilobytes(const std::string& status, const std::string& key) {
 }
 
 }  // namespace
+
+void return_large_blocks_at_once() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+#endif
+}
 
 ProcessMemory process_memory() {
   ProcessMemory memory;
