@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <mutex>
+#include <thread>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -19,6 +22,7 @@
 
 #include "core/srgb.h"
 #include "ptex_test_writer.h"
+#include "scene/budgeted_faces.h"
 #include "test_support.h"
 
 namespace {
@@ -279,3 +283,55 @@ TEST(Memory, SceneRenderMemoryComesFromTheSizesBeforeAnyTexelIsBaked) {
 
 
 }  // namespace
+
+TEST(Memory, FacesInABudgetNeverHoldMoreThanItTogether) {
+  // Weights 1..9 and one face heavier than the budget; every face runs once, and the faces running
+  // at any moment weigh at most the budget together, except the heavy one, which runs alone.
+  std::vector<size_t> weights;
+  for (size_t f = 0; f < 60; ++f) weights.push_back(1 + f % 9);
+  weights[17] = 50;
+  const size_t budget = 12;
+  std::mutex mutex;
+  size_t running = 0, running_weight = 0, most = 0, heavy_company = 0;
+  std::vector<int> runs(weights.size(), 0);
+  for_each_face_in_budget(
+      weights.size(),
+      [&](size_t f) {
+        {
+          const std::lock_guard lock(mutex);
+          ++running;
+          running_weight += weights[f];
+          ++runs[f];
+          if (f == 17) heavy_company = std::max(heavy_company, running - 1);
+          if (f != 17) most = std::max(most, running_weight);
+        }
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+        const std::lock_guard lock(mutex);
+        --running;
+        running_weight -= weights[f];
+      },
+      [&](size_t f) { return weights[f]; }, budget);
+  EXPECT_EQ(std::count(runs.begin(), runs.end(), 1), static_cast<long>(weights.size()));
+  EXPECT_EQ(heavy_company, 0u);
+  EXPECT_LE(most, budget);
+  if (std::thread::hardware_concurrency() > 1)
+    EXPECT_GT(most, 9u) << "faces did run together within the budget (on more than one core)";
+  // An exception reaches the caller and frees the budget of the face that threw.
+  EXPECT_THROW(for_each_face_in_budget(
+                   8, [](size_t f) { if (f == 3) throw std::runtime_error("face 3"); }, [](size_t) { return size_t{1}; }, 2),
+               std::runtime_error);
+}
+
+TEST(Memory, TextureMakingBytesAreADeferredChainsFloats) {
+  Scene scene = generate_scene("quad2", {});
+  EXPECT_EQ(texture_making_bytes(scene, 0), 0u) << "a stored chain is read where it is";
+  GeneratorOptions deferred;
+  deferred.defer_textures = true;
+  scene = generate_scene("quad2", deferred);
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    size_t texels = 0;
+    for (const TextureLevel& level : face_texture(scene, f).levels) texels += level.texels.size();
+    EXPECT_GT(texels, 0u);
+    EXPECT_EQ(texture_making_bytes(scene, f), texels * sizeof(glm::vec4)) << f;
+  }
+}
