@@ -577,26 +577,26 @@ TEST(Assets, TheAssetCacheCountsKeptPtexBytesAndReloadsASceneWhoseImageChanged) 
   fs::create_directories(root.path() / "maps");
   fs::copy_file(sample("wave_lo.ptx"), root.path() / "maps" / "wave_lo.ptx");
   const size_t ptex_bytes = static_cast<size_t>(fs::file_size(root.path() / "maps" / "wave_lo.ptx"));
-  root.write("scenes/wave.json", R"({"mesh": "../plane.obj", "texture": "../maps/wave_lo.ptx"})");
-  write_image((root.path() / "scenes" / "face.png").string(), 8, 8, varied_pixels(8, 8, 1));
-  root.write("scenes/image.json", image_cube_scene({"face.png"}).dump());
+  root.write("wave.json", R"({"mesh": "plane.obj", "texture": "maps/wave_lo.ptx"})");
+  write_image((root.path() / "face.png").string(), 8, 8, varied_pixels(8, 8, 1));
+  root.write("image.json", image_cube_scene({"face.png"}).dump());
   AssetDirectory assets(root.path().string(), {size_t{64} << 20, 8});
 
   // A deferred .ptx named inside a scene file: its bytes are kept by the scene, and counted.
-  const auto wave = assets.load("scenes/wave.json", "", deferring());
+  const auto wave = assets.load("wave.json", "", deferring());
   EXPECT_EQ(wave->texture_source_bytes, ptex_bytes);
   EXPECT_EQ(assets.cached_bytes(), scene_host_bytes(scene_sizes(*wave)) + ptex_bytes);
-  EXPECT_EQ(assets.load("scenes/wave.json", "", {})->texture_source_bytes, 0u) << "baked: nothing kept";
+  EXPECT_EQ(assets.load("wave.json", "", {})->texture_source_bytes, 0u) << "baked: nothing kept";
 
   // An image face changed after the scene was cached: the entry is stale, loaded again.
-  const auto first = assets.load("scenes/image.json", "", deferring());
+  const auto first = assets.load("image.json", "", deferring());
   const long long loads = assets.file_loads();
-  EXPECT_EQ(assets.load("scenes/image.json", "", deferring()), first);
+  EXPECT_EQ(assets.load("image.json", "", deferring()), first);
   EXPECT_EQ(assets.file_loads(), loads);
-  const fs::path image = root.path() / "scenes" / "face.png";
+  const fs::path image = root.path() / "face.png";
   write_image(image.string(), 8, 8, varied_pixels(8, 8, 2));
   fs::last_write_time(image, fs::last_write_time(image) + std::chrono::seconds(2));
-  const auto again = assets.load("scenes/image.json", "", deferring());
+  const auto again = assets.load("image.json", "", deferring());
   EXPECT_NE(again, first);
   EXPECT_EQ(assets.file_loads(), loads + 1);
   EXPECT_NO_THROW(face_texture(*again, 0));
