@@ -1,6 +1,9 @@
-/* Stage 3: raster. One work-item per row of a tile (SEAMCL_TILE_SIZE pixels): it walks its tile's
- * list once and tests the row with 16-wide integer vectors, written vectorised here because
- * PoCL's work-item loop cannot vectorise a loop over a per-pixel list.
+/* Stage 3: raster. One work-item per tile (SEAMCL_TILE_SIZE x SEAMCL_TILE_SIZE pixels): it walks
+ * its tile's list once, each entry over the tile rows its box covers (tile_entry_rows, from
+ * binning: no row reads an entry that misses it, and a record is read once, not once per row), and
+ * tests a row with 16-wide integer vectors, written vectorised here because PoCL's work-item loop
+ * cannot vectorise a loop over a per-pixel list. The tile's winners stay in private memory
+ * (16 rows x 16 x SEAMCL_MAX_SAMPLES slots, 16 KiB) until the list is done.
  *
  * For each sample of the pixel (D3D11 standard positions, below), a triangle covers it iff all
  * three edge functions are >= 0 at the sample's fixed-point position (top-left rule folded into
@@ -18,10 +21,9 @@
  * then follows the covered pixels, not pixels x samples.
  * Depths are computed only where a covered sample already has a triangle (overlapping front
  * faces), both from their planes with the twin's float steps: the eager z-buffer's result.
- * Each row skips, from tile_entry_rows alone, the list entries whose box misses it.
  * Host guarantees: bin lists and tile_entry_rows built for this frame; bin_entries <= bin_capacity
  * (else it re-runs);
- * global size (tiles_x, tiles_y * SEAMCL_TILE_SIZE); image sides <= 16384 (kMaxImageSide), so
+ * global size (tiles_x, tiles_y), work-groups of one; image sides <= 16384 (kMaxImageSide), so
  * fixed-point sample positions fit 32 bits and convert to float exactly. Twin: host/twins/raster.cpp. */
 
 /* The D3D11 sample pattern (sample_offsets, sample_pattern_row) is defined in triangle_setup.cl,
@@ -45,6 +47,10 @@ SEAMCL_INLINE long sample_fixed_y(int y, int row, int s) {
 /* Edges whose |a| + |b| is below this keep every in-row offset (< 4096 (|a| + |b|)) under 2^29. */
 #define SEAMCL_RASTER_NARROW_EDGE (1 << 17)
 #define SEAMCL_RASTER_CLAMP (1 << 29)
+/* How many list entries ahead raster prefetches a record. */
+#define SEAMCL_RASTER_PREFETCH_AHEAD 4
+/* Winners kept per tile row: SEAMCL_MAX_SAMPLES vectors of 16. */
+#define SEAMCL_TILE_ROW_WINNERS (SEAMCL_MAX_SAMPLES * SEAMCL_TILE_SIZE)
 
 /* 1/w of t's plane at the lanes' fixed-point sample positions (px, py): the twin's float steps. */
 SEAMCL_INLINE float16 raster_depth(__global const TriangleSetup* t, int16 px, int16 py) {
@@ -118,48 +124,52 @@ SEAMCL_INLINE void raster_take(__global const TriangleSetup* setups, uint triang
   vstore16(select(old_slot, (uint16)slot, takes), 0, best_slot);
 }
 
-/* Rows of one sample (or few): the vector runs over the row's 16 pixels, the loop over samples;
- * winners stored per sample [16 s + lane]. */
-SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, uint triangles, __global const uint* tile_lists,
-                                       __global const ushort* tile_entry_rows, uint begin, uint end, int x0, int y,
-                                       int samples, int row, uint* best_slot) {
+/* Rows of one sample (or few): the vector runs over a row's 16 pixels, the loop over samples;
+ * winners stored per row r and sample [r * SEAMCL_TILE_ROW_WINNERS + 16 s + lane]. One list entry
+ * (slot) over the rows y_first .. y_last of the tile at (x0, y0): its record is read once for all
+ * of them. */
+SEAMCL_INLINE void raster_entry_by_lanes(__global const TriangleSetup* setups, uint triangles, uint slot, int x0, int y0,
+                                         int y_first, int y_last, int samples, int row, uint* best_tile) {
+  __global const TriangleSetup* t = setups + slot;
   const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   const int16 x = x0 + lane;
-  /* Fixed-point x of each lane's pixel centre; the row's y. */
+  /* Fixed-point x of each lane's pixel centre. */
   const int16 centre_x = x * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
-  const int centre_y = y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
-  const uint tile_row = (uint)(y % SEAMCL_TILE_SIZE);
-  for (uint entry = begin; entry < end; ++entry) {
-    /* Rows of the tile the entry's box covers (binning): most entries of a tile of small
-     * triangles miss this row, and are skipped without a read of their record. */
-    const uint rows = tile_entry_rows[entry];
-    if (tile_row < (rows & 15u) || tile_row > ((rows >> 4) & 15u)) continue;
-    const uint slot = tile_lists[entry];
-    __global const TriangleSetup* t = setups + slot;
-    if (y < t->bbox_min_y || y > t->bbox_max_y || x0 + SEAMCL_TILE_SIZE - 1 < t->bbox_min_x || x0 > t->bbox_max_x) continue;
-    /* The twin visits the pixels of the bounding box only. */
-    const int16 in_box = (x >= t->bbox_min_x) & (x <= t->bbox_max_x);
-    const int tame = raster_plane_is_tame(t);
-    int wide = 0;
-    for (int i = 0; i < 3; ++i) wide |= (long)abs(t->edge_a[i]) + (long)abs(t->edge_b[i]) >= SEAMCL_RASTER_NARROW_EDGE;
-    if (!wide) {
+  /* The twin visits the pixels of the bounding box only. */
+  const int16 in_box = (x >= t->bbox_min_x) & (x <= t->bbox_max_x);
+  const int tame = raster_plane_is_tame(t);
+  int a[3], b[3];
+  long c[3];
+  int wide = 0;
+  for (int i = 0; i < 3; ++i) {
+    a[i] = t->edge_a[i];
+    b[i] = t->edge_b[i];
+    c[i] = t->edge_c[i];
+    wide |= (long)abs(a[i]) + (long)abs(b[i]) >= SEAMCL_RASTER_NARROW_EDGE;
+  }
+  if (!wide) {
+    /* Per edge, its lowest and highest change over a pixel's sample box [-8, 7] / 16. */
+    int low[3], high[3];
+    for (int i = 0; i < 3; ++i) {
+      low[i] = a[i] * (a[i] > 0 ? -128 : 112) + b[i] * (b[i] > 0 ? -128 : 112);
+      high[i] = a[i] * (a[i] > 0 ? 112 : -128) + b[i] * (b[i] > 0 ? 112 : -128);
+    }
+    for (int y = y_first; y <= y_last; ++y) {
+      uint* best_slot = best_tile + (y - y0) * SEAMCL_TILE_ROW_WINNERS;
+      const int centre_y = y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
       int16 e[3];
       for (int i = 0; i < 3; ++i) {
-        const long at_row = (long)t->edge_a[i] * (x0 * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2) +
-                            (long)t->edge_b[i] * centre_y + t->edge_c[i];
+        const long at_row = (long)a[i] * (x0 * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2) + (long)b[i] * centre_y + c[i];
         const int clamped = (int)clamp(at_row, (long)-SEAMCL_RASTER_CLAMP, (long)SEAMCL_RASTER_CLAMP);
-        e[i] = clamped + t->edge_a[i] * SEAMCL_SUBPIXEL_ONE * lane;
+        e[i] = clamped + a[i] * SEAMCL_SUBPIXEL_ONE * lane;
       }
       /* Lanes whose every sample position (all within [-8, 7] / 16 pixel of the centre) is
        * inside all three edges, and lanes outside one edge at all of them: only the others
        * (pixels an edge crosses) need the test per sample. */
       int16 full = in_box, outside = (int16)(0);
       for (int i = 0; i < 3; ++i) {
-        const int a = t->edge_a[i], b = t->edge_b[i];
-        const int low = a * (a > 0 ? -128 : 112) + b * (b > 0 ? -128 : 112);
-        const int high = a * (a > 0 ? 112 : -128) + b * (b > 0 ? 112 : -128);
-        full &= e[i] + low >= 0;
-        outside |= e[i] + high < 0;
+        full &= e[i] + low[i] >= 0;
+        outside |= e[i] + high[i] < 0;
       }
       const int16 partial = in_box & ~full & ~outside;
       const int any_partial = raster_any(partial);
@@ -169,24 +179,26 @@ SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, uin
         const int oy = sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
         int16 covered = full;
         if (any_partial) {
-          const int16 any_negative = (e[0] + (t->edge_a[0] * ox + t->edge_b[0] * oy)) |
-                                     (e[1] + (t->edge_a[1] * ox + t->edge_b[1] * oy)) |
-                                     (e[2] + (t->edge_a[2] * ox + t->edge_b[2] * oy));
+          const int16 any_negative = (e[0] + (a[0] * ox + b[0] * oy)) | (e[1] + (a[1] * ox + b[1] * oy)) |
+                                     (e[2] + (a[2] * ox + b[2] * oy));
           covered |= partial & (any_negative >= 0);
           if (!raster_any(covered)) continue;
         }
         raster_take(setups, triangles, slot, tame, covered, centre_x + ox, (int16)(centre_y + oy), best_slot + s * SEAMCL_TILE_SIZE);
       }
-    } else {
+    }
+  } else {
+    const long16 lane_x = convert_long16(centre_x);
+    for (int y = y_first; y <= y_last; ++y) {
+      uint* best_slot = best_tile + (y - y0) * SEAMCL_TILE_ROW_WINNERS;
+      const int centre_y = y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
       long16 e[3];
-      const long16 lane_x = convert_long16(centre_x);
-      for (int i = 0; i < 3; ++i) e[i] = (long)t->edge_a[i] * lane_x + (long)t->edge_b[i] * centre_y + t->edge_c[i];
+      for (int i = 0; i < 3; ++i) e[i] = (long)a[i] * lane_x + (long)b[i] * centre_y + c[i];
       for (int s = 0; s < samples; ++s) {
         const long ox = sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16);
         const long oy = sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
-        const long16 any_negative = (e[0] + (t->edge_a[0] * ox + t->edge_b[0] * oy)) |
-                               (e[1] + (t->edge_a[1] * ox + t->edge_b[1] * oy)) |
-                               (e[2] + (t->edge_a[2] * ox + t->edge_b[2] * oy));
+        const long16 any_negative = (e[0] + (a[0] * ox + b[0] * oy)) | (e[1] + (a[1] * ox + b[1] * oy)) |
+                                    (e[2] + (a[2] * ox + b[2] * oy));
         const int16 covered = in_box & convert_int16(any_negative >= 0);
         if (!raster_any(covered)) continue;
         raster_take(setups, triangles, slot, tame, covered, centre_x + (int)ox, (int16)(centre_y + (int)oy), best_slot + s * SEAMCL_TILE_SIZE);
@@ -199,60 +211,52 @@ SEAMCL_INLINE void raster_row_by_lanes(__global const TriangleSetup* setups, uin
 #define SEAMCL_RASTER_NARROW_PIXEL_EDGE (1 << 22)
 
 /* Rows of many samples: the vector runs over one pixel's samples (lanes past the count off), the
- * loop over the pixels of the row inside the triangle's box; winners stored per pixel
- * [16 lane + s]. A pixel whose sample box [-8, 7] / 16 lies inside all three edges is covered at
- * every sample, one outside an edge at none: only pixels an edge crosses test their samples. */
-SEAMCL_INLINE void raster_row_by_pixels(__global const TriangleSetup* setups, uint triangles, __global const uint* tile_lists,
-                                        __global const ushort* tile_entry_rows, uint begin, uint end, int x0, int y,
-                                        int samples, int row, uint* best_slot) {
-  int offset_x[SEAMCL_MAX_SAMPLES], offset_y[SEAMCL_MAX_SAMPLES];
-  for (int s = 0; s < SEAMCL_MAX_SAMPLES; ++s) {
-    offset_x[s] = s < samples ? sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16) : 0;
-    offset_y[s] = s < samples ? sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16) : 0;
-  }
-  const int16 sample_x = vload16(0, offset_x);
-  const int16 sample_y = vload16(0, offset_y);
+ * loop over the pixels of a row inside the triangle's box; winners stored per row r and pixel
+ * [r * SEAMCL_TILE_ROW_WINNERS + 16 lane + s]. A pixel whose sample box [-8, 7] / 16 lies inside
+ * all three edges is covered at every sample, one outside an edge at none: only pixels an edge
+ * crosses test their samples. One list entry (slot) over the rows y_first .. y_last of the tile at
+ * (x0, y0), its record read once. */
+SEAMCL_INLINE void raster_entry_by_pixels(__global const TriangleSetup* setups, uint triangles, uint slot, int x0, int y0,
+                                          int y_first, int y_last, int samples, int row, int16 sample_x,
+                                          int16 sample_y, uint* best_tile) {
+  __global const TriangleSetup* t = setups + slot;
   const int16 valid = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15) < samples;
-  const int centre_y = y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
-  const int16 py = centre_y + sample_y;
-  const uint tile_row = (uint)(y % SEAMCL_TILE_SIZE);
-  for (uint entry = begin; entry < end; ++entry) {
-    /* Rows of the tile the entry's box covers (binning): most entries of a tile of small
-     * triangles miss this row, and are skipped without a read of their record. */
-    const uint rows = tile_entry_rows[entry];
-    if (tile_row < (rows & 15u) || tile_row > ((rows >> 4) & 15u)) continue;
-    const uint slot = tile_lists[entry];
-    __global const TriangleSetup* t = setups + slot;
-    if (y < t->bbox_min_y || y > t->bbox_max_y || x0 + SEAMCL_TILE_SIZE - 1 < t->bbox_min_x || x0 > t->bbox_max_x) continue;
-    const int tame = raster_plane_is_tame(t);
-    /* Per edge: its value at the first pixel's centre, its step per pixel, and its lowest and
-     * highest change over the sample box. */
-    long e[3], step[3], low[3], high[3];
-    int narrow = 1;
-    int16 d[3];
-    const int first = max(t->bbox_min_x, x0) - x0, last = min(t->bbox_max_x, x0 + SEAMCL_TILE_SIZE - 1) - x0;
-    for (int i = 0; i < 3; ++i) {
-      const long a = t->edge_a[i], b = t->edge_b[i];
-      e[i] = a * ((x0 + first) * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2) + b * centre_y + t->edge_c[i];
-      step[i] = a * SEAMCL_SUBPIXEL_ONE;
-      low[i] = a * (a > 0 ? -128 : 112) + b * (b > 0 ? -128 : 112);
-      high[i] = a * (a > 0 ? 112 : -128) + b * (b > 0 ? 112 : -128);
-      narrow &= abs(a) + abs(b) < SEAMCL_RASTER_NARROW_PIXEL_EDGE;
-    }
-    /* The change at each sample, in 32 bits when the edges are narrow (else unused). */
-    for (int i = 0; i < 3; ++i) d[i] = narrow ? t->edge_a[i] * sample_x + t->edge_b[i] * sample_y : (int16)(0);
+  const int tame = raster_plane_is_tame(t);
+  /* Per edge: its step per pixel, and its lowest and highest change over the sample box. */
+  long a[3], b[3], c[3], step[3], low[3], high[3];
+  int narrow = 1;
+  int16 d[3];
+  const int first = max(t->bbox_min_x, x0) - x0, last = min(t->bbox_max_x, x0 + SEAMCL_TILE_SIZE - 1) - x0;
+  for (int i = 0; i < 3; ++i) {
+    a[i] = t->edge_a[i];
+    b[i] = t->edge_b[i];
+    c[i] = t->edge_c[i];
+    step[i] = a[i] * SEAMCL_SUBPIXEL_ONE;
+    low[i] = a[i] * (a[i] > 0 ? -128 : 112) + b[i] * (b[i] > 0 ? -128 : 112);
+    high[i] = a[i] * (a[i] > 0 ? 112 : -128) + b[i] * (b[i] > 0 ? 112 : -128);
+    narrow &= abs(a[i]) + abs(b[i]) < SEAMCL_RASTER_NARROW_PIXEL_EDGE;
+  }
+  /* The change at each sample, in 32 bits when the edges are narrow (else unused). */
+  for (int i = 0; i < 3; ++i) d[i] = narrow ? (int)a[i] * sample_x + (int)b[i] * sample_y : (int16)(0);
+  for (int y = y_first; y <= y_last; ++y) {
+    uint* best_slot = best_tile + (y - y0) * SEAMCL_TILE_ROW_WINNERS;
+    const int centre_y = y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2;
+    const int16 py = centre_y + sample_y;
+    /* Per edge, its value at the first pixel's centre. */
+    long e[3];
+    for (int i = 0; i < 3; ++i) e[i] = a[i] * ((x0 + first) * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2) + b[i] * centre_y + c[i];
     for (int l = first; l <= last; ++l, e[0] += step[0], e[1] += step[1], e[2] += step[2]) {
       if (e[0] + high[0] < 0 || e[1] + high[1] < 0 || e[2] + high[2] < 0) continue;
       int16 covered = valid;
       if (e[0] + low[0] < 0 || e[1] + low[1] < 0 || e[2] + low[2] < 0) {
         if (narrow) {
-          int c[3];
-          for (int i = 0; i < 3; ++i) c[i] = (int)clamp(e[i], (long)-SEAMCL_RASTER_CLAMP, (long)SEAMCL_RASTER_CLAMP);
-          covered &= ((c[0] + d[0]) | (c[1] + d[1]) | (c[2] + d[2])) >= 0;
+          int cl[3];
+          for (int i = 0; i < 3; ++i) cl[i] = (int)clamp(e[i], (long)-SEAMCL_RASTER_CLAMP, (long)SEAMCL_RASTER_CLAMP);
+          covered &= ((cl[0] + d[0]) | (cl[1] + d[1]) | (cl[2] + d[2])) >= 0;
         } else {
           const long16 wide_x = convert_long16(sample_x), wide_y = convert_long16(sample_y);
           long16 any_negative = (long16)(0);
-          for (int i = 0; i < 3; ++i) any_negative |= e[i] + (long)t->edge_a[i] * wide_x + (long)t->edge_b[i] * wide_y;
+          for (int i = 0; i < 3; ++i) any_negative |= e[i] + a[i] * wide_x + b[i] * wide_y;
           covered &= convert_int16(any_negative >= 0);
         }
         if (!raster_any(covered)) continue;
@@ -271,27 +275,62 @@ __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup
                      __global const uint* tile_lists, __global const ushort* tile_entry_rows,
                      __global uint* sample_triangle) {
   const int tile_x = (int)get_global_id(0);
-  const int y = (int)get_global_id(1);
-  if (tile_x >= frame->tiles_x || y >= frame->height) return;
-  const int x0 = tile_x * SEAMCL_TILE_SIZE;
+  const int tile_y = (int)get_global_id(1);
+  if (tile_x >= frame->tiles_x || tile_y >= frame->tiles_y) return;
+  const int x0 = tile_x * SEAMCL_TILE_SIZE, y0 = tile_y * SEAMCL_TILE_SIZE;
   const int samples = frame->sample_count;
   const int row = sample_pattern_row(samples);
-  const int tile = (y / SEAMCL_TILE_SIZE) * frame->tiles_x + tile_x;
+  const int tile = tile_y * frame->tiles_x + tile_x;
   const uint begin = tile_offsets[tile];
   const uint end = min(begin + tile_counts[tile], frame->bin_capacity);
   const int lanes = min(SEAMCL_TILE_SIZE, frame->width - x0);
-  __global uint* out = sample_triangle + ((size_t)y * (size_t)frame->width + (size_t)x0) * (size_t)samples;
-  uint best_slot[SEAMCL_MAX_SAMPLES * SEAMCL_TILE_SIZE];
-  for (int i = 0; i < SEAMCL_MAX_SAMPLES; ++i) vstore16((uint16)(SEAMCL_NO_TRIANGLE), i, best_slot);
-  if (samples < SEAMCL_RASTER_BY_PIXELS_FROM) {
-    raster_row_by_lanes(setups, (uint)frame->input_triangles, tile_lists, tile_entry_rows, begin, end, x0, y, samples, row, best_slot);
-    for (int l = 0; l < lanes; ++l) {
-      for (int s = 0; s < samples; ++s) out[l * samples + s] = best_slot[s * SEAMCL_TILE_SIZE + l];
+  const int rows = min(SEAMCL_TILE_SIZE, frame->height - y0);
+  const int by_pixels = samples >= SEAMCL_RASTER_BY_PIXELS_FROM;
+  /* The tile's winners, row by row; by lanes a row uses its first `samples` vectors. */
+  uint best_tile[SEAMCL_TILE_SIZE * SEAMCL_TILE_ROW_WINNERS];
+  const int vectors_per_row = by_pixels ? SEAMCL_TILE_SIZE : samples;
+  for (int r = 0; r < rows; ++r) {
+    for (int i = 0; i < vectors_per_row; ++i) vstore16((uint16)(SEAMCL_NO_TRIANGLE), r * SEAMCL_MAX_SAMPLES + i, best_tile);
+  }
+  int offset_x[SEAMCL_MAX_SAMPLES], offset_y[SEAMCL_MAX_SAMPLES];
+  for (int s = 0; s < SEAMCL_MAX_SAMPLES; ++s) {
+    offset_x[s] = s < samples ? sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16) : 0;
+    offset_y[s] = s < samples ? sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16) : 0;
+  }
+  const int16 sample_x = vload16(0, offset_x), sample_y = vload16(0, offset_y);
+  for (uint entry = begin; entry < end; ++entry) {
+    /* The record a few entries ahead: its first read misses the cache (records lie in input
+     * order, lists in tile order), and the walk's branches depend on it. */
+    if (entry + SEAMCL_RASTER_PREFETCH_AHEAD < end) {
+      __builtin_prefetch(setups + tile_lists[entry + SEAMCL_RASTER_PREFETCH_AHEAD]);
     }
-  } else {
-    raster_row_by_pixels(setups, (uint)frame->input_triangles, tile_lists, tile_entry_rows, begin, end, x0, y, samples, row, best_slot);
-    for (int l = 0; l < lanes; ++l) {
-      for (int s = 0; s < samples; ++s) out[l * samples + s] = best_slot[l * SEAMCL_TILE_SIZE + s];
+    /* The rows of the tile the entry's box covers (binning), cut to the record's box and the image
+     * (a list may hold entries that miss the tile: the box decides). */
+    const uint entry_rows = tile_entry_rows[entry];
+    const uint slot = tile_lists[entry];
+    __global const TriangleSetup* t = setups + slot;
+    if (x0 + SEAMCL_TILE_SIZE - 1 < t->bbox_min_x || x0 > t->bbox_max_x) continue;
+    const int y_first = max(y0 + (int)(entry_rows & 15u), t->bbox_min_y);
+    const int y_last = min(min(y0 + (int)((entry_rows >> 4) & 15u), t->bbox_max_y), y0 + rows - 1);
+    if (y_first > y_last) continue;
+    if (by_pixels) {
+      raster_entry_by_pixels(setups, (uint)frame->input_triangles, slot, x0, y0, y_first, y_last, samples, row, sample_x,
+                             sample_y, best_tile);
+    } else {
+      raster_entry_by_lanes(setups, (uint)frame->input_triangles, slot, x0, y0, y_first, y_last, samples, row, best_tile);
+    }
+  }
+  for (int r = 0; r < rows; ++r) {
+    __global uint* out = sample_triangle + ((size_t)(y0 + r) * (size_t)frame->width + (size_t)x0) * (size_t)samples;
+    const uint* best_slot = best_tile + r * SEAMCL_TILE_ROW_WINNERS;
+    if (by_pixels) {
+      for (int l = 0; l < lanes; ++l) {
+        for (int s = 0; s < samples; ++s) out[l * samples + s] = best_slot[l * SEAMCL_TILE_SIZE + s];
+      }
+    } else {
+      for (int l = 0; l < lanes; ++l) {
+        for (int s = 0; s < samples; ++s) out[l * samples + s] = best_slot[s * SEAMCL_TILE_SIZE + l];
+      }
     }
   }
 }

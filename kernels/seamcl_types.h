@@ -199,7 +199,7 @@ typedef struct {
   cl_uint bin_entries;      /* tile-list entries needed (may exceed bin_capacity: then re-run) */
   cl_uint fragments;        /* (pixel, triangle) pairs shaded; samples in SEAMCL_SHADE_SAMPLE */
   cl_uint visible_triangles;/* clip slots that produced a non-empty triangle */
-  cl_uint pad0;
+  cl_uint early_culled;     /* input triangles triangle_setup's early cull stopped (setup_may_be_visible) */
 } FrameStats;
 
 /* ---- Displacement (kernels/tessellate.cl; host/pipeline/displacement_packing.h) ---- */

@@ -14,7 +14,11 @@
  * edge functions with the top-left rule and perspective-correct attribute planes.
  * An early cull (setup_may_be_visible: back faces, zero area, boxes past an image side, for
  * triangles inside all planes) runs first for every triangle, in a work-item loop of its own;
- * the full setup runs only for the others, with the same result as without the early cull.
+ * the full setup runs only for the others, with the same result as without the early cull: a
+ * survivor inside all planes takes its snapped vertices and 1/w from the cull (SnappedTriangle,
+ * the same float steps) into setup_snapped_triangle, so the transform and snapping run once.
+ * stats->early_culled counts the triangles the early cull stopped (its twin:
+ * early_culled_reference), stats->visible_triangles the visible slots.
  * A new vertex on an edge is always computed from the edge's inside end, so two triangles that
  * share the edge create bit-identical vertices: clipping keeps the mesh watertight.
  * Twin: host/triangle_setup.cpp. */
@@ -117,17 +121,15 @@ SEAMCL_INLINE float subpixel_y(float y, float inv_w, __constant FrameParams* fra
   return sy * (float)SEAMCL_SUBPIXEL_ONE;
 }
 
-/* Setup of one screen triangle from three clip-space vertices; empty if culled. */
-SEAMCL_INLINE TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, ClipVertex c2, uint face,
-                                           __constant FrameParams* frame) {
-  ClipVertex c[3] = {c0, c1, c2};
-  long X[3], Y[3];
-  float inv_w[3];
-  for (int i = 0; i < 3; ++i) {
-    inv_w[i] = 1.0f / c[i].w;
-    X[i] = (long)rint(subpixel_x(c[i].x, inv_w[i], frame));
-    Y[i] = (long)rint(subpixel_y(c[i].y, inv_w[i], frame));
-  }
+/* Setup of one screen triangle from its snapped vertices (X, Y in 1/SEAMCL_SUBPIXEL_ONE pixels),
+ * their 1/w and uv; empty if culled. The early cull's survivors come here with the vertices it
+ * snapped; setup_screen_triangle snaps clipped ones the same way. */
+SEAMCL_INLINE TriangleSetup setup_snapped_triangle(long X0, long Y0, long X1, long Y1, long X2, long Y2, float inv_w0,
+                                                   float inv_w1, float inv_w2, float u0, float v0, float u1, float v1,
+                                                   float u2, float v2, uint face, __constant FrameParams* frame) {
+  long X[3] = {X0, X1, X2}, Y[3] = {Y0, Y1, Y2};
+  float inv_w[3] = {inv_w0, inv_w1, inv_w2};
+  float u[3] = {u0, u1, u2}, v[3] = {v0, v1, v2};
   long area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
   /* Counter-clockwise in NDC (y up) is clockwise on screen (y down): negative area. */
   if (area2 >= 0) return empty_setup(face);
@@ -136,7 +138,8 @@ SEAMCL_INLINE TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, 
     long tx = X[1]; X[1] = X[2]; X[2] = tx;
     long ty = Y[1]; Y[1] = Y[2]; Y[2] = ty;
     float tw = inv_w[1]; inv_w[1] = inv_w[2]; inv_w[2] = tw;
-    ClipVertex tc = c[1]; c[1] = c[2]; c[2] = tc;
+    float tu = u[1]; u[1] = u[2]; u[2] = tu;
+    float tv = v[1]; v[1] = v[2]; v[2] = tv;
     area2 = -area2;
   }
   TriangleSetup s;
@@ -174,8 +177,8 @@ SEAMCL_INLINE TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, 
   float attr[3][3];
   for (int i = 0; i < 3; ++i) {
     attr[0][i] = inv_w[i];
-    attr[1][i] = c[i].u * inv_w[i];
-    attr[2][i] = c[i].v * inv_w[i];
+    attr[1][i] = u[i] * inv_w[i];
+    attr[2][i] = v[i] * inv_w[i];
   }
   float plane[3][3];
   for (int k = 0; k < 3; ++k) {
@@ -191,6 +194,21 @@ SEAMCL_INLINE TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, 
     s.v_over_w[i] = plane[2][i];
   }
   return s;
+}
+
+/* Setup of one screen triangle from three clip-space vertices; empty if culled. */
+SEAMCL_INLINE TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, ClipVertex c2, uint face,
+                                                  __constant FrameParams* frame) {
+  const ClipVertex c[3] = {c0, c1, c2};
+  long X[3], Y[3];
+  float inv_w[3];
+  for (int i = 0; i < 3; ++i) {
+    inv_w[i] = 1.0f / c[i].w;
+    X[i] = (long)rint(subpixel_x(c[i].x, inv_w[i], frame));
+    Y[i] = (long)rint(subpixel_y(c[i].y, inv_w[i], frame));
+  }
+  return setup_snapped_triangle(X[0], Y[0], X[1], Y[1], X[2], Y[2], inv_w[0], inv_w[1], inv_w[2], c[0].u, c[0].v,
+                                c[1].u, c[1].v, c[2].u, c[2].v, face, frame);
 }
 
 /* Clips the triangle polygon[0..2] (clip space, with uv) against the five planes and writes the
@@ -276,13 +294,22 @@ SEAMCL_INLINE uint setup_input_triangle(__constant FrameParams* frame, __global 
   return visible;
 }
 
+/* What the early cull learns of a triangle, for the full setup of a survivor that needs no
+ * clipping: its snapped vertices (valid where inside) and their 1/w. */
+typedef struct {
+  int inside; /* all three vertices inside the near plane and the guard band */
+  int X0, Y0, X1, Y1, X2, Y2;
+  float inv_w0, inv_w1, inv_w2;
+} SnappedTriangle;
+
 /* Snapped screen position (1/SEAMCL_SUBPIXEL_ONE pixels) of a world position, for the early cull;
  * *inside &= whether it lies inside the near plane and the guard band. The clip transform, the five
  * plane tests (clip_distance's, spelled out, without its switch) and the
  * rounding are those of setup_input_triangle and setup_screen_triangle, so the early cull sees the
  * vertices setup snaps. Outside the planes (or NaN) the position is 0 and unused. p: x, y, z (read as
  * floats). */
-SEAMCL_INLINE void cull_vertex(__constant FrameParams* frame, __global const float* p, int* inside, int* X, int* Y) {
+SEAMCL_INLINE void cull_vertex(__constant FrameParams* frame, __global const float* p, int* inside, int* X, int* Y,
+                               float* inv_w_out) {
   const __constant float* m = frame->view_proj;
   const float x = m[0] * p[0] + m[4] * p[1] + m[8] * p[2] + m[12];
   const float y = m[1] * p[0] + m[5] * p[1] + m[9] * p[2] + m[13];
@@ -295,6 +322,7 @@ SEAMCL_INLINE void cull_vertex(__constant FrameParams* frame, __global const flo
    * snapped coordinates lie in [-W, 2W] pixels: 25 bits. */
   *X = in ? (int)__builtin_rintf(subpixel_x(x, inv_w, frame)) : 0;
   *Y = in ? (int)__builtin_rintf(subpixel_y(y, inv_w, frame)) : 0;
+  *inv_w_out = inv_w;
 }
 
 /* Whether input triangle t may leave a visible slot: 0 only where setup_input_triangle would cull
@@ -303,17 +331,20 @@ SEAMCL_INLINE void cull_vertex(__constant FrameParams* frame, __global const flo
  * side, where no sample lies. Others (clipped ones too) return 1 and the full setup decides.
  * Straight-line code over a few loads: on paper at 99,037 faces a setup that stops here for every
  * triangle took under 1 ms for 198,074 triangles (PoCL does not vectorise it: a few
- * scalar operations per vertex). */
+ * scalar operations per vertex). *v receives the snapped vertices, their 1/w and whether all three
+ * lie inside the planes, for the full setup. */
 SEAMCL_INLINE int setup_may_be_visible(__constant FrameParams* frame, __global const float4* positions,
-                                       __global const FaceGpu* faces, int t) {
+                                       __global const FaceGpu* faces, int t, SnappedTriangle* v) {
   __global const FaceGpu* face = faces + t / 2;
   const int odd = t & 1;
   int inside = 1;
   int X0, Y0, X1, Y1, X2, Y2;
   __global const float* xyzw = (__global const float*)positions;
-  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[0], &inside, &X0, &Y0);
-  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[odd ? 2 : 1], &inside, &X1, &Y1);
-  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[odd ? 3 : 2], &inside, &X2, &Y2);
+  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[0], &inside, &X0, &Y0, &v->inv_w0);
+  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[odd ? 2 : 1], &inside, &X1, &Y1, &v->inv_w1);
+  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[odd ? 3 : 2], &inside, &X2, &Y2, &v->inv_w2);
+  v->X0 = X0; v->Y0 = Y0; v->X1 = X1; v->Y1 = Y1; v->X2 = X2; v->Y2 = Y2;
+  v->inside = inside;
   const long area2 = (long)(X1 - X0) * (long)(Y2 - Y0) - (long)(Y1 - Y0) * (long)(X2 - X0);
   /* Samples of pixel p lie in [p*ONE, p*ONE + ONE - 16]. */
   const int last_x = (frame->width - 1) * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE - 16;
@@ -326,18 +357,32 @@ SEAMCL_INLINE int setup_may_be_visible(__constant FrameParams* frame, __global c
 __kernel __attribute__((reqd_work_group_size(SEAMCL_SETUP_GROUP, 1, 1)))
 void triangle_setup(__constant FrameParams* frame, __global const float4* positions, __global const FaceGpu* faces,
                     __global TriangleSetup* out, __global uint* slot_counts, __global FrameStats* stats) {
-  /* Visible slots are summed per work-group, without atomics: a locked add per triangle waits
-   * for the triangle's record stores to drain, and cost a quarter of this stage. */
+  /* Visible slots and early-culled triangles are summed per work-group, without atomics: a locked
+   * add per triangle waits for the triangle's record stores to drain, and cost a quarter of this
+   * stage. */
   __local uint group_visible[SEAMCL_SETUP_GROUP];
+  __local uint group_early_culled[SEAMCL_SETUP_GROUP];
   const int t = (int)get_global_id(0);
   const int in_range = t < frame->input_triangles;
   /* The early cull runs in a work-item loop of its own (PoCL splits the loop at a barrier); the
    * full setup, branchy and heavy on private arrays, then runs for the survivors only (about half
    * of a closed mesh's triangles are back faces). */
-  const int may_be_visible = in_range && setup_may_be_visible(frame, positions, faces, t);
+  SnappedTriangle snapped = {0, 0, 0, 0, 0, 0, 0, 0.0f, 0.0f, 0.0f};
+  const int may_be_visible = in_range && setup_may_be_visible(frame, positions, faces, t, &snapped);
+  group_early_culled[get_local_id(0)] = in_range && !may_be_visible;
   barrier(CLK_LOCAL_MEM_FENCE);
   uint visible = 0;
-  if (may_be_visible) {
+  if (may_be_visible && snapped.inside) {
+    /* setup_input_triangle's path for triangles inside all planes, from the cull's snapped
+     * vertices (corner uv: t even takes corners 0, 1, 2, odd 0, 2, 3). */
+    const int odd = t & 1;
+    const TriangleSetup s = setup_snapped_triangle(
+        snapped.X0, snapped.Y0, snapped.X1, snapped.Y1, snapped.X2, snapped.Y2, snapped.inv_w0, snapped.inv_w1,
+        snapped.inv_w2, 0.0f, 0.0f, 1.0f, odd ? 1.0f : 0.0f, odd ? 0.0f : 1.0f, 1.0f, (uint)(t / 2), frame);
+    visible = s.bbox_max_x >= s.bbox_min_x && s.bbox_max_y >= s.bbox_min_y;
+    if (visible) out[t] = s; /* slot 0 */
+    slot_counts[t] = visible;
+  } else if (may_be_visible) {
     visible = setup_input_triangle(frame, positions, faces, out, slot_counts, t);
   } else if (in_range) {
     slot_counts[t] = 0;
@@ -345,8 +390,12 @@ void triangle_setup(__constant FrameParams* frame, __global const float4* positi
   group_visible[get_local_id(0)] = visible;
   barrier(CLK_LOCAL_MEM_FENCE);
   if (get_local_id(0) == 0) {
-    uint sum = 0;
-    for (int i = 0; i < SEAMCL_SETUP_GROUP; ++i) sum += group_visible[i];
+    uint sum = 0, culled = 0;
+    for (int i = 0; i < SEAMCL_SETUP_GROUP; ++i) {
+      sum += group_visible[i];
+      culled += group_early_culled[i];
+    }
     if (sum > 0) atomic_add(&stats->visible_triangles, sum);
+    if (culled > 0) atomic_add(&stats->early_culled, culled);
   }
 }

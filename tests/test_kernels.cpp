@@ -336,6 +336,17 @@ TEST(KernelVsTwin, EarlyCullKeepsEveryTriangleTheFullSetupKeeps) {
       // the random quads keeps 53 slots, the paper scenes thousands).
       EXPECT_GT(visible, 40u);
       EXPECT_GT(empty_first_slots, 100u);
+      // The early cull must fire, on exactly the triangles its rule names (the twin counts them
+      // from its own snapped vertices): else the checks above would pass with it switched off.
+      const size_t early_culled = early_culled_reference(renderer.packed_scene(), frame);
+      EXPECT_EQ(result.stats.early_culled, early_culled);
+      EXPECT_LE(early_culled, size_t{empty_first_slots});  // it stops only triangles setup empties
+      if (name != "small random quads") {
+        // Half the paper's triangles face away, and the cull stops those that need no clipping.
+        EXPECT_GT(early_culled * 3, static_cast<size_t>(frame.input_triangles)) << early_culled;
+      } else {
+        EXPECT_GT(early_culled, 100u);
+      }
     }
   }
 }

@@ -135,10 +135,10 @@ std::vector<uint32_t> run_raster_kernel(const std::vector<TriangleSetup>& setups
   kernel.setArg(4, list_buffer);
   kernel.setArg(5, rows_buffer);
   kernel.setArg(6, winners);
-  // The renderer's launch: one work-item per tile row.
+  // The renderer's launch: one work-item per tile.
   queue.enqueueNDRangeKernel(kernel, cl::NullRange,
-                             cl::NDRange(static_cast<size_t>(frame.tiles_x), static_cast<size_t>(frame.tiles_y) * SEAMCL_TILE_SIZE),
-                             cl::NDRange(1, SEAMCL_TILE_SIZE));
+                             cl::NDRange(static_cast<size_t>(frame.tiles_x), static_cast<size_t>(frame.tiles_y)),
+                             cl::NDRange(1, 1));
   std::vector<uint32_t> out(samples);
   queue.enqueueReadBuffer(winners, CL_TRUE, 0, samples * sizeof(cl_uint), out.data());
   return out;

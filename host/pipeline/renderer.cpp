@@ -281,10 +281,10 @@ struct Renderer::Impl {
     raster_kernel.setArg(4, tile_lists);
     raster_kernel.setArg(5, tile_entry_rows);
     raster_kernel.setArg(6, sample_triangle);
-    // One work-item per tile row (kernels/raster.cl keeps a row in a 16-wide vector).
+    // One work-item per tile (kernels/raster.cl walks a tile's list once, a row in a 16-wide vector).
     queue.enqueueNDRangeKernel(raster_kernel, cl::NullRange,
-                               cl::NDRange(static_cast<size_t>(p.tiles_x), static_cast<size_t>(p.tiles_y) * SEAMCL_TILE_SIZE),
-                               cl::NDRange(1, SEAMCL_TILE_SIZE), nullptr, next(ev.raster));
+                               cl::NDRange(static_cast<size_t>(p.tiles_x), static_cast<size_t>(p.tiles_y)),
+                               cl::NDRange(1, 1), nullptr, next(ev.raster));
 
     shade_kernel.setArg(0, frame_params);
     shade_kernel.setArg(1, setups);

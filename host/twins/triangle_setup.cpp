@@ -106,7 +106,48 @@ TriangleSetup setup_screen_triangle(std::array<ClipVertex, 3> c, uint32_t face, 
   return s;
 }
 
+// Clip-space vertex i (0..2) of input triangle t (face t/2; t even: quad corners 0,1,2, odd: 0,2,3).
+ClipVertex input_vertex(const PackedScene& scene, const FrameParams& f, int t, int i) {
+  constexpr float corner_u[4] = {0, 1, 1, 0};
+  constexpr float corner_v[4] = {0, 0, 1, 1};
+  const FaceGpu& face = scene.faces.at(static_cast<size_t>(t / 2));
+  const int corner = i == 0 ? 0 : (t & 1) ? i + 1 : i;
+  const cl_float4& p = scene.positions.at(face.vertex[corner]);
+  const float* m = f.view_proj;
+  const float px = p.s[0], py = p.s[1], pz = p.s[2];
+  return {m[0] * px + m[4] * py + m[8] * pz + m[12], m[1] * px + m[5] * py + m[9] * pz + m[13],
+          m[3] * px + m[7] * py + m[11] * pz + m[15], corner_u[corner], corner_v[corner]};
+}
+
 }  // namespace
+
+size_t early_culled_reference(const PackedScene& scene, const FrameParams& f) {
+  constexpr int64_t one = SEAMCL_SUBPIXEL_ONE;
+  // Samples of pixel p lie in [p*one, p*one + one - 16].
+  const int64_t last_x = (f.width - 1) * one + one - 16, last_y = (f.height - 1) * one + one - 16;
+  size_t culled = 0;
+  for (int t = 0; t < f.input_triangles; ++t) {
+    bool inside = true;
+    std::array<int64_t, 3> X{}, Y{};
+    for (int i = 0; i < 3; ++i) {
+      const ClipVertex c = input_vertex(scene, f, t, i);
+      for (int plane = 0; plane < 5; ++plane) inside &= clip_distance(c, plane, f) >= 0.0f;
+      // setup_screen_triangle's snapping
+      const float inv_w = 1.0f / c.w;
+      const float sx = (c.x * inv_w * 0.5f + 0.5f) * static_cast<float>(f.width);
+      const float sy = (0.5f - c.y * inv_w * 0.5f) * static_cast<float>(f.height);
+      X[i] = static_cast<int64_t>(std::rint(sx * static_cast<float>(one)));
+      Y[i] = static_cast<int64_t>(std::rint(sy * static_cast<float>(one)));
+    }
+    if (!inside) continue;  // clipped triangles go to the full setup
+    const int64_t area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
+    const auto all = [](const std::array<int64_t, 3>& v, auto past) { return past(v[0]) && past(v[1]) && past(v[2]); };
+    const bool off_image = all(X, [](int64_t v) { return v < 0; }) || all(Y, [](int64_t v) { return v < 0; }) ||
+                           all(X, [&](int64_t v) { return v > last_x; }) || all(Y, [&](int64_t v) { return v > last_y; });
+    culled += area2 >= 0 || off_image;
+  }
+  return culled;
+}
 
 bool box_holds_sample(int64_t min_x, int64_t max_x, int64_t min_y, int64_t max_y, const FrameParams& f) {
   constexpr int64_t one = SEAMCL_SUBPIXEL_ONE;
@@ -125,20 +166,10 @@ bool box_holds_sample(int64_t min_x, int64_t max_x, int64_t min_y, int64_t max_y
 std::vector<TriangleSetup> setup_triangles_reference(const PackedScene& scene, const FrameParams& f, bool cull_sampleless) {
   std::vector<TriangleSetup> out;
   out.reserve(static_cast<size_t>(f.input_triangles) * SEAMCL_CLIP_SLOTS);
-  constexpr float corner_u[4] = {0, 1, 1, 0};
-  constexpr float corner_v[4] = {0, 0, 1, 1};
   for (int t = 0; t < f.input_triangles; ++t) {
     const uint32_t face_index = static_cast<uint32_t>(t / 2);
-    const FaceGpu& face = scene.faces.at(face_index);
-    const int corner[3] = {0, (t & 1) ? 2 : 1, (t & 1) ? 3 : 2};
     std::vector<ClipVertex> polygon;
-    for (int i = 0; i < 3; ++i) {
-      const cl_float4& p = scene.positions.at(face.vertex[corner[i]]);
-      const float* m = f.view_proj;
-      const float px = p.s[0], py = p.s[1], pz = p.s[2];
-      polygon.push_back({m[0] * px + m[4] * py + m[8] * pz + m[12], m[1] * px + m[5] * py + m[9] * pz + m[13],
-                         m[3] * px + m[7] * py + m[11] * pz + m[15], corner_u[corner[i]], corner_v[corner[i]]});
-    }
+    for (int i = 0; i < 3; ++i) polygon.push_back(input_vertex(scene, f, t, i));
     // Sutherland-Hodgman against the near plane and the guard band.
     for (int plane = 0; plane < 5 && !polygon.empty(); ++plane) {
       std::vector<float> d;

@@ -1,6 +1,7 @@
 // Scalar twin of kernels/triangle_setup.cl: the same clipping, snapping, culling, edge functions
 // and attribute planes, one triangle at a time.
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -15,6 +16,11 @@ namespace seamcl {
 // test that they cover none.
 std::vector<TriangleSetup> setup_triangles_reference(const PackedScene& scene, const FrameParams& frame,
                                                      bool cull_sampleless = true);
+
+// How many input triangles triangle_setup.cl's early cull (setup_may_be_visible) stops before the
+// full setup: those inside the near plane and the guard band whose snapped vertices face away,
+// have zero area, or lie all past one image side. FrameStats.early_culled must equal it.
+size_t early_culled_reference(const PackedScene& scene, const FrameParams& frame);
 
 // Whether the fixed-point box [min_x, max_x] x [min_y, max_y] holds a position of one of the
 // frame's samples (sample_count's pattern) in the image: setup culls triangles whose box holds none.
