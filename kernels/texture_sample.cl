@@ -438,23 +438,22 @@ SEAMCL_INLINE FilterSum filter_texture(const FaceGpu* face, __global const uint*
   return sum;
 }
 
-/* Whether any tap of face `other` can weigh anything in a lookup (derivatives in this face's uv)
- * whose point must travel at least distance_u along u and distance_v along v (uv, this face's
+/* Whether any tap of a face whose shorter side is min_side texels and longer max_side (or of any
+ * face no shorter and of no larger aspect: the bound only grows as min_side shrinks and max_side /
+ * min_side grows) can weigh anything in a lookup (derivatives in this face's uv) whose point must travel at least distance_u along u and distance_v along v (uv, this face's
  * frame; a negative distance never decides) to reach the other face's square. Conservative: a
  * neighbour it rules out would add exactly nothing, so skipping it changes no bit of the result;
  * it spares interior lookups the neighbours' filters, with no division (the sides are powers of
  * two, so multiplying by them is exact). The bound, term by term, is argued in the twin
  * (host/twins/texture_sample.cpp, neighbor_may_contribute). */
-SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, int max_aniso, float distance_u,
-                                          float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
+SEAMCL_INLINE int sides_may_contribute(float min_side, float max_side, int filter, int max_aniso, float distance_u,
+                                       float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
   const float axis_x = fabs(dudx) + fabs(dvdx);
   const float axis_y = fabs(dudy) + fabs(dvdy);
   const float axes = axis_x + axis_y;
   if (!(axes < INFINITY)) return 1;
   const float longest = fmax(axis_x, axis_y);
   const float shortest = fmin(axis_x, axis_y);
-  const float min_side = (float)min(other->width, other->height);
-  const float max_side = (float)max(other->width, other->height);
   const float probe_axis = filter == SEAMCL_FILTER_ANISO ? fmax(shortest, longest / (float)max_aniso) : longest;
   /* texel * min_side */
   const float texel_sides = filter == SEAMCL_FILTER_BILINEAR ? 1.0f
@@ -467,8 +466,15 @@ SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, int 
   const float texel_reach = texel_sides * ((filter == SEAMCL_FILTER_EWA ? 1.0f : TAP_REACH_TEXELS) + (float)GUARD);
   const float counted_u = distance_u > 2.0f ? 2.0f : distance_u;
   const float counted_v = distance_v > 2.0f ? 2.0f : distance_v;
-  return !(counted_u * min_side >= spread_u * min_side + texel_reach ||
-           counted_v * min_side >= spread_v * min_side + texel_reach);
+  /* min_side 0: sides not known (an unfilled edge record): never rules out. */
+  return !(min_side > 0.0f && (counted_u * min_side >= spread_u * min_side + texel_reach ||
+                               counted_v * min_side >= spread_v * min_side + texel_reach));
+}
+
+SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, int max_aniso, float distance_u,
+                                          float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
+  return sides_may_contribute((float)min(other->width, other->height), (float)max(other->width, other->height), filter,
+                              max_aniso, distance_u, distance_v, dudx, dvdx, dudy, dvdy);
 }
 
 /* The same filter, border-addressed, on face `other` at this lookup's point and footprint carried
@@ -536,15 +542,31 @@ SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* 
   /* How far the point lies inside each edge: the least distance to the face across it, along v
    * (edges 0 and 2) or u (1 and 3); the other axis never decides (-1). */
   const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
+  /* First, from this face's record alone, whether the lookup lies too far inside edge k for any
+   * face across it or past its ends (the sides stored per edge bound theirs: the smallest min
+   * side and the largest aspect give the largest reach), so that an interior lookup decides with
+   * four tests and reads no other face's record. A bit set: edge k may reach something. */
+  const int early_out = SEAMCL_TRAVERSE_EARLY_OUT;
+  int edge_may_reach = 0;
   for (int k = 0; k < 4; ++k) {
+    const int along_v = (k & 1) == 0;
+    const int may = !early_out || sides_may_contribute(n->reach_min_side[k], n->reach_max_side[k], filter, max_aniso,
+                                                       along_v ? -1.0f : inside[k], along_v ? inside[k] : -1.0f,
+                                                       dudx, dvdx, dudy, dvdy);
+    edge_may_reach |= may << k;
+  }
+  if (edge_may_reach == 0) return;
+  for (int k = 0; k < 4; ++k) {
+    if (((edge_may_reach >> k) & 1) == 0) continue;
     const int along_v = (k & 1) == 0;
     accumulate_across(sum, faces, n->neighbor[k], n->transform[k], along_v ? -1.0f : inside[k],
                       along_v ? inside[k] : -1.0f, level_offsets, texels, srgb_to_linear, filter, max_aniso, u, v,
                       dudx, dvdx, dudy, dvdy);
   }
   if (!corners) return;
-  /* Corner k lies between edges k-1 and k: past both. */
+  /* Corner k lies between edges k-1 and k: past both; either edge's test rules it out. */
   for (int k = 0; k < 4; ++k) {
+    if (((edge_may_reach >> k) & (edge_may_reach >> ((k + 3) & 3)) & 1) == 0) continue;
     const float a = inside[(k + 3) & 3], b = inside[k];
     const int b_along_v = (k & 1) == 0;
     accumulate_across(sum, faces, n->corner[k], n->corner_transform[k], b_along_v ? a : b, b_along_v ? b : a,

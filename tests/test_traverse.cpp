@@ -446,6 +446,98 @@ TEST(Traverse, ReachTestSkipsOnlyNeighboursThatWouldAddNothing) {
   EXPECT_GT(reaching, kept / 2) << "kept " << kept << " reaching " << reaching;
 }
 
+TEST(Traverse, EdgeReachTestSkipsOnlyFacesThatWouldAddNothing) {
+  // edges_may_reach decides from the lookup's own FaceNeighbors record (the sides pack_scene
+  // stores per edge) whether a face across edge k or past its ends can be reached; a clear bit
+  // skips those three faces unread. Each face it skips must be one neighbor_may_contribute skips
+  // too (the stored sides bound every face's) and must weigh exactly zero. Faces of mixed sizes
+  // (1x1 to 256x256, non-square), valence 3, 4 and 5, every filter.
+  Scene prism = seamcl_tests::split_pentagonal_prism();
+  seamcl_tests::set_textures(prism, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+  Scene cube = seamcl_tests::subdivided_cube(2);
+  seamcl_tests::set_textures(cube, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+  for (const Scene* scene : {&prism, &cube}) {
+    const PackedScene packed = pack_scene(*scene, TexelFormat::Rgba32f);
+    const TextureView view = packed.textures();
+    const std::vector<Lookup> lookups = lookups_near_edges(scene->faces.size(), 20000, 12);
+    std::mt19937 rng(13);
+    size_t edges_skipped = 0, edges_kept = 0, interior_decided = 0, interior = 0;
+    for (const Lookup& l : lookups) {
+      const Filter filter = static_cast<Filter>(rng() % 4);
+      const SamplerParams sampler =
+          sampler_params(Method::Traverse, filter, 1 + static_cast<int>(rng() % 16), ZeroCoverage::Clamp);
+      const FaceNeighbors& n = packed.neighbors[l.face];
+      const int mask = edges_may_reach(n, sampler.filter, sampler.max_aniso, 0, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+      const bool inside_face = l.u > 0.1f && l.u < 0.9f && l.v > 0.1f && l.v < 0.9f;
+      interior += inside_face;
+      interior_decided += inside_face && mask == 0;
+      const float inside[4] = {l.v, 1.0f - l.u, 1.0f - l.v, l.u};
+      for (int k = 0; k < 4; ++k) {
+        if ((mask >> k) & 1) {
+          ++edges_kept;
+          continue;
+        }
+        ++edges_skipped;
+        // The neighbour across edge k, and the diagonal faces past its ends (corners k and k + 1).
+        for (int j : {k, 4 + k, 4 + (k + 1) % 4}) {
+          const int c = j % 4;
+          const int other = j < 4 ? n.neighbor[c] : n.corner[c];
+          if (other < 0) continue;
+          const bool c_along_v = c % 2 == 0;
+          const float a = j < 4 ? -1.0f : inside[(c + 3) % 4], b = inside[c];
+          ASSERT_FALSE(neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], sampler.filter,
+                                               sampler.max_aniso, 0, c_along_v ? a : b, c_along_v ? b : a, l.dudx,
+                                               l.dvdx, l.dudy, l.dvdy))
+              << "edge " << k << " skips face " << other << " that the per-face test keeps";
+          const UvMap map = uv_map(j < 4 ? n.transform[c] : n.corner_transform[c]);
+          const glm::vec2 p = map.point({l.u, l.v}), dx = map.direction({l.dudx, l.dvdx}),
+                          dy = map.direction({l.dudy, l.dvdy});
+          const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler,
+                                                       SEAMCL_ADDRESS_BORDER, p.x, p.y, dx.x, dx.y, dy.x, dy.y);
+          ASSERT_TRUE(same_bits(s, FilterSum{})) << "a skipped face adds weight " << s.weight;
+        }
+      }
+    }
+    // Not vacuous: most edges of these lookups, and most lookups well inside, decide here.
+    EXPECT_GT(edges_skipped, edges_kept);
+    EXPECT_GT(interior_decided, interior / 2) << interior_decided << " of " << interior;
+  }
+}
+
+TEST(Traverse, EdgeReachRecordsBoundTheFacesAround) {
+  // pack_scene fills reach_min_side / reach_max_side per edge from the faces across it and past
+  // its ends: the smallest shorter side, and that times the largest aspect; an edge with no face
+  // around keeps 0, and a record of zeros rules nothing out.
+  Scene prism = seamcl_tests::split_pentagonal_prism();
+  seamcl_tests::set_textures(prism, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+  const PackedScene packed = pack_scene(prism, TexelFormat::Rgba32f);
+  size_t filled = 0;
+  for (size_t f = 0; f < packed.neighbors.size(); ++f) {
+    const FaceNeighbors& n = packed.neighbors[f];
+    for (int k = 0; k < 4; ++k) {
+      float min_side = 0.0f, aspect = 0.0f;
+      for (int other : {n.neighbor[k], n.corner[k], n.corner[(k + 1) % 4]}) {
+        if (other < 0) continue;
+        const FaceGpu& g = packed.faces[static_cast<size_t>(other)];
+        const float shorter = static_cast<float>(std::min(g.width, g.height));
+        min_side = min_side == 0.0f ? shorter : std::min(min_side, shorter);
+        aspect = std::max(aspect, static_cast<float>(std::max(g.width, g.height)) / shorter);
+      }
+      EXPECT_EQ(n.reach_min_side[k], min_side) << "face " << f << " edge " << k;
+      EXPECT_EQ(n.reach_max_side[k], min_side * aspect) << "face " << f << " edge " << k;
+      filled += min_side > 0.0f;
+    }
+  }
+  EXPECT_GT(filled, packed.neighbors.size() * 3);
+  FaceNeighbors unfilled{};
+  for (int k = 0; k < 4; ++k) unfilled.neighbor[k] = unfilled.corner[k] = -1;
+  for (Filter filter : {Filter::Bilinear, Filter::Trilinear, Filter::Aniso, Filter::Ewa}) {
+    EXPECT_EQ(edges_may_reach(unfilled, sampler_params(Method::Traverse, filter, 16, ZeroCoverage::Clamp).filter, 16, 0,
+                              0.5f, 0.5f, 1e-4f, 0.0f, 0.0f, 1e-4f),
+              15);
+  }
+}
+
 TEST(Traverse, EarlyOutsChangeNoBitOfTheTwin) {
   // The twin's traverse with its early-outs (neighbor_may_contribute, lookup_may_reach_face)
   // and without them, on faces of mixed sizes (valence 3, 4, 5) and on paper: the same bits.

@@ -149,6 +149,31 @@ void pack_banded_deferred(const Scene& scene, PackedScene& out, const std::vecto
 
 }  // namespace
 
+void fill_edge_reach(const std::vector<FaceGpu>& faces, std::vector<FaceNeighbors>& neighbors) {
+  for (FaceNeighbors& n : neighbors) {
+    for (int k = 0; k < 4; ++k) {
+      // The faces a lookup reaches across edge k: the neighbour and the diagonal faces past its ends.
+      const int across[3] = {n.neighbor[k], n.corner[k], n.corner[(k + 1) % 4]};
+      float min_side = 0.0f, aspect = 0.0f;
+      for (int other : across) {
+        if (other < 0 || static_cast<size_t>(other) >= faces.size()) continue;
+        const FaceGpu& g = faces[static_cast<size_t>(other)];
+        const float shorter = static_cast<float>(std::min(g.width, g.height));
+        const float longer = static_cast<float>(std::max(g.width, g.height));
+        if (!(shorter >= 1.0f)) {  // not a valid face: leave the edge unfilled (never skips)
+          min_side = 0.0f;
+          aspect = 0.0f;
+          break;
+        }
+        min_side = min_side == 0.0f ? shorter : std::min(min_side, shorter);
+        aspect = std::max(aspect, longer / shorter);  // powers of two: exact
+      }
+      n.reach_min_side[k] = min_side;
+      n.reach_max_side[k] = min_side * aspect;  // powers of two: exact
+    }
+  }
+}
+
 PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
   if (guard_band < 0 || guard_band > kMaxGuardBand) throw std::invalid_argument("guard band out of range");
   PackedScene out;
@@ -190,6 +215,7 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
     out.faces.push_back(gpu);
   }
   if (texels != stored_texels) throw std::logic_error("pack_scene: level sizes disagree with packed_texture_memory");
+  fill_edge_reach(out.faces, out.neighbors);
   // ... then the texels, faces in parallel, each into its own range: exactly sized up front.
   if (format == TexelFormat::Rgba8) {
     out.texels8.resize(stored_texels);

@@ -305,8 +305,8 @@ FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, 
   return sum;
 }
 
-bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, int guard_band, float distance_u,
-                             float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
+bool sides_may_contribute(float min_side, float max_side, int filter, int max_aniso, int guard_band, float distance_u,
+                          float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
   // Footprint axes by their 1-norms in uv: no shorter than their lengths, and kept by the maps
   // between faces (which only permute and negate u and v).
   const float axis_x = std::fabs(dudx) + std::fabs(dvdx);
@@ -316,8 +316,6 @@ bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, in
   if (!(axes < INFINITY)) return true;
   const float longest = std::fmax(axis_x, axis_y);
   const float shortest = std::fmin(axis_x, axis_y);
-  const float min_side = static_cast<float>(std::min(other.width, other.height));
-  const float max_side = static_cast<float>(std::max(other.width, other.height));
   // A tap weighs something only within half a texel of its probe (kTapReachTexels). The coarsest texel the other
   // face's filter can weigh (uv): bilinear reads level 0; the others a trilinear pair at lod (at
   // least 0) and the next level, whose texels are up to twice 2^lod level-0 texels (2.01:
@@ -347,8 +345,32 @@ bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, in
   // beyond 2. A NaN distance is never skipped.
   const float counted_u = distance_u > 2.0f ? 2.0f : distance_u;
   const float counted_v = distance_v > 2.0f ? 2.0f : distance_v;
-  return !(counted_u * min_side >= spread_u * min_side + texel_reach ||
-           counted_v * min_side >= spread_v * min_side + texel_reach);
+  // Every term grows as min_side shrinks or max_side / min_side grows (and rounding keeps that
+  // order: each step is monotone), so sides that bound several faces' bound each of them.
+  // min_side 0: sides not known (an unfilled FaceNeighbors edge record): never rules out.
+  return !(min_side > 0.0f && (counted_u * min_side >= spread_u * min_side + texel_reach ||
+                               counted_v * min_side >= spread_v * min_side + texel_reach));
+}
+
+bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, int guard_band, float distance_u,
+                             float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
+  return sides_may_contribute(static_cast<float>(std::min(other.width, other.height)),
+                              static_cast<float>(std::max(other.width, other.height)), filter, max_aniso, guard_band,
+                              distance_u, distance_v, dudx, dvdx, dudy, dvdy);
+}
+
+int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, int guard_band, float u, float v, float dudx,
+                    float dvdx, float dudy, float dvdy) {
+  const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
+  int mask = 0;
+  for (int k = 0; k < 4; ++k) {
+    const bool along_v = k % 2 == 0;
+    const bool may = sides_may_contribute(n.reach_min_side[k], n.reach_max_side[k], filter, max_aniso, guard_band,
+                                          along_v ? -1.0f : inside[k], along_v ? inside[k] : -1.0f, dudx, dvdx, dudy,
+                                          dvdy);
+    mask |= (may ? 1 : 0) << k;
+  }
+  return mask;
 }
 
 bool lookup_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float u, float v, float dudx,
@@ -401,13 +423,20 @@ FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const Samp
   // (edges 0 and 2) or u (1 and 3); the other axis never decides (-1).
   const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
   const FaceNeighbors& n = tex.neighbors->at(face);
+  // First, from this face's record alone, the edges whose faces (across and past the ends) the
+  // lookup may reach: the others' three faces are not read at all.
+  const int edge_may_reach =
+      early_out ? edges_may_reach(n, sampler.filter, sampler.max_aniso, tex.guard_band, u, v, dudx, dvdx, dudy, dvdy) : 15;
   for (int k = 0; k < 4; ++k) {
+    if (((edge_may_reach >> k) & 1) == 0) continue;
     const bool along_v = k % 2 == 0;
     add_across(n.neighbor[k], n.transform[k], along_v ? -1.0f : inside[k], along_v ? inside[k] : -1.0f);
   }
   if (sampler.traverse != SEAMCL_TRAVERSE_CORNERS) return sum;
   // Past a valence-4 corner, the diagonal face (corner k lies between edges k-1 and k): past both.
   for (int k = 0; k < 4; ++k) {
+    // Corner k lies at the ends of edges k - 1 and k: either edge's test rules it out.
+    if (((edge_may_reach >> k) & (edge_may_reach >> ((k + 3) % 4)) & 1) == 0) continue;
     const float a = inside[(k + 3) % 4], b = inside[k];
     const bool b_along_v = k % 2 == 0;
     add_across(n.corner[k], n.corner_transform[k], b_along_v ? a : b, b_along_v ? b : a);

@@ -24,6 +24,15 @@ FilterSum filter_texture_reference(const TextureView& textures, uint32_t face, c
 // neighbour it rules out would have added exactly nothing. Traverse skips those.
 bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, int guard_band, float distance_u,
                              float distance_v, float dudx, float dvdx, float dudy, float dvdy);
+// The same bound for any face whose shorter side is no less than min_side and whose aspect
+// (longer / shorter) is no more than max_side / min_side; min_side 0 (not known) never rules out.
+bool sides_may_contribute(float min_side, float max_side, int filter, int max_aniso, int guard_band, float distance_u,
+                          float distance_v, float dudx, float dvdx, float dudy, float dvdy);
+// Traverse's first test, from the lookup's own face record alone: bit k set when the lookup may
+// reach a face across edge k or past its two ends (sides_may_contribute with the edge's
+// reach_min_side / reach_max_side); a clear bit skips those three faces unread.
+int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, int guard_band, float u, float v, float dudx,
+                    float dvdx, float dudy, float dvdy);
 // Whether a border-addressed lookup with `filter` on `face` (its own uv and derivatives) can put
 // weight inside it (or in its guard band of `guard_band` texels per level): bilinear, trilinear
 // and aniso test the very probes the filter takes (their line, and a texel of the coarser level
