@@ -256,9 +256,17 @@ SEAMCL_INLINE int probe_reaches_face(float u, float v, float reach_u, float reac
   return !(u + reach_u <= 0.0f || u - reach_u >= 1.0f || v + reach_v <= 0.0f || v - reach_v >= 1.0f);
 }
 
+/* 1 / max(side >> level, 1) for a power-of-two side, made from the exponent rather than divided:
+ * the same bits as the division (both exact), without its latency. (A side that is not a power of
+ * two, which the host never packs, gets 1 / the power of two below it: a larger reach.) */
+SEAMCL_INLINE float inverse_level_side(int side, int level) {
+  const int log2_side = 31 - (int)clz(side);
+  return as_float((127 - max(log2_side - level, 0)) << 23);
+}
+
 SEAMCL_INLINE int probes_reach_face(const FaceGpu* face, int level, float u, float v, float half_u, float half_v) {
-  return probe_reaches_face(u, v, half_u + (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->width >> level, 1),
-                            half_v + (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->height >> level, 1));
+  return probe_reaches_face(u, v, half_u + (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->width, level),
+                            half_v + (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->height, level));
 }
 
 /* The line of trilinear probes an aniso lookup takes, computed once so that the reach test of
@@ -305,8 +313,8 @@ SEAMCL_INLINE void accumulate_probes(FilterSum* sum, const FaceGpu* face, __glob
   float pu = p.first_u;
   float pv = p.first_v;
   const int level = coarser_level(face, p.lod);
-  const float reach_u = (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->width >> level, 1);
-  const float reach_v = (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->height >> level, 1);
+  const float reach_u = (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->width, level);
+  const float reach_v = (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->height, level);
   for (int i = 0; i < p.probes; ++i) {
     if (!SEAMCL_TRAVERSE_EARLY_OUT || address != SEAMCL_ADDRESS_BORDER || probe_reaches_face(pu, pv, reach_u, reach_v)) {
       accumulate_trilinear(sum, face, level_offsets, texels, srgb_to_linear, pu, pv, p.lod, p.weight, address);
