@@ -154,22 +154,31 @@ void fill_edge_reach(const std::vector<FaceGpu>& faces, std::vector<FaceNeighbor
     for (int k = 0; k < 4; ++k) {
       // The faces a lookup reaches across edge k: the neighbour and the diagonal faces past its ends.
       const int across[3] = {n.neighbor[k], n.corner[k], n.corner[(k + 1) % 4]};
-      float min_side = 0.0f, aspect = 0.0f;
-      for (int other : across) {
-        if (other < 0 || static_cast<size_t>(other) >= faces.size()) continue;
-        const FaceGpu& g = faces[static_cast<size_t>(other)];
-        const float shorter = static_cast<float>(std::min(g.width, g.height));
-        const float longer = static_cast<float>(std::max(g.width, g.height));
-        if (!(shorter >= 1.0f)) {  // not a valid face: leave the edge unfilled (never skips)
-          min_side = 0.0f;
-          aspect = 0.0f;
+      const float* maps[3] = {n.transform[k], n.corner_transform[k], n.corner_transform[(k + 1) % 4]};
+      // Edges 0 and 2 are crossed along v, 1 and 3 along u (this face's uv).
+      const bool along_v = k % 2 == 0;
+      float side = 0.0f, ratio = 0.0f;
+      for (int i = 0; i < 3; ++i) {
+        if (across[i] < 0) continue;
+        if (static_cast<size_t>(across[i]) >= faces.size()) {  // not a face: leave the edge unfilled (never skips)
+          side = 0.0f;
           break;
         }
-        min_side = min_side == 0.0f ? shorter : std::min(min_side, shorter);
-        aspect = std::max(aspect, longer / shorter);  // powers of two: exact
+        const FaceGpu& g = faces[static_cast<size_t>(across[i])];
+        // The maps are signed permutations: t0 = 0 when the other face's u runs along this face's v.
+        const bool swapped = maps[i][0] == 0.0f;
+        const float side_u = static_cast<float>(swapped ? g.height : g.width);
+        const float side_v = static_cast<float>(swapped ? g.width : g.height);
+        const float along = along_v ? side_v : side_u, cross = along_v ? side_u : side_v;
+        if (!(along >= 1.0f && cross >= 1.0f)) {  // not a valid size: leave the edge unfilled
+          side = 0.0f;
+          break;
+        }
+        side = side == 0.0f ? along : std::min(side, along);
+        ratio = std::max(ratio, cross / along);  // powers of two: exact
       }
-      n.reach_min_side[k] = min_side;
-      n.reach_max_side[k] = min_side * aspect;  // powers of two: exact
+      n.reach_min_side[k] = side;
+      n.reach_max_side[k] = side * ratio;  // powers of two: exact
     }
   }
 }
