@@ -91,6 +91,16 @@ typedef struct {
   cl_float transform[4][6];
   cl_int corner[4];
   cl_float corner_transform[4][6];
+  /* Traverse's early-out per edge k, filled when the scene is packed (fill_edge_reach): over the
+   * faces a lookup reaches across edge k (neighbor[k]) and past its two ends (corner[k],
+   * corner[(k + 1) & 3]), their sides as they lie in this face's uv (a map may swap u and v):
+   * reach_min_side[k] is the smallest side along the axis that crosses edge k (v for edges 0 and
+   * 2, u for 1 and 3), reach_max_side[k] that times the largest ratio of a face's side along the
+   * other axis to its side along this one (powers of two, exact). A lookup too far inside edge k
+   * for faces of these sides skips all three without reading them (texture_sample.cl,
+   * accumulate_neighbors). 0: not filled, or no such face; never skips. */
+  cl_float reach_min_side[4];
+  cl_float reach_max_side[4];
 } FaceNeighbors;
 
 /* CubeSampler.method: how a cube-map lookup treats its filter taps at the faces' edges. */

@@ -256,9 +256,17 @@ SEAMCL_INLINE int probe_reaches_face(float u, float v, float reach_u, float reac
   return !(u + reach_u <= 0.0f || u - reach_u >= 1.0f || v + reach_v <= 0.0f || v - reach_v >= 1.0f);
 }
 
+/* 1 / max(side >> level, 1) for a power-of-two side, made from the exponent rather than divided:
+ * the same bits as the division (both exact), without its latency. (A side that is not a power of
+ * two, which the host never packs, gets 1 / the power of two below it: a larger reach.) */
+SEAMCL_INLINE float inverse_level_side(int side, int level) {
+  const int log2_side = 31 - (int)clz(side);
+  return as_float((127 - max(log2_side - level, 0)) << 23);
+}
+
 SEAMCL_INLINE int probes_reach_face(const FaceGpu* face, int level, float u, float v, float half_u, float half_v) {
-  return probe_reaches_face(u, v, half_u + (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->width >> level, 1),
-                            half_v + (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->height >> level, 1));
+  return probe_reaches_face(u, v, half_u + (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->width, level),
+                            half_v + (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->height, level));
 }
 
 /* The line of trilinear probes an aniso lookup takes, computed once so that the reach test of
@@ -305,8 +313,8 @@ SEAMCL_INLINE void accumulate_probes(FilterSum* sum, const FaceGpu* face, __glob
   float pu = p.first_u;
   float pv = p.first_v;
   const int level = coarser_level(face, p.lod);
-  const float reach_u = (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->width >> level, 1);
-  const float reach_v = (TAP_REACH_TEXELS + (float)GUARD) / (float)max(face->height >> level, 1);
+  const float reach_u = (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->width, level);
+  const float reach_v = (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->height, level);
   for (int i = 0; i < p.probes; ++i) {
     if (!SEAMCL_TRAVERSE_EARLY_OUT || address != SEAMCL_ADDRESS_BORDER || probe_reaches_face(pu, pv, reach_u, reach_v)) {
       accumulate_trilinear(sum, face, level_offsets, texels, srgb_to_linear, pu, pv, p.lod, p.weight, address);
@@ -438,37 +446,69 @@ SEAMCL_INLINE FilterSum filter_texture(const FaceGpu* face, __global const uint*
   return sum;
 }
 
-/* Whether any tap of face `other` can weigh anything in a lookup (derivatives in this face's uv)
- * whose point must travel at least distance_u along u and distance_v along v (uv, this face's
- * frame; a negative distance never decides) to reach the other face's square. Conservative: a
- * neighbour it rules out would add exactly nothing, so skipping it changes no bit of the result;
- * it spares interior lookups the neighbours' filters, with no division (the sides are powers of
- * two, so multiplying by them is exact). The bound, term by term, is argued in the twin
- * (host/twins/texture_sample.cpp, neighbor_may_contribute). */
-SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int filter, int max_aniso, float distance_u,
-                                          float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
+/* Whether any tap of a face whose shorter side is min_side texels and longer max_side (or of any
+ * face no shorter and of no larger aspect: the bound only grows as min_side shrinks and max_side /
+ * min_side grows) can weigh anything in an EWA lookup (derivatives in this face's uv) whose point
+ * must travel at least distance_u along u and distance_v along v (uv, this face's frame; a
+ * negative distance never decides) to reach the other face's square. Conservative: a neighbour
+ * it rules out would add exactly nothing, so skipping it changes no bit of the result; it spares
+ * interior lookups the neighbours' filters, with no division (the sides are powers of two, so
+ * multiplying by them is exact). The bound, term by term, is argued in the twin
+ * (host/twins/texture_sample.cpp, ewa_sides_may_contribute). min_side 0: never rules out. */
+SEAMCL_INLINE int ewa_sides_may_contribute(float min_side, float max_side, float distance_u, float distance_v,
+                                           float dudx, float dvdx, float dudy, float dvdy) {
   const float axis_x = fabs(dudx) + fabs(dvdx);
   const float axis_y = fabs(dudy) + fabs(dvdy);
   const float axes = axis_x + axis_y;
   if (!(axes < INFINITY)) return 1;
-  const float longest = fmax(axis_x, axis_y);
-  const float shortest = fmin(axis_x, axis_y);
-  const float min_side = (float)min(other->width, other->height);
-  const float max_side = (float)max(other->width, other->height);
-  const float probe_axis = filter == SEAMCL_FILTER_ANISO ? fmax(shortest, longest / (float)max_aniso) : longest;
   /* texel * min_side */
-  const float texel_sides = filter == SEAMCL_FILTER_BILINEAR ? 1.0f
-                                                             : fmin(min_side, fmax(2.0f, 2.01f * max_side * probe_axis));
-  const float spread_u = filter == SEAMCL_FILTER_ANISO ? 0.5f * fmax(fabs(dudx), fabs(dudy))
-                         : filter == SEAMCL_FILTER_EWA ? (1.0f + max_side / min_side) * axes
-                                                       : 0.0f;
-  const float spread_v = filter == SEAMCL_FILTER_ANISO ? 0.5f * fmax(fabs(dvdx), fabs(dvdy)) : spread_u;
-  /* EWA's ellipse is widened by about a texel: it keeps the whole texel of before. */
-  const float texel_reach = texel_sides * ((filter == SEAMCL_FILTER_EWA ? 1.0f : TAP_REACH_TEXELS) + (float)GUARD);
+  const float texel_sides = fmin(min_side, fmax(2.0f, 2.01f * max_side * fmax(axis_x, axis_y)));
+  const float spread = (1.0f + max_side / min_side) * axes;
+  /* The ellipse is widened by about a texel: it keeps a whole texel. */
+  const float texel_reach = texel_sides * (1.0f + (float)GUARD);
   const float counted_u = distance_u > 2.0f ? 2.0f : distance_u;
   const float counted_v = distance_v > 2.0f ? 2.0f : distance_v;
-  return !(counted_u * min_side >= spread_u * min_side + texel_reach ||
-           counted_v * min_side >= spread_v * min_side + texel_reach);
+  return !(min_side > 0.0f && (counted_u * min_side >= spread * min_side + texel_reach ||
+                               counted_v * min_side >= spread * min_side + texel_reach));
+}
+
+/* The same for a bilinear, trilinear or aniso lookup, along one axis of this face's uv: whether
+ * its point, `distance` (uv) inside the edge across that axis, is too far from a face whose side
+ * along that axis is `side` texels and along the other axis `cross_side` texels for any tap to
+ * reach it. x_a, y_a: the screen axes' components along this axis (d(uv)/dx and /dy, absolute,
+ * finite), x_b, y_b: along the other. The same holds for any face whose side along this axis is
+ * no shorter and whose cross_side / side is no larger (the bound grows as side shrinks and the
+ * ratio grows), which is what the per-edge records of FaceNeighbors store. No division by a side
+ * (powers of two: multiplying by them is exact). Argued term by term in the twin
+ * (host/twins/texture_sample.cpp, axis_rules_out). side 0: never rules out. */
+SEAMCL_INLINE int axis_rules_out(float side, float cross_side, int filter, int max_aniso, float distance, float x_a,
+                                 float x_b, float y_a, float y_b) {
+  const float len_x = x_a * side + x_b * cross_side;
+  const float len_y = y_a * side + y_b * cross_side;
+  const float probe_len = filter == SEAMCL_FILTER_ANISO ? fmax(fmin(len_x, len_y), fmax(len_x, len_y) / (float)max_aniso)
+                                                        : fmax(len_x, len_y);
+  /* the coarsest texel read, in level-0 texels, at most the whole side */
+  const float texel_sides = filter == SEAMCL_FILTER_BILINEAR ? 1.0f : fmin(side, fmax(2.0f, 2.01f * probe_len));
+  const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f * fmax(x_a, y_a) : 0.0f;
+  const float texel_reach = texel_sides * (TAP_REACH_TEXELS + (float)GUARD);
+  const float counted = distance > 2.0f ? 2.0f : distance;
+  return side > 0.0f && counted * side >= spread * side + texel_reach;
+}
+
+/* Whether face `other` can receive weight from a lookup at distance_u / distance_v (as above) of
+ * it; `swapped`: its uv axes run along this face's v and u (the map's linear part swaps them). */
+SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int swapped, int filter, int max_aniso, float distance_u,
+                                          float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
+  if (filter == SEAMCL_FILTER_EWA) {
+    return ewa_sides_may_contribute((float)min(other->width, other->height), (float)max(other->width, other->height),
+                                    distance_u, distance_v, dudx, dvdx, dudy, dvdy);
+  }
+  const float x_u = fabs(dudx), x_v = fabs(dvdx), y_u = fabs(dudy), y_v = fabs(dvdy);
+  if (!(x_u + x_v + y_u + y_v < INFINITY)) return 1;
+  const float side_u = (float)(swapped ? other->height : other->width);
+  const float side_v = (float)(swapped ? other->width : other->height);
+  return !(axis_rules_out(side_u, side_v, filter, max_aniso, distance_u, x_u, x_v, y_u, y_v) ||
+           axis_rules_out(side_v, side_u, filter, max_aniso, distance_v, x_v, x_u, y_v, y_u));
 }
 
 /* The same filter, border-addressed, on face `other` at this lookup's point and footprint carried
@@ -485,7 +525,9 @@ SEAMCL_INLINE void accumulate_across(FilterSum* sum, __global const FaceGpu* fac
   if (other < 0) return;
   const FaceGpu g = faces[other];
   const int early_out = SEAMCL_TRAVERSE_EARLY_OUT;
-  if (early_out && !neighbor_may_contribute(&g, filter, max_aniso, distance_u, distance_v, dudx, dvdx, dudy, dvdy)) {
+  /* A map whose linear part swaps u and v has t0 = 0 (it is a signed permutation). */
+  if (early_out && !neighbor_may_contribute(&g, t[0] == 0.0f, filter, max_aniso, distance_u, distance_v, dudx, dvdx,
+                                            dudy, dvdy)) {
     return;
   }
   const float gu = t[0] * u + t[1] * v + t[2];
@@ -536,15 +578,35 @@ SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* 
   /* How far the point lies inside each edge: the least distance to the face across it, along v
    * (edges 0 and 2) or u (1 and 3); the other axis never decides (-1). */
   const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
+  /* First, from this face's record alone, whether the lookup lies too far inside edge k for any
+   * face across it or past its ends (the sides stored per edge bound theirs: the smallest min
+   * side and the largest aspect give the largest reach), so that an interior lookup decides with
+   * four tests and reads no other face's record. A bit set: edge k may reach something. */
+  const int early_out = SEAMCL_TRAVERSE_EARLY_OUT;
+  int edge_may_reach = 15;
+  const float x_u = fabs(dudx), x_v = fabs(dvdx), y_u = fabs(dudy), y_v = fabs(dvdy);
+  if (early_out && filter != SEAMCL_FILTER_EWA && x_u + x_v + y_u + y_v < INFINITY) {
+    edge_may_reach = 0;
+    for (int k = 0; k < 4; ++k) {
+      const int along_v = (k & 1) == 0;
+      const int ruled_out = axis_rules_out(n->reach_min_side[k], n->reach_max_side[k], filter, max_aniso, inside[k],
+                                           along_v ? x_v : x_u, along_v ? x_u : x_v, along_v ? y_v : y_u,
+                                           along_v ? y_u : y_v);
+      edge_may_reach |= (ruled_out ? 0 : 1) << k;
+    }
+  }
+  if (edge_may_reach == 0) return;
   for (int k = 0; k < 4; ++k) {
+    if (((edge_may_reach >> k) & 1) == 0) continue;
     const int along_v = (k & 1) == 0;
     accumulate_across(sum, faces, n->neighbor[k], n->transform[k], along_v ? -1.0f : inside[k],
                       along_v ? inside[k] : -1.0f, level_offsets, texels, srgb_to_linear, filter, max_aniso, u, v,
                       dudx, dvdx, dudy, dvdy);
   }
   if (!corners) return;
-  /* Corner k lies between edges k-1 and k: past both. */
+  /* Corner k lies between edges k-1 and k: past both; either edge's test rules it out. */
   for (int k = 0; k < 4; ++k) {
+    if (((edge_may_reach >> k) & (edge_may_reach >> ((k + 3) & 3)) & 1) == 0) continue;
     const float a = inside[(k + 3) & 3], b = inside[k];
     const int b_along_v = (k & 1) == 0;
     accumulate_across(sum, faces, n->corner[k], n->corner_transform[k], b_along_v ? a : b, b_along_v ? b : a,

@@ -349,13 +349,14 @@ TEST(Traverse, SkipsOnlyNeighboursThatWouldAddNothing) {
       const bool k_along_v = k % 2 == 0;
       const float a = j < 4 ? -1.0f : inside[(k + 3) % 4], b = inside[k];
       const float distance_u = k_along_v ? a : b, distance_v = k_along_v ? b : a;
-      if (neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], sampler.filter, sampler.max_aniso, 0,
-                                  distance_u, distance_v, dudx, dvdx, dudy, dvdy)) {
+      const float* transform = j < 4 ? n.transform[k] : n.corner_transform[k];
+      if (neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], map_swaps_axes(transform), sampler.filter,
+                                  sampler.max_aniso, 0, distance_u, distance_v, dudx, dvdx, dudy, dvdy)) {
         ++kept;
         continue;
       }
       ++skipped;
-      const UvMap map = uv_map(j < 4 ? n.transform[k] : n.corner_transform[k]);
+      const UvMap map = uv_map(transform);
       const glm::vec2 p = map.point({u, v}), dx = map.direction({dudx, dvdx}), dy = map.direction({dudy, dvdy});
       const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER,
                                                    p.x, p.y, dx.x, dx.y, dy.x, dy.y);
@@ -444,6 +445,112 @@ TEST(Traverse, ReachTestSkipsOnlyNeighboursThatWouldAddNothing) {
   EXPECT_GT(skipped, kept);
   // Not loose: of the neighbours it keeps, most do hold weight (the test is about the probes).
   EXPECT_GT(reaching, kept / 2) << "kept " << kept << " reaching " << reaching;
+}
+
+TEST(Traverse, EdgeReachTestSkipsOnlyFacesThatWouldAddNothing) {
+  // edges_may_reach decides from the lookup's own FaceNeighbors record (the sides pack_scene
+  // stores per edge) whether a face across edge k or past its ends can be reached; a clear bit
+  // skips those three faces unread. Each face it skips must be one neighbor_may_contribute skips
+  // too (the stored sides bound every face's) and must weigh exactly zero. Faces of mixed sizes
+  // (1x1 to 256x256, non-square), valence 3, 4 and 5, every filter.
+  Scene prism = seamcl_tests::split_pentagonal_prism();
+  seamcl_tests::set_textures(prism, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+  Scene cube = seamcl_tests::subdivided_cube(2);
+  seamcl_tests::set_textures(cube, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+  for (const Scene* scene : {&prism, &cube}) {
+    const PackedScene packed = pack_scene(*scene, TexelFormat::Rgba32f);
+    const TextureView view = packed.textures();
+    const std::vector<Lookup> lookups = lookups_near_edges(scene->faces.size(), 20000, 12);
+    std::mt19937 rng(13);
+    size_t edges_skipped = 0, edges_kept = 0, interior_decided = 0, interior = 0;
+    for (const Lookup& l : lookups) {
+      const Filter filter = static_cast<Filter>(rng() % 4);
+      const SamplerParams sampler =
+          sampler_params(Method::Traverse, filter, 1 + static_cast<int>(rng() % 16), ZeroCoverage::Clamp);
+      const FaceNeighbors& n = packed.neighbors[l.face];
+      const int mask = edges_may_reach(n, sampler.filter, sampler.max_aniso, 0, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+      const bool inside_face = l.u > 0.1f && l.u < 0.9f && l.v > 0.1f && l.v < 0.9f;
+      interior += inside_face;
+      interior_decided += inside_face && mask == 0;
+      const float inside[4] = {l.v, 1.0f - l.u, 1.0f - l.v, l.u};
+      for (int k = 0; k < 4; ++k) {
+        if ((mask >> k) & 1) {
+          ++edges_kept;
+          continue;
+        }
+        ++edges_skipped;
+        // The neighbour across edge k, and the diagonal faces past its ends (corners k and k + 1).
+        for (int j : {k, 4 + k, 4 + (k + 1) % 4}) {
+          const int c = j % 4;
+          const int other = j < 4 ? n.neighbor[c] : n.corner[c];
+          if (other < 0) continue;
+          const bool c_along_v = c % 2 == 0;
+          const float a = j < 4 ? -1.0f : inside[(c + 3) % 4], b = inside[c];
+          const float* transform = j < 4 ? n.transform[c] : n.corner_transform[c];
+          ASSERT_FALSE(neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], map_swaps_axes(transform),
+                                               sampler.filter, sampler.max_aniso, 0, c_along_v ? a : b,
+                                               c_along_v ? b : a, l.dudx, l.dvdx, l.dudy, l.dvdy))
+              << "edge " << k << " skips face " << other << " that the per-face test keeps";
+          const UvMap map = uv_map(transform);
+          const glm::vec2 p = map.point({l.u, l.v}), dx = map.direction({l.dudx, l.dvdx}),
+                          dy = map.direction({l.dudy, l.dvdy});
+          const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler,
+                                                       SEAMCL_ADDRESS_BORDER, p.x, p.y, dx.x, dx.y, dy.x, dy.y);
+          ASSERT_TRUE(same_bits(s, FilterSum{})) << "a skipped face adds weight " << s.weight;
+        }
+      }
+    }
+    // Not vacuous: a good share of the edges of these lookups (footprints up to a whole face,
+    // crowded at edges: about 40% measured) and of the lookups well inside (about 12%) decide here.
+    EXPECT_GT(edges_skipped, edges_kept / 2) << edges_skipped << " skipped, " << edges_kept << " kept";
+    EXPECT_GT(interior_decided, interior / 16) << interior_decided << " of " << interior;
+  }
+}
+
+TEST(Traverse, EdgeReachRecordsBoundTheFacesAround) {
+  // pack_scene fills reach_min_side / reach_max_side per edge from the faces across it and past
+  // its ends, their sides as they lie in this face's uv: the smallest side along the axis that
+  // crosses the edge, and that times the largest ratio of the other axis's side to it. Checked
+  // through the maps themselves: the other face's extent along this face's axis is its side
+  // mapped back. An edge with no face around keeps 0, and a record of zeros rules nothing out.
+  Scene prism = seamcl_tests::split_pentagonal_prism();
+  seamcl_tests::set_textures(prism, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
+  const PackedScene packed = pack_scene(prism, TexelFormat::Rgba32f);
+  size_t filled = 0, swapped = 0;
+  for (size_t f = 0; f < packed.neighbors.size(); ++f) {
+    const FaceNeighbors& n = packed.neighbors[f];
+    for (int k = 0; k < 4; ++k) {
+      const bool along_v = k % 2 == 0;
+      float side = 0.0f, ratio = 0.0f;
+      const int across[3] = {n.neighbor[k], n.corner[k], n.corner[(k + 1) % 4]};
+      const float* maps[3] = {n.transform[k], n.corner_transform[k], n.corner_transform[(k + 1) % 4]};
+      for (int i = 0; i < 3; ++i) {
+        if (across[i] < 0) continue;
+        const FaceGpu& g = packed.faces[static_cast<size_t>(across[i])];
+        // This face's unit step along u (or v) in the other face's uv: along which of its axes it runs.
+        const UvMap map = uv_map(maps[i]);
+        const glm::vec2 step_u = map.direction({1.0f, 0.0f}), step_v = map.direction({0.0f, 1.0f});
+        const float side_u = std::fabs(step_u.x) * static_cast<float>(g.width) + std::fabs(step_u.y) * static_cast<float>(g.height);
+        const float side_v = std::fabs(step_v.x) * static_cast<float>(g.width) + std::fabs(step_v.y) * static_cast<float>(g.height);
+        swapped += step_u.x == 0.0f;
+        const float along = along_v ? side_v : side_u, cross = along_v ? side_u : side_v;
+        side = side == 0.0f ? along : std::min(side, along);
+        ratio = std::max(ratio, cross / along);
+      }
+      EXPECT_EQ(n.reach_min_side[k], side) << "face " << f << " edge " << k;
+      EXPECT_EQ(n.reach_max_side[k], side * ratio) << "face " << f << " edge " << k;
+      filled += side > 0.0f;
+    }
+  }
+  EXPECT_GT(filled, packed.neighbors.size() * 3);
+  EXPECT_GT(swapped, 0u) << "the prism should hold maps that swap u and v";
+  FaceNeighbors unfilled{};
+  for (int k = 0; k < 4; ++k) unfilled.neighbor[k] = unfilled.corner[k] = -1;
+  for (Filter filter : {Filter::Bilinear, Filter::Trilinear, Filter::Aniso, Filter::Ewa}) {
+    EXPECT_EQ(edges_may_reach(unfilled, sampler_params(Method::Traverse, filter, 16, ZeroCoverage::Clamp).filter, 16, 0,
+                              0.5f, 0.5f, 1e-4f, 0.0f, 0.0f, 1e-4f),
+              15);
+  }
 }
 
 TEST(Traverse, EarlyOutsChangeNoBitOfTheTwin) {

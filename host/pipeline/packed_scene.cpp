@@ -150,6 +150,40 @@ void pack_banded_deferred(const Scene& scene, PackedScene& out, const std::vecto
 
 }  // namespace
 
+void fill_edge_reach(const std::vector<FaceGpu>& faces, std::vector<FaceNeighbors>& neighbors) {
+  for (FaceNeighbors& n : neighbors) {
+    for (int k = 0; k < 4; ++k) {
+      // The faces a lookup reaches across edge k: the neighbour and the diagonal faces past its ends.
+      const int across[3] = {n.neighbor[k], n.corner[k], n.corner[(k + 1) % 4]};
+      const float* maps[3] = {n.transform[k], n.corner_transform[k], n.corner_transform[(k + 1) % 4]};
+      // Edges 0 and 2 are crossed along v, 1 and 3 along u (this face's uv).
+      const bool along_v = k % 2 == 0;
+      float side = 0.0f, ratio = 0.0f;
+      for (int i = 0; i < 3; ++i) {
+        if (across[i] < 0) continue;
+        if (static_cast<size_t>(across[i]) >= faces.size()) {  // not a face: leave the edge unfilled (never skips)
+          side = 0.0f;
+          break;
+        }
+        const FaceGpu& g = faces[static_cast<size_t>(across[i])];
+        // The maps are signed permutations: t0 = 0 when the other face's u runs along this face's v.
+        const bool swapped = maps[i][0] == 0.0f;
+        const float side_u = static_cast<float>(swapped ? g.height : g.width);
+        const float side_v = static_cast<float>(swapped ? g.width : g.height);
+        const float along = along_v ? side_v : side_u, cross = along_v ? side_u : side_v;
+        if (!(along >= 1.0f && cross >= 1.0f)) {  // not a valid size: leave the edge unfilled
+          side = 0.0f;
+          break;
+        }
+        side = side == 0.0f ? along : std::min(side, along);
+        ratio = std::max(ratio, cross / along);  // powers of two: exact
+      }
+      n.reach_min_side[k] = side;
+      n.reach_max_side[k] = side * ratio;  // powers of two: exact
+    }
+  }
+}
+
 PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
   if (guard_band < 0 || guard_band > kMaxGuardBand) throw std::invalid_argument("guard band out of range");
   PackedScene out;
@@ -191,6 +225,7 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
     out.faces.push_back(gpu);
   }
   if (texels != stored_texels) throw std::logic_error("pack_scene: level sizes disagree with packed_texture_memory");
+  fill_edge_reach(out.faces, out.neighbors);
   // ... then the texels, faces in parallel, each into its own range: exactly sized up front.
   if (format == TexelFormat::Rgba8) {
     out.texels8.resize(stored_texels);

@@ -305,8 +305,8 @@ FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, 
   return sum;
 }
 
-bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, int guard_band, float distance_u,
-                             float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
+bool ewa_sides_may_contribute(float min_side, float max_side, int guard_band, float distance_u, float distance_v,
+                              float dudx, float dvdx, float dudy, float dvdy) {
   // Footprint axes by their 1-norms in uv: no shorter than their lengths, and kept by the maps
   // between faces (which only permute and negate u and v).
   const float axis_x = std::fabs(dudx) + std::fabs(dvdx);
@@ -314,41 +314,84 @@ bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, in
   const float axes = axis_x + axis_y;
   // A non-finite footprint sends every filter to the coarsest level: it may reach anything.
   if (!(axes < INFINITY)) return true;
-  const float longest = std::fmax(axis_x, axis_y);
-  const float shortest = std::fmin(axis_x, axis_y);
-  const float min_side = static_cast<float>(std::min(other.width, other.height));
-  const float max_side = static_cast<float>(std::max(other.width, other.height));
-  // A tap weighs something only within half a texel of its probe (kTapReachTexels). The coarsest texel the other
-  // face's filter can weigh (uv): bilinear reads level 0; the others a trilinear pair at lod (at
-  // least 0) and the next level, whose texels are up to twice 2^lod level-0 texels (2.01:
-  // approx_log2's error); none is longer than the face. Trilinear's lod is log2 of the longer
-  // axis in the other face's level-0 texels (at most max side x `longest`); aniso's that divided
-  // by its N probes, N >= min(major / minor, max_aniso), so at most the longer of the minor axis
-  // and major / max_aniso (the minor one measured in the other face's texels: still no longer
-  // than max side x `shortest`). Kept multiplied by min_side (a power of two: exact), so that
-  // the kernel divides nothing.
-  const float probe_axis =
-      filter == SEAMCL_FILTER_ANISO ? std::fmax(shortest, longest / static_cast<float>(max_aniso)) : longest;
-  const float texel_sides =
-      filter == SEAMCL_FILTER_BILINEAR ? 1.0f : std::fmin(min_side, std::fmax(2.0f, 2.01f * max_side * probe_axis));
-  // How far the probes spread from the point along u and v: aniso's over half its major axis,
-  // which is one of the two screen axes (whichever the other face's texels make longer); EWA's
-  // ellipse over both axes, its minor one grown up to max/min side times in uv by the
-  // eccentricity clamp.
-  const float spread_u = filter == SEAMCL_FILTER_ANISO ? 0.5f * std::fmax(std::fabs(dudx), std::fabs(dudy))
-                         : filter == SEAMCL_FILTER_EWA ? (1.0f + max_side / min_side) * axes
-                                                       : 0.0f;
-  const float spread_v = filter == SEAMCL_FILTER_ANISO ? 0.5f * std::fmax(std::fabs(dvdx), std::fabs(dvdy)) : spread_u;
-  // A guard band's texels read as inside too.
-  // EWA's ellipse is widened by about a texel (the + 1 of accumulate_ewa_level): it keeps a whole one.
-  const float texel_reach =
-      texel_sides * ((filter == SEAMCL_FILTER_EWA ? 1.0f : kTapReachTexels) + static_cast<float>(guard_band));
+  // The coarsest texel EWA's trilinear pair of levels can weigh (uv): the level where the minor
+  // axis (no longer than max side x the longer 1-norm, in level-0 texels) spans a texel, and the
+  // next, whose texels are up to twice that (2.01: approx_log2's error); none longer than the
+  // face. Kept multiplied by min_side (a power of two: exact), so that the kernel divides nothing.
+  const float texel_sides = std::fmin(min_side, std::fmax(2.0f, 2.01f * max_side * std::fmax(axis_x, axis_y)));
+  // The ellipse spreads over both axes, its minor one grown up to max/min side times in uv by the
+  // eccentricity clamp; it is widened by about a texel (the + 1 of accumulate_ewa_level): a whole one.
+  const float spread = (1.0f + max_side / min_side) * axes;
+  const float texel_reach = texel_sides * (1.0f + static_cast<float>(guard_band));  // band texels read as inside
   // EWA pulls a centre more than two face widths out back to two widths: count no distance
   // beyond 2. A NaN distance is never skipped.
   const float counted_u = distance_u > 2.0f ? 2.0f : distance_u;
   const float counted_v = distance_v > 2.0f ? 2.0f : distance_v;
-  return !(counted_u * min_side >= spread_u * min_side + texel_reach ||
-           counted_v * min_side >= spread_v * min_side + texel_reach);
+  return !(min_side > 0.0f && (counted_u * min_side >= spread * min_side + texel_reach ||
+                               counted_v * min_side >= spread * min_side + texel_reach));
+}
+
+bool axis_rules_out(float side, float cross_side, int filter, int max_aniso, int guard_band, float distance, float x_a,
+                    float x_b, float y_a, float y_b) {
+  // The screen axes' lengths in the face's level-0 texels, bounded by their 1-norms weighted by
+  // the sides: |a| side + |b| cross_side >= sqrt((a side)^2 + (b cross_side)^2).
+  const float len_x = x_a * side + x_b * cross_side;
+  const float len_y = y_a * side + y_b * cross_side;
+  // The coarsest texel the face's filter can weigh, in level-0 texels: bilinear reads level 0;
+  // the others a trilinear pair at lod (at least 0) and the next level, whose texels are up to
+  // twice 2^lod (2.01: approx_log2's error); none longer than the side (a 1-texel level).
+  // Trilinear's 2^lod is the longer axis; aniso's that divided by its N probes, N >= min(major /
+  // minor, max_aniso), so at most the longer of the minor axis and major / max_aniso (whichever
+  // of the two screen axes the face's texels make the minor one: the shorter bound serves).
+  const float probe_len = filter == SEAMCL_FILTER_ANISO
+                              ? std::fmax(std::fmin(len_x, len_y), std::fmax(len_x, len_y) / static_cast<float>(max_aniso))
+                              : std::fmax(len_x, len_y);
+  const float texel_sides = filter == SEAMCL_FILTER_BILINEAR ? 1.0f : std::fmin(side, std::fmax(2.0f, 2.01f * probe_len));
+  // Aniso's probes spread over half its major axis, one of the two screen axes.
+  const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f * std::fmax(x_a, y_a) : 0.0f;
+  // A tap weighs something only within half a texel of its probe (kTapReachTexels); band texels read as inside.
+  const float texel_reach = texel_sides * (kTapReachTexels + static_cast<float>(guard_band));
+  // No distance beyond 2 counts (as for EWA); a NaN or negative one never decides.
+  const float counted = distance > 2.0f ? 2.0f : distance;
+  // In units of 1 / side (exact: powers of two). Every term grows as side shrinks or cross_side /
+  // side grows, and rounding keeps that order (each step is monotone and the scaling by side is
+  // exact), so a side and ratio that bound several faces' bound each of them.
+  return side > 0.0f && counted * side >= spread * side + texel_reach;
+}
+
+bool neighbor_may_contribute(const FaceGpu& other, bool swapped, int filter, int max_aniso, int guard_band,
+                             float distance_u, float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
+  if (filter == SEAMCL_FILTER_EWA) {
+    return ewa_sides_may_contribute(static_cast<float>(std::min(other.width, other.height)),
+                                    static_cast<float>(std::max(other.width, other.height)), guard_band, distance_u,
+                                    distance_v, dudx, dvdx, dudy, dvdy);
+  }
+  const float x_u = std::fabs(dudx), x_v = std::fabs(dvdx), y_u = std::fabs(dudy), y_v = std::fabs(dvdy);
+  if (!(x_u + x_v + y_u + y_v < INFINITY)) return true;
+  // The other face's sides along this face's u and v.
+  const float side_u = static_cast<float>(swapped ? other.height : other.width);
+  const float side_v = static_cast<float>(swapped ? other.width : other.height);
+  return !(axis_rules_out(side_u, side_v, filter, max_aniso, guard_band, distance_u, x_u, x_v, y_u, y_v) ||
+           axis_rules_out(side_v, side_u, filter, max_aniso, guard_band, distance_v, x_v, x_u, y_v, y_u));
+}
+
+bool map_swaps_axes(const float transform[6]) { return transform[0] == 0.0f; }
+
+int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, int guard_band, float u, float v, float dudx,
+                    float dvdx, float dudy, float dvdy) {
+  const float x_u = std::fabs(dudx), x_v = std::fabs(dvdx), y_u = std::fabs(dudy), y_v = std::fabs(dvdy);
+  if (filter == SEAMCL_FILTER_EWA || !(x_u + x_v + y_u + y_v < INFINITY)) return 15;
+  const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
+  int mask = 0;
+  for (int k = 0; k < 4; ++k) {
+    // Edges 0 and 2 are crossed along v, 1 and 3 along u.
+    const bool along_v = k % 2 == 0;
+    const bool ruled_out = axis_rules_out(n.reach_min_side[k], n.reach_max_side[k], filter, max_aniso, guard_band,
+                                          inside[k], along_v ? x_v : x_u, along_v ? x_u : x_v, along_v ? y_v : y_u,
+                                          along_v ? y_u : y_v);
+    mask |= (ruled_out ? 0 : 1) << k;
+  }
+  return mask;
 }
 
 bool lookup_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float u, float v, float dudx,
@@ -381,7 +424,7 @@ FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const Samp
   auto add_across = [&](int other, const float* t, float distance_u, float distance_v) {
     if (other < 0) return;
     const FaceGpu& g = tex.faces->at(static_cast<size_t>(other));
-    if (early_out && !neighbor_may_contribute(g, sampler.filter, sampler.max_aniso, tex.guard_band, distance_u, distance_v,
+    if (early_out && !neighbor_may_contribute(g, map_swaps_axes(t), sampler.filter, sampler.max_aniso, tex.guard_band, distance_u, distance_v,
                                               dudx, dvdx, dudy, dvdy)) {
       return;
     }
@@ -401,13 +444,20 @@ FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const Samp
   // (edges 0 and 2) or u (1 and 3); the other axis never decides (-1).
   const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
   const FaceNeighbors& n = tex.neighbors->at(face);
+  // First, from this face's record alone, the edges whose faces (across and past the ends) the
+  // lookup may reach: the others' three faces are not read at all.
+  const int edge_may_reach =
+      early_out ? edges_may_reach(n, sampler.filter, sampler.max_aniso, tex.guard_band, u, v, dudx, dvdx, dudy, dvdy) : 15;
   for (int k = 0; k < 4; ++k) {
+    if (((edge_may_reach >> k) & 1) == 0) continue;
     const bool along_v = k % 2 == 0;
     add_across(n.neighbor[k], n.transform[k], along_v ? -1.0f : inside[k], along_v ? inside[k] : -1.0f);
   }
   if (sampler.traverse != SEAMCL_TRAVERSE_CORNERS) return sum;
   // Past a valence-4 corner, the diagonal face (corner k lies between edges k-1 and k): past both.
   for (int k = 0; k < 4; ++k) {
+    // Corner k lies at the ends of edges k - 1 and k: either edge's test rules it out.
+    if (((edge_may_reach >> k) & (edge_may_reach >> ((k + 3) % 4)) & 1) == 0) continue;
     const float a = inside[(k + 3) % 4], b = inside[k];
     const bool b_along_v = k % 2 == 0;
     add_across(n.corner[k], n.corner_transform[k], b_along_v ? a : b, b_along_v ? b : a);

@@ -21,9 +21,29 @@ FilterSum filter_texture_reference(const TextureView& textures, uint32_t face, c
 // derivatives in this face's uv; `guard_band` texels per level stored around each level)
 // whose point must travel at least distance_u along u and distance_v along v (this face's uv; a
 // negative distance never decides) to reach the other face's square: a conservative bound, so a
-// neighbour it rules out would have added exactly nothing. Traverse skips those.
-bool neighbor_may_contribute(const FaceGpu& other, int filter, int max_aniso, int guard_band, float distance_u,
-                             float distance_v, float dudx, float dvdx, float dudy, float dvdy);
+// neighbour it rules out would have added exactly nothing. Traverse skips those. `swapped`: the
+// other face's u and v run along this face's v and u (map_swaps_axes of the map to it).
+bool neighbor_may_contribute(const FaceGpu& other, bool swapped, int filter, int max_aniso, int guard_band,
+                             float distance_u, float distance_v, float dudx, float dvdx, float dudy, float dvdy);
+// Whether a FaceNeighbors uv map (transform or corner_transform) swaps u and v (a signed
+// permutation with t0 = 0).
+bool map_swaps_axes(const float transform[6]);
+// EWA's bound, for any face whose shorter side is no less than min_side and whose aspect is no
+// more than max_side / min_side; min_side 0 (not known) never rules out.
+bool ewa_sides_may_contribute(float min_side, float max_side, int guard_band, float distance_u, float distance_v,
+                              float dudx, float dvdx, float dudy, float dvdy);
+// Bilinear, trilinear and aniso's bound along one axis of this face's uv: true when a lookup
+// `distance` (uv) inside the edge across that axis cannot reach a face whose side along it is
+// `side` texels and along the other axis `cross_side`, nor any face whose side along it is no
+// shorter and whose cross_side / side is no larger. x_a, y_a: the screen axes' components
+// (absolute, finite) along this axis; x_b, y_b: along the other. side 0 never rules out.
+bool axis_rules_out(float side, float cross_side, int filter, int max_aniso, int guard_band, float distance, float x_a,
+                    float x_b, float y_a, float y_b);
+// Traverse's first test, from the lookup's own face record alone: bit k set when the lookup may
+// reach a face across edge k or past its two ends (axis_rules_out with the edge's
+// reach_min_side / reach_max_side); a clear bit skips those three faces unread. EWA: all set.
+int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, int guard_band, float u, float v, float dudx,
+                    float dvdx, float dudy, float dvdy);
 // Whether a border-addressed lookup with `filter` on `face` (its own uv and derivatives) can put
 // weight inside it (or in its guard band of `guard_band` texels per level): bilinear, trilinear
 // and aniso test the very probes the filter takes (their line, and a texel of the coarser level
