@@ -90,10 +90,10 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
                                                   SceneSourceOptions options) {
   // Every file the load resolves, stamped when resolved (before it is read), so that a file
   // changed while or after it is read makes the entry stale rather than the stamp new.
-  auto files = std::make_shared<std::vector<std::pair<std::string, std::string>>>();
+  auto files = std::make_shared<std::map<std::string, std::string>>();
   options.resolve = [this, files](const std::string& name, const std::string& relative_to, const std::string& field) {
     std::string path = resolve(name, relative_to, field);
-    files->emplace_back(path, file_stamp(path));
+    if (!files->contains(path)) files->emplace(path, file_stamp(path));
     return path;
   };
   std::ostringstream key;

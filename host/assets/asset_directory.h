@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <list>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -63,7 +64,9 @@ class AssetDirectory {
     std::string key;
     std::shared_ptr<const Scene> scene;
     size_t bytes = 0;
-    std::vector<std::pair<std::string, std::string>> files;  // every path the load resolved, and its stamp then
+    // Every path the load resolved, once (a file many faces name is checked once), and its stamp
+    // when first resolved.
+    std::map<std::string, std::string> files;
   };
 
   std::string root_;  // canonical

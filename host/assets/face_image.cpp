@@ -45,7 +45,8 @@ void check_unchanged(const FaceImageFile& file) {
 FaceImageFile open_face_image(const std::string& path, const std::string& field) {
   FaceImageFile file{path, field};
   // The stamp first: a file changed while its header is read then fails the later check.
-  stamp_of(path, file.file_bytes, file.modified);
+  if (!stamp_of(path, file.file_bytes, file.modified))
+    throw InputError(field, "image '" + path + "' is not a regular file that can be read");
   try {
     read_image_size(path, file.width, file.height);
   } catch (const std::exception& error) {
