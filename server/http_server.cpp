@@ -777,7 +777,7 @@ void HttpServer::refuse_scene_over_budget(const Scene& scene, const RenderOption
   const RenderMemory memory = scene_render_memory(sizes, options);
   // The request holds its own copy of an inline scene or asset on top of the Renderer's, and what
   // its texture_source keeps (a deferred .ptx's bytes, also one named inside a scene file).
-  const size_t held = key.empty() ? saturating_add(scene_host_bytes(sizes), scene.texture_source_bytes) : 0;
+  const size_t held = key.empty() ? scene_held_bytes(scene) : 0;
   refuse_over_budget(memory.device_bytes(), saturating_add(memory.host_bytes(), held), field,
                      "the scene (" + std::to_string(sizes.faces.size()) + " faces, " +
                          std::to_string(memory.textures.texels) + " packed texels)");
@@ -808,7 +808,7 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   const SceneSizes sizes = scene_sizes(*scene);
   const RenderMemory memory = render_memory(sizes, options);
   const bool frame_drives = memory.frame_device_bytes() >= memory.scene_device_bytes();
-  const size_t held = inline_request ? saturating_add(scene_host_bytes(sizes), scene->texture_source_bytes) : 0;
+  const size_t held = inline_request ? scene_held_bytes(*scene) : 0;
   refuse_over_budget(memory.device_bytes(), saturating_add(memory.host_bytes(), held),
                      frame_drives ? "size" : inline_request ? "scene" : "texels", "this render");
 

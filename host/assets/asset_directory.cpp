@@ -125,10 +125,9 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
   }
   // Read outside the lock: a large file does not hold up requests for cached ones.
   auto loaded = std::make_shared<const Scene>(load_scene_source(scene, texture, options));
-  size_t bytes = scene_host_bytes(scene_sizes(*loaded));
-  // What its texture_source keeps to make the faces from (a deferred .ptx's whole file, metadata
-  // included, also one named inside a scene file): counted on top.
-  bytes = saturating_add(bytes, loaded->texture_source_bytes);
+  // With what its texture_source keeps to make the faces from (a deferred .ptx's whole file,
+  // metadata included, also one named inside a scene file).
+  const size_t bytes = scene_held_bytes(*loaded);
   std::lock_guard lock(mutex_);
   if (bytes > limits_.max_bytes || limits_.max_entries == 0) return loaded;
   entries_.push_front({key.str(), loaded, bytes, std::move(*files)});

@@ -108,6 +108,8 @@ size_t scene_host_bytes(const SceneSizes& scene) {
   return bytes;
 }
 
+size_t scene_held_bytes(const Scene& scene) { return add(scene_host_bytes(scene_sizes(scene)), scene.texture_source_bytes); }
+
 RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options) {
   RenderMemory m;
   m.textures = packed_texture_memory(scene, options.texels, sampler_params(options).guard_band);

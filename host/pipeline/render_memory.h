@@ -120,6 +120,10 @@ size_t saturating_mul(size_t a, size_t b);
 // Renderer's copy, or the caller's.
 size_t scene_host_bytes(const SceneSizes& scene);
 
+// What a loaded Scene holds while it is kept: scene_host_bytes plus the bytes its texture_source
+// keeps to make deferred faces from (a deferred .ptx's whole file).
+size_t scene_held_bytes(const Scene& scene);
+
 // What this process holds, as Linux counts it: VmHWM and VmRSS of /proc/self/status (where that
 // cannot be read, getrusage's ru_maxrss for the peak and 0 for the current). The peak includes the
 // OpenCL runtime's own (PoCL's floor: about 227 MB for the two-face quad2 render).
