@@ -951,7 +951,9 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
     }
   }
   refuse_scene_over_budget(*scene, frame, inline_scene, key);
-  const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, entries, reference_settings);
+  const bool seamless = std::find(reference_kinds.begin(), reference_kinds.end(), ReferenceKind::Seamless) != reference_kinds.end();
+  const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, entries, reference_settings, reference_kinds,
+                                              seamless ? std::optional(seamless_scene_sizes(*scene)) : std::nullopt);
   refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this compare");
   // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
   const Clock::time_point deadline =

@@ -353,6 +353,66 @@ TEST(Budget, CompareMemoryBoundsWhatTheCompareHolds) {
   EXPECT_GE(expected.host_bytes, expected.reference.host_image + expected.reference.host_scene);
 }
 
+TEST(Budget, CompareMemoryCountsTheAnalyticAndSeamlessReferences) {
+  const Scene scene = generate_scene("closeup-corner", {});
+  RenderOptions frame = options_of(Method::Discard, TexelFormat::Rgba8, 1, 24, 16);
+  frame.scene = "closeup-corner";
+  ReferenceSettings settings;
+  settings.use_cache = false;
+  settings.msaa = 4;
+  const std::vector<MethodEntry> entries = method_entries(to_json(frame), {"discard"}, {1, 4});
+  const SceneSizes sizes = scene_sizes(scene);
+
+  // The seamless scene's sizes from the grid alone are those of the scene seamless_scene makes.
+  const SceneSizes seamless_sizes = seamless_scene_sizes(scene);
+  const Scene seamless = seamless_scene(scene);
+  EXPECT_EQ(seamless_sizes.faces, scene_sizes(seamless).faces);
+  EXPECT_EQ(seamless_sizes.vertices, scene_sizes(seamless).vertices);
+  try {
+    seamless_scene_sizes(generate_scene("paper", {}));
+    ADD_FAILURE() << "paper has no seamless grid";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "reference");
+  }
+  EXPECT_THROW(compare_memory(sizes, frame, entries, settings, {ReferenceKind::Seamless}), std::logic_error);
+
+  const CompareMemory paper = compare_memory(sizes, frame, entries, settings);
+  const CompareMemory all = compare_memory(sizes, frame, entries, settings,
+                                           {ReferenceKind::Paper, ReferenceKind::Analytic, ReferenceKind::Seamless},
+                                           seamless_sizes);
+  EXPECT_EQ(paper.analytic.image, 0u);
+  EXPECT_EQ(paper.seamless.image, 0u);
+  // The analytic reference renders the 8x frame at 1 sample, reads back its winners, setups and
+  // image, and makes an albedo image as large: all of it on the host at once.
+  EXPECT_EQ(all.analytic.samples, 24u * 8u * 16u * 8u * sizeof(uint32_t));
+  EXPECT_EQ(all.analytic.image, 24u * 8u * 16u * 8u * sizeof(glm::vec4));
+  EXPECT_GE(all.host_bytes, paper.host_bytes + 2 * all.analytic.host_image + all.analytic.setups);
+  // The seamless Renderer at the largest rate, its scene the one face.
+  EXPECT_EQ(all.seamless.samples, 24u * 16u * 4u * sizeof(uint32_t));
+  EXPECT_EQ(all.seamless.scene_device_bytes(), render_memory(seamless, frame).scene_device_bytes());
+
+  // The seamless phase as prepare_targets runs it: the first Renderer keeps its scene, the second
+  // renders each rate; together they stay within the bound.
+  Renderer renderer(seamcl_tests::shared_runtime());
+  renderer.load_scene(scene, frame.texels);
+  const std::vector<ReferenceImage> high =
+      reference_images(renderer, scene.camera, frame, settings, {ReferenceKind::Paper, ReferenceKind::Analytic});
+  ASSERT_EQ(high.size(), 2u);
+  Renderer second(seamcl_tests::shared_runtime());
+  second.load_scene(seamless, frame.texels);
+  size_t together = 0, second_peak = 0;
+  for (int rate : {1, 4}) {
+    RenderOptions measured = frame;
+    measured.msaa = rate;
+    seamless_reference(second, scene.camera, measured);
+    together = std::max(together, renderer.device_bytes() + second.device_bytes());
+    second_peak = std::max(second_peak, second.device_bytes());
+  }
+  EXPECT_EQ(second_peak, all.seamless.device_bytes());  // its buffers at the largest rate, exactly
+  EXPECT_GT(together, renderer.device_bytes());
+  EXPECT_LE(together, all.device_bytes_bound);
+}
+
 // ---------------------------------------------------------------- the reference cache's bound
 
 fs::path fresh_dir(const std::string& stem) {

@@ -1,6 +1,7 @@
 #include <seamcl/eval/compare_memory.h>
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <seamcl/pipeline/gpu_types.h>
 
@@ -32,45 +33,90 @@ struct PhaseDevice {
 }  // namespace
 
 CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame, const std::vector<MethodEntry>& entries,
-                             const ReferenceSettings& settings) {
+                             const ReferenceSettings& settings, const std::vector<ReferenceKind>& kinds,
+                             const std::optional<SceneSizes>& seamless_scene) {
+  const auto has = [&](ReferenceKind kind) { return std::find(kinds.begin(), kinds.end(), kind) != kinds.end(); };
+  const bool analytic = has(ReferenceKind::Analytic);
+  const bool seamless = has(ReferenceKind::Seamless);
+  if (seamless && !seamless_scene) throw std::logic_error("compare_memory: the seamless reference needs its scene's sizes");
+  const bool high_res = std::any_of(kinds.begin(), kinds.end(), [](ReferenceKind k) { return k != ReferenceKind::Seamless; });
+  if (kinds.empty()) throw std::logic_error("compare_memory: no reference");
+
   CompareMemory out;
   RenderOptions face_map_options = frame;  // as render_face_map renders it
   face_map_options.msaa = 1;
   face_map_options.shading = ShadingMode::Pixel;
   out.face_map = render_memory(scene, face_map_options);
-  out.reference = render_memory(scene, reference_render_options(frame, settings));
+  if (high_res) out.reference = render_memory(scene, reference_render_options(frame, settings));
+  if (analytic) {
+    ReferenceSettings one_sample = settings;  // reference_images renders the analytic frame at 1 sample
+    one_sample.msaa = 1;
+    out.analytic = render_memory(scene, reference_render_options(frame, one_sample));
+  }
 
   PhaseDevice phase1;
   RenderOptions loaded = frame;  // load_scene packs the frame's format without a band, as any method but guardband
   loaded.method = Method::Discard;
   phase1.include(render_memory(scene, loaded));
   phase1.include(out.face_map);
-  phase1.include(out.reference);
-  PhaseDevice phase2;
+  if (high_res) phase1.include(out.reference);
+  if (analytic) phase1.include(out.analytic);
+  PhaseDevice phase3;
   size_t largest_packed = std::max(out.face_map.host_packed, out.reference.host_packed);
+  int largest_rate = 1;
+  std::vector<int> rates;
   for (const MethodEntry& entry : entries) {
     out.entries.push_back(render_memory(scene, entry.options));
-    phase2.include(out.entries.back());
+    phase3.include(out.entries.back());
     RenderOptions warm_up = entry.options;  // Renderer::warm_up: one tile
     warm_up.width = SEAMCL_TILE_SIZE;
     warm_up.height = SEAMCL_TILE_SIZE;
-    phase2.include(render_memory(scene, warm_up));
+    phase3.include(render_memory(scene, warm_up));
     largest_packed = std::max(largest_packed, out.entries.back().host_packed);
+    largest_rate = std::max(largest_rate, entry.options.msaa);
+    if (std::find(rates.begin(), rates.end(), entry.options.msaa) == rates.end()) rates.push_back(entry.options.msaa);
   }
-  out.device_bytes = std::max(phase1.bytes(false), phase2.bytes(false));
-  out.device_bytes_bound = std::max(phase1.bytes(true), phase2.bytes(true));
+  // Phase 2: the first Renderer keeps its scene (frame buffers released); the seamless one packs
+  // its single face and renders the frame at each rate with discard, its buffers only growing.
+  size_t phase2_device = 0;
+  if (seamless) {
+    RenderOptions seamless_frame = frame;
+    seamless_frame.method = Method::Discard;
+    seamless_frame.msaa = largest_rate;
+    out.seamless = render_memory(*seamless_scene, seamless_frame);
+    phase2_device = add(add(phase1.scene, phase1.constants), out.seamless.device_bytes_bound());
+  }
+  out.device_bytes = std::max({phase1.bytes(false), phase2_device, phase3.bytes(false)});
+  out.device_bytes_bound = std::max({phase1.bytes(true), phase2_device, phase3.bytes(true)});
 
   const size_t pixels = mul(static_cast<size_t>(std::max(frame.width, 1)), static_cast<size_t>(std::max(frame.height, 1)));
   const size_t frame_image = mul(pixels, sizeof(glm::vec4));
   const size_t mask = pixels;  // one byte a pixel
+  const size_t masks = mul(mask, std::max<size_t>(rates.size(), 1));  // one seam mask per measured rate
+  // Every reference is kept at the frame's size: one per high-resolution kind, one per rate for seamless.
+  const size_t high_res_kinds = static_cast<size_t>(
+      std::count_if(kinds.begin(), kinds.end(), [](ReferenceKind k) { return k != ReferenceKind::Seamless; }));
+  const size_t references = mul(frame_image, add(high_res_kinds, seamless ? rates.size() : 0));
   // render_face_map: its image, the winners and setups read back, the face per slot, the map.
   const size_t face_map = add(add(out.face_map.host_image, mul(pixels, sizeof(uint32_t))),
                               add(out.face_map.setups, add(mul(mul(scene.triangle_count(), SEAMCL_CLIP_SLOTS), sizeof(uint32_t)),
                                                                    mul(pixels, sizeof(int32_t)))));
-  const size_t phase1_host = std::max(add(face_map, mask), add(add(out.reference.host_image, mul(frame_image, 2)), mask));
-  size_t phase2_host = add(add(frame_image, mask), out.entries.empty() ? 0 : frame_image);  // reference, mask, a read-back
-  for (size_t i = 0; i < entries.size(); ++i) phase2_host = add(phase2_host, add(frame_image, mul(pixels, sizeof(float))));
-  out.host_bytes = add(add(out.reference.host_scene, largest_packed), std::max(phase1_host, phase2_host));
+  // The 8x read-back and the downsample's two frame-sized buffers; with the analytic reference,
+  // also its 8x render's read-back, winners (one uint a pixel at 1 sample), setups and albedo image.
+  size_t high_res_host = high_res ? add(out.reference.host_image, mul(frame_image, 2)) : 0;
+  if (analytic) {
+    const size_t fine_pixels = out.analytic.host_image / sizeof(glm::vec4);
+    high_res_host = add(high_res_host, add(add(out.analytic.host_image, mul(fine_pixels, sizeof(uint32_t))),
+                                           add(out.analytic.setups, out.analytic.host_image)));
+  }
+  const size_t seamless_held = seamless ? out.seamless.host_scene : 0;  // seamless_scene's result
+  const size_t phase1_host = add(std::max(add(face_map, masks), add(high_res_host, add(masks, references))), seamless_held);
+  // Phase 2: the seamless Scene, the second Renderer's copy and packing, one image per rate.
+  const size_t phase2_host = seamless ? add(add(mul(seamless_held, 2), out.seamless.host_packed), add(masks, references)) : 0;
+  size_t phase3_host = add(add(references, masks), out.entries.empty() ? 0 : frame_image);  // references, masks, a read-back
+  for (size_t i = 0; i < entries.size(); ++i) phase3_host = add(phase3_host, add(frame_image, mul(pixels, sizeof(float))));
+  out.host_bytes = add(add(out.face_map.host_scene, largest_packed),
+                       std::max({phase1_host, phase2_host, phase3_host}));
   return out;
 }
 

@@ -3,11 +3,16 @@
 // any texture or buffer exists. The parts are render_memory()s (host/pipeline/render_memory.h);
 // the totals are over the phases of the run:
 //   1. load_scene, the 1-sample face-map frame (seam mask), the 8x reference render and its
-//      Mitchell downsample; reference_image(Renderer&, ...) then releases the frame buffers;
-//   2. per entry: load_scene in the entry's format, a 16x16 warm-up, `repeat` renders; each
+//      Mitchell downsample (with the analytic reference: the 8x frame at 1 sample, its winners
+//      and setups read back and its albedo image); reference_images then releases the frame
+//      buffers. With the seamless reference, its Scene (made first) is held through phase 2;
+//   2. with the seamless reference: a second Renderer loads the seamless scene and renders it at
+//      each measured rate, beside the first Renderer's scene;
+//   3. per entry: load_scene in the entry's format, a 16x16 warm-up, `repeat` renders; each
 //      entry's image and error distances are kept until the end.
 #pragma once
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include <seamcl/eval/comparison.h>
@@ -19,6 +24,8 @@ namespace seamcl {
 struct CompareMemory {
   RenderMemory face_map;              // the seam mask's frame: msaa 1, pixel shading
   RenderMemory reference;             // the 8x render (reference_render_options)
+  RenderMemory analytic;              // the analytic reference's 8x render at 1 sample (zero without it)
+  RenderMemory seamless;              // the seamless Renderer at the largest measured rate (zero without it)
   std::vector<RenderMemory> entries;  // one per method x rate
 
   // Upper bound of the device bytes the compare's Renderer holds at any moment: the larger
@@ -37,9 +44,13 @@ struct CompareMemory {
   size_t host_bytes = 0;
 };
 
-// Assumes the reference is rendered (a cache hit needs less). Throws what
+// Assumes the references are rendered (a cache hit needs less). `kinds` are the references
+// measured against (as prepare_targets takes them); `seamless_scene`, seamless_scene_sizes of the
+// scene, is needed when they include the seamless one (std::logic_error without it). Throws what
 // reference_render_options throws (InputError "size", "reference_method", "reference_msaa").
 CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame, const std::vector<MethodEntry>& entries,
-                             const ReferenceSettings& settings);
+                             const ReferenceSettings& settings,
+                             const std::vector<ReferenceKind>& kinds = {ReferenceKind::Paper},
+                             const std::optional<SceneSizes>& seamless_scene = std::nullopt);
 
 }  // namespace seamcl

@@ -585,25 +585,56 @@ GridLayout grid_layout(const Scene& scene) {
   return grid;
 }
 
-}  // namespace
+InputError seamless_refusal(const Scene& scene, const std::string& why) {
+  return InputError("reference", "the seamless reference needs a planar grid of equal-resolution faces; scene '" +
+                                     scene.name + "': " + why);
+}
 
-Scene seamless_scene(const Scene& scene) {
-  auto refuse = [&](const std::string& why) {
-    return InputError("reference", "the seamless reference needs a planar grid of equal-resolution faces; scene '" +
-                                       scene.name + "': " + why);
-  };
-  const GridLayout grid = grid_layout(scene);
-  if (!grid.why_not.empty()) throw refuse(grid.why_not);
-  const int w = scene.faces[grid.faces[0]].texture.width(), h = scene.faces[grid.faces[0]].texture.height();
-  for (size_t f : grid.faces) {
+// The grid of a seamless-able scene with its faces' common size and the combined texture's, or
+// the refusal (the corners' planarity is checked by seamless_scene, which places them).
+struct SeamlessGrid {
+  GridLayout grid;
+  int face_width = 0, face_height = 0;
+  int width = 0, height = 0;  // the combined texture
+};
+
+SeamlessGrid seamless_grid(const Scene& scene) {
+  SeamlessGrid out;
+  out.grid = grid_layout(scene);
+  if (!out.grid.why_not.empty()) throw seamless_refusal(scene, out.grid.why_not);
+  const int w = scene.faces[out.grid.faces[0]].texture.width(), h = scene.faces[out.grid.faces[0]].texture.height();
+  for (size_t f : out.grid.faces) {
     if (scene.faces[f].texture.width() != w || scene.faces[f].texture.height() != h) {
-      throw refuse("its faces' textures differ in size");
+      throw seamless_refusal(scene, "its faces' textures differ in size");
     }
   }
-  const int W = w * grid.columns, H = h * grid.rows;
+  const int W = w * out.grid.columns, H = h * out.grid.rows;
   if ((W & (W - 1)) != 0 || (H & (H - 1)) != 0) {
-    throw refuse("the combined texture (" + std::to_string(W) + "x" + std::to_string(H) + ") is not a power of two");
+    throw seamless_refusal(scene, "the combined texture (" + std::to_string(W) + "x" + std::to_string(H) +
+                                      ") is not a power of two");
   }
+  out.face_width = w;
+  out.face_height = h;
+  out.width = W;
+  out.height = H;
+  return out;
+}
+
+}  // namespace
+
+SceneSizes seamless_scene_sizes(const Scene& scene) {
+  const SeamlessGrid grid = seamless_grid(scene);
+  SceneSizes sizes;
+  sizes.vertices = 4;
+  sizes.faces = {{grid.width, grid.height}};
+  return sizes;
+}
+
+Scene seamless_scene(const Scene& scene) {
+  auto refuse = [&](const std::string& why) { return seamless_refusal(scene, why); };
+  const SeamlessGrid layout = seamless_grid(scene);
+  const GridLayout& grid = layout.grid;
+  const int w = layout.face_width, h = layout.face_height, W = layout.width, H = layout.height;
   // The grid's vertices on a parallelogram lattice: corner (i, j) at p00 + i a + j b.
   auto corner = [&](int i, int j) {
     const int c = std::min(i, grid.columns - 1), r = std::min(j, grid.rows - 1);
