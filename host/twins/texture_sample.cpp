@@ -394,6 +394,32 @@ int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, int guard
   return mask;
 }
 
+bool footprint_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float u, float v,
+                              float dudx, float dvdx, float dudy, float dvdy) {
+  if (filter != SEAMCL_FILTER_TRILINEAR && filter != SEAMCL_FILTER_ANISO) return true;
+  const Footprint f = footprint(face, dudx, dvdx, dudy, dvdy);
+  // A non-finite footprint reads the coarsest level: it may reach.
+  if (!f.finite) return true;
+  const bool x_major = f.len2_x >= f.len2_y;
+  const float major2 = x_major ? f.len2_x : f.len2_y;
+  const float minor2 = x_major ? f.len2_y : f.len2_x;
+  // A probe's extent in level-0 texels, squared: trilinear's is the major axis; aniso's is
+  // major / N with N >= min(major / minor, max_aniso), so at most max(minor, major / max_aniso).
+  const float aniso = static_cast<float>(max_aniso);
+  const float probe2 = filter == SEAMCL_FILTER_ANISO ? std::fmax(minor2, major2 / (aniso * aniso)) : major2;
+  // The filter's lod is log2 of that extent (or less), computed with approx_log2 (under 2e-5 off
+  // in all, a factor 1.00002 on probe2): floor(lod) <= floor(log2(1.001 probe2) / 2), which the
+  // exponent of 1.001 probe2 gives without a logarithm. The coarser level read is floor(lod) + 1,
+  // at least 1 (lod below 0 reads levels 0 and 1) and at most the last (coarser_level's clamps).
+  const int exponent = ((std::bit_cast<int32_t>(probe2 * 1.001f) >> 23) & 255) - 127;
+  const int lod_floor = exponent >> 1;  // floor(exponent / 2), negative exponents included
+  const int level = std::min(std::max(lod_floor, 0) + 1, face.level_count - 1);
+  // Aniso's probes lie within half the major axis of the centre (probes_reach_face's spread).
+  const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f : 0.0f;
+  return probes_reach_face(face, guard_band, level, u, v, spread * std::fabs(x_major ? f.ax_u : f.ay_u),
+                           spread * std::fabs(x_major ? f.ax_v : f.ay_v));
+}
+
 bool lookup_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float u, float v, float dudx,
                            float dvdx, float dudy, float dvdy) {
   const Footprint f = footprint(face, dudx, dvdx, dudy, dvdy);
@@ -401,8 +427,11 @@ bool lookup_may_reach_face(const FaceGpu& face, int guard_band, int filter, int 
     case SEAMCL_FILTER_BILINEAR:
       return probes_reach_face(face, guard_band, 0, u, v, 0.0f, 0.0f);
     case SEAMCL_FILTER_TRILINEAR:
-      return probes_reach_face(face, guard_band, coarser_level(face, trilinear_lod(face, f)), u, v, 0.0f, 0.0f);
+      return footprint_may_reach_face(face, guard_band, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy) &&
+             probes_reach_face(face, guard_band, coarser_level(face, trilinear_lod(face, f)), u, v, 0.0f, 0.0f);
     case SEAMCL_FILTER_ANISO: {
+      // The kernel tests the footprint first (no logarithm), then the probes.
+      if (!footprint_may_reach_face(face, guard_band, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy)) return false;
       const AnisoProbes p = aniso_probes(face, u, v, f, max_aniso);
       // The probes lie within (N - 1) / 2 steps of the centre; N / 2 leaves half a step spare.
       const float spread = 0.5f * static_cast<float>(p.probes);
