@@ -84,13 +84,15 @@ void accumulate_bilinear(FilterSum& sum, const TextureView& tex, Level level, fl
   add_texel(sum, tex, row1 + static_cast<uint32_t>(x1), weight * w11 * in_x1 * in_y1);
 }
 
+// `finer` false leaves out the finer level of the pair: a border-addressed probe too far past the
+// edge for that level's taps, which would add exactly zero (accumulate_probes).
 void accumulate_trilinear(FilterSum& sum, const TextureView& tex, const FaceGpu& face, float u, float v, float lod,
-                          float weight, int address) {
+                          float weight, int address, bool finer = true) {
   lod = std::fmin(std::fmax(lod, 0.0f), static_cast<float>(face.level_count - 1));
   const int level0 = static_cast<int>(lod);
   const int level1 = std::min(level0 + 1, face.level_count - 1);
   const float t = lod - static_cast<float>(level0);
-  accumulate_bilinear(sum, tex, face_level(tex, face, level0), u, v, weight * (1.0f - t), address);
+  if (finer) accumulate_bilinear(sum, tex, face_level(tex, face, level0), u, v, weight * (1.0f - t), address);
   accumulate_bilinear(sum, tex, face_level(tex, face, level1), u, v, weight * t, address);
 }
 
@@ -173,9 +175,15 @@ void accumulate_probes(FilterSum& sum, const TextureView& tex, const FaceGpu& fa
   const float texels = kTapReachTexels + static_cast<float>(tex.guard_band);
   const float reach_u = texels / static_cast<float>(std::max(face.width >> level, 1));
   const float reach_v = texels / static_cast<float>(std::max(face.height >> level, 1));
+  // The finer level of the pair reaches half as far past the edge (its texels are half the size).
+  const int finer = static_cast<int>(std::fmin(std::fmax(p.lod, 0.0f), static_cast<float>(face.level_count - 1)));
+  const float finer_reach_u = texels / static_cast<float>(std::max(face.width >> finer, 1));
+  const float finer_reach_v = texels / static_cast<float>(std::max(face.height >> finer, 1));
+  const bool border = address == SEAMCL_ADDRESS_BORDER;
   for (int i = 0; i < p.probes; ++i) {
-    if (address != SEAMCL_ADDRESS_BORDER || probe_reaches_face(pu, pv, reach_u, reach_v)) {
-      accumulate_trilinear(sum, tex, face, pu, pv, p.lod, p.weight, address);
+    if (!border || probe_reaches_face(pu, pv, reach_u, reach_v)) {
+      accumulate_trilinear(sum, tex, face, pu, pv, p.lod, p.weight, address,
+                           !border || probe_reaches_face(pu, pv, finer_reach_u, finer_reach_v));
     }
     pu += p.step_u;
     pv += p.step_v;
