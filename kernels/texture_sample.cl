@@ -192,30 +192,18 @@ SEAMCL_INLINE void accumulate_bilinear(FilterSum* sum, TEXEL_BUFFER texels, __gl
   add_texel(sum, texels, srgb_to_linear, row1 + (uint)x1, weight * w11 * in_x1 * in_y1);
 }
 
-/* weight * trilinear at `lod` (clamped to the chain) into sum; `finer` 0 leaves out the finer
- * level of the pair (for a border-addressed probe too far past the edge for that level's taps to
- * weigh anything: it would add exactly zero). */
-SEAMCL_INLINE void accumulate_trilinear_levels(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
-                                               TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u,
-                                               float v, float lod, float weight, int address, int finer) {
-  lod = fmin(fmax(lod, 0.0f), (float)(face->level_count - 1));
-  const int level0 = (int)lod;
-  const int level1 = min(level0 + 1, face->level_count - 1);
-  const float t = lod - (float)level0;
-  if (finer) {
-    accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level0), u, v, weight * (1.0f - t),
-                        address);
-  }
-  /* The second level tied to the first; the summed weight is finite. */
-  accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level1), u + TIE(sum->weight), v,
-                      weight * t, address);
-}
-
 /* weight * trilinear at `lod` (clamped to the chain) into sum. */
 SEAMCL_INLINE void accumulate_trilinear(FilterSum* sum, const FaceGpu* face, __global const uint* level_offsets,
                                  TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
                                  float lod, float weight, int address) {
-  accumulate_trilinear_levels(sum, face, level_offsets, texels, srgb_to_linear, u, v, lod, weight, address, 1);
+  lod = fmin(fmax(lod, 0.0f), (float)(face->level_count - 1));
+  const int level0 = (int)lod;
+  const int level1 = min(level0 + 1, face->level_count - 1);
+  const float t = lod - (float)level0;
+  accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level0), u, v, weight * (1.0f - t), address);
+  /* The second level tied to the first; the summed weight is finite. */
+  accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, level1), u + TIE(sum->weight), v,
+                      weight * t, address);
 }
 
 /* Screen axes of the footprint in level-0 texels, squared lengths. A non-finite footprint
@@ -281,36 +269,6 @@ SEAMCL_INLINE int probes_reach_face(const FaceGpu* face, int level, float u, flo
                             half_v + (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->height, level));
 }
 
-/* Whether a border-addressed trilinear or aniso lookup on `face` centred at (u, v), with
- * footprint f (in its level-0 texels), can put weight inside the face, decided from the footprint
- * alone: before aniso_probes (a division, a square root and two logarithms) or trilinear_lod (a
- * logarithm), so that traverse's neighbours that lie out of reach cost no more than the footprint.
- * The level: an aniso probe spans sqrt(major2) / N <= sqrt(max(minor2, major2 / max_aniso^2))
- * texels (N >= min(major / minor, max_aniso)), a trilinear one sqrt(major2); the level read is at
- * most floor(lod) + 1 with 2^lod no more than that, and floor(lod) at most floor(log2(x) / 2) of
- * any x above its square, read from x's exponent (x = 1.001 times it: approx_log2's error in the
- * filter's lod is under 2e-5, a factor 1.00002 on x). Both clamps of coarser_level are kept (at
- * least level 1 below lod 0, at most the last level). The probes lie within half the major axis of
- * the centre (probes_reach_face's spread). Conservative like probes_reach_face, which it precedes
- * (the level bound is an integer, so it is as tight as that test but for the probe count's ceil).
- * Twin: footprint_may_reach_face in host/twins/texture_sample.cpp. */
-SEAMCL_INLINE int footprint_reaches_face(const FaceGpu* face, Footprint f, int filter, int max_aniso, float u, float v) {
-  if (!f.finite) return 1;
-  const int x_major = f.len2_x >= f.len2_y;
-  const float major2 = x_major ? f.len2_x : f.len2_y;
-  const float minor2 = x_major ? f.len2_y : f.len2_x;
-  const float aniso = (float)max_aniso;
-  const float probe2 = filter == SEAMCL_FILTER_ANISO ? fmax(minor2, major2 / (aniso * aniso)) : major2;
-  const int lod_floor = (((as_int(probe2 * 1.001f) >> 23) & 255) - 127) >> 1;
-  const int level = min(max(lod_floor, 0) + 1, face->level_count - 1);
-  const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f : 0.0f;
-  const float half_u = spread * fabs(x_major ? f.ax_u : f.ay_u);
-  const float half_v = spread * fabs(x_major ? f.ax_v : f.ay_v);
-  const float reach = TAP_REACH_TEXELS + (float)GUARD;
-  return probe_reaches_face(u, v, half_u + reach * inverse_level_side(face->width, level),
-                            half_v + reach * inverse_level_side(face->height, level));
-}
-
 /* The line of trilinear probes an aniso lookup takes, computed once so that the reach test of
  * traverse (probes_reach_face) and the filter read the same values. */
 typedef struct {
@@ -357,16 +315,9 @@ SEAMCL_INLINE void accumulate_probes(FilterSum* sum, const FaceGpu* face, __glob
   const int level = coarser_level(face, p.lod);
   const float reach_u = (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->width, level);
   const float reach_v = (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->height, level);
-  /* The finer level of the pair has texels half the size: a probe near the edge often reaches
-   * past it only on the coarser level (traverse's neighbours: about 40% of their levels). */
-  const int finer = (int)fmin(fmax(p.lod, 0.0f), (float)(face->level_count - 1));
-  const float finer_reach_u = (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->width, finer);
-  const float finer_reach_v = (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->height, finer);
-  const int skipping = SEAMCL_TRAVERSE_EARLY_OUT && address == SEAMCL_ADDRESS_BORDER;
   for (int i = 0; i < p.probes; ++i) {
-    if (!skipping || probe_reaches_face(pu, pv, reach_u, reach_v)) {
-      accumulate_trilinear_levels(sum, face, level_offsets, texels, srgb_to_linear, pu, pv, p.lod, p.weight, address,
-                                  !skipping || probe_reaches_face(pu, pv, finer_reach_u, finer_reach_v));
+    if (!SEAMCL_TRAVERSE_EARLY_OUT || address != SEAMCL_ADDRESS_BORDER || probe_reaches_face(pu, pv, reach_u, reach_v)) {
+      accumulate_trilinear(sum, face, level_offsets, texels, srgb_to_linear, pu, pv, p.lod, p.weight, address);
     }
     pu += p.step_u;
     pv += p.step_v;
@@ -589,16 +540,11 @@ SEAMCL_INLINE void accumulate_across(FilterSum* sum, __global const FaceGpu* fac
     accumulate_bilinear(&s, texels, srgb_to_linear, face_level(&g, level_offsets, 0), gu, gv, 1.0f,
                         SEAMCL_ADDRESS_BORDER);
   } else if (filter == SEAMCL_FILTER_TRILINEAR) {
-    const Footprint fg = footprint(&g, gdudx, gdvdx, gdudy, gdvdy);
-    if (early_out && !footprint_reaches_face(&g, fg, filter, max_aniso, gu, gv)) return;
-    const float lod = trilinear_lod(&g, fg);
+    const float lod = trilinear_lod(&g, footprint(&g, gdudx, gdvdx, gdudy, gdvdy));
     if (early_out && !probes_reach_face(&g, coarser_level(&g, lod), gu, gv, 0.0f, 0.0f)) return;
     accumulate_trilinear(&s, &g, level_offsets, texels, srgb_to_linear, gu, gv, lod, 1.0f, SEAMCL_ADDRESS_BORDER);
   } else if (filter == SEAMCL_FILTER_ANISO) {
-    const Footprint fg = footprint(&g, gdudx, gdvdx, gdudy, gdvdy);
-    /* Most neighbours that pass the size test but lie out of reach go here, before aniso_probes. */
-    if (early_out && !footprint_reaches_face(&g, fg, filter, max_aniso, gu, gv)) return;
-    const AnisoProbes p = aniso_probes(&g, gu, gv, fg, max_aniso);
+    const AnisoProbes p = aniso_probes(&g, gu, gv, footprint(&g, gdudx, gdvdx, gdudy, gdvdy), max_aniso);
     /* The probes lie within (N - 1) / 2 steps of the centre; N / 2 leaves half a step spare. */
     const float spread = 0.5f * (float)p.probes;
     if (early_out && !probes_reach_face(&g, coarser_level(&g, p.lod), gu, gv, spread * fabs(p.step_u),

@@ -447,52 +447,6 @@ TEST(Traverse, ReachTestSkipsOnlyNeighboursThatWouldAddNothing) {
   EXPECT_GT(reaching, kept / 2) << "kept " << kept << " reaching " << reaching;
 }
 
-TEST(Traverse, FootprintTestSkipsOnlyNeighboursThatWouldAddNothing) {
-  // footprint_may_reach_face bounds the level a trilinear or aniso lookup reads from the
-  // footprint's exponent (no probe count, no logarithm); traverse's kernel runs it before a
-  // neighbour's aniso_probes. Every neighbour it rules out must weigh exactly zero, on faces of
-  // mixed sizes (1x1 to 256x256, non-square) at every max_aniso, and it must rule out most of the
-  // neighbours that hold no weight (what spares their probe setup).
-  Scene scene = seamcl_tests::subdivided_cube(2);
-  seamcl_tests::set_textures(scene, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
-  const PackedScene packed = pack_scene(scene, TexelFormat::Rgba32f);
-  const TextureView view = packed.textures();
-  const std::vector<Lookup> lookups = lookups_near_edges(scene.faces.size(), 20000, 21);
-  std::mt19937 rng(22);
-  size_t skipped = 0, empty = 0, kept_empty = 0, full_test_skipped = 0;
-  for (const Lookup& l : lookups) {
-    const Filter filter = rng() % 2 == 0 ? Filter::Trilinear : Filter::Aniso;
-    const SamplerParams sampler = sampler_params(Method::Traverse, filter, 1 + static_cast<int>(rng() % 16), ZeroCoverage::Clamp);
-    const FaceNeighbors& n = packed.neighbors[l.face];
-    for (int j = 0; j < 8; ++j) {
-      const int k = j % 4;
-      const int other = j < 4 ? n.neighbor[k] : n.corner[k];
-      if (other < 0) continue;
-      const UvMap map = uv_map(j < 4 ? n.transform[k] : n.corner_transform[k]);
-      const glm::vec2 p = map.point({l.u, l.v}), dx = map.direction({l.dudx, l.dvdx}), dy = map.direction({l.dudy, l.dvdy});
-      const FaceGpu& g = packed.faces[static_cast<size_t>(other)];
-      const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER,
-                                                   p.x, p.y, dx.x, dx.y, dy.x, dy.y);
-      const bool may = footprint_may_reach_face(g, 0, sampler.filter, sampler.max_aniso, p.x, p.y, dx.x, dx.y, dy.x, dy.y);
-      empty += s.weight == 0.0f;
-      full_test_skipped +=
-          !lookup_may_reach_face(g, 0, sampler.filter, sampler.max_aniso, p.x, p.y, dx.x, dx.y, dy.x, dy.y);
-      if (may) {
-        kept_empty += s.weight == 0.0f;
-        continue;
-      }
-      ++skipped;
-      ASSERT_EQ(s.weight, 0.0f) << "face " << l.face << " neighbour " << other << " (" << (j < 4 ? "edge " : "corner ")
-                                << k << ") at " << l.u << "," << l.v << " " << to_string(filter);
-      ASSERT_TRUE(same_bits(s, FilterSum{})) << "a skipped neighbour adds colour";
-    }
-  }
-  // Not loose: it leaves few of the empty neighbours to the probe test.
-  EXPECT_GT(skipped, 0u);
-  EXPECT_LE(skipped, full_test_skipped) << "lookup_may_reach_face applies this test first";
-  EXPECT_LT(kept_empty * 4, empty) << "skipped " << skipped << " of " << empty << " empty neighbours";
-}
-
 TEST(Traverse, EdgeReachTestSkipsOnlyFacesThatWouldAddNothing) {
   // edges_may_reach decides from the lookup's own FaceNeighbors record (the sides pack_scene
   // stores per edge) whether a face across edge k or past its ends can be reached; a clear bit

@@ -84,15 +84,13 @@ void accumulate_bilinear(FilterSum& sum, const TextureView& tex, Level level, fl
   add_texel(sum, tex, row1 + static_cast<uint32_t>(x1), weight * w11 * in_x1 * in_y1);
 }
 
-// `finer` false leaves out the finer level of the pair: a border-addressed probe too far past the
-// edge for that level's taps, which would add exactly zero (accumulate_probes).
 void accumulate_trilinear(FilterSum& sum, const TextureView& tex, const FaceGpu& face, float u, float v, float lod,
-                          float weight, int address, bool finer = true) {
+                          float weight, int address) {
   lod = std::fmin(std::fmax(lod, 0.0f), static_cast<float>(face.level_count - 1));
   const int level0 = static_cast<int>(lod);
   const int level1 = std::min(level0 + 1, face.level_count - 1);
   const float t = lod - static_cast<float>(level0);
-  if (finer) accumulate_bilinear(sum, tex, face_level(tex, face, level0), u, v, weight * (1.0f - t), address);
+  accumulate_bilinear(sum, tex, face_level(tex, face, level0), u, v, weight * (1.0f - t), address);
   accumulate_bilinear(sum, tex, face_level(tex, face, level1), u, v, weight * t, address);
 }
 
@@ -175,15 +173,9 @@ void accumulate_probes(FilterSum& sum, const TextureView& tex, const FaceGpu& fa
   const float texels = kTapReachTexels + static_cast<float>(tex.guard_band);
   const float reach_u = texels / static_cast<float>(std::max(face.width >> level, 1));
   const float reach_v = texels / static_cast<float>(std::max(face.height >> level, 1));
-  // The finer level of the pair reaches half as far past the edge (its texels are half the size).
-  const int finer = static_cast<int>(std::fmin(std::fmax(p.lod, 0.0f), static_cast<float>(face.level_count - 1)));
-  const float finer_reach_u = texels / static_cast<float>(std::max(face.width >> finer, 1));
-  const float finer_reach_v = texels / static_cast<float>(std::max(face.height >> finer, 1));
-  const bool border = address == SEAMCL_ADDRESS_BORDER;
   for (int i = 0; i < p.probes; ++i) {
-    if (!border || probe_reaches_face(pu, pv, reach_u, reach_v)) {
-      accumulate_trilinear(sum, tex, face, pu, pv, p.lod, p.weight, address,
-                           !border || probe_reaches_face(pu, pv, finer_reach_u, finer_reach_v));
+    if (address != SEAMCL_ADDRESS_BORDER || probe_reaches_face(pu, pv, reach_u, reach_v)) {
+      accumulate_trilinear(sum, tex, face, pu, pv, p.lod, p.weight, address);
     }
     pu += p.step_u;
     pv += p.step_v;
@@ -402,32 +394,6 @@ int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, int guard
   return mask;
 }
 
-bool footprint_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float u, float v,
-                              float dudx, float dvdx, float dudy, float dvdy) {
-  if (filter != SEAMCL_FILTER_TRILINEAR && filter != SEAMCL_FILTER_ANISO) return true;
-  const Footprint f = footprint(face, dudx, dvdx, dudy, dvdy);
-  // A non-finite footprint reads the coarsest level: it may reach.
-  if (!f.finite) return true;
-  const bool x_major = f.len2_x >= f.len2_y;
-  const float major2 = x_major ? f.len2_x : f.len2_y;
-  const float minor2 = x_major ? f.len2_y : f.len2_x;
-  // A probe's extent in level-0 texels, squared: trilinear's is the major axis; aniso's is
-  // major / N with N >= min(major / minor, max_aniso), so at most max(minor, major / max_aniso).
-  const float aniso = static_cast<float>(max_aniso);
-  const float probe2 = filter == SEAMCL_FILTER_ANISO ? std::fmax(minor2, major2 / (aniso * aniso)) : major2;
-  // The filter's lod is log2 of that extent (or less), computed with approx_log2 (under 2e-5 off
-  // in all, a factor 1.00002 on probe2): floor(lod) <= floor(log2(1.001 probe2) / 2), which the
-  // exponent of 1.001 probe2 gives without a logarithm. The coarser level read is floor(lod) + 1,
-  // at least 1 (lod below 0 reads levels 0 and 1) and at most the last (coarser_level's clamps).
-  const int exponent = ((std::bit_cast<int32_t>(probe2 * 1.001f) >> 23) & 255) - 127;
-  const int lod_floor = exponent >> 1;  // floor(exponent / 2), negative exponents included
-  const int level = std::min(std::max(lod_floor, 0) + 1, face.level_count - 1);
-  // Aniso's probes lie within half the major axis of the centre (probes_reach_face's spread).
-  const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f : 0.0f;
-  return probes_reach_face(face, guard_band, level, u, v, spread * std::fabs(x_major ? f.ax_u : f.ay_u),
-                           spread * std::fabs(x_major ? f.ax_v : f.ay_v));
-}
-
 bool lookup_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float u, float v, float dudx,
                            float dvdx, float dudy, float dvdy) {
   const Footprint f = footprint(face, dudx, dvdx, dudy, dvdy);
@@ -435,11 +401,8 @@ bool lookup_may_reach_face(const FaceGpu& face, int guard_band, int filter, int 
     case SEAMCL_FILTER_BILINEAR:
       return probes_reach_face(face, guard_band, 0, u, v, 0.0f, 0.0f);
     case SEAMCL_FILTER_TRILINEAR:
-      return footprint_may_reach_face(face, guard_band, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy) &&
-             probes_reach_face(face, guard_band, coarser_level(face, trilinear_lod(face, f)), u, v, 0.0f, 0.0f);
+      return probes_reach_face(face, guard_band, coarser_level(face, trilinear_lod(face, f)), u, v, 0.0f, 0.0f);
     case SEAMCL_FILTER_ANISO: {
-      // The kernel tests the footprint first (no logarithm), then the probes.
-      if (!footprint_may_reach_face(face, guard_band, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy)) return false;
       const AnisoProbes p = aniso_probes(face, u, v, f, max_aniso);
       // The probes lie within (N - 1) / 2 steps of the centre; N / 2 leaves half a step spare.
       const float spread = 0.5f * static_cast<float>(p.probes);

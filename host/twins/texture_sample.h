@@ -44,12 +44,6 @@ bool axis_rules_out(float side, float cross_side, int filter, int max_aniso, int
 // reach_min_side / reach_max_side); a clear bit skips those three faces unread. EWA: all set.
 int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, int guard_band, float u, float v, float dudx,
                     float dvdx, float dudy, float dvdy);
-// The same question for trilinear and aniso, from the footprint alone (no probe count, no
-// logarithm: the level read bounded from the footprint's exponent), the test the kernel runs
-// before a neighbour's aniso_probes; looser than lookup_may_reach_face (which applies it first)
-// only by the probe count's rounding up. Bilinear and EWA: always may.
-bool footprint_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float u, float v,
-                              float dudx, float dvdx, float dudy, float dvdy);
 // Whether a border-addressed lookup with `filter` on `face` (its own uv and derivatives) can put
 // weight inside it (or in its guard band of `guard_band` texels per level): bilinear, trilinear
 // and aniso test the very probes the filter takes (their line, and a texel of the coarser level
