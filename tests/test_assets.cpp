@@ -540,6 +540,46 @@ TEST(Assets, AnImageFaceThatChangedOrWentBeforeItIsPackedIsAnInputError) {
   EXPECT_TRUE(same_chains(face_texture(scene, 0), face_texture(scene, 0)));
 }
 
+// A face's image swapped, after the scene was read, for a larger one of the same size on disk and
+// modification time (so the stamp check passes): refused at its header, in the file as opened for
+// the read, before any pixel is decoded. The larger file's pixel data is cut off, so a decode of
+// it would fail with a decoder's error instead of naming the sizes.
+TEST(Assets, AnImageFaceSwappedForALargerOneIsRefusedAtItsHeaderBeforeAnyPixelIsDecoded) {
+  TempDir dir;
+  const fs::path image = dir.path() / "face.png";
+  write_image(image.string(), 64, 64, varied_pixels(64, 64, 8));
+  const Scene scene = load_scene_source(dir.write("one.json", image_cube_scene({"face.png"}).dump()), "", deferring());
+  ASSERT_EQ(scene.faces[0].texture.width(), 64);
+
+  // 128 x 128 noise, cut to the 64 x 64 file's length: a whole header, part of its pixel data.
+  const fs::path larger = dir.path() / "larger.png";
+  write_image(larger.string(), 128, 128, varied_pixels(128, 128, 9));
+  const auto length = fs::file_size(image);
+  ASSERT_GT(fs::file_size(larger), length + 100);
+  fs::resize_file(larger, length);
+  int width = 0, height = 0;
+  try {
+    read_image(larger.string(), width, height);
+    ADD_FAILURE() << "the cut file decoded";
+  } catch (const std::runtime_error& error) {
+    EXPECT_EQ(std::string(error.what()).find("128x128"), std::string::npos) << error.what();
+  }
+  // The swap: renamed over the face's file, with the old file's modification time.
+  fs::last_write_time(larger, fs::last_write_time(image));
+  const auto stamp = fs::last_write_time(image);
+  fs::rename(larger, image);
+  ASSERT_EQ(fs::file_size(image), length);
+  ASSERT_EQ(fs::last_write_time(image), stamp);
+
+  const std::string field = "faces[0].texture.image";
+  for (const std::string& message :
+       {input_error([&] { face_texture(scene, 0); }, field), input_error([&] { Renderer(shared_runtime()).load_scene(scene); }, field)}) {
+    EXPECT_NE(message.find("changed since the scene was read (64x64, 4 channels -> 128x128, 4 channels)"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("face.png"), std::string::npos) << message;
+  }
+}
+
 TEST(Assets, ImageFacesWithBadPixelsAreRefusedWhenParsedOrWhenDeferredWhenMade) {
   TempDir dir;
   // A PNG whose header is whole and whose pixel data is cut off: its size is readable, its pixels not.

@@ -48,7 +48,10 @@ FaceImageFile open_face_image(const std::string& path, const std::string& field)
   if (!stamp_of(path, file.file_bytes, file.modified))
     throw InputError(field, "image '" + path + "' is not a regular file that can be read");
   try {
-    read_image_size(path, file.width, file.height);
+    const ImageHeader header = read_image_header(path);
+    file.width = header.width;
+    file.height = header.height;
+    file.channels = header.channels;
   } catch (const std::exception& error) {
     throw InputError(field, error.what());
   }
@@ -59,17 +62,31 @@ FaceImageFile open_face_image(const std::string& path, const std::string& field)
 
 TextureLevel read_face_image(const FaceImageFile& file) {
   check_unchanged(file);
+  // The header of the file as opened for the read, checked before any pixel is decoded: a file
+  // swapped since the stamp check (for one of the same stamp, or between the check and the open)
+  // is refused at its header, not decoded at whatever size it now has.
+  const auto same_header = [&file](const ImageHeader& header) {
+    check_side(header.width, "wide", file.path, file.field);
+    check_side(header.height, "high", file.path, file.field);
+    if (header.width != file.width || header.height != file.height || header.channels != file.channels)
+      throw InputError(file.field, "image '" + file.path + "' changed since the scene was read (" +
+                                       std::to_string(file.width) + "x" + std::to_string(file.height) + ", " +
+                                       std::to_string(file.channels) + " channels -> " + std::to_string(header.width) +
+                                       "x" + std::to_string(header.height) + ", " + std::to_string(header.channels) +
+                                       " channels); load the scene again");
+  };
   int width = 0, height = 0;
   std::vector<glm::vec4> pixels;
   try {
-    pixels = read_image(file.path, width, height);
+    pixels = read_image(file.path, width, height, same_header);
+  } catch (const InputError&) {
+    throw;
   } catch (const std::exception& error) {
     throw InputError(file.field, error.what());
   }
-  if (width != file.width || height != file.height)
-    throw InputError(file.field, "image '" + file.path + "' changed while it was read (" + std::to_string(file.width) +
-                                     "x" + std::to_string(file.height) + " -> " + std::to_string(width) + "x" +
-                                     std::to_string(height) + ")");
+  if (width != file.width || height != file.height)  // read_image keeps to the header it showed
+    throw std::logic_error("read_face_image: read " + std::to_string(width) + "x" + std::to_string(height) +
+                           " pixels after a header of " + std::to_string(file.width) + "x" + std::to_string(file.height));
   check_unchanged(file);  // the pixels read are the stamped file's
   // Image rows run top to bottom; texture rows run from v = 0 upwards: rows swapped in place, so
   // that no second copy of the face's level 0 exists.
