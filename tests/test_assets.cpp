@@ -535,6 +535,16 @@ TEST(Assets, AnImageFaceThatChangedOrWentBeforeItIsPackedIsAnInputError) {
   EXPECT_NE(input_error([&] { Renderer(shared_runtime()).load_scene(std::move(scene)); }, field).find("is gone"),
             std::string::npos);
 
+  // Each of them names the scene file, as the errors found when it is parsed do.
+  scene = fresh();
+  fs::remove(image);
+  const std::string in_file = " (in '" + file + "')";
+  for (const std::string& message : {input_error([&] { face_texture(scene, 0); }, field),
+                                     input_error([&] { Renderer(shared_runtime()).load_scene(scene); }, field)})
+    EXPECT_TRUE(message.ends_with("is gone (it was there when the scene was read)" + in_file)) << message;
+  const std::string parse_time = input_error([&] { load_scene_source(file, "", deferring()); }, field);
+  EXPECT_TRUE(parse_time.ends_with(in_file)) << parse_time;
+
   // Unchanged: made as often as asked, the same each time.
   scene = fresh();
   EXPECT_TRUE(same_chains(face_texture(scene, 0), face_texture(scene, 0)));
@@ -607,7 +617,9 @@ TEST(Assets, ImageFacesWithBadPixelsAreRefusedWhenParsedOrWhenDeferredWhenMade) 
   const std::string eager_message = input_error([&] { load_scene_source(nan); }, "faces[0].texture");
   EXPECT_NE(eager_message.find("mip level 0 has a non-finite texel"), std::string::npos) << eager_message;
   const Scene with_nan = load_scene_source(nan, "", deferring());
-  EXPECT_EQ(input_error([&] { face_texture(with_nan, 0); }, "faces[0].texture"), eager_message.substr(0, eager_message.find(" (in '")));
+  // The whole message, the scene file's name included (it is a pack-time error of a scene file).
+  EXPECT_EQ(input_error([&] { face_texture(with_nan, 0); }, "faces[0].texture"), eager_message);
+  EXPECT_TRUE(eager_message.ends_with(" (in '" + nan + "')")) << eager_message;
   input_error([&] { Renderer(shared_runtime()).load_scene(with_nan); }, "faces[0].texture");
 }
 

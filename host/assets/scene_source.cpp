@@ -133,7 +133,7 @@ struct Loader {
       apply_generator_options(scene, options.generator);
       return scene;
     } catch (const InputError& error) {
-      throw InputError(error.field(), message_of(error) + " (in '" + path + "')");
+      throw error_in_scene_file(error, path);
     }
   }
 };

@@ -504,11 +504,6 @@ Scene realize(SceneSource source, const GeneratorOptions& extra) {
   return scene;
 }
 
-// The message of an InputError without its "field: " prefix.
-std::string message_of(const InputError& error) {
-  return std::string(error.what()).substr(error.field().size() + 2);
-}
-
 SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load_image, bool defer) {
   std::error_code error_code;
   if (!std::filesystem::exists(path, error_code))
@@ -526,8 +521,24 @@ SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load
   try {
     return read_document(doc, std::filesystem::path(path).stem().string(), load_image, defer);
   } catch (const InputError& error) {
-    throw InputError(error.field(), message_of(error) + " (in '" + path + "')");
+    throw error_in_scene_file(error, path);
   }
+}
+
+// A scene file's scene: what its faces find wrong when they are made (packed, for a deferred one)
+// names the file as what the parse found wrong does.
+Scene realize_file(SceneSource source, const GeneratorOptions& extra, const std::string& path) {
+  Scene scene = realize(std::move(source), extra);
+  if (scene.texture_source) {
+    scene.texture_source = [source = std::move(scene.texture_source), path](size_t f) {
+      try {
+        return source(f);
+      } catch (const InputError& error) {
+        throw error_in_scene_file(error, path);
+      }
+    };
+  }
+  return scene;
 }
 
 }  // namespace
@@ -544,16 +555,21 @@ Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_im
 }
 
 Scene load_scene_file(const std::string& path, const FaceImageLoader& load_image) {
-  return realize(read_scene_file(path, load_image, false), {});
+  return realize_file(read_scene_file(path, load_image, false), {}, path);
 }
 
 Scene load_scene(const std::string& name_or_path, const GeneratorOptions& options, const FaceImageLoader& load_image) {
   if (is_generator_name(name_or_path)) return generate_scene(name_or_path, options);
   std::error_code ignored;
   if (name_or_path.ends_with(".json") || std::filesystem::exists(name_or_path, ignored))
-    return realize(read_scene_file(name_or_path, load_image, options.defer_textures), options);
+    return realize_file(read_scene_file(name_or_path, load_image, options.defer_textures), options, name_or_path);
   throw InputError("scene", "unknown scene '" + name_or_path + "' (known: " +
                                 known_generator_names() + "; or the path of a .json scene file)");
+}
+
+InputError error_in_scene_file(const InputError& error, const std::string& path) {
+  const std::string message = std::string(error.what()).substr(error.field().size() + 2);  // without "field: "
+  return InputError(error.field(), message + " (in '" + path + "')");
 }
 
 bool is_builtin_scene(const std::string& name) { return is_generator_name(name); }
