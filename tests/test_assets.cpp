@@ -22,6 +22,7 @@
 
 #include <seamcl/assets/asset_directory.h>
 #include <seamcl/assets/asset_scene.h>
+#include <seamcl/assets/file_stamp.h>
 #include <seamcl/assets/obj_mesh.h>
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/core/input_error.h>
@@ -621,6 +622,26 @@ TEST(Assets, ImageFacesWithBadPixelsAreRefusedWhenParsedOrWhenDeferredWhenMade) 
   EXPECT_EQ(input_error([&] { face_texture(with_nan, 0); }, "faces[0].texture"), eager_message);
   EXPECT_TRUE(eager_message.ends_with(" (in '" + nan + "')")) << eager_message;
   input_error([&] { Renderer(shared_runtime()).load_scene(with_nan); }, "faces[0].texture");
+}
+
+// The one stamp the image faces and the asset cache tell a changed file by: size and modification
+// time, none for what is not a regular file.
+TEST(Assets, AFileStampIsItsSizeAndModificationTime) {
+  TempDir dir;
+  const std::string file = dir.write("a.txt", "four");
+  const std::optional<FileStamp> first = file_stamp(file);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->bytes, 4u);
+  EXPECT_EQ(first->modified, fs::last_write_time(file));
+  EXPECT_EQ(file_stamp(file), first);
+  fs::last_write_time(file, first->modified + std::chrono::seconds(2));
+  EXPECT_NE(file_stamp(file), first) << "touched";
+  dir.write("a.txt", "five!");
+  fs::last_write_time(file, first->modified);
+  EXPECT_NE(file_stamp(file), first) << "another size at the same time";
+  EXPECT_EQ(file_stamp(file)->bytes, 5u);
+  EXPECT_FALSE(file_stamp((dir.path() / "none.txt").string()));
+  EXPECT_FALSE(file_stamp(dir.path().string())) << "a directory";
 }
 
 TEST(Assets, TheAssetCacheCountsKeptPtexBytesAndReloadsASceneWhoseImageChanged) {

@@ -23,13 +23,12 @@ bool is_within(const fs::path& path, const fs::path& root) {
   return true;
 }
 
-// Size and modification time: a changed file is a different cache entry.
-std::string file_stamp(const std::string& path) {
-  std::error_code error;
-  const auto size = fs::file_size(path, error);
-  const auto time = fs::last_write_time(path, error);
+// A file's stamp as text, for the cache key: a changed scene or texture file is a different entry.
+std::string stamp_text(const std::string& path) {
+  const std::optional<FileStamp> stamp = file_stamp(path);
+  if (!stamp) return "none";
   std::ostringstream out;
-  out << size << "@" << time.time_since_epoch().count();
+  out << stamp->bytes << "@" << stamp->modified.time_since_epoch().count();
   return out.str();
 }
 
@@ -90,15 +89,15 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
                                                   SceneSourceOptions options) {
   // Every file the load resolves, stamped when resolved (before it is read), so that a file
   // changed while or after it is read makes the entry stale rather than the stamp new.
-  auto files = std::make_shared<std::map<std::string, std::string>>();
+  auto files = std::make_shared<std::map<std::string, std::optional<FileStamp>>>();
   options.resolve = [this, files](const std::string& name, const std::string& relative_to, const std::string& field) {
     std::string path = resolve(name, relative_to, field);
     if (!files->contains(path)) files->emplace(path, file_stamp(path));
     return path;
   };
   std::ostringstream key;
-  key << resolve(scene, "", "scene") << "|" << file_stamp(resolve(scene, "", "scene")) << "|";
-  if (!texture.empty()) key << resolve(texture, "", "texture") << "|" << file_stamp(resolve(texture, "", "texture"));
+  key << resolve(scene, "", "scene") << "|" << stamp_text(resolve(scene, "", "scene")) << "|";
+  if (!texture.empty()) key << resolve(texture, "", "texture") << "|" << stamp_text(resolve(texture, "", "texture"));
   // Deferred or baked is part of the key: a caller that reads the stored texels must not be handed
   // a deferred scene, nor one that packs face by face a baked one (its float copy of every face).
   key << "|" << options.generator.tint << "|" << options.generator.defer_textures << "|" << options.mesh_texture_size

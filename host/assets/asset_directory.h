@@ -10,10 +10,12 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <seamcl/assets/file_stamp.h>
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/scene/scene.h>
 
@@ -66,7 +68,7 @@ class AssetDirectory {
     size_t bytes = 0;
     // Every path the load resolved, once (a file many faces name is checked once), and its stamp
     // when first resolved.
-    std::map<std::string, std::string> files;
+    std::map<std::string, std::optional<FileStamp>> files;
   };
 
   std::string root_;  // canonical

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <stdexcept>
-#include <system_error>
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/io/image_io.h>
@@ -16,27 +15,15 @@ void check_side(int side, const char* which, const std::string& path, const std:
                                 "; each side must be a power of two from 1 to " + std::to_string(kMaxFaceImageSide));
 }
 
-// The file's size and modification time; false when it cannot be looked at (gone, not a file).
-bool stamp_of(const std::string& path, std::uintmax_t& bytes, std::filesystem::file_time_type& modified) {
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) return false;
-  bytes = std::filesystem::file_size(path, error);
-  if (error) return false;
-  modified = std::filesystem::last_write_time(path, error);
-  return !error;
-}
-
 // Throws unless the file on disk still has the stamp it had when the scene was read.
 void check_unchanged(const FaceImageFile& file) {
-  std::uintmax_t bytes = 0;
-  std::filesystem::file_time_type modified{};
-  if (!stamp_of(file.path, bytes, modified))
-    throw InputError(file.field, "image '" + file.path + "' is gone (it was there when the scene was read)");
-  if (bytes != file.file_bytes || modified != file.modified)
+  const std::optional<FileStamp> now = file_stamp(file.path);
+  if (!now) throw InputError(file.field, "image '" + file.path + "' is gone (it was there when the scene was read)");
+  if (*now != file.stamp)
     throw InputError(file.field, "image '" + file.path + "' changed since the scene was read (" +
-                                     (bytes != file.file_bytes ? std::to_string(file.file_bytes) + " -> " +
-                                                                     std::to_string(bytes) + " bytes"
-                                                               : std::string("modified again")) +
+                                     (now->bytes != file.stamp.bytes ? std::to_string(file.stamp.bytes) + " -> " +
+                                                                           std::to_string(now->bytes) + " bytes"
+                                                                     : std::string("modified again")) +
                                      "); load the scene again");
 }
 
@@ -45,8 +32,9 @@ void check_unchanged(const FaceImageFile& file) {
 FaceImageFile open_face_image(const std::string& path, const std::string& field) {
   FaceImageFile file{path, field};
   // The stamp first: a file changed while its header is read then fails the later check.
-  if (!stamp_of(path, file.file_bytes, file.modified))
-    throw InputError(field, "image '" + path + "' is not a regular file that can be read");
+  const std::optional<FileStamp> stamp = file_stamp(path);
+  if (!stamp) throw InputError(field, "image '" + path + "' is not a regular file that can be read");
+  file.stamp = *stamp;
   try {
     const ImageHeader header = read_image_header(path);
     file.width = header.width;

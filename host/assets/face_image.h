@@ -1,10 +1,9 @@
 // A face's texture from an image file, for users whose per-face textures are PNG or EXR tiles
 // ("texture": {"image": NAME} in a scene file): any format OpenImageIO reads.
 #pragma once
-#include <cstdint>
-#include <filesystem>
 #include <string>
 
+#include <seamcl/assets/file_stamp.h>
 #include <seamcl/scene/scene.h>
 
 namespace seamcl {
@@ -22,8 +21,7 @@ struct FaceImageFile {
   // The file's size and modification time when its header was read: read_face_image refuses a
   // file whose stamp has moved since, so a deferred face never shows other pixels than the ones
   // whose size the scene was checked against.
-  std::uintmax_t file_bytes = 0;
-  std::filesystem::file_time_type modified{};
+  FileStamp stamp;
 };
 
 // Reads the header only: each side must be a power of two up to kMaxFaceImageSide. Every failure

@@ -145,6 +145,11 @@ Camera orbit_camera(const Scene& scene, int frame, int frames);
 // field on the first violation.
 void validate_scene(const Scene& scene);
 
+// Throws InputError(field) naming the first mip level that holds a NaN or infinite texel: what
+// validate_scene checks of a stored chain, and what a deferred chain's source checks when it makes
+// one (an image may hold NaN or infinity, and large finite values may overflow in the box filter).
+void check_finite_texels(const MipChain& chain, const std::string& field);
+
 }  // namespace seamcl
 
 namespace seamcl {

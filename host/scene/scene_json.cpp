@@ -287,15 +287,6 @@ MipChain make_face_chain(const FaceRecipe& recipe) {
   return build_mip_chain(std::move(level0));
 }
 
-// What validate_scene checks of a stored chain's texels, for a deferred one when it is made: an
-// image may hold NaN or infinity, and large finite values may overflow in the box filter.
-void check_finite_texels(const MipChain& chain, const std::string& field) {
-  for (size_t k = 0; k < chain.levels.size(); ++k)
-    for (const glm::vec4& t : chain.levels[k].texels)
-      if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z) || !std::isfinite(t.w))
-        throw InputError(field, "mip level " + std::to_string(k) + " has a non-finite texel");
-}
-
 TexturePlan read_texture(const json& value, const std::string& path) {
   const ObjectFields fields(value, path, {"width", "height", "content", "color", "image"});
   TexturePlan plan;
