@@ -40,6 +40,7 @@ FaceImageFile open_face_image(const std::string& path, const std::string& field)
     file.width = header.width;
     file.height = header.height;
     file.channels = header.channels;
+    file.decode_bytes = header.decode_bytes;
   } catch (const std::exception& error) {
     throw InputError(field, error.what());
   }

@@ -18,6 +18,7 @@ struct FaceImageFile {
   int width = 0;
   int height = 0;
   int channels = 0;
+  size_t decode_bytes = 0;  // the header's: what decoding the pixels holds beside level 0
   // The file's size and modification time when its header was read: read_face_image refuses a
   // file whose stamp has moved since, so a deferred face never shows other pixels than the ones
   // whose size the scene was checked against.

@@ -105,7 +105,11 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path) {
   return input;
 }
 
-ImageHeader header_of(const OIIO::ImageSpec& spec) { return ImageHeader{spec.width, spec.height, spec.nchannels}; }
+ImageHeader header_of(const OIIO::ImageSpec& spec) {
+  constexpr OIIO::imagesize_t kReadChunkBytes = OIIO::imagesize_t{64} << 20;  // ImageInput::read_image's
+  const OIIO::imagesize_t chunk = std::min(spec.image_bytes(true), kReadChunkBytes);
+  return ImageHeader{spec.width, spec.height, spec.nchannels, static_cast<size_t>(chunk + chunk / 4)};
+}
 
 }  // namespace
 

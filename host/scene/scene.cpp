@@ -268,6 +268,7 @@ void set_constant_textures(Scene& scene, glm::vec4 color) {
   // No face is deferred afterwards: what made them (a .ptx's bytes, say) is no longer needed.
   scene.texture_source = {};
   scene.texture_source_bytes = 0;
+  scene.texture_source_decode_bytes.clear();
   for (Face& face : scene.faces) {
     const int width = face.texture.width();
     const int height = face.texture.height();

@@ -115,6 +115,9 @@ struct Scene {
   // The bytes texture_source keeps to make the faces from (a deferred .ptx's whole file): memory
   // a scene holds beyond its Face records, shared by its copies, for budgets to count.
   size_t texture_source_bytes = 0;
+  // Per face (empty: 0 for all), what texture_source holds beside the face's level 0 while it makes
+  // the face: an image face's decode buffers (texture_making_bytes counts them).
+  std::vector<size_t> texture_source_decode_bytes;
 
   size_t triangle_count() const { return faces.size() * 2; }
   std::array<glm::vec3, 4> corners(const Face& f) const;

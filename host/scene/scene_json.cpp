@@ -273,6 +273,7 @@ struct FaceRecipe {
   std::array<glm::vec3, 4> corners{};
   std::function<TextureLevel()> read_image;  // image faces: the loader's reader
   std::string field;                         // faces[f].texture
+  size_t decode_bytes = 0;                   // image faces: what read_image holds beside level 0
 };
 
 MipChain make_face_chain(const FaceRecipe& recipe) {
@@ -440,6 +441,7 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name, cons
       recipe.plan.width = image.width;
       recipe.plan.height = image.height;
       recipe.read_image = std::move(image.read);
+      recipe.decode_bytes = image.decode_bytes;
       total_texels += static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
       if (total_texels > kMaxSceneTexels)
         throw InputError(image_path, "the scene's textures exceed " + std::to_string(kMaxSceneTexels) + " texels in all");
@@ -449,6 +451,8 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name, cons
   if (defer) {
     for (size_t f = 0; f < scene.faces.size(); ++f)
       scene.faces[f].texture = deferred_mip_chain(recipes[f].plan.width, recipes[f].plan.height);
+    if (std::any_of(recipes.begin(), recipes.end(), [](const FaceRecipe& r) { return r.decode_bytes > 0; }))
+      for (const FaceRecipe& recipe : recipes) scene.texture_source_decode_bytes.push_back(recipe.decode_bytes);
     scene.texture_source = [recipes = std::make_shared<const std::vector<FaceRecipe>>(recipes)](size_t f) {
       const FaceRecipe& recipe = recipes->at(f);
       MipChain chain = make_face_chain(recipe);

@@ -19,6 +19,7 @@ struct FaceImage {
   int width = 0;
   int height = 0;
   std::function<TextureLevel()> read;  // throws InputError naming the field (the file changed, went)
+  size_t decode_bytes = 0;             // what `read` holds beside level 0 while it decodes
 };
 
 // Looks up the image a face names ("texture": {"image": NAME}): refuses a missing or bad file
