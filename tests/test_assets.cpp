@@ -6,11 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -674,6 +676,35 @@ TEST(Assets, TheAssetCacheCountsKeptPtexBytesAndReloadsASceneWhoseImageChanged) 
   EXPECT_EQ(assets.file_loads(), loads + 1);
   EXPECT_NO_THROW(face_texture(*again, 0));
   input_error([&] { face_texture(*first, 0); }, "faces[0].texture.image");  // a holder of the old one is told
+}
+
+// A cache hit stamps its files outside the cache's lock: while it looks at a file, another thread's
+// call that takes the lock is answered (within a bound, 10 s; under the lock it would wait for
+// the look to end).
+TEST(Assets, TheAssetCacheStampsFilesOutsideItsLock) {
+  TempDir root;
+  fs::copy_file(sample("plane.obj"), root.path() / "plane.obj");
+  fs::copy_file(sample("wave_lo.ptx"), root.path() / "wave_lo.ptx");
+  std::atomic<bool> watching = false;
+  AssetDirectory* watched = nullptr;
+  std::vector<std::future<size_t>> callers;  // kept past the look: a caller blocked by the lock ends after it
+  std::vector<bool> answered;
+  AssetDirectory assets(root.path().string(), {size_t{64} << 20, 4}, [&](const std::string& path) {
+    if (watching) {
+      callers.push_back(std::async(std::launch::async, [&] { return watched->cached_entries(); }));
+      answered.push_back(callers.back().wait_for(std::chrono::seconds(10)) == std::future_status::ready);
+    }
+    return file_stamp(path);
+  });
+  watched = &assets;
+  const auto first = assets.load("plane.obj", "wave_lo.ptx", {});
+  watching = true;
+  EXPECT_EQ(assets.load("plane.obj", "wave_lo.ptx", {}), first);
+  watching = false;
+  EXPECT_EQ(assets.file_loads(), 1);
+  ASSERT_GE(answered.size(), 4u) << "the key's two files and the entry's two";
+  for (size_t k = 0; k < answered.size(); ++k) EXPECT_TRUE(answered[k]) << "look " << k << " held the cache's lock";
+  for (auto& caller : callers) EXPECT_EQ(caller.get(), 1u);
 }
 
 TEST(Assets, TheAssetDirectoryRefusesNamesThatLeaveItAndCachesWhatItLoads) {
