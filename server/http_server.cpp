@@ -765,12 +765,14 @@ void HttpServer::refuse_over_budget(size_t device_bytes, size_t host_bytes, cons
 void HttpServer::refuse_scene_over_budget(const Scene& scene, const RenderOptions& options, const json& inline_scene,
                                           const std::string& key) const {
   std::string field = inline_scene.is_null() ? (key.empty() ? "scene" : "texels") : "scene";
+  // An inline generator's sizing options: the field is the first given, the message names them all.
+  std::string sized_by;
   if (const auto given = inline_scene.is_object() ? inline_scene.find("options") : inline_scene.end();
       !inline_scene.is_null() && given != inline_scene.end() && given->is_object()) {
     for (const char* option : {"faces", "texture_scale_log2"})
       if (given->contains(option)) {
-        field = std::string("scene.options.") + option;
-        break;
+        if (sized_by.empty()) field = std::string("scene.options.") + option;
+        sized_by += (sized_by.empty() ? ", sized by scene.options." : " and scene.options.") + std::string(option);
       }
   }
   const SceneSizes sizes = scene_sizes(scene);
@@ -780,7 +782,7 @@ void HttpServer::refuse_scene_over_budget(const Scene& scene, const RenderOption
   const size_t held = key.empty() ? scene_held_bytes(scene) : 0;
   refuse_over_budget(memory.device_bytes(), saturating_add(memory.host_bytes(), held), field,
                      "the scene (" + std::to_string(sizes.faces.size()) + " faces, " +
-                         std::to_string(memory.textures.texels) + " packed texels)");
+                         std::to_string(memory.textures.texels) + " packed texels" + sized_by + ")");
 }
 
 void HttpServer::handle_render(const json& request, httplib::Response& res) {

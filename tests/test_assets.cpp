@@ -6,11 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -22,6 +24,7 @@
 
 #include <seamcl/assets/asset_directory.h>
 #include <seamcl/assets/asset_scene.h>
+#include <seamcl/assets/file_stamp.h>
 #include <seamcl/assets/obj_mesh.h>
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/core/input_error.h>
@@ -535,9 +538,59 @@ TEST(Assets, AnImageFaceThatChangedOrWentBeforeItIsPackedIsAnInputError) {
   EXPECT_NE(input_error([&] { Renderer(shared_runtime()).load_scene(std::move(scene)); }, field).find("is gone"),
             std::string::npos);
 
+  // Each of them names the scene file, as the errors found when it is parsed do.
+  scene = fresh();
+  fs::remove(image);
+  const std::string in_file = " (in '" + file + "')";
+  for (const std::string& message : {input_error([&] { face_texture(scene, 0); }, field),
+                                     input_error([&] { Renderer(shared_runtime()).load_scene(scene); }, field)})
+    EXPECT_TRUE(message.ends_with("is gone (it was there when the scene was read)" + in_file)) << message;
+  const std::string parse_time = input_error([&] { load_scene_source(file, "", deferring()); }, field);
+  EXPECT_TRUE(parse_time.ends_with(in_file)) << parse_time;
+
   // Unchanged: made as often as asked, the same each time.
   scene = fresh();
   EXPECT_TRUE(same_chains(face_texture(scene, 0), face_texture(scene, 0)));
+}
+
+// A face's image swapped, after the scene was read, for a larger one of the same size on disk and
+// modification time (so the stamp check passes): refused at its header, in the file as opened for
+// the read, before any pixel is decoded. The larger file's pixel data is cut off, so a decode of
+// it would fail with a decoder's error instead of naming the sizes.
+TEST(Assets, AnImageFaceSwappedForALargerOneIsRefusedAtItsHeaderBeforeAnyPixelIsDecoded) {
+  TempDir dir;
+  const fs::path image = dir.path() / "face.png";
+  write_image(image.string(), 64, 64, varied_pixels(64, 64, 8));
+  const Scene scene = load_scene_source(dir.write("one.json", image_cube_scene({"face.png"}).dump()), "", deferring());
+  ASSERT_EQ(scene.faces[0].texture.width(), 64);
+
+  // 128 x 128 noise, cut to the 64 x 64 file's length: a whole header, part of its pixel data.
+  const fs::path larger = dir.path() / "larger.png";
+  write_image(larger.string(), 128, 128, varied_pixels(128, 128, 9));
+  const auto length = fs::file_size(image);
+  ASSERT_GT(fs::file_size(larger), length + 100);
+  fs::resize_file(larger, length);
+  int width = 0, height = 0;
+  try {
+    read_image(larger.string(), width, height);
+    ADD_FAILURE() << "the cut file decoded";
+  } catch (const std::runtime_error& error) {
+    EXPECT_EQ(std::string(error.what()).find("128x128"), std::string::npos) << error.what();
+  }
+  // The swap: renamed over the face's file, with the old file's modification time.
+  fs::last_write_time(larger, fs::last_write_time(image));
+  const auto stamp = fs::last_write_time(image);
+  fs::rename(larger, image);
+  ASSERT_EQ(fs::file_size(image), length);
+  ASSERT_EQ(fs::last_write_time(image), stamp);
+
+  const std::string field = "faces[0].texture.image";
+  for (const std::string& message :
+       {input_error([&] { face_texture(scene, 0); }, field), input_error([&] { Renderer(shared_runtime()).load_scene(scene); }, field)}) {
+    EXPECT_NE(message.find("changed since the scene was read (64x64, 4 channels -> 128x128, 4 channels)"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("face.png"), std::string::npos) << message;
+  }
 }
 
 TEST(Assets, ImageFacesWithBadPixelsAreRefusedWhenParsedOrWhenDeferredWhenMade) {
@@ -567,8 +620,30 @@ TEST(Assets, ImageFacesWithBadPixelsAreRefusedWhenParsedOrWhenDeferredWhenMade) 
   const std::string eager_message = input_error([&] { load_scene_source(nan); }, "faces[0].texture");
   EXPECT_NE(eager_message.find("mip level 0 has a non-finite texel"), std::string::npos) << eager_message;
   const Scene with_nan = load_scene_source(nan, "", deferring());
-  EXPECT_EQ(input_error([&] { face_texture(with_nan, 0); }, "faces[0].texture"), eager_message.substr(0, eager_message.find(" (in '")));
+  // The whole message, the scene file's name included (it is a pack-time error of a scene file).
+  EXPECT_EQ(input_error([&] { face_texture(with_nan, 0); }, "faces[0].texture"), eager_message);
+  EXPECT_TRUE(eager_message.ends_with(" (in '" + nan + "')")) << eager_message;
   input_error([&] { Renderer(shared_runtime()).load_scene(with_nan); }, "faces[0].texture");
+}
+
+// The one stamp the image faces and the asset cache tell a changed file by: size and modification
+// time, none for what is not a regular file.
+TEST(Assets, AFileStampIsItsSizeAndModificationTime) {
+  TempDir dir;
+  const std::string file = dir.write("a.txt", "four");
+  const std::optional<FileStamp> first = file_stamp(file);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->bytes, 4u);
+  EXPECT_EQ(first->modified, fs::last_write_time(file));
+  EXPECT_EQ(file_stamp(file), first);
+  fs::last_write_time(file, first->modified + std::chrono::seconds(2));
+  EXPECT_NE(file_stamp(file), first) << "touched";
+  dir.write("a.txt", "five!");
+  fs::last_write_time(file, first->modified);
+  EXPECT_NE(file_stamp(file), first) << "another size at the same time";
+  EXPECT_EQ(file_stamp(file)->bytes, 5u);
+  EXPECT_FALSE(file_stamp((dir.path() / "none.txt").string()));
+  EXPECT_FALSE(file_stamp(dir.path().string())) << "a directory";
 }
 
 TEST(Assets, TheAssetCacheCountsKeptPtexBytesAndReloadsASceneWhoseImageChanged) {
@@ -601,6 +676,35 @@ TEST(Assets, TheAssetCacheCountsKeptPtexBytesAndReloadsASceneWhoseImageChanged) 
   EXPECT_EQ(assets.file_loads(), loads + 1);
   EXPECT_NO_THROW(face_texture(*again, 0));
   input_error([&] { face_texture(*first, 0); }, "faces[0].texture.image");  // a holder of the old one is told
+}
+
+// A cache hit stamps its files outside the cache's lock: while it looks at a file, another thread's
+// call that takes the lock is answered (within a bound, 10 s; under the lock it would wait for
+// the look to end).
+TEST(Assets, TheAssetCacheStampsFilesOutsideItsLock) {
+  TempDir root;
+  fs::copy_file(sample("plane.obj"), root.path() / "plane.obj");
+  fs::copy_file(sample("wave_lo.ptx"), root.path() / "wave_lo.ptx");
+  std::atomic<bool> watching = false;
+  AssetDirectory* watched = nullptr;
+  std::vector<std::future<size_t>> callers;  // kept past the look: a caller blocked by the lock ends after it
+  std::vector<bool> answered;
+  AssetDirectory assets(root.path().string(), {size_t{64} << 20, 4}, [&](const std::string& path) {
+    if (watching) {
+      callers.push_back(std::async(std::launch::async, [&] { return watched->cached_entries(); }));
+      answered.push_back(callers.back().wait_for(std::chrono::seconds(10)) == std::future_status::ready);
+    }
+    return file_stamp(path);
+  });
+  watched = &assets;
+  const auto first = assets.load("plane.obj", "wave_lo.ptx", {});
+  watching = true;
+  EXPECT_EQ(assets.load("plane.obj", "wave_lo.ptx", {}), first);
+  watching = false;
+  EXPECT_EQ(assets.file_loads(), 1);
+  ASSERT_GE(answered.size(), 4u) << "the key's two files and the entry's two";
+  for (size_t k = 0; k < answered.size(); ++k) EXPECT_TRUE(answered[k]) << "look " << k << " held the cache's lock";
+  for (auto& caller : callers) EXPECT_EQ(caller.get(), 1u);
 }
 
 TEST(Assets, TheAssetDirectoryRefusesNamesThatLeaveItAndCachesWhatItLoads) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,8 @@
 
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/io/image_io.h>
+#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/pipeline/render_options.h>
 #include "server_support.h"
 
 namespace fs = std::filesystem;
@@ -189,4 +192,52 @@ TEST(AssetsService, WithoutAssetsNoFileIsReachableAndAHugeAssetIsRefusedNotLoade
   ASSERT_TRUE(answer);
   EXPECT_TRUE(answer->status == 400 || answer->status == 413) << answer->status << " " << answer->body;
   EXPECT_EQ(json::parse(answer->body).at("field"), "texture");
+}
+
+// A deferred .ptx keeps its file's bytes to make the faces from (Scene::texture_source_bytes), and
+// a request's host budget counts them: an asset whose render memory alone fits the budget, but not
+// with those bytes, is refused with a 413 naming the budget; at exactly both it renders.
+TEST(AssetsService, ADeferredPtexsKeptBytesCountAgainstTheHostBudget) {
+  Workspace w;
+  fs::copy_file(sample("ptex_test_object.obj"), w.path("assets/object.obj"));
+  fs::copy_file(sample("cellnoise.ptx"), w.path("assets/cellnoise.ptx"));
+  const json body = {{"scene", "object.obj"}, {"texture", "cellnoise.ptx"}, {"size", "16x16"}};
+
+  // What the server measures a request against, from the library as the server loads the asset.
+  seamcl::SceneSourceOptions source;
+  source.generator.defer_textures = true;
+  const seamcl::Scene scene =
+      seamcl::load_scene_source(w.path("assets/object.obj").string(), w.path("assets/cellnoise.ptx").string(), source);
+  const seamcl::RenderOptions options = seamcl::parse_render_options(body);
+  const seamcl::SceneSizes sizes = seamcl::scene_sizes(scene);
+  const size_t render_bytes = std::max(seamcl::scene_render_memory(sizes, options).host_bytes(),
+                                       seamcl::render_memory(sizes, options).host_bytes());
+  const size_t kept = scene.texture_source_bytes;
+  ASSERT_EQ(kept, fs::file_size(sample("cellnoise.ptx")));
+  const size_t held = seamcl::scene_held_bytes(scene);  // the request's copy of the scene, and the kept bytes
+  ASSERT_EQ(held, seamcl::scene_host_bytes(sizes) + kept);
+  ASSERT_LE(scene.texel_count() * sizeof(glm::vec4), render_bytes) << "the reader's own limit must not refuse it first";
+
+  // One byte short of the sum (it would pass without the kept bytes, which are far more), then the sum.
+  for (const size_t budget : {render_bytes + held - 1, render_bytes + held}) {
+    SCOPED_TRACE(budget);
+    seamcl::server::ServerOptions server_options;
+    server_options.threads = 1;
+    server_options.assets_dir = w.path("assets").string();
+    server_options.max_request_host_bytes = budget;
+    LiveServer server(server_options);
+    httplib::Client client("127.0.0.1", server.port());
+    client.set_read_timeout(120, 0);
+    const auto answer = client.Post("/v1/render", body.dump(), "application/json");
+    ASSERT_TRUE(answer);
+    if (budget < render_bytes + held) {
+      ASSERT_EQ(answer->status, 413) << answer->body;
+      const json error = json::parse(answer->body);
+      EXPECT_EQ(error.at("field"), "scene");
+      EXPECT_NE(error.at("error").get<std::string>().find("of host memory, over this server's limit of"), std::string::npos)
+          << answer->body;
+    } else {
+      EXPECT_EQ(answer->status, 200) << answer->body;
+    }
+  }
 }

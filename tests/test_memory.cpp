@@ -2,6 +2,7 @@
 // Scene::texture_source pack to exactly the texels of baked ones, hold no float copy, and the
 // memory a render reports (render --json "memory") adds up to the faces' packed sizes.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -9,6 +10,9 @@
 #include <mutex>
 #include <thread>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -16,6 +20,7 @@
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/reference.h>
+#include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
@@ -372,4 +377,45 @@ TEST(Memory, TextureMakingBytesAreADeferredChainsFloats) {
     EXPECT_GT(texels, 0u);
     EXPECT_EQ(texture_making_bytes(scene, f), texels * sizeof(glm::vec4)) << f;
   }
+}
+
+// An image face is decoded through buffers beside its level 0 (the file's pixels in their stored
+// format), dropped before the rest of its chain is built: its estimate is whichever is more. A
+// half-float EXR's buffers (8 bytes a texel) outweigh the chain's finer-than-level-0 part (a third
+// of level 0); an 8-bit PNG's (4 bytes a texel) do not.
+TEST(Memory, AnImageFacesMakingBytesCountItsDecodeBuffersBesideLevelZero) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("seamcl_memory_images_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::vector<glm::vec4> pixels(64 * 64, glm::vec4(0.25f, 0.5f, 0.75f, 1.0f));
+  write_image((dir / "half.exr").string(), 64, 64, pixels);
+  write_image((dir / "bytes.png").string(), 64, 64, pixels);
+  const nlohmann::json doc = {
+      {"positions", {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}}},
+      {"faces", {{{"vertices", {0, 1, 4, 3}}, {"texture", {{"image", "half.exr"}}}},
+                 {{"vertices", {1, 2, 5, 4}}, {"texture", {{"image", "bytes.png"}}}},
+                 {{"vertices", {0, 2, 5, 3}}, {"texture", {{"width", 64}, {"height", 64}}}}}},
+      {"camera", {{"eye", {1, 0.5, 3}}, {"target", {1, 0.5, 0}}}}};
+  std::ofstream((dir / "two.json").string()) << doc.dump();
+  SceneSourceOptions deferring;
+  deferring.generator.defer_textures = true;
+  const Scene scene = load_scene_source((dir / "two.json").string(), "", deferring);
+  const Scene eager = load_scene_source((dir / "two.json").string());
+
+  const size_t level0 = 64 * 64 * sizeof(glm::vec4);
+  size_t chain = 0;
+  for (const TextureLevel& level : face_texture(scene, 0).levels) chain += level.texels.size() * sizeof(glm::vec4);
+  const ImageHeader half = read_image_header((dir / "half.exr").string());
+  const ImageHeader bytes = read_image_header((dir / "bytes.png").string());
+  EXPECT_GE(half.decode_bytes, size_t{64 * 64 * 4 * 2}) << "at least the stored half floats";
+  EXPECT_GE(bytes.decode_bytes, size_t{64 * 64 * 4}) << "at least the stored bytes";
+  ASSERT_EQ(scene.texture_source_decode_bytes, (std::vector<size_t>{half.decode_bytes, bytes.decode_bytes, 0}));
+  EXPECT_GT(level0 + half.decode_bytes, chain);
+  EXPECT_EQ(texture_making_bytes(scene, 0), level0 + half.decode_bytes);
+  EXPECT_LT(level0 + bytes.decode_bytes, chain);
+  EXPECT_EQ(texture_making_bytes(scene, 1), chain);
+  EXPECT_EQ(texture_making_bytes(scene, 2), chain) << "a baked face decodes nothing";
+  for (size_t f = 0; f < 3; ++f) EXPECT_EQ(texture_making_bytes(eager, f), 0u) << f;
+  EXPECT_TRUE(eager.texture_source_decode_bytes.empty());
+  fs::remove_all(dir);
 }

@@ -894,11 +894,16 @@ TEST_F(Server, AnInlineSceneOverTheBudgetIsRefusedNamingItBeforeItIsBaked) {
   EXPECT_NE(error.find("the scene (2"), std::string::npos) << error;
   EXPECT_NE(error.find(" MiB of "), std::string::npos) << error;
   EXPECT_NE(error.find("memory, over this server's limit of 1024.0 MiB per request"), std::string::npos) << error;
+  // Every option that sized it is named.
+  EXPECT_NE(error.find(" packed texels, sized by scene.options.faces and scene.options.texture_scale_log2)"), std::string::npos)
+      << error;
   // Without the face count, the texture scale is what makes it too big.
   auto scaled = post_json(c, R"({"scene": {"generator": "paper", "options": {"texture_scale_log2": 1}}, "size": "64x64", "texels": "rgba32f"})");
   ASSERT_TRUE(scaled);
   ASSERT_EQ(scaled->status, 413) << scaled->body;
   EXPECT_EQ(json::parse(scaled->body).at("field"), "scene.options.texture_scale_log2") << scaled->body;
+  const std::string scaled_error = json::parse(scaled->body).at("error");
+  EXPECT_NE(scaled_error.find(" packed texels, sized by scene.options.texture_scale_log2)"), std::string::npos) << scaled_error;
   if (peak_reset) {
     const size_t grown = after.peak_rss_bytes > before.rss_bytes ? after.peak_rss_bytes - before.rss_bytes : 0;
     EXPECT_LT(grown, size_t{400} << 20) << "the refused request raised the peak RSS by " << grown << " bytes";

@@ -23,19 +23,18 @@ bool is_within(const fs::path& path, const fs::path& root) {
   return true;
 }
 
-// Size and modification time: a changed file is a different cache entry.
-std::string file_stamp(const std::string& path) {
-  std::error_code error;
-  const auto size = fs::file_size(path, error);
-  const auto time = fs::last_write_time(path, error);
+// A file's stamp as text, for the cache key: a changed scene or texture file is a different entry.
+std::string stamp_text(const std::optional<FileStamp>& stamp) {
+  if (!stamp) return "none";
   std::ostringstream out;
-  out << size << "@" << time.time_since_epoch().count();
+  out << stamp->bytes << "@" << stamp->modified.time_since_epoch().count();
   return out.str();
 }
 
 }  // namespace
 
-AssetDirectory::AssetDirectory(const std::string& root, AssetCacheLimits limits) : limits_(limits) {
+AssetDirectory::AssetDirectory(const std::string& root, AssetCacheLimits limits, FileStamper stamp)
+    : limits_(limits), stamp_(std::move(stamp)) {
   std::error_code error;
   if (!fs::is_directory(root, error)) throw InputError("assets", "'" + root + "' is not a directory");
   root_ = fs::canonical(root, error).string();
@@ -90,15 +89,19 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
                                                   SceneSourceOptions options) {
   // Every file the load resolves, stamped when resolved (before it is read), so that a file
   // changed while or after it is read makes the entry stale rather than the stamp new.
-  auto files = std::make_shared<std::map<std::string, std::string>>();
+  auto files = std::make_shared<FileStamps>();
   options.resolve = [this, files](const std::string& name, const std::string& relative_to, const std::string& field) {
     std::string path = resolve(name, relative_to, field);
-    if (!files->contains(path)) files->emplace(path, file_stamp(path));
+    if (!files->contains(path)) files->emplace(path, stamp_(path));
     return path;
   };
   std::ostringstream key;
-  key << resolve(scene, "", "scene") << "|" << file_stamp(resolve(scene, "", "scene")) << "|";
-  if (!texture.empty()) key << resolve(texture, "", "texture") << "|" << file_stamp(resolve(texture, "", "texture"));
+  const std::string scene_path = resolve(scene, "", "scene");
+  key << scene_path << "|" << stamp_text(stamp_(scene_path)) << "|";
+  if (!texture.empty()) {
+    const std::string texture_path = resolve(texture, "", "texture");
+    key << texture_path << "|" << stamp_text(stamp_(texture_path));
+  }
   // Deferred or baked is part of the key: a caller that reads the stored texels must not be handed
   // a deferred scene, nor one that packs face by face a baked one (its float copy of every face).
   key << "|" << options.generator.tint << "|" << options.generator.defer_textures << "|" << options.mesh_texture_size
@@ -107,17 +110,32 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
     const glm::vec3 c = *options.generator.constant_color;
     key << "|" << c.r << "," << c.g << "," << c.b;
   }
+  // The entry, if any, under the lock; its files stamped outside it, so that a cache hit does not
+  // hold up other requests while it stats its files. The lock never kept the files from changing:
+  // a hit serves the scene whose files had their stamps when they were taken, as it did under the
+  // lock. Meanwhile the entry may have been evicted, or found stale and replaced, by another load:
+  // a fresh one is served all the same (it is what the stamps say), a stale one is loaded again.
+  std::shared_ptr<const Scene> cached;
+  std::shared_ptr<const FileStamps> stamps;
   {
     std::lock_guard lock(mutex_);
     const auto found = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.key == key.str(); });
-    const bool fresh = found != entries_.end() && std::all_of(found->files.begin(), found->files.end(), [](const auto& file) {
-                         return file_stamp(file.first) == file.second;
-                       });
-    if (fresh) {
-      entries_.splice(entries_.begin(), entries_, found);
-      return found->scene;
+    if (found != entries_.end()) {
+      cached = found->scene;
+      stamps = found->files;
     }
-    if (found != entries_.end()) {  // a file it read has changed since: loaded again below
+  }
+  const bool fresh = cached && std::all_of(stamps->begin(), stamps->end(), [this](const auto& file) {
+                       return stamp_(file.first) == file.second;
+                     });
+  {
+    std::lock_guard lock(mutex_);
+    const auto found = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.scene == cached; });
+    if (fresh) {
+      if (found != entries_.end()) entries_.splice(entries_.begin(), entries_, found);
+      return cached;
+    }
+    if (cached && found != entries_.end()) {  // a file it read has changed since: loaded again below
       bytes_ -= found->bytes;
       entries_.erase(found);
     }
@@ -130,7 +148,7 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
   const size_t bytes = scene_held_bytes(*loaded);
   std::lock_guard lock(mutex_);
   if (bytes > limits_.max_bytes || limits_.max_entries == 0) return loaded;
-  entries_.push_front({key.str(), loaded, bytes, std::move(*files)});
+  entries_.push_front({key.str(), loaded, bytes, std::move(files)});
   bytes_ += bytes;
   while (entries_.size() > limits_.max_entries || bytes_ > limits_.max_bytes) {
     bytes_ -= entries_.back().bytes;

@@ -6,14 +6,17 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <list>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <seamcl/assets/file_stamp.h>
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/scene/scene.h>
 
@@ -32,8 +35,11 @@ struct AssetCacheLimits {
 
 class AssetDirectory {
  public:
+  // How the cache stamps a file (file_stamp; a test may watch the calls).
+  using FileStamper = std::function<std::optional<FileStamp>(const std::string& path)>;
+
   // `root` must be an existing directory: InputError("assets") otherwise.
-  explicit AssetDirectory(const std::string& root, AssetCacheLimits limits = {});
+  explicit AssetDirectory(const std::string& root, AssetCacheLimits limits = {}, FileStamper stamp = file_stamp);
 
   const std::string& root() const { return root_; }
 
@@ -52,7 +58,8 @@ class AssetDirectory {
   // same options were loaded before and every file the load resolved (the scene and texture, and
   // the files a scene file names: meshes, .ptx, face and environment images) still has the size
   // and modification time it had when it was resolved; otherwise loaded again. (A deferred image
-  // face reads its file when packed: a cached scene must not name a file changed since.)
+  // face reads its file when packed: a cached scene must not name a file changed since.) The
+  // files are stamped outside the cache's lock.
   std::shared_ptr<const Scene> load(const std::string& scene, const std::string& texture, SceneSourceOptions options);
 
   size_t cached_entries() const;
@@ -60,17 +67,19 @@ class AssetDirectory {
   long long file_loads() const;  // cache misses so far
 
  private:
+  using FileStamps = std::map<std::string, std::optional<FileStamp>>;
   struct Entry {
     std::string key;
     std::shared_ptr<const Scene> scene;
     size_t bytes = 0;
     // Every path the load resolved, once (a file many faces name is checked once), and its stamp
     // when first resolved.
-    std::map<std::string, std::string> files;
+    std::shared_ptr<const FileStamps> files;
   };
 
   std::string root_;  // canonical
   AssetCacheLimits limits_;
+  FileStamper stamp_;
   mutable std::mutex mutex_;
   std::list<Entry> entries_;  // most recently used first
   size_t bytes_ = 0;

@@ -21,29 +21,26 @@ EnvironmentImage read_environment_files(const EnvironmentFiles& files, const std
   for (size_t k = 0; k < files.names.size(); ++k) {
     const std::string path = resolve(files.names[k], directory, fields[k]);
     DecodedImage image;
+    // Sizes are refused from the header of the file as opened for the read, before its pixels are
+    // allocated; the texels afterwards.
+    const auto within_limits = [&](const ImageHeader& header) {
+      if (header.width < 1 || header.height < 1 || header.width > kMaxEnvironmentImageSide ||
+          header.height > kMaxEnvironmentImageSide)
+        throw InputError(fields[k], "'" + path + "' is " + std::to_string(header.width) + " x " +
+                                        std::to_string(header.height) + "; each side must be in 1.." +
+                                        std::to_string(kMaxEnvironmentImageSide));
+      total += static_cast<size_t>(header.width) * static_cast<size_t>(header.height);
+      if (total > kMaxEnvironmentTexels)
+        throw InputError(fields[k], "'" + path + "': the environment's images hold more than " +
+                                        std::to_string(kMaxEnvironmentTexels) + " texels");
+    };
     try {
-      read_image_size(path, image.width, image.height);
+      image.pixels = read_image(path, image.width, image.height, within_limits);
+    } catch (const InputError&) {
+      throw;
     } catch (const std::exception& error) {
       throw InputError(fields[k], error.what());
     }
-    // Sizes are refused here, before the pixels are allocated; the texels afterwards.
-    if (image.width < 1 || image.height < 1 || image.width > kMaxEnvironmentImageSide ||
-        image.height > kMaxEnvironmentImageSide)
-      throw InputError(fields[k], "'" + path + "' is " + std::to_string(image.width) + " x " +
-                                      std::to_string(image.height) + "; each side must be in 1.." +
-                                      std::to_string(kMaxEnvironmentImageSide));
-    total += static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
-    if (total > kMaxEnvironmentTexels)
-      throw InputError(fields[k], "'" + path + "': the environment's images hold more than " +
-                                      std::to_string(kMaxEnvironmentTexels) + " texels");
-    int width = 0, height = 0;
-    try {
-      image.pixels = read_image(path, width, height);
-    } catch (const std::exception& error) {
-      throw InputError(fields[k], error.what());
-    }
-    if (width != image.width || height != image.height)
-      throw InputError(fields[k], "'" + path + "' changed size while being read");
     images.push_back(std::move(image));
   }
   try {

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <stdexcept>
-#include <system_error>
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/io/image_io.h>
@@ -16,27 +15,15 @@ void check_side(int side, const char* which, const std::string& path, const std:
                                 "; each side must be a power of two from 1 to " + std::to_string(kMaxFaceImageSide));
 }
 
-// The file's size and modification time; false when it cannot be looked at (gone, not a file).
-bool stamp_of(const std::string& path, std::uintmax_t& bytes, std::filesystem::file_time_type& modified) {
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) return false;
-  bytes = std::filesystem::file_size(path, error);
-  if (error) return false;
-  modified = std::filesystem::last_write_time(path, error);
-  return !error;
-}
-
 // Throws unless the file on disk still has the stamp it had when the scene was read.
 void check_unchanged(const FaceImageFile& file) {
-  std::uintmax_t bytes = 0;
-  std::filesystem::file_time_type modified{};
-  if (!stamp_of(file.path, bytes, modified))
-    throw InputError(file.field, "image '" + file.path + "' is gone (it was there when the scene was read)");
-  if (bytes != file.file_bytes || modified != file.modified)
+  const std::optional<FileStamp> now = file_stamp(file.path);
+  if (!now) throw InputError(file.field, "image '" + file.path + "' is gone (it was there when the scene was read)");
+  if (*now != file.stamp)
     throw InputError(file.field, "image '" + file.path + "' changed since the scene was read (" +
-                                     (bytes != file.file_bytes ? std::to_string(file.file_bytes) + " -> " +
-                                                                     std::to_string(bytes) + " bytes"
-                                                               : std::string("modified again")) +
+                                     (now->bytes != file.stamp.bytes ? std::to_string(file.stamp.bytes) + " -> " +
+                                                                           std::to_string(now->bytes) + " bytes"
+                                                                     : std::string("modified again")) +
                                      "); load the scene again");
 }
 
@@ -45,10 +32,15 @@ void check_unchanged(const FaceImageFile& file) {
 FaceImageFile open_face_image(const std::string& path, const std::string& field) {
   FaceImageFile file{path, field};
   // The stamp first: a file changed while its header is read then fails the later check.
-  if (!stamp_of(path, file.file_bytes, file.modified))
-    throw InputError(field, "image '" + path + "' is not a regular file that can be read");
+  const std::optional<FileStamp> stamp = file_stamp(path);
+  if (!stamp) throw InputError(field, "image '" + path + "' is not a regular file that can be read");
+  file.stamp = *stamp;
   try {
-    read_image_size(path, file.width, file.height);
+    const ImageHeader header = read_image_header(path);
+    file.width = header.width;
+    file.height = header.height;
+    file.channels = header.channels;
+    file.decode_bytes = header.decode_bytes;
   } catch (const std::exception& error) {
     throw InputError(field, error.what());
   }
@@ -59,17 +51,31 @@ FaceImageFile open_face_image(const std::string& path, const std::string& field)
 
 TextureLevel read_face_image(const FaceImageFile& file) {
   check_unchanged(file);
+  // The header of the file as opened for the read, checked before any pixel is decoded: a file
+  // swapped since the stamp check (for one of the same stamp, or between the check and the open)
+  // is refused at its header, not decoded at whatever size it now has.
+  const auto same_header = [&file](const ImageHeader& header) {
+    check_side(header.width, "wide", file.path, file.field);
+    check_side(header.height, "high", file.path, file.field);
+    if (header.width != file.width || header.height != file.height || header.channels != file.channels)
+      throw InputError(file.field, "image '" + file.path + "' changed since the scene was read (" +
+                                       std::to_string(file.width) + "x" + std::to_string(file.height) + ", " +
+                                       std::to_string(file.channels) + " channels -> " + std::to_string(header.width) +
+                                       "x" + std::to_string(header.height) + ", " + std::to_string(header.channels) +
+                                       " channels); load the scene again");
+  };
   int width = 0, height = 0;
   std::vector<glm::vec4> pixels;
   try {
-    pixels = read_image(file.path, width, height);
+    pixels = read_image(file.path, width, height, same_header);
+  } catch (const InputError&) {
+    throw;
   } catch (const std::exception& error) {
     throw InputError(file.field, error.what());
   }
-  if (width != file.width || height != file.height)
-    throw InputError(file.field, "image '" + file.path + "' changed while it was read (" + std::to_string(file.width) +
-                                     "x" + std::to_string(file.height) + " -> " + std::to_string(width) + "x" +
-                                     std::to_string(height) + ")");
+  if (width != file.width || height != file.height)  // read_image keeps to the header it showed
+    throw std::logic_error("read_face_image: read " + std::to_string(width) + "x" + std::to_string(height) +
+                           " pixels after a header of " + std::to_string(file.width) + "x" + std::to_string(file.height));
   check_unchanged(file);  // the pixels read are the stamped file's
   // Image rows run top to bottom; texture rows run from v = 0 upwards: rows swapped in place, so
   // that no second copy of the face's level 0 exists.

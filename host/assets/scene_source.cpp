@@ -122,7 +122,8 @@ struct Loader {
       const FaceImageLoader load_image = [this, directory](const std::string& name, const std::string& field) {
         FaceImageFile file = open_face_image(resolve(name, directory, field), field);
         const int width = file.width, height = file.height;
-        return FaceImage{width, height, [file = std::move(file)] { return read_face_image(file); }};
+        const size_t decode_bytes = file.decode_bytes;
+        return FaceImage{width, height, [file = std::move(file)] { return read_face_image(file); }, decode_bytes};
       };
       Scene scene = load_scene(path, options.generator, load_image);
       if (scene.environment) load_environment_files(*scene.environment, directory, resolve);
@@ -133,7 +134,7 @@ struct Loader {
       apply_generator_options(scene, options.generator);
       return scene;
     } catch (const InputError& error) {
-      throw InputError(error.field(), message_of(error) + " (in '" + path + "')");
+      throw error_in_scene_file(error, path);
     }
   }
 };

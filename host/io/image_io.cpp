@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <stdexcept>
 
 #include <OpenImageIO/filesystem.h>
@@ -95,38 +96,55 @@ std::string encode_image(ImageFormat format, int width, int height, const std::v
   return std::string(bytes.begin(), bytes.end());
 }
 
-std::vector<glm::vec4> read_image(const std::string& path, int& width, int& height) {
-  OIIO::ImageBuf input(path);
-  if (!input.read(0, 0, true, OIIO::TypeDesc::FLOAT)) throw std::runtime_error("cannot read " + path + ": " + input.geterror());
-  // Converted in place and copied once, straight into the RGBA result: a large face or
-  // environment image is decoded with its float pixels held twice at most, not four times.
-  const std::string colorspace = input.spec().get_string_attribute("oiio:ColorSpace");
-  if (colorspace == "sRGB") {
-    if (!OIIO::ImageBufAlgo::colorconvert(input, input, "sRGB", "linear")) {
-      throw std::runtime_error("cannot convert " + path + " to linear: " + input.geterror());
-    }
-  }
-  width = input.spec().width;
-  height = input.spec().height;
-  const int channels = input.spec().nchannels;
+namespace {
+
+// The file opened for reading: its header is read, none of its pixels yet.
+std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path) {
+  auto input = OIIO::ImageInput::open(path);
+  if (!input) throw std::runtime_error("cannot read " + path + ": " + OIIO::geterror());
+  return input;
+}
+
+ImageHeader header_of(const OIIO::ImageSpec& spec) {
+  constexpr OIIO::imagesize_t kReadChunkBytes = OIIO::imagesize_t{64} << 20;  // ImageInput::read_image's
+  const OIIO::imagesize_t chunk = std::min(spec.image_bytes(true), kReadChunkBytes);
+  return ImageHeader{spec.width, spec.height, spec.nchannels, static_cast<size_t>(chunk + chunk / 4)};
+}
+
+}  // namespace
+
+ImageHeader read_image_header(const std::string& path) { return header_of(open_image(path)->spec()); }
+
+std::vector<glm::vec4> read_image(const std::string& path, int& width, int& height,
+                                  const std::function<void(const ImageHeader&)>& check_header) {
+  // One open file for the header check and the pixels: the pixels decoded are those of the header
+  // the caller saw, whatever happens to the path meanwhile.
+  const std::unique_ptr<OIIO::ImageInput> input = open_image(path);
+  const OIIO::ImageSpec spec = input->spec();
+  if (check_header) check_header(header_of(spec));
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
+    throw std::runtime_error("cannot read " + path + ": it holds no pixels");
+  width = spec.width;
+  height = spec.height;
+  const int channels = spec.nchannels;
+  // Channels 0..3 straight into x, y, z, w of each pixel (the rest keep 0, 0, 0, 1): the only
+  // float copy of the pixels (OpenImageIO converts from the stored format chunk by chunk) ...
   std::vector<glm::vec4> pixels(static_cast<size_t>(width) * height, glm::vec4(0, 0, 0, 1));
-  // Channels 0..3 into x, y, z, w of each pixel (the rest keep 0, 0, 0, 1) ...
   const OIIO::stride_t pixel_stride = sizeof(glm::vec4);
-  if (!input.get_pixels(OIIO::ROI(0, width, 0, height, 0, 1, 0, std::min(channels, 4)), OIIO::TypeDesc::FLOAT,
-                        pixels.data(), pixel_stride, pixel_stride * width))
-    throw std::runtime_error("cannot read " + path + ": " + input.geterror());
+  if (!input->read_image(0, 0, 0, std::min(channels, 4), OIIO::TypeDesc::FLOAT, pixels.data(), pixel_stride,
+                         pixel_stride * width))
+    throw std::runtime_error("cannot read " + path + ": " + input->geterror());
+  input->close();
+  // ... converted to linear in place (alpha, a stored one or the 1 above, is not converted) ...
+  if (spec.get_string_attribute("oiio:ColorSpace") == "sRGB") {
+    OIIO::ImageBuf in_place(OIIO::ImageSpec(width, height, 4, OIIO::TypeDesc::FLOAT), pixels.data());
+    if (!OIIO::ImageBufAlgo::colorconvert(in_place, in_place, "sRGB", "linear"))
+      throw std::runtime_error("cannot convert " + path + " to linear: " + in_place.geterror());
+  }
   // ... and grey (with alpha in y) spread to RGB.
   if (channels <= 2)
     for (glm::vec4& p : pixels) p = glm::vec4(glm::vec3(p.x), channels == 2 ? p.y : 1.0f);
   return pixels;
-}
-
-void read_image_size(const std::string& path, int& width, int& height) {
-  auto input = OIIO::ImageInput::open(path);
-  if (!input) throw std::runtime_error("cannot read " + path + ": " + OIIO::geterror());
-  width = input->spec().width;
-  height = input->spec().height;
-  input->close();
 }
 
 }  // namespace seamcl

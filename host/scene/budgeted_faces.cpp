@@ -1,5 +1,6 @@
 #include "scene/budgeted_faces.h"
 
+#include <algorithm>
 #include <condition_variable>
 #include <mutex>
 
@@ -44,7 +45,10 @@ size_t texture_making_bytes(const Scene& scene, size_t face) {
   if (!is_deferred(chain)) return 0;
   size_t texels = 0;
   for (const TextureLevel& level : chain.levels) texels += static_cast<size_t>(level.width) * static_cast<size_t>(level.height);
-  return texels * sizeof(glm::vec4);
+  const size_t chain_bytes = texels * sizeof(glm::vec4);
+  if (face >= scene.texture_source_decode_bytes.size()) return chain_bytes;
+  const size_t level0_bytes = static_cast<size_t>(chain.width()) * static_cast<size_t>(chain.height()) * sizeof(glm::vec4);
+  return std::max(chain_bytes, level0_bytes + scene.texture_source_decode_bytes[face]);
 }
 
 }  // namespace seamcl

@@ -16,8 +16,10 @@ namespace seamcl {
 void for_each_face_in_budget(size_t count, const std::function<void(size_t face)>& work,
                              const std::function<size_t(size_t face)>& weight, size_t budget);
 
-// The float RGBA bytes of face f's chain while it is made: every level's texels for a deferred
-// face, 0 for a stored one (read where it is).
+// The most face f holds while it is made, for a deferred face: its float RGBA chain (every level's
+// texels), or its level 0 with what its source decodes it from beside it
+// (Scene::texture_source_decode_bytes: an image's decode buffers, dropped before the chain is
+// built), whichever is more. 0 for a stored face (read where it is).
 size_t texture_making_bytes(const Scene& scene, size_t face);
 
 }  // namespace seamcl

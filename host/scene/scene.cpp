@@ -84,10 +84,8 @@ void check_texture(const MipChain& chain, const std::string& field, bool may_def
                                   std::to_string(level.texels.size()) + " texels, expected " +
                                   size_text(expected_width, expected_height));
     }
-    for (const glm::vec4& texel : level.texels)
-      if (!is_finite(texel))
-        throw InputError(field, "mip level " + std::to_string(k) + " has a non-finite texel");
   }
+  check_finite_texels(chain, field);
 }
 
 }  // namespace
@@ -270,6 +268,7 @@ void set_constant_textures(Scene& scene, glm::vec4 color) {
   // No face is deferred afterwards: what made them (a .ptx's bytes, say) is no longer needed.
   scene.texture_source = {};
   scene.texture_source_bytes = 0;
+  scene.texture_source_decode_bytes.clear();
   for (Face& face : scene.faces) {
     const int width = face.texture.width();
     const int height = face.texture.height();
@@ -353,6 +352,12 @@ void check_reflective_face(const Scene& scene, const Face& face, const std::stri
 }
 
 }  // namespace
+
+void check_finite_texels(const MipChain& chain, const std::string& field) {
+  for (size_t k = 0; k < chain.levels.size(); ++k)
+    for (const glm::vec4& texel : chain.levels[k].texels)
+      if (!is_finite(texel)) throw InputError(field, "mip level " + std::to_string(k) + " has a non-finite texel");
+}
 
 void validate_scene(const Scene& scene) {
   if (scene.faces.empty()) throw InputError("faces", "the scene has no faces");

@@ -115,6 +115,9 @@ struct Scene {
   // The bytes texture_source keeps to make the faces from (a deferred .ptx's whole file): memory
   // a scene holds beyond its Face records, shared by its copies, for budgets to count.
   size_t texture_source_bytes = 0;
+  // Per face (empty: 0 for all), what texture_source holds beside the face's level 0 while it makes
+  // the face: an image face's decode buffers (texture_making_bytes counts them).
+  std::vector<size_t> texture_source_decode_bytes;
 
   size_t triangle_count() const { return faces.size() * 2; }
   std::array<glm::vec3, 4> corners(const Face& f) const;
@@ -144,6 +147,11 @@ Camera orbit_camera(const Scene& scene, int frame, int frames);
 // full chain, finite positions and camera, non-degenerate camera); throws InputError naming the
 // field on the first violation.
 void validate_scene(const Scene& scene);
+
+// Throws InputError(field) naming the first mip level that holds a NaN or infinite texel: what
+// validate_scene checks of a stored chain, and what a deferred chain's source checks when it makes
+// one (an image may hold NaN or infinity, and large finite values may overflow in the box filter).
+void check_finite_texels(const MipChain& chain, const std::string& field);
 
 }  // namespace seamcl
 

@@ -273,6 +273,7 @@ struct FaceRecipe {
   std::array<glm::vec3, 4> corners{};
   std::function<TextureLevel()> read_image;  // image faces: the loader's reader
   std::string field;                         // faces[f].texture
+  size_t decode_bytes = 0;                   // image faces: what read_image holds beside level 0
 };
 
 MipChain make_face_chain(const FaceRecipe& recipe) {
@@ -285,15 +286,6 @@ MipChain make_face_chain(const FaceRecipe& recipe) {
                     : bake_face_texture(recipe.corners, plan.width, plan.height,
                                         [&color](glm::vec3 p) { return surface_pattern(p) * color; });
   return build_mip_chain(std::move(level0));
-}
-
-// What validate_scene checks of a stored chain's texels, for a deferred one when it is made: an
-// image may hold NaN or infinity, and large finite values may overflow in the box filter.
-void check_finite_texels(const MipChain& chain, const std::string& field) {
-  for (size_t k = 0; k < chain.levels.size(); ++k)
-    for (const glm::vec4& t : chain.levels[k].texels)
-      if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z) || !std::isfinite(t.w))
-        throw InputError(field, "mip level " + std::to_string(k) + " has a non-finite texel");
 }
 
 TexturePlan read_texture(const json& value, const std::string& path) {
@@ -449,6 +441,7 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name, cons
       recipe.plan.width = image.width;
       recipe.plan.height = image.height;
       recipe.read_image = std::move(image.read);
+      recipe.decode_bytes = image.decode_bytes;
       total_texels += static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
       if (total_texels > kMaxSceneTexels)
         throw InputError(image_path, "the scene's textures exceed " + std::to_string(kMaxSceneTexels) + " texels in all");
@@ -458,6 +451,8 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name, cons
   if (defer) {
     for (size_t f = 0; f < scene.faces.size(); ++f)
       scene.faces[f].texture = deferred_mip_chain(recipes[f].plan.width, recipes[f].plan.height);
+    if (std::any_of(recipes.begin(), recipes.end(), [](const FaceRecipe& r) { return r.decode_bytes > 0; }))
+      for (const FaceRecipe& recipe : recipes) scene.texture_source_decode_bytes.push_back(recipe.decode_bytes);
     scene.texture_source = [recipes = std::make_shared<const std::vector<FaceRecipe>>(recipes)](size_t f) {
       const FaceRecipe& recipe = recipes->at(f);
       MipChain chain = make_face_chain(recipe);
@@ -504,11 +499,6 @@ Scene realize(SceneSource source, const GeneratorOptions& extra) {
   return scene;
 }
 
-// The message of an InputError without its "field: " prefix.
-std::string message_of(const InputError& error) {
-  return std::string(error.what()).substr(error.field().size() + 2);
-}
-
 SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load_image, bool defer) {
   std::error_code error_code;
   if (!std::filesystem::exists(path, error_code))
@@ -526,8 +516,24 @@ SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load
   try {
     return read_document(doc, std::filesystem::path(path).stem().string(), load_image, defer);
   } catch (const InputError& error) {
-    throw InputError(error.field(), message_of(error) + " (in '" + path + "')");
+    throw error_in_scene_file(error, path);
   }
+}
+
+// A scene file's scene: what its faces find wrong when they are made (packed, for a deferred one)
+// names the file as what the parse found wrong does.
+Scene realize_file(SceneSource source, const GeneratorOptions& extra, const std::string& path) {
+  Scene scene = realize(std::move(source), extra);
+  if (scene.texture_source) {
+    scene.texture_source = [source = std::move(scene.texture_source), path](size_t f) {
+      try {
+        return source(f);
+      } catch (const InputError& error) {
+        throw error_in_scene_file(error, path);
+      }
+    };
+  }
+  return scene;
 }
 
 }  // namespace
@@ -544,16 +550,21 @@ Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_im
 }
 
 Scene load_scene_file(const std::string& path, const FaceImageLoader& load_image) {
-  return realize(read_scene_file(path, load_image, false), {});
+  return realize_file(read_scene_file(path, load_image, false), {}, path);
 }
 
 Scene load_scene(const std::string& name_or_path, const GeneratorOptions& options, const FaceImageLoader& load_image) {
   if (is_generator_name(name_or_path)) return generate_scene(name_or_path, options);
   std::error_code ignored;
   if (name_or_path.ends_with(".json") || std::filesystem::exists(name_or_path, ignored))
-    return realize(read_scene_file(name_or_path, load_image, options.defer_textures), options);
+    return realize_file(read_scene_file(name_or_path, load_image, options.defer_textures), options, name_or_path);
   throw InputError("scene", "unknown scene '" + name_or_path + "' (known: " +
                                 known_generator_names() + "; or the path of a .json scene file)");
+}
+
+InputError error_in_scene_file(const InputError& error, const std::string& path) {
+  const std::string message = std::string(error.what()).substr(error.field().size() + 2);  // without "field: "
+  return InputError(error.field(), message + " (in '" + path + "')");
 }
 
 bool is_builtin_scene(const std::string& name) { return is_generator_name(name); }

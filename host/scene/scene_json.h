@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include <seamcl/core/input_error.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
 
@@ -18,6 +19,7 @@ struct FaceImage {
   int width = 0;
   int height = 0;
   std::function<TextureLevel()> read;  // throws InputError naming the field (the file changed, went)
+  size_t decode_bytes = 0;             // what `read` holds beside level 0 while it decodes
 };
 
 // Looks up the image a face names ("texture": {"image": NAME}): refuses a missing or bad file
@@ -37,8 +39,10 @@ Scene parse_scene_json(const nlohmann::json& doc, const FaceImageLoader& load_im
                        const GeneratorOptions& options = {});
 
 // Reads and parses a scene file. An unreadable file or bad JSON syntax is InputError("scene", ...)
-// naming the path and the parse error; errors in the content keep their JSON path as the field.
-// An explicit scene without "name" is named after the file.
+// naming the path and the parse error; errors in the content keep their JSON path as the field
+// and name the file (error_in_scene_file), also those found only when a deferred face is made
+// (an image file changed since, a non-finite texel). An explicit scene without "name" is named
+// after the file.
 Scene load_scene_file(const std::string& path, const FaceImageLoader& load_image = {});
 
 // A built-in scene name, else a scene file (a path that ends in .json or exists). `options`
@@ -46,6 +50,10 @@ Scene load_scene_file(const std::string& path, const FaceImageLoader& load_image
 // constant colour over the file's; for an explicit scene, as apply_generator_options.
 Scene load_scene(const std::string& name_or_path, const GeneratorOptions& options,
                  const FaceImageLoader& load_image = {});
+
+// `error` as every error of a scene file reads: its message followed by " (in 'path')", its
+// field kept.
+InputError error_in_scene_file(const InputError& error, const std::string& path);
 
 // True for a built-in scene name (scene_generators()).
 bool is_builtin_scene(const std::string& name);
