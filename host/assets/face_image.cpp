@@ -30,7 +30,9 @@ void check_unchanged(const FaceImageFile& file) {
 }  // namespace
 
 FaceImageFile open_face_image(const std::string& path, const std::string& field) {
-  FaceImageFile file{path, field};
+  FaceImageFile file;
+  file.path = path;
+  file.field = field;
   // The stamp first: a file changed while its header is read then fails the later check.
   const std::optional<FileStamp> stamp = file_stamp(path);
   if (!stamp) throw InputError(field, "image '" + path + "' is not a regular file that can be read");
