@@ -312,13 +312,24 @@ TEST(Budget, TileListGrowthStaysUnderTheBoundAndALimitRefusesIt) {
   EXPECT_EQ(std::memcmp(again.pixels.data(), grown.pixels.data(), grown.pixels.size() * sizeof(glm::vec4)), 0);
 }
 
-TEST(Budget, CompareMemoryBoundsWhatTheCompareHolds) {
-  const Scene scene = generate_scene("quad2", {});
+// A 24x16 discard frame of the built-in scene `name`, as a compare's frame.
+RenderOptions compare_frame(const std::string& name) {
   RenderOptions frame = options_of(Method::Discard, TexelFormat::Rgba8, 1, 24, 16);
-  frame.scene = "quad2";
+  frame.scene = name;
+  return frame;
+}
+
+ReferenceSettings uncached_reference(int msaa) {
   ReferenceSettings settings;
   settings.use_cache = false;
-  settings.msaa = 1;
+  settings.msaa = msaa;
+  return settings;
+}
+
+TEST(Budget, CompareMemoryBoundsWhatTheCompareHolds) {
+  const Scene scene = generate_scene("quad2", {});
+  const RenderOptions frame = compare_frame("quad2");
+  const ReferenceSettings settings = uncached_reference(1);
   const std::vector<MethodEntry> entries =
       method_entries(to_json(frame), {"discard", "guardband", "clamp"}, {1, 4});
   const CompareMemory expected = compare_memory(scene_sizes(scene), frame, entries, settings);
@@ -355,11 +366,8 @@ TEST(Budget, CompareMemoryBoundsWhatTheCompareHolds) {
 
 TEST(Budget, CompareMemoryCountsTheAnalyticAndSeamlessReferences) {
   const Scene scene = generate_scene("closeup-corner", {});
-  RenderOptions frame = options_of(Method::Discard, TexelFormat::Rgba8, 1, 24, 16);
-  frame.scene = "closeup-corner";
-  ReferenceSettings settings;
-  settings.use_cache = false;
-  settings.msaa = 4;
+  const RenderOptions frame = compare_frame("closeup-corner");
+  const ReferenceSettings settings = uncached_reference(4);
   const std::vector<MethodEntry> entries = method_entries(to_json(frame), {"discard"}, {1, 4});
   const SceneSizes sizes = scene_sizes(scene);
 
