@@ -261,6 +261,8 @@ __kernel void tessellated_setup(__constant FrameParams* frame, __constant Tessel
     polygon[k].u = tv.u;
     polygon[k].v = tv.v;
   }
-  const uint visible = clip_and_setup(polygon, (uint)patch, frame, out + tri, (size_t)frame->input_triangles);
+  /* Every slot written (the host fills slot_counts with SEAMCL_CLIP_SLOTS for tessellation). */
+  uint fan = 0;
+  const uint visible = clip_and_setup(polygon, (uint)patch, frame, out + tri, (size_t)frame->input_triangles, 1, &fan);
   if (visible > 0) atomic_add(&stats->visible_triangles, visible);
 }

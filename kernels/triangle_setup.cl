@@ -3,8 +3,9 @@
  * k * input_triangles + t (slot-major, kernels/seamcl_types.h: unclipped triangles' records dense).
  *
  * slot_counts[t]: how many of t's slots were written (0 .. SEAMCL_CLIP_SLOTS; later ones hold
- * stale data and count as empty): binning reads only those (the host fills it with
- * SEAMCL_CLIP_SLOTS when tessellate.cl writes every slot instead).
+ * stale data and count as empty): 1 or 0 for a triangle that needs no clipping, the size of its
+ * fan for a clipped one; binning reads only those (the host fills it with SEAMCL_CLIP_SLOTS when
+ * tessellate.cl writes every slot instead).
  * Inputs: positions (world, xyz of float4), faces, frame (view_proj, image size, clip planes).
  * Steps: transform to clip space; clip against w >= near_w and the guard band |x| <= guard_x w,
  * |y| <= guard_y w (Sutherland-Hodgman; the host sizes the guard band so that snapped coordinates
@@ -13,7 +14,7 @@
  * area and triangles whose bounding box holds no sample position of the frame's pattern; build
  * edge functions with the top-left rule and perspective-correct attribute planes.
  * An early cull (setup_may_be_visible: back faces, zero area, boxes past an image side, for
- * triangles inside all planes) runs first for every triangle, in a work-item loop of its own;
+ * triangles inside all planes; triangles wholly outside one plane) runs first for every triangle, in a work-item loop of its own;
  * the full setup runs only for the others, with the same result as without the early cull: a
  * survivor inside all planes takes its snapped vertices and 1/w from the cull (SnappedTriangle,
  * the same float steps) into setup_snapped_triangle, so the transform and snapping run once.
@@ -121,43 +122,47 @@ SEAMCL_INLINE float subpixel_y(float y, float inv_w, __constant FrameParams* fra
   return sy * (float)SEAMCL_SUBPIXEL_ONE;
 }
 
+/* Edge function i of a setup, from vertex (Xi, Yi) to (Xj, Yj), the top-left rule folded in. */
+SEAMCL_INLINE void setup_edge(TriangleSetup* s, int i, long Xi, long Yi, long Xj, long Yj) {
+  const long a = Yi - Yj;
+  const long b = Xj - Xi;
+  const int top_left = a > 0 || (a == 0 && b > 0);
+  s->edge_a[i] = (int)a;
+  s->edge_b[i] = (int)b;
+  s->edge_c[i] = -(a * Xi + b * Yi) - (top_left ? 0 : 1);
+}
+
+/* The plane of an attribute with values a0, a1, a2 at the three vertices: the value at vertex 0
+ * and the screen gradient. */
+SEAMCL_INLINE void setup_plane(float* plane, float a0, float a1, float a2, float dx1, float dy1, float dx2, float dy2,
+                               float inv_det) {
+  const float d1 = a1 - a0;
+  const float d2 = a2 - a0;
+  plane[0] = a0;
+  plane[1] = (d1 * dy2 - d2 * dy1) * inv_det;
+  plane[2] = (d2 * dx1 - d1 * dx2) * inv_det;
+}
+
 /* Setup of one screen triangle from its snapped vertices (X, Y in 1/SEAMCL_SUBPIXEL_ONE pixels),
  * their 1/w and uv; empty if culled. The early cull's survivors come here with the vertices it
- * snapped; setup_screen_triangle snaps clipped ones the same way. */
+ * snapped; setup_screen_triangle snaps clipped ones the same way. Scalars only, no private arrays:
+ * PoCL keeps an array that lives in a work-item loop in memory, and the narrow stores of a vertex
+ * swap read back by wider loads stalled (a quarter of this stage's samples). */
 SEAMCL_INLINE TriangleSetup setup_snapped_triangle(long X0, long Y0, long X1, long Y1, long X2, long Y2, float inv_w0,
                                                    float inv_w1, float inv_w2, float u0, float v0, float u1, float v1,
                                                    float u2, float v2, uint face, __constant FrameParams* frame) {
-  long X[3] = {X0, X1, X2}, Y[3] = {Y0, Y1, Y2};
-  float inv_w[3] = {inv_w0, inv_w1, inv_w2};
-  float u[3] = {u0, u1, u2}, v[3] = {v0, v1, v2};
-  long area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
+  const long area2 = (X1 - X0) * (Y2 - Y0) - (Y1 - Y0) * (X2 - X0);
   /* Counter-clockwise in NDC (y up) is clockwise on screen (y down): negative area. */
   if (area2 >= 0) return empty_setup(face);
-  {
-    /* Make the interior positive for all three edge functions. */
-    long tx = X[1]; X[1] = X[2]; X[2] = tx;
-    long ty = Y[1]; Y[1] = Y[2]; Y[2] = ty;
-    float tw = inv_w[1]; inv_w[1] = inv_w[2]; inv_w[2] = tw;
-    float tu = u[1]; u[1] = u[2]; u[2] = tu;
-    float tv = v[1]; v[1] = v[2]; v[2] = tv;
-    area2 = -area2;
-  }
+  /* Vertices 0, 2, 1 in turn (a, b, c) make the interior positive for all three edge functions. */
+  const long Xa = X0, Ya = Y0, Xb = X2, Yb = Y2, Xc = X1, Yc = Y1;
   TriangleSetup s;
   s.face = face;
-  long min_x = X[0], max_x = X[0], min_y = Y[0], max_y = Y[0];
-  for (int i = 0; i < 3; ++i) {
-    const int j = (i + 1) % 3;
-    const long a = Y[i] - Y[j];
-    const long b = X[j] - X[i];
-    const int top_left = a > 0 || (a == 0 && b > 0);
-    s.edge_a[i] = (int)a;
-    s.edge_b[i] = (int)b;
-    s.edge_c[i] = -(a * X[i] + b * Y[i]) - (top_left ? 0 : 1);
-    min_x = min(min_x, X[i]);
-    max_x = max(max_x, X[i]);
-    min_y = min(min_y, Y[i]);
-    max_y = max(max_y, Y[i]);
-  }
+  setup_edge(&s, 0, Xa, Ya, Xb, Yb);
+  setup_edge(&s, 1, Xb, Yb, Xc, Yc);
+  setup_edge(&s, 2, Xc, Yc, Xa, Ya);
+  const long min_x = min(min(Xa, Xb), Xc), max_x = max(max(Xa, Xb), Xc);
+  const long min_y = min(min(Ya, Yb), Yc), max_y = max(max(Ya, Yb), Yc);
   /* Samples of pixel p lie in [p*ONE, p*ONE + ONE - 16] (D3D offsets are -8..7 sixteenths). */
   const int sample_span = SEAMCL_SUBPIXEL_ONE - 16;
   s.bbox_min_x = (int)max(floor_div_subpixel(min_x - sample_span + SEAMCL_SUBPIXEL_ONE - 1), 0L);
@@ -166,33 +171,16 @@ SEAMCL_INLINE TriangleSetup setup_snapped_triangle(long X0, long Y0, long X1, lo
   s.bbox_max_y = (int)min(floor_div_subpixel(max_y), (long)frame->height - 1);
   if (!box_holds_sample(min_x, max_x, min_y, max_y, frame)) return empty_setup(face);
 
-  /* Attribute planes over the snapped positions, relative to vertex 0 for precision. */
+  /* Attribute planes over the snapped positions, relative to vertex a for precision. */
   const float scale = 1.0f / (float)SEAMCL_SUBPIXEL_ONE;
-  const float x0 = (float)X[0] * scale, y0 = (float)Y[0] * scale;
-  const float dx1 = (float)(X[1] - X[0]) * scale, dy1 = (float)(Y[1] - Y[0]) * scale;
-  const float dx2 = (float)(X[2] - X[0]) * scale, dy2 = (float)(Y[2] - Y[0]) * scale;
-  const float inv_det = 1.0f / ((float)area2 * scale * scale);
-  s.ref_x = x0;
-  s.ref_y = y0;
-  float attr[3][3];
-  for (int i = 0; i < 3; ++i) {
-    attr[0][i] = inv_w[i];
-    attr[1][i] = u[i] * inv_w[i];
-    attr[2][i] = v[i] * inv_w[i];
-  }
-  float plane[3][3];
-  for (int k = 0; k < 3; ++k) {
-    const float d1 = attr[k][1] - attr[k][0];
-    const float d2 = attr[k][2] - attr[k][0];
-    plane[k][0] = attr[k][0];
-    plane[k][1] = (d1 * dy2 - d2 * dy1) * inv_det;
-    plane[k][2] = (d2 * dx1 - d1 * dx2) * inv_det;
-  }
-  for (int i = 0; i < 3; ++i) {
-    s.inv_w[i] = plane[0][i];
-    s.u_over_w[i] = plane[1][i];
-    s.v_over_w[i] = plane[2][i];
-  }
+  const float dx1 = (float)(Xb - Xa) * scale, dy1 = (float)(Yb - Ya) * scale;
+  const float dx2 = (float)(Xc - Xa) * scale, dy2 = (float)(Yc - Ya) * scale;
+  const float inv_det = 1.0f / ((float)(-area2) * scale * scale);
+  s.ref_x = (float)Xa * scale;
+  s.ref_y = (float)Ya * scale;
+  setup_plane(s.inv_w, inv_w0, inv_w2, inv_w1, dx1, dy1, dx2, dy2, inv_det);
+  setup_plane(s.u_over_w, u0 * inv_w0, u2 * inv_w2, u1 * inv_w1, dx1, dy1, dx2, dy2, inv_det);
+  setup_plane(s.v_over_w, v0 * inv_w0, v2 * inv_w2, v1 * inv_w1, dx1, dy1, dx2, dy2, inv_det);
   return s;
 }
 
@@ -212,12 +200,13 @@ SEAMCL_INLINE TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, 
 }
 
 /* Clips the triangle polygon[0..2] (clip space, with uv) against the five planes and writes the
- * fan of the clipped polygon as SEAMCL_CLIP_SLOTS setups (empty ones past its end) to out[k *
- * slot_stride], k = 0 .. SEAMCL_CLIP_SLOTS - 1 (slot-major records: slot_stride is the frame's
- * input triangles); returns how many are visible. triangle_setup and tessellate.cl's
- * tessellated_setup both call it, so their micro-triangles and faces clip and snap identically. */
+ * fan of the clipped polygon as setups to out[k * slot_stride], k = 0 .. fan - 1 (slot-major
+ * records: slot_stride is the frame's input triangles), and with write_empty_slots empty ones past
+ * it up to SEAMCL_CLIP_SLOTS - 1; *fan receives the fan's size (0 when nothing is left); returns
+ * how many are visible. triangle_setup and tessellate.cl's tessellated_setup both call it, so
+ * their micro-triangles and faces clip and snap identically. */
 SEAMCL_INLINE uint clip_and_setup(ClipVertex* polygon, uint face_index, __constant FrameParams* frame,
-                                  __global TriangleSetup* out, size_t slot_stride) {
+                                  __global TriangleSetup* out, size_t slot_stride, int write_empty_slots, uint* fan) {
   int count = 3;
   for (int plane = 0; plane < 5 && count > 0; ++plane) {
     float d[8];
@@ -242,7 +231,9 @@ SEAMCL_INLINE uint clip_and_setup(ClipVertex* polygon, uint face_index, __consta
   }
 
   uint visible = 0;
+  *fan = (uint)max(count - 2, 0);
   for (int k = 0; k < SEAMCL_CLIP_SLOTS; ++k) {
+    if (k + 2 >= count && !write_empty_slots) break;
     TriangleSetup s = empty_setup(face_index);
     if (k + 2 < count) s = setup_screen_triangle(polygon[0], polygon[k + 1], polygon[k + 2], face_index, frame);
     visible += s.bbox_max_x >= s.bbox_min_x && s.bbox_max_y >= s.bbox_min_y;
@@ -288,8 +279,10 @@ SEAMCL_INLINE uint setup_input_triangle(__constant FrameParams* frame, __global 
     if (visible) slots[0] = s;
     slot_counts[t] = visible;
   } else {
-    visible = clip_and_setup(polygon, face_index, frame, slots, (size_t)frame->input_triangles);
-    slot_counts[t] = SEAMCL_CLIP_SLOTS;
+    /* Only the fan's slots: binning reads no more than slot_counts[t]. */
+    uint fan = 0;
+    visible = clip_and_setup(polygon, face_index, frame, slots, (size_t)frame->input_triangles, 0, &fan);
+    slot_counts[t] = fan;
   }
   return visible;
 }
@@ -308,8 +301,8 @@ typedef struct {
  * rounding are those of setup_input_triangle and setup_screen_triangle, so the early cull sees the
  * vertices setup snaps. Outside the planes (or NaN) the position is 0 and unused. p: x, y, z (read as
  * floats). */
-SEAMCL_INLINE void cull_vertex(__constant FrameParams* frame, __global const float* p, int* inside, int* X, int* Y,
-                               float* inv_w_out) {
+SEAMCL_INLINE void cull_vertex(__constant FrameParams* frame, __global const float* p, int* inside,
+                               int* outside_all, int* X, int* Y, float* inv_w_out) {
   const __constant float* m = frame->view_proj;
   const float x = m[0] * p[0] + m[4] * p[1] + m[8] * p[2] + m[12];
   const float y = m[1] * p[0] + m[5] * p[1] + m[9] * p[2] + m[13];
@@ -317,6 +310,10 @@ SEAMCL_INLINE void cull_vertex(__constant FrameParams* frame, __global const flo
   const int in = (w - frame->near_w >= 0.0f) & (frame->guard_x * w - x >= 0.0f) & (frame->guard_x * w + x >= 0.0f) &
                  (frame->guard_y * w - y >= 0.0f) & (frame->guard_y * w + y >= 0.0f);
   *inside &= in;
+  /* Bit k: outside plane k (clip_distance < 0, clip_and_setup's test; NaN is not outside). */
+  *outside_all &= (w - frame->near_w < 0.0f) | (frame->guard_x * w - x < 0.0f) << 1 |
+                  (frame->guard_x * w + x < 0.0f) << 2 | (frame->guard_y * w - y < 0.0f) << 3 |
+                  (frame->guard_y * w + y < 0.0f) << 4;
   const float inv_w = 1.0f / w;
   /* rint, as setup rounds (the builtin: no library call). Inside the guard band the
    * snapped coordinates lie in [-W, 2W] pixels: 25 bits. */
@@ -326,9 +323,10 @@ SEAMCL_INLINE void cull_vertex(__constant FrameParams* frame, __global const flo
 }
 
 /* Whether input triangle t may leave a visible slot: 0 only where setup_input_triangle would cull
- * it whole, for triangles that need no clipping (the common case): a back face or zero area (the
+ * it whole: for triangles that need no clipping (the common case), a back face or zero area (the
  * same snapped vertices and area sign as setup_screen_triangle), or a bounding box past an image
- * side, where no sample lies. Others (clipped ones too) return 1 and the full setup decides.
+ * side, where no sample lies; for the others, all three vertices outside one clip plane. Others
+ * return 1 and the full setup decides.
  * Straight-line code over a few loads: on paper at 99,037 faces a setup that stops here for every
  * triangle took under 1 ms for 198,074 triangles (PoCL does not vectorise it: a few
  * scalar operations per vertex). *v receives the snapped vertices, their 1/w and whether all three
@@ -337,12 +335,12 @@ SEAMCL_INLINE int setup_may_be_visible(__constant FrameParams* frame, __global c
                                        __global const FaceGpu* faces, int t, SnappedTriangle* v) {
   __global const FaceGpu* face = faces + t / 2;
   const int odd = t & 1;
-  int inside = 1;
+  int inside = 1, outside_all = 31;
   int X0, Y0, X1, Y1, X2, Y2;
   __global const float* xyzw = (__global const float*)positions;
-  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[0], &inside, &X0, &Y0, &v->inv_w0);
-  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[odd ? 2 : 1], &inside, &X1, &Y1, &v->inv_w1);
-  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[odd ? 3 : 2], &inside, &X2, &Y2, &v->inv_w2);
+  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[0], &inside, &outside_all, &X0, &Y0, &v->inv_w0);
+  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[odd ? 2 : 1], &inside, &outside_all, &X1, &Y1, &v->inv_w1);
+  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[odd ? 3 : 2], &inside, &outside_all, &X2, &Y2, &v->inv_w2);
   v->X0 = X0; v->Y0 = Y0; v->X1 = X1; v->Y1 = Y1; v->X2 = X2; v->Y2 = Y2;
   v->inside = inside;
   const long area2 = (long)(X1 - X0) * (long)(Y2 - Y0) - (long)(Y1 - Y0) * (long)(X2 - X0);
@@ -351,7 +349,12 @@ SEAMCL_INLINE int setup_may_be_visible(__constant FrameParams* frame, __global c
   const int last_y = (frame->height - 1) * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE - 16;
   const int off_image = (X0 < 0 && X1 < 0 && X2 < 0) | (Y0 < 0 && Y1 < 0 && Y2 < 0) |
                         (X0 > last_x && X1 > last_x && X2 > last_x) | (Y0 > last_y && Y1 > last_y && Y2 > last_y);
-  return !inside || (area2 < 0 && !off_image);
+  /* Clipped triangles go to the full setup, unless all three vertices lie outside one plane:
+   * then clipping leaves nothing (the near plane is clipped first, so its test is exact; a guard
+   * plane's clipped vertices could only round back onto the plane, three image sides beyond the
+   * image, where no sample lies). */
+  if (!inside) return outside_all == 0;
+  return area2 < 0 && !off_image;
 }
 
 __kernel __attribute__((reqd_work_group_size(SEAMCL_SETUP_GROUP, 1, 1)))

@@ -121,17 +121,21 @@ ClipVertex input_vertex(const PackedScene& scene, const FrameParams& f, int t, i
 
 }  // namespace
 
-size_t early_culled_reference(const PackedScene& scene, const FrameParams& f) {
+EarlyCullCounts early_culled_reference(const PackedScene& scene, const FrameParams& f) {
   constexpr int64_t one = SEAMCL_SUBPIXEL_ONE;
   // Samples of pixel p lie in [p*one, p*one + one - 16].
   const int64_t last_x = (f.width - 1) * one + one - 16, last_y = (f.height - 1) * one + one - 16;
-  size_t culled = 0;
+  EarlyCullCounts culled;
   for (int t = 0; t < f.input_triangles; ++t) {
     bool inside = true;
+    std::array<bool, 5> outside_all{true, true, true, true, true};
     std::array<int64_t, 3> X{}, Y{};
     for (int i = 0; i < 3; ++i) {
       const ClipVertex c = input_vertex(scene, f, t, i);
-      for (int plane = 0; plane < 5; ++plane) inside &= clip_distance(c, plane, f) >= 0.0f;
+      for (int plane = 0; plane < 5; ++plane) {
+        inside &= clip_distance(c, plane, f) >= 0.0f;
+        outside_all[static_cast<size_t>(plane)] = outside_all[static_cast<size_t>(plane)] && clip_distance(c, plane, f) < 0.0f;
+      }
       // setup_screen_triangle's snapping
       const float inv_w = 1.0f / c.w;
       const float sx = (c.x * inv_w * 0.5f + 0.5f) * static_cast<float>(f.width);
@@ -139,12 +143,16 @@ size_t early_culled_reference(const PackedScene& scene, const FrameParams& f) {
       X[i] = static_cast<int64_t>(std::rint(sx * static_cast<float>(one)));
       Y[i] = static_cast<int64_t>(std::rint(sy * static_cast<float>(one)));
     }
-    if (!inside) continue;  // clipped triangles go to the full setup
+    if (!inside) {
+      // Clipped triangles go to the full setup, unless all three vertices lie outside one plane.
+      culled.outside_a_plane += std::find(outside_all.begin(), outside_all.end(), true) != outside_all.end();
+      continue;
+    }
     const int64_t area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
     const auto all = [](const std::array<int64_t, 3>& v, auto past) { return past(v[0]) && past(v[1]) && past(v[2]); };
     const bool off_image = all(X, [](int64_t v) { return v < 0; }) || all(Y, [](int64_t v) { return v < 0; }) ||
                            all(X, [&](int64_t v) { return v > last_x; }) || all(Y, [&](int64_t v) { return v > last_y; });
-    culled += area2 >= 0 || off_image;
+    culled.unclipped += area2 >= 0 || off_image;
   }
   return culled;
 }

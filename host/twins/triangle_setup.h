@@ -18,9 +18,14 @@ std::vector<TriangleSetup> setup_triangles_reference(const PackedScene& scene, c
                                                      bool cull_sampleless = true);
 
 // How many input triangles triangle_setup.cl's early cull (setup_may_be_visible) stops before the
-// full setup: those inside the near plane and the guard band whose snapped vertices face away,
-// have zero area, or lie all past one image side. FrameStats.early_culled must equal it.
-size_t early_culled_reference(const PackedScene& scene, const FrameParams& frame);
+// full setup, by rule. FrameStats.early_culled must equal their total.
+struct EarlyCullCounts {
+  size_t unclipped = 0;        // inside the near plane and the guard band, whose snapped vertices
+                               // face away, have zero area, or lie all past one image side
+  size_t outside_a_plane = 0;  // all three vertices outside one clip plane
+  size_t total() const { return unclipped + outside_a_plane; }
+};
+EarlyCullCounts early_culled_reference(const PackedScene& scene, const FrameParams& frame);
 
 // Whether the fixed-point box [min_x, max_x] x [min_y, max_y] holds a position of one of the
 // frame's samples (sample_count's pattern) in the image: setup culls triangles whose box holds none.
