@@ -199,7 +199,7 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
   // First the tables, from the sizes alone (a level stores (w + 2 band) x (h + 2 band) texels) ...
   std::vector<size_t> first_level(scene.faces.size());
   const size_t band = static_cast<size_t>(guard_band);
-  size_t texels = 0;
+  size_t texels = 0, max_levels = 0;
   for (size_t f = 0; f < scene.faces.size(); ++f) {
     const Face& face = scene.faces[f];
     FaceGpu gpu{};
@@ -215,14 +215,24 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
     gpu.reflective = face.roughness >= 0.0f ? static_cast<cl_int>(out.reflective_faces.size()) : -1;
     if (face.roughness >= 0.0f) out.reflective_faces.push_back(reflective_face(scene, face));
     first_level[f] = out.level_offsets.size();
-    for (const TextureLevel& level : face.texture.levels) {
+    out.level_offsets.resize(out.level_offsets.size() + face.texture.levels.size());
+    max_levels = std::max(max_levels, face.texture.levels.size());
+    out.faces.push_back(gpu);
+  }
+  // Level-major: level l of every face (in face order), then level l + 1. Neighbouring faces'
+  // coarse levels, which a scene of many small faces reads, then share cache lines and pages;
+  // face-major, a face's whole chain lay between them.
+  for (size_t l = 0; l < max_levels; ++l) {
+    for (size_t f = 0; f < scene.faces.size(); ++f) {
+      const MipChain& chain = scene.faces[f].texture;
+      if (l >= chain.levels.size()) continue;
+      const TextureLevel& level = chain.levels[l];
       const size_t own = static_cast<size_t>(level.width) * static_cast<size_t>(level.height);
       const size_t stored = (static_cast<size_t>(level.width) + 2 * band) * (static_cast<size_t>(level.height) + 2 * band);
-      out.level_offsets.push_back(static_cast<uint32_t>(texels));
+      out.level_offsets[first_level[f] + l] = static_cast<uint32_t>(texels);
       texels += stored;
       out.band_texels += stored - own;
     }
-    out.faces.push_back(gpu);
   }
   if (texels != stored_texels) throw std::logic_error("pack_scene: level sizes disagree with packed_texture_memory");
   fill_edge_reach(out.faces, out.neighbors);
