@@ -171,7 +171,8 @@ typedef struct {
 
 /* One quad patch. Texture texels of all faces live in one buffer; level l of a face starts at
  * level_offsets[level_table + l] and holds max(w >> l, 1) x max(h >> l, 1) texels, row-major,
- * row 0 at v = 0. Texel (i, j) of a level of size W x H has its centre at ((i+.5)/W, (j+.5)/H). */
+ * row 0 at v = 0. Texel (i, j) of a level of size W x H has its centre at ((i+.5)/W, (j+.5)/H).
+ * The host stores the levels level-major: level 0 of every face, then level 1, ... */
 typedef struct {
   cl_uint vertex[4];        /* uv (0,0), (1,0), (1,1), (0,1); counter-clockwise seen from the front */
   cl_uint level_table;      /* index of level 0's entry in level_offsets */

@@ -120,10 +120,47 @@ TEST(Memory, ADeferredChainNeedsASourceOfTheRightSize) {
   replaced.faces[1].texture = build_mip_chain(TextureLevel{32, 16, std::vector<glm::vec4>(512, glm::vec4(0.5f))});
   const PackedScene packed = pack_scene(replaced);
   const PackedScene original = pack_scene(scene);
-  const size_t first = packed.level_offsets[packed.faces[1].level_table];
-  for (size_t t = first; t < packed.texels8.size(); ++t) ASSERT_EQ(packed.texels8[t], encode_srgb8(glm::vec4(0.5f)));
-  EXPECT_TRUE(std::equal(packed.texels8.begin(), packed.texels8.begin() + static_cast<std::ptrdiff_t>(first),
-                         original.texels8.begin()));
+  // Face 1's levels (stored level-major, between face 0's) hold its texels; every other texel is
+  // face 0's, as packed from the deferred source.
+  ASSERT_EQ(packed.texels8.size(), original.texels8.size());
+  std::vector<bool> of_face1(packed.texels8.size(), false);
+  const FaceGpu& face1 = packed.faces[1];
+  for (int l = 0; l < face1.level_count; ++l) {
+    const size_t first = packed.level_offsets[face1.level_table + static_cast<uint32_t>(l)];
+    const size_t count = static_cast<size_t>(std::max(face1.width >> l, 1)) * static_cast<size_t>(std::max(face1.height >> l, 1));
+    for (size_t t = first; t < first + count; ++t) of_face1[t] = true;
+  }
+  size_t face1_texels = 0;
+  for (size_t t = 0; t < packed.texels8.size(); ++t) {
+    if (of_face1[t]) {
+      ++face1_texels;
+      ASSERT_EQ(packed.texels8[t], encode_srgb8(glm::vec4(0.5f))) << t;
+    } else {
+      ASSERT_EQ(packed.texels8[t], original.texels8[t]) << t;
+    }
+  }
+  EXPECT_EQ(face1_texels, 32u * 16 + 16 * 8 + 8 * 4 + 4 * 2 + 2 * 1 + 1);
+}
+
+TEST(Memory, LevelsAreStoredLevelMajor) {
+  // Level l of every face, in face order, then level l + 1: neighbouring faces' coarse levels
+  // share cache lines. Faces of different sizes and level counts (mixed).
+  const PackedScene packed = pack_scene(generated("mixed", true));
+  std::vector<std::pair<uint32_t, std::pair<int, size_t>>> by_offset;
+  for (size_t f = 0; f < packed.faces.size(); ++f)
+    for (int l = 0; l < packed.faces[f].level_count; ++l)
+      by_offset.push_back({packed.level_offsets[packed.faces[f].level_table + static_cast<uint32_t>(l)], {l, f}});
+  std::sort(by_offset.begin(), by_offset.end());
+  ASSERT_GT(by_offset.size(), packed.faces.size());
+  uint32_t next = 0;
+  for (size_t i = 0; i < by_offset.size(); ++i) {
+    const auto [offset, key] = by_offset[i];
+    const FaceGpu& face = packed.faces[key.second];
+    EXPECT_EQ(offset, next) << "level " << key.first << " of face " << key.second << " not right after the one before";
+    next = offset + static_cast<uint32_t>(std::max(face.width >> key.first, 1) * std::max(face.height >> key.first, 1));
+    if (i > 0) EXPECT_LT(by_offset[i - 1].second, key) << "offsets not in (level, face) order";
+  }
+  EXPECT_EQ(next, packed.texels8.size());
 }
 
 TEST(Memory, ReportedPackedBytesAreTheSumOfTheFacesPackedSizes) {

@@ -14,7 +14,8 @@ struct PackedScene {
   std::vector<cl_float4> positions;     // xyz, w = 1
   std::vector<FaceGpu> faces;
   std::vector<FaceNeighbors> neighbors;  // edge adjacency, for traverse
-  std::vector<uint32_t> level_offsets;  // per face, per level: first texel in `texels`
+  std::vector<uint32_t> level_offsets;  // per face, per level: first texel in `texels`; stored
+                                        // level-major (level 0 of every face, then level 1, ...)
   TexelFormat format = TexelFormat::Rgba8;
   int guard_band = 0;                   // band texels stored around every level (guardband method)
   size_t band_texels = 0;               // of all stored texels, those in bands
