@@ -49,16 +49,6 @@ SEAMCL_INLINE long sample_fixed_y(int y, int row, int s) {
 #define SEAMCL_RASTER_CLAMP (1 << 29)
 /* How many list entries ahead raster prefetches a record. */
 #define SEAMCL_RASTER_PREFETCH_AHEAD 4
-/* Clang's prefetch is the one PoCL turns into an instruction; OpenCL C's own prefetch() is the
- * portable fallback for compilers without it. */
-#if defined(__has_builtin)
-#if __has_builtin(__builtin_prefetch)
-#define SEAMCL_PREFETCH_RECORD(p) __builtin_prefetch(p)
-#endif
-#endif
-#ifndef SEAMCL_PREFETCH_RECORD
-#define SEAMCL_PREFETCH_RECORD(p) prefetch((__global const char*)(p), sizeof(TriangleSetup))
-#endif
 /* Winners kept per tile row: SEAMCL_MAX_SAMPLES vectors of 16. */
 #define SEAMCL_TILE_ROW_WINNERS (SEAMCL_MAX_SAMPLES * SEAMCL_TILE_SIZE)
 /* A row's winners are SEAMCL_MAX_SAMPLES vectors whether they run over pixels (a vector per
@@ -317,7 +307,7 @@ __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup
     /* The record a few entries ahead: its first read misses the cache (records lie in input
      * order, lists in tile order), and the walk's branches depend on it. */
     if (entry + SEAMCL_RASTER_PREFETCH_AHEAD < end) {
-      SEAMCL_PREFETCH_RECORD(setups + tile_lists[entry + SEAMCL_RASTER_PREFETCH_AHEAD]);
+      SEAMCL_PREFETCH(setups + tile_lists[entry + SEAMCL_RASTER_PREFETCH_AHEAD]);
     }
     /* The rows of the tile the entry's box covers (binning), cut to the record's box and the image
      * (a list may hold entries that miss the tile: the box decides). */

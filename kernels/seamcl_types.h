@@ -11,6 +11,16 @@
 /* Every helper inlined: a helper left as a call (LLVM's inliner gives up on the larger sampler
  * functions) stops PoCL from vectorising the work-group loop around it. */
 #define SEAMCL_INLINE inline __attribute__((always_inline))
+/* A prefetch of the cache line at p: clang's builtin is the one PoCL turns into an instruction;
+ * OpenCL C's own prefetch() is the portable fallback for compilers without it. */
+#if defined(__has_builtin)
+#if __has_builtin(__builtin_prefetch)
+#define SEAMCL_PREFETCH(p) __builtin_prefetch(p)
+#endif
+#endif
+#ifndef SEAMCL_PREFETCH
+#define SEAMCL_PREFETCH(p) prefetch((__global const char*)(p), 64)
+#endif
 typedef uint cl_uint;
 typedef int cl_int;
 typedef long cl_long;
