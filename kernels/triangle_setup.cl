@@ -91,24 +91,23 @@ SEAMCL_INLINE int box_holds_sample(long min_x, long max_x, long min_y, long max_
   return 0;
 }
 
-SEAMCL_INLINE TriangleSetup empty_setup(uint face) {
-  TriangleSetup s;
+/* Writes the empty record (bbox_max < bbox_min) of a slot that holds no triangle. */
+SEAMCL_INLINE void store_empty_setup(__global TriangleSetup* out, uint face) {
   for (int i = 0; i < 3; ++i) {
-    s.edge_a[i] = 0;
-    s.edge_b[i] = 0;
-    s.edge_c[i] = -1;
-    s.inv_w[i] = 0.0f;
-    s.u_over_w[i] = 0.0f;
-    s.v_over_w[i] = 0.0f;
+    out->edge_a[i] = 0;
+    out->edge_b[i] = 0;
+    out->edge_c[i] = -1;
+    out->inv_w[i] = 0.0f;
+    out->u_over_w[i] = 0.0f;
+    out->v_over_w[i] = 0.0f;
   }
-  s.bbox_min_x = 0;
-  s.bbox_min_y = 0;
-  s.bbox_max_x = -1;
-  s.bbox_max_y = -1;
-  s.face = face;
-  s.ref_x = 0.0f;
-  s.ref_y = 0.0f;
-  return s;
+  out->bbox_min_x = 0;
+  out->bbox_min_y = 0;
+  out->bbox_max_x = -1;
+  out->bbox_max_y = -1;
+  out->face = face;
+  out->ref_x = 0.0f;
+  out->ref_y = 0.0f;
 }
 
 /* Screen position of a clip-space vertex in 1/SEAMCL_SUBPIXEL_ONE pixels, before rounding (setup
@@ -123,7 +122,7 @@ SEAMCL_INLINE float subpixel_y(float y, float inv_w, __constant FrameParams* fra
 }
 
 /* Edge function i of a setup, from vertex (Xi, Yi) to (Xj, Yj), the top-left rule folded in. */
-SEAMCL_INLINE void setup_edge(TriangleSetup* s, int i, long Xi, long Yi, long Xj, long Yj) {
+SEAMCL_INLINE void setup_edge(__global TriangleSetup* s, int i, long Xi, long Yi, long Xj, long Yj) {
   const long a = Yi - Yj;
   const long b = Xj - Xi;
   const int top_left = a > 0 || (a == 0 && b > 0);
@@ -134,7 +133,7 @@ SEAMCL_INLINE void setup_edge(TriangleSetup* s, int i, long Xi, long Yi, long Xj
 
 /* The plane of an attribute with values a0, a1, a2 at the three vertices: the value at vertex 0
  * and the screen gradient. */
-SEAMCL_INLINE void setup_plane(float* plane, float a0, float a1, float a2, float dx1, float dy1, float dx2, float dy2,
+SEAMCL_INLINE void setup_plane(__global float* plane, float a0, float a1, float a2, float dx1, float dy1, float dx2, float dy2,
                                float inv_det) {
   const float d1 = a1 - a0;
   const float d2 = a2 - a0;
@@ -144,59 +143,61 @@ SEAMCL_INLINE void setup_plane(float* plane, float a0, float a1, float a2, float
 }
 
 /* Setup of one screen triangle from its snapped vertices (X, Y in 1/SEAMCL_SUBPIXEL_ONE pixels),
- * their 1/w and uv; empty if culled. The early cull's survivors come here with the vertices it
- * snapped; setup_screen_triangle snaps clipped ones the same way. Scalars only, no private arrays:
- * PoCL keeps an array that lives in a work-item loop in memory, and the narrow stores of a vertex
- * swap read back by wider loads stalled (a quarter of this stage's samples). */
-SEAMCL_INLINE TriangleSetup setup_snapped_triangle(long X0, long Y0, long X1, long Y1, long X2, long Y2, float inv_w0,
-                                                   float inv_w1, float inv_w2, float u0, float v0, float u1, float v1,
-                                                   float u2, float v2, uint face, __constant FrameParams* frame) {
+ * their 1/w and uv, written to *out field by field; returns whether it is visible. A culled one
+ * writes the empty record if write_empty, else nothing. The early cull's survivors come here with
+ * the vertices it snapped; setup_screen_triangle snaps clipped ones the same way. Scalars and
+ * direct stores only: PoCL keeps a private array or struct that lives in a work-item loop in
+ * memory, and narrow stores read back by wider loads stalled (a vertex swap through private
+ * arrays, then the record copied whole from a private struct: each up to 40% of this stage's
+ * samples, varying from run to run). */
+SEAMCL_INLINE int setup_snapped_triangle(__global TriangleSetup* out, int write_empty, long X0, long Y0, long X1,
+                                         long Y1, long X2, long Y2, float inv_w0, float inv_w1, float inv_w2, float u0,
+                                         float v0, float u1, float v1, float u2, float v2, uint face,
+                                         __constant FrameParams* frame) {
   const long area2 = (X1 - X0) * (Y2 - Y0) - (Y1 - Y0) * (X2 - X0);
-  /* Counter-clockwise in NDC (y up) is clockwise on screen (y down): negative area. */
-  if (area2 >= 0) return empty_setup(face);
   /* Vertices 0, 2, 1 in turn (a, b, c) make the interior positive for all three edge functions. */
   const long Xa = X0, Ya = Y0, Xb = X2, Yb = Y2, Xc = X1, Yc = Y1;
-  TriangleSetup s;
-  s.face = face;
-  setup_edge(&s, 0, Xa, Ya, Xb, Yb);
-  setup_edge(&s, 1, Xb, Yb, Xc, Yc);
-  setup_edge(&s, 2, Xc, Yc, Xa, Ya);
   const long min_x = min(min(Xa, Xb), Xc), max_x = max(max(Xa, Xb), Xc);
   const long min_y = min(min(Ya, Yb), Yc), max_y = max(max(Ya, Yb), Yc);
+  /* Counter-clockwise in NDC (y up) is clockwise on screen (y down): negative area. A box that
+   * holds no sample covers none. */
+  if (area2 >= 0 || !box_holds_sample(min_x, max_x, min_y, max_y, frame)) {
+    if (write_empty) store_empty_setup(out, face);
+    return 0;
+  }
+  out->face = face;
+  setup_edge(out, 0, Xa, Ya, Xb, Yb);
+  setup_edge(out, 1, Xb, Yb, Xc, Yc);
+  setup_edge(out, 2, Xc, Yc, Xa, Ya);
   /* Samples of pixel p lie in [p*ONE, p*ONE + ONE - 16] (D3D offsets are -8..7 sixteenths). */
   const int sample_span = SEAMCL_SUBPIXEL_ONE - 16;
-  s.bbox_min_x = (int)max(floor_div_subpixel(min_x - sample_span + SEAMCL_SUBPIXEL_ONE - 1), 0L);
-  s.bbox_min_y = (int)max(floor_div_subpixel(min_y - sample_span + SEAMCL_SUBPIXEL_ONE - 1), 0L);
-  s.bbox_max_x = (int)min(floor_div_subpixel(max_x), (long)frame->width - 1);
-  s.bbox_max_y = (int)min(floor_div_subpixel(max_y), (long)frame->height - 1);
-  if (!box_holds_sample(min_x, max_x, min_y, max_y, frame)) return empty_setup(face);
-
+  out->bbox_min_x = (int)max(floor_div_subpixel(min_x - sample_span + SEAMCL_SUBPIXEL_ONE - 1), 0L);
+  out->bbox_min_y = (int)max(floor_div_subpixel(min_y - sample_span + SEAMCL_SUBPIXEL_ONE - 1), 0L);
+  out->bbox_max_x = (int)min(floor_div_subpixel(max_x), (long)frame->width - 1);
+  out->bbox_max_y = (int)min(floor_div_subpixel(max_y), (long)frame->height - 1);
   /* Attribute planes over the snapped positions, relative to vertex a for precision. */
   const float scale = 1.0f / (float)SEAMCL_SUBPIXEL_ONE;
   const float dx1 = (float)(Xb - Xa) * scale, dy1 = (float)(Yb - Ya) * scale;
   const float dx2 = (float)(Xc - Xa) * scale, dy2 = (float)(Yc - Ya) * scale;
   const float inv_det = 1.0f / ((float)(-area2) * scale * scale);
-  s.ref_x = (float)Xa * scale;
-  s.ref_y = (float)Ya * scale;
-  setup_plane(s.inv_w, inv_w0, inv_w2, inv_w1, dx1, dy1, dx2, dy2, inv_det);
-  setup_plane(s.u_over_w, u0 * inv_w0, u2 * inv_w2, u1 * inv_w1, dx1, dy1, dx2, dy2, inv_det);
-  setup_plane(s.v_over_w, v0 * inv_w0, v2 * inv_w2, v1 * inv_w1, dx1, dy1, dx2, dy2, inv_det);
-  return s;
+  out->ref_x = (float)Xa * scale;
+  out->ref_y = (float)Ya * scale;
+  setup_plane(out->inv_w, inv_w0, inv_w2, inv_w1, dx1, dy1, dx2, dy2, inv_det);
+  setup_plane(out->u_over_w, u0 * inv_w0, u2 * inv_w2, u1 * inv_w1, dx1, dy1, dx2, dy2, inv_det);
+  setup_plane(out->v_over_w, v0 * inv_w0, v2 * inv_w2, v1 * inv_w1, dx1, dy1, dx2, dy2, inv_det);
+  return 1;
 }
 
-/* Setup of one screen triangle from three clip-space vertices; empty if culled. */
-SEAMCL_INLINE TriangleSetup setup_screen_triangle(ClipVertex c0, ClipVertex c1, ClipVertex c2, uint face,
-                                                  __constant FrameParams* frame) {
-  const ClipVertex c[3] = {c0, c1, c2};
-  long X[3], Y[3];
-  float inv_w[3];
-  for (int i = 0; i < 3; ++i) {
-    inv_w[i] = 1.0f / c[i].w;
-    X[i] = (long)rint(subpixel_x(c[i].x, inv_w[i], frame));
-    Y[i] = (long)rint(subpixel_y(c[i].y, inv_w[i], frame));
-  }
-  return setup_snapped_triangle(X[0], Y[0], X[1], Y[1], X[2], Y[2], inv_w[0], inv_w[1], inv_w[2], c[0].u, c[0].v,
-                                c[1].u, c[1].v, c[2].u, c[2].v, face, frame);
+/* Setup of one screen triangle from three clip-space vertices, written to *out (the empty record
+ * if culled); returns whether it is visible. */
+SEAMCL_INLINE int setup_screen_triangle(__global TriangleSetup* out, ClipVertex c0, ClipVertex c1, ClipVertex c2,
+                                        uint face, __constant FrameParams* frame) {
+  const float inv_w0 = 1.0f / c0.w, inv_w1 = 1.0f / c1.w, inv_w2 = 1.0f / c2.w;
+  return setup_snapped_triangle(out, 1, (long)rint(subpixel_x(c0.x, inv_w0, frame)),
+                                (long)rint(subpixel_y(c0.y, inv_w0, frame)), (long)rint(subpixel_x(c1.x, inv_w1, frame)),
+                                (long)rint(subpixel_y(c1.y, inv_w1, frame)), (long)rint(subpixel_x(c2.x, inv_w2, frame)),
+                                (long)rint(subpixel_y(c2.y, inv_w2, frame)), inv_w0, inv_w1, inv_w2, c0.u, c0.v, c1.u,
+                                c1.v, c2.u, c2.v, face, frame);
 }
 
 /* Clips the triangle polygon[0..2] (clip space, with uv) against the five planes and writes the
@@ -233,11 +234,14 @@ SEAMCL_INLINE uint clip_and_setup(ClipVertex* polygon, uint face_index, __consta
   uint visible = 0;
   *fan = (uint)max(count - 2, 0);
   for (int k = 0; k < SEAMCL_CLIP_SLOTS; ++k) {
-    if (k + 2 >= count && !write_empty_slots) break;
-    TriangleSetup s = empty_setup(face_index);
-    if (k + 2 < count) s = setup_screen_triangle(polygon[0], polygon[k + 1], polygon[k + 2], face_index, frame);
-    visible += s.bbox_max_x >= s.bbox_min_x && s.bbox_max_y >= s.bbox_min_y;
-    out[k * slot_stride] = s;
+    if (k + 2 < count) {
+      visible += (uint)setup_screen_triangle(out + k * slot_stride, polygon[0], polygon[k + 1], polygon[k + 2],
+                                             face_index, frame);
+    } else if (write_empty_slots) {
+      store_empty_setup(out + k * slot_stride, face_index);
+    } else {
+      break;
+    }
   }
   return visible;
 }
@@ -274,9 +278,13 @@ SEAMCL_INLINE uint setup_input_triangle(__constant FrameParams* frame, __global 
   __global TriangleSetup* slots = out + t; /* slot k at slots[k * input_triangles] */
   uint visible;
   if (inside) {
-    const TriangleSetup s = setup_screen_triangle(polygon[0], polygon[1], polygon[2], face_index, frame);
-    visible = s.bbox_max_x >= s.bbox_min_x && s.bbox_max_y >= s.bbox_min_y;
-    if (visible) slots[0] = s;
+    const float inv_w0 = 1.0f / polygon[0].w, inv_w1 = 1.0f / polygon[1].w, inv_w2 = 1.0f / polygon[2].w;
+    visible = (uint)setup_snapped_triangle(
+        slots, 0, (long)rint(subpixel_x(polygon[0].x, inv_w0, frame)), (long)rint(subpixel_y(polygon[0].y, inv_w0, frame)),
+        (long)rint(subpixel_x(polygon[1].x, inv_w1, frame)), (long)rint(subpixel_y(polygon[1].y, inv_w1, frame)),
+        (long)rint(subpixel_x(polygon[2].x, inv_w2, frame)), (long)rint(subpixel_y(polygon[2].y, inv_w2, frame)), inv_w0,
+        inv_w1, inv_w2, polygon[0].u, polygon[0].v, polygon[1].u, polygon[1].v, polygon[2].u, polygon[2].v, face_index,
+        frame);
     slot_counts[t] = visible;
   } else {
     /* Only the fan's slots: binning reads no more than slot_counts[t]. */
@@ -379,11 +387,9 @@ void triangle_setup(__constant FrameParams* frame, __global const float4* positi
     /* setup_input_triangle's path for triangles inside all planes, from the cull's snapped
      * vertices (corner uv: t even takes corners 0, 1, 2, odd 0, 2, 3). */
     const int odd = t & 1;
-    const TriangleSetup s = setup_snapped_triangle(
-        snapped.X0, snapped.Y0, snapped.X1, snapped.Y1, snapped.X2, snapped.Y2, snapped.inv_w0, snapped.inv_w1,
-        snapped.inv_w2, 0.0f, 0.0f, 1.0f, odd ? 1.0f : 0.0f, odd ? 0.0f : 1.0f, 1.0f, (uint)(t / 2), frame);
-    visible = s.bbox_max_x >= s.bbox_min_x && s.bbox_max_y >= s.bbox_min_y;
-    if (visible) out[t] = s; /* slot 0 */
+    visible = (uint)setup_snapped_triangle(out + t /* slot 0 */, 0, snapped.X0, snapped.Y0, snapped.X1, snapped.Y1,
+                                           snapped.X2, snapped.Y2, snapped.inv_w0, snapped.inv_w1, snapped.inv_w2, 0.0f,
+                                           0.0f, 1.0f, odd ? 1.0f : 0.0f, odd ? 0.0f : 1.0f, 1.0f, (uint)(t / 2), frame);
     slot_counts[t] = visible;
   } else if (may_be_visible) {
     visible = setup_input_triangle(frame, positions, faces, out, slot_counts, t);
