@@ -11,15 +11,18 @@
 /* Every helper inlined: a helper left as a call (LLVM's inliner gives up on the larger sampler
  * functions) stops PoCL from vectorising the work-group loop around it. */
 #define SEAMCL_INLINE inline __attribute__((always_inline))
-/* A prefetch of the cache line at p: clang's builtin is the one PoCL turns into an instruction;
- * OpenCL C's own prefetch() is the portable fallback for compilers without it. */
+/* A prefetch of the cache line at p, to read it or to write it: clang's builtin is the one PoCL
+ * turns into an instruction; OpenCL C's own prefetch() is the portable fallback for compilers
+ * without it. */
 #if defined(__has_builtin)
 #if __has_builtin(__builtin_prefetch)
 #define SEAMCL_PREFETCH(p) __builtin_prefetch(p)
+#define SEAMCL_PREFETCH_WRITE(p) __builtin_prefetch(p, 1)
 #endif
 #endif
 #ifndef SEAMCL_PREFETCH
 #define SEAMCL_PREFETCH(p) prefetch((__global const char*)(p), 64)
+#define SEAMCL_PREFETCH_WRITE(p) prefetch((__global const char*)(p), 64)
 #endif
 typedef uint cl_uint;
 typedef int cl_int;

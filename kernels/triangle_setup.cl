@@ -383,6 +383,13 @@ void triangle_setup(__constant FrameParams* frame, __global const float4* positi
   group_early_culled[get_local_id(0)] = in_range && !may_be_visible;
   barrier(CLK_LOCAL_MEM_FENCE);
   uint visible = 0;
+  /* The record lines of the triangle 8 ahead, to be written: the scattered record stores missed
+   * the cache (a 22 MB array at 99,037 faces), and the store misses made this stage take 600 or
+   * 1,100 samples from one run to the next; with the prefetch 670-760. */
+  if (t + 8 < frame->input_triangles) {
+    SEAMCL_PREFETCH_WRITE(out + t + 8);
+    SEAMCL_PREFETCH_WRITE((__global const char*)(out + t + 8) + 64);
+  }
   if (may_be_visible && snapped.inside) {
     /* setup_input_triangle's path for triangles inside all planes, from the cull's snapped
      * vertices (corner uv: t even takes corners 0, 1, 2, odd 0, 2, 3). */
