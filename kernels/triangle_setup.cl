@@ -14,7 +14,8 @@
  * area and triangles whose bounding box holds no sample position of the frame's pattern; build
  * edge functions with the top-left rule and perspective-correct attribute planes.
  * An early cull (setup_may_be_visible: back faces, zero area, boxes past an image side, for
- * triangles inside all planes; triangles wholly outside one plane) runs first for every triangle, in a work-item loop of its own;
+ * triangles inside all planes; triangles wholly outside one plane) runs first for every triangle,
+ * in a work-item loop of its own;
  * the full setup runs only for the others, with the same result as without the early cull: a
  * survivor inside all planes takes its snapped vertices and 1/w from the cull (SnappedTriangle,
  * the same float steps) into setup_snapped_triangle, so the transform and snapping run once.
@@ -188,12 +189,12 @@ SEAMCL_INLINE int setup_snapped_triangle(__global TriangleSetup* out, int write_
   return 1;
 }
 
-/* Setup of one screen triangle from three clip-space vertices, written to *out (the empty record
- * if culled); returns whether it is visible. */
-SEAMCL_INLINE int setup_screen_triangle(__global TriangleSetup* out, ClipVertex c0, ClipVertex c1, ClipVertex c2,
-                                        uint face, __constant FrameParams* frame) {
+/* Setup of one screen triangle from three clip-space vertices, written to *out (a culled one: the
+ * empty record if write_empty, else nothing); returns whether it is visible. */
+SEAMCL_INLINE int setup_screen_triangle(__global TriangleSetup* out, int write_empty, ClipVertex c0, ClipVertex c1,
+                                        ClipVertex c2, uint face, __constant FrameParams* frame) {
   const float inv_w0 = 1.0f / c0.w, inv_w1 = 1.0f / c1.w, inv_w2 = 1.0f / c2.w;
-  return setup_snapped_triangle(out, 1, (long)rint(subpixel_x(c0.x, inv_w0, frame)),
+  return setup_snapped_triangle(out, write_empty, (long)rint(subpixel_x(c0.x, inv_w0, frame)),
                                 (long)rint(subpixel_y(c0.y, inv_w0, frame)), (long)rint(subpixel_x(c1.x, inv_w1, frame)),
                                 (long)rint(subpixel_y(c1.y, inv_w1, frame)), (long)rint(subpixel_x(c2.x, inv_w2, frame)),
                                 (long)rint(subpixel_y(c2.y, inv_w2, frame)), inv_w0, inv_w1, inv_w2, c0.u, c0.v, c1.u,
@@ -235,7 +236,7 @@ SEAMCL_INLINE uint clip_and_setup(ClipVertex* polygon, uint face_index, __consta
   *fan = (uint)max(count - 2, 0);
   for (int k = 0; k < SEAMCL_CLIP_SLOTS; ++k) {
     if (k + 2 < count) {
-      visible += (uint)setup_screen_triangle(out + k * slot_stride, polygon[0], polygon[k + 1], polygon[k + 2],
+      visible += (uint)setup_screen_triangle(out + k * slot_stride, 1, polygon[0], polygon[k + 1], polygon[k + 2],
                                              face_index, frame);
     } else if (write_empty_slots) {
       store_empty_setup(out + k * slot_stride, face_index);
@@ -278,13 +279,7 @@ SEAMCL_INLINE uint setup_input_triangle(__constant FrameParams* frame, __global 
   __global TriangleSetup* slots = out + t; /* slot k at slots[k * input_triangles] */
   uint visible;
   if (inside) {
-    const float inv_w0 = 1.0f / polygon[0].w, inv_w1 = 1.0f / polygon[1].w, inv_w2 = 1.0f / polygon[2].w;
-    visible = (uint)setup_snapped_triangle(
-        slots, 0, (long)rint(subpixel_x(polygon[0].x, inv_w0, frame)), (long)rint(subpixel_y(polygon[0].y, inv_w0, frame)),
-        (long)rint(subpixel_x(polygon[1].x, inv_w1, frame)), (long)rint(subpixel_y(polygon[1].y, inv_w1, frame)),
-        (long)rint(subpixel_x(polygon[2].x, inv_w2, frame)), (long)rint(subpixel_y(polygon[2].y, inv_w2, frame)), inv_w0,
-        inv_w1, inv_w2, polygon[0].u, polygon[0].v, polygon[1].u, polygon[1].v, polygon[2].u, polygon[2].v, face_index,
-        frame);
+    visible = (uint)setup_screen_triangle(slots, 0, polygon[0], polygon[1], polygon[2], face_index, frame);
     slot_counts[t] = visible;
   } else {
     /* Only the fan's slots: binning reads no more than slot_counts[t]. */
@@ -359,8 +354,8 @@ SEAMCL_INLINE int setup_may_be_visible(__constant FrameParams* frame, __global c
                         (X0 > last_x && X1 > last_x && X2 > last_x) | (Y0 > last_y && Y1 > last_y && Y2 > last_y);
   /* Clipped triangles go to the full setup, unless all three vertices lie outside one plane:
    * then clipping leaves nothing (the near plane is clipped first, so its test is exact; a guard
-   * plane's clipped vertices could only round back onto the plane, three image sides beyond the
-   * image, where no sample lies). */
+   * plane's clipped vertices could only round back onto the plane, an image width or height
+   * beyond the image, where no sample lies). */
   if (!inside) return outside_all == 0;
   return area2 < 0 && !off_image;
 }

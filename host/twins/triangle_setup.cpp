@@ -133,8 +133,9 @@ EarlyCullCounts early_culled_reference(const PackedScene& scene, const FramePara
     for (int i = 0; i < 3; ++i) {
       const ClipVertex c = input_vertex(scene, f, t, i);
       for (int plane = 0; plane < 5; ++plane) {
-        inside &= clip_distance(c, plane, f) >= 0.0f;
-        outside_all[static_cast<size_t>(plane)] = outside_all[static_cast<size_t>(plane)] && clip_distance(c, plane, f) < 0.0f;
+        const float d = clip_distance(c, plane, f);
+        inside &= d >= 0.0f;
+        outside_all[static_cast<size_t>(plane)] = outside_all[static_cast<size_t>(plane)] && d < 0.0f;
       }
       // setup_screen_triangle's snapping
       const float inv_w = 1.0f / c.w;
