@@ -149,8 +149,8 @@ SEAMCL_INLINE void setup_plane(__global float* plane, float a0, float a1, float 
  * the vertices it snapped; setup_screen_triangle snaps clipped ones the same way. Scalars and
  * direct stores only: PoCL keeps a private array or struct that lives in a work-item loop in
  * memory, and narrow stores read back by wider loads stalled (a vertex swap through private
- * arrays, then the record copied whole from a private struct: each up to 40% of this stage's
- * samples, varying from run to run). */
+ * arrays, then the record copied whole from a private struct: 24% and 43% of this stage's
+ * samples at 99,037 faces, varying from run to run). */
 SEAMCL_INLINE int setup_snapped_triangle(__global TriangleSetup* out, int write_empty, long X0, long Y0, long X1,
                                          long Y1, long X2, long Y2, float inv_w0, float inv_w1, float inv_w2, float u0,
                                          float v0, float u1, float v1, float u2, float v2, uint face,
@@ -371,16 +371,17 @@ void triangle_setup(__constant FrameParams* frame, __global const float4* positi
   const int t = (int)get_global_id(0);
   const int in_range = t < frame->input_triangles;
   /* The early cull runs in a work-item loop of its own (PoCL splits the loop at a barrier); the
-   * full setup, branchy and heavy on private arrays, then runs for the survivors only (about half
+   * full setup, branchy and longer, then runs for the survivors only (about half
    * of a closed mesh's triangles are back faces). */
   SnappedTriangle snapped = {0, 0, 0, 0, 0, 0, 0, 0.0f, 0.0f, 0.0f};
   const int may_be_visible = in_range && setup_may_be_visible(frame, positions, faces, t, &snapped);
   group_early_culled[get_local_id(0)] = in_range && !may_be_visible;
   barrier(CLK_LOCAL_MEM_FENCE);
   uint visible = 0;
-  /* The record lines of the triangle 8 ahead, to be written: the scattered record stores missed
-   * the cache (a 22 MB array at 99,037 faces), and the store misses made this stage take 600 or
-   * 1,100 samples from one run to the next; with the prefetch 670-760. */
+  /* Two of the (up to three) record lines of the triangle 8 ahead, to be written; neighbouring
+   * work-items cover the rest. The record stores missed the cache (a 22 MB array at 99,037
+   * faces), and this stage took 675-1,093 samples from one run to the next; with the prefetch
+   * 677-691. */
   if (t + 8 < frame->input_triangles) {
     SEAMCL_PREFETCH_WRITE(out + t + 8);
     SEAMCL_PREFETCH_WRITE((__global const char*)(out + t + 8) + 64);

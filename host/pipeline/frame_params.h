@@ -15,6 +15,9 @@ inline constexpr float kNearPlane = 0.01f;
 // far inside 64 bits) and so bounds how far the float attribute planes are extrapolated from
 // their reference vertex (a near-plane vertex would otherwise sit millions of pixels away).
 inline constexpr float kGuardBand = 3.0f;
+// Setup's early cull drops a triangle whose three vertices lie outside one guard plane: a clipped
+// sliver could only round back onto that plane, which must lie beyond the image's samples.
+static_assert(kGuardBand >= 2.0f, "triangle_setup.cl's cull outside one plane needs the guard planes past the image");
 
 glm::mat4 view_projection(const Camera& camera, int width, int height);
 

@@ -485,7 +485,7 @@ std::vector<TriangleSetup> Renderer::read_setups() {
       read_buffer<TriangleSetup>(impl_->runtime.queue(), impl_->setups, triangles * SEAMCL_CLIP_SLOTS);
   if (slot_major.empty()) return {};
   // Setup writes only a triangle's first slot_counts[t] slots (the rest hold stale data): fill the
-  // others with the empty record triangle_setup.cl's empty_setup makes, so every slot reads as before.
+  // others with the empty record triangle_setup.cl's store_empty_setup writes, so every slot reads as before.
   const std::vector<uint32_t> written = read_buffer<uint32_t>(impl_->runtime.queue(), impl_->slot_counts, triangles);
   std::vector<TriangleSetup> setups(slot_major.size());
   for (size_t t = 0; t < triangles; ++t) {
