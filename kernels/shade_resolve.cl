@@ -132,8 +132,7 @@ SEAMCL_INLINE float3 shade_sky(__constant FrameParams* frame, __global const flo
  * them: a 112-byte record starts 0, 16, 32 or 48 bytes into a line), pixel x + 2's face (whose
  * record that line brought), pixel x + 1's level table (whose face). PoCL runs a group's
  * work-items in x order. Prefetches change no result; this took 4-7% off this stage's CPU time
- * (paper at 2,474 and 99,037 faces), about 3% at 16x, and traverse's samples were 5% higher,
- * within its runs' spread. */
+ * (paper at 2,474 and 99,037 faces), about 3% at 16x, nothing with traverse. */
 SEAMCL_INLINE void prefetch_ahead(__constant FrameParams* frame, __global const TriangleSetup* setups,
                                   __global const FaceGpu* faces, __global const uint* level_offsets,
                                   __global const uint* ids, int x) {
