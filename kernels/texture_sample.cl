@@ -269,6 +269,9 @@ SEAMCL_INLINE int probes_reach_face(const FaceGpu* face, int level, float u, flo
                             half_v + (TAP_REACH_TEXELS + (float)GUARD) * inverse_level_side(face->height, level));
 }
 
+/* log2 of a probe count 1..SEAMCL_MAX_PROBES, index N - 1 (see SEAMCL_LOG2_PROBE_COUNTS). */
+__constant float log2_probe_count[SEAMCL_MAX_PROBES] = SEAMCL_LOG2_PROBE_COUNTS;
+
 /* The line of trilinear probes an aniso lookup takes, computed once so that the reach test of
  * traverse (probes_reach_face) and the filter read the same values. */
 typedef struct {
@@ -287,10 +290,11 @@ SEAMCL_INLINE AnisoProbes aniso_probes(const FaceGpu* face, float u, float v, Fo
   /* N = min(ceil(major / minor), max_aniso) probes; ratio computed on squares, then sqrt. */
   /* A line footprint takes the most probes; a point footprint one. */
   const float ratio = minor2 > 0.0f ? sqrt(major2 / minor2) : major2 > 0.0f ? (float)max_aniso : 1.0f;
-  p.probes = f.finite ? clamp((int)__builtin_ceilf(fmin(ratio, 16.0f)), 1, max_aniso) : 1;
+  /* At least 1 whatever max_aniso is: N indexes log2_probe_count. */
+  p.probes = f.finite ? max(min((int)__builtin_ceilf(fmin(ratio, (float)SEAMCL_MAX_PROBES)), max_aniso), 1) : 1;
   p.weight = 1.0f / (float)p.probes;
   /* Each probe is trilinear at log2(major / N). */
-  p.lod = f.finite ? lod_of(major2) - approx_log2((float)p.probes) : (float)(face->level_count - 1);
+  p.lod = f.finite ? lod_of(major2) - log2_probe_count[p.probes - 1] : (float)(face->level_count - 1);
   p.step_u = (x_major ? f.ax_u : f.ay_u) * p.weight;
   p.step_v = (x_major ? f.ax_v : f.ay_v) * p.weight;
   /* Probe i sits at (i + 0.5) / N - 0.5 of the major axis from the centre. */

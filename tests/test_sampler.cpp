@@ -3,6 +3,7 @@
 // constant, weights sum to one, nothing outside a face is read, NaN only where every tap is out.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <random>
 
@@ -135,6 +136,18 @@ TEST(KernelVsTwin, SamplerEveryFilterAddressModeStorageAndMethod) {
         }
       }
     }
+  }
+}
+
+// The table the kernels read log2(N) from holds exactly what approx_log2 gives for each probe
+// count (so the table changed no lod), and that is log2(N) to within the polynomial's 5e-6.
+TEST(Sampler, ProbeCountLog2TableIsTheKernelsPolynomial) {
+  for (int n = 1; n <= SEAMCL_MAX_PROBES; ++n) {
+    const float from_table = log2_probe_count(n);
+    const float from_polynomial = approx_log2(static_cast<float>(n));
+    EXPECT_EQ(std::bit_cast<uint32_t>(from_table), std::bit_cast<uint32_t>(from_polynomial))
+        << n << " probes: table " << from_table << ", polynomial " << from_polynomial;
+    EXPECT_NEAR(from_table, std::log2(static_cast<double>(n)), 5e-6) << n << " probes";
   }
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -129,9 +130,9 @@ AnisoProbes aniso_probes(const FaceGpu& face, float u, float v, const Footprint&
   // A line footprint takes the most probes; a point footprint one.
   const float ratio = minor2 > 0.0f ? std::sqrt(major2 / minor2) : major2 > 0.0f ? static_cast<float>(max_aniso) : 1.0f;
   AnisoProbes p{};
-  p.probes = f.finite ? std::clamp(static_cast<int>(std::ceil(std::fmin(ratio, 16.0f))), 1, max_aniso) : 1;
+  p.probes = f.finite ? std::max(std::min(static_cast<int>(std::ceil(std::fmin(ratio, static_cast<float>(SEAMCL_MAX_PROBES)))), max_aniso), 1) : 1;
   p.weight = 1.0f / static_cast<float>(p.probes);
-  p.lod = f.finite ? lod_of(major2) - approx_log2(static_cast<float>(p.probes)) : static_cast<float>(face.level_count - 1);
+  p.lod = f.finite ? lod_of(major2) - log2_probe_count(p.probes) : static_cast<float>(face.level_count - 1);
   p.step_u = (x_major ? f.ax_u : f.ay_u) * p.weight;
   p.step_v = (x_major ? f.ax_v : f.ay_v) * p.weight;
   // Probe i at (i + 0.5) / N - 0.5 of the major axis from the centre.
@@ -281,6 +282,12 @@ float approx_log2(float x) {
   const float p = m * (1.442517034f + m * (-0.7178983813f + m * (0.4568941740f + m * (-0.2773650501f +
                   m * (0.1219141394f + m * -0.02606630148f)))));
   return exponent + p;
+}
+
+float log2_probe_count(int probes) {
+  static constexpr float kLog2ProbeCounts[SEAMCL_MAX_PROBES] = SEAMCL_LOG2_PROBE_COUNTS;
+  assert(probes >= 1 && probes <= SEAMCL_MAX_PROBES);
+  return kLog2ProbeCounts[probes - 1];
 }
 
 FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, const SamplerParams& sampler, int address,

@@ -14,6 +14,9 @@ namespace seamcl {
 
 // log2 within 5e-6 for x > 0, the polynomial the kernels use.
 float approx_log2(float x);
+// log2 of an aniso probe count 1..SEAMCL_MAX_PROBES as the kernels read it
+// (SEAMCL_LOG2_PROBE_COUNTS: approx_log2's bits for each count).
+float log2_probe_count(int probes);
 
 FilterSum filter_texture_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler,
                                    int address, float u, float v, float dudx, float dvdx, float dudy, float dvdy);
