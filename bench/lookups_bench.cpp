@@ -15,9 +15,10 @@
 // i.e. different data, so OIIO is measured on the float file only and seamcl's RGBA8 figures
 // are compared with that.
 //
-// At the end it prints the ratios: seamcl aniso16 / OIIO aniso, seamcl trilinear / OIIO
-// trilinear, and aniso / (trilinear / mean probe count), where the mean probe count is computed
-// on the host with the kernel's formula N = min(ceil(major / minor), 16).
+// At the end it prints the ratios, each of median rates over the repetitions: seamcl aniso16 /
+// OIIO aniso, seamcl trilinear / OIIO trilinear, and aniso / (trilinear / mean probe count),
+// where the mean probe count is computed on the host with the kernel's formula
+// N = min(ceil(major / minor), 16).
 //
 // aniso16-grouped: the same aniso lookups grouped by probe count (TextureLookups::
 // set_aniso_grouped); its time is the wall time of the planning pass, the host's ordering of the
@@ -136,12 +137,14 @@ struct Setup {
   OIIO::TextureSystem* oiio = nullptr;
 };
 Setup* g_setup = nullptr;
-std::map<std::string, double> g_rates;  // benchmark name -> lookups per second
+// benchmark name -> lookups per second of each repetition (--benchmark_repetitions runs a
+// benchmark that many times; the ratios use the median, as the aggregates do)
+std::map<std::string, std::vector<double>> g_rates;
 
 void record(benchmark::State& state, const std::string& name, double lookups, double seconds) {
   const double rate = seconds > 0.0 ? lookups / seconds : 0.0;
   state.counters["lookups_per_s"] = rate;
-  g_rates[name] = rate;
+  g_rates[name].push_back(rate);
 }
 
 void bm_seamcl(benchmark::State& state, Filter filter, TexelFormat format, const std::string& name, bool grouped) {
@@ -210,7 +213,11 @@ void bm_oiio(benchmark::State& state, OIIO::TextureOpt::MipMode mip, const std::
 void print_ratios(std::FILE* f) {
   auto rate = [](const std::string& name) {
     auto it = g_rates.find(name);
-    return it == g_rates.end() ? NAN : it->second;
+    if (it == g_rates.end() || it->second.empty()) return std::nan("");
+    std::vector<double> rates = it->second;
+    std::sort(rates.begin(), rates.end());
+    const size_t n = rates.size();
+    return n % 2 == 1 ? rates[n / 2] : 0.5 * (rates[n / 2 - 1] + rates[n / 2]);
   };
   auto line = [&](const char* what, double value, const char* goal) {
     if (std::isnan(value)) {
