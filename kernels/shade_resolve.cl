@@ -151,6 +151,39 @@ SEAMCL_INLINE void prefetch_ahead(__constant FrameParams* frame, __global const 
   }
 }
 
+/* A pixel's sample slots in a 16-lane vector (lanes past `samples` repeat the first ones; the
+ * masks below drop them). */
+SEAMCL_INLINE uint16 pixel_sample_ids(__global const uint* ids, int samples) {
+  uint16 v;
+  if (samples == 16) {
+    v = vload16(0, ids);
+  } else if (samples == 8) {
+    const uint8 h = vload8(0, ids);
+    v = (uint16)(h, h);
+  } else if (samples == 4) {
+    const uint4 q = vload4(0, ids);
+    v = (uint16)(q, q, q, q);
+  } else {
+    v = (uint16)(ids[0]);
+    if (samples == 2) v.s1 = ids[1];
+  }
+  return v;
+}
+
+/* Bit l set where lane l of v equals value: an OR tree over disjoint bits. */
+SEAMCL_INLINE uint lanes_equal(uint16 v, uint value) {
+  const uint16 bits = select((uint16)(0u), (uint16)(1u, 2u, 4u, 8u, 16u, 32u, 64u, 128u, 256u, 512u, 1024u, 2048u,
+                                                    4096u, 8192u, 16384u, 32768u),
+                             v == (uint16)(value));
+  const uint8 b8 = bits.lo | bits.hi;
+  const uint4 b4 = b8.lo | b8.hi;
+  const uint2 b2 = b4.lo | b4.hi;
+  return b2.x | b2.y;
+}
+
+/* The index of the lowest set bit of x != 0. */
+SEAMCL_INLINE int lowest_bit(uint x) { return (int)popcount((x & (0u - x)) - 1u); }
+
 SEAMCL_INLINE float3 shade_fragment(__constant FrameParams* frame, __global const TriangleSetup* t,
                              __global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
                              __global const uint* level_offsets, TEXEL_BUFFER texels,
@@ -286,15 +319,15 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
         ++fragments;
       }
     } else {
-      /* Each distinct triangle once, in the order of its first sample: one pass over the samples
-       * gives its coverage mask, so a pixel costs samples x distinct triangles compares. */
-      uint done = 0;
-      for (int s = 0; s < samples; ++s) {
-        if ((done >> s) & 1u) continue;
+      /* Each distinct triangle once, in the order of its first sample (the lowest sample not yet
+       * done), with the mask of the samples it holds: one vector compare of all of them. */
+      const uint16 pixel_ids = pixel_sample_ids(ids, samples);
+      uint remaining = (1u << samples) - 1u; /* samples <= SEAMCL_MAX_SAMPLES = 16 */
+      while (remaining != 0) {
+        const int s = lowest_bit(remaining);
         const uint slot = ids[s];
-        uint mask = 0;
-        for (int r = s; r < samples; ++r) mask |= (uint)(ids[r] == slot) << r;
-        done |= mask;
+        const uint mask = (lanes_equal(pixel_ids, slot) | (1u << s)) & remaining;
+        remaining &= ~mask;
         const int covered = (int)popcount(mask);
         if (slot == SEAMCL_NO_TRIANGLE) {
           uncovered = covered;
