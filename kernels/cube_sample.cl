@@ -252,7 +252,7 @@ CUBE_CALL FilterSum cube_filter(__global const float* texels, CubeSampler cube, 
     const float major2 = x_major ? len2_x : len2_y;
     const float minor2 = x_major ? len2_y : len2_x;
     const float ratio = minor2 > 0.0f ? sqrt(major2 / minor2) : major2 > 0.0f ? (float)cube.max_aniso : 1.0f;
-    probes = max(min((int)__builtin_ceilf(fmin(ratio, (float)SEAMCL_MAX_PROBES)), cube.max_aniso), 1);
+    probes = probe_count(ratio, cube.max_aniso);
     lod = lod_of(major2) - log2_probe_count[probes - 1];
     step_u = (x_major ? ax_u : ay_u) / (float)probes;
     step_v = (x_major ? ax_v : ay_v) / (float)probes;

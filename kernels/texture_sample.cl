@@ -272,6 +272,13 @@ SEAMCL_INLINE int probes_reach_face(const FaceGpu* face, int level, float u, flo
 /* log2 of a probe count 1..SEAMCL_MAX_PROBES, index N - 1 (see SEAMCL_LOG2_PROBE_COUNTS). */
 __constant float log2_probe_count[SEAMCL_MAX_PROBES] = SEAMCL_LOG2_PROBE_COUNTS;
 
+/* An aniso lookup's probe count N for a footprint's major / minor ratio: its ceiling, at most
+ * SEAMCL_MAX_PROBES and max_aniso, and at least 1 whatever max_aniso is (N indexes
+ * log2_probe_count). Texture and cube lookups alike. */
+SEAMCL_INLINE int probe_count(float ratio, int max_aniso) {
+  return max(min((int)__builtin_ceilf(fmin(ratio, (float)SEAMCL_MAX_PROBES)), max_aniso), 1);
+}
+
 /* The line of trilinear probes an aniso lookup takes, computed once so that the reach test of
  * traverse (probes_reach_face) and the filter read the same values. */
 typedef struct {
@@ -290,8 +297,7 @@ SEAMCL_INLINE AnisoProbes aniso_probes(const FaceGpu* face, float u, float v, Fo
   /* N = min(ceil(major / minor), max_aniso) probes; ratio computed on squares, then sqrt. */
   /* A line footprint takes the most probes; a point footprint one. */
   const float ratio = minor2 > 0.0f ? sqrt(major2 / minor2) : major2 > 0.0f ? (float)max_aniso : 1.0f;
-  /* At least 1 whatever max_aniso is: N indexes log2_probe_count. */
-  p.probes = f.finite ? max(min((int)__builtin_ceilf(fmin(ratio, (float)SEAMCL_MAX_PROBES)), max_aniso), 1) : 1;
+  p.probes = f.finite ? probe_count(ratio, max_aniso) : 1;
   p.weight = 1.0f / (float)p.probes;
   /* Each probe is trilinear at log2(major / N). */
   p.lod = f.finite ? lod_of(major2) - log2_probe_count[p.probes - 1] : (float)(face->level_count - 1);
@@ -767,6 +773,9 @@ SEAMCL_INLINE void aniso_group_lookup(__global const FaceGpu* faces, __global co
     aniso_group_lookup(faces, level_offsets, texels, srgb_to_linear, sampler, lookups, plans, order, first, count, \
                        out, N);                                                                                   \
   }
+#if SEAMCL_MAX_PROBES != 16
+#error "one aniso_group_batch_N kernel per probe count 1..SEAMCL_MAX_PROBES"
+#endif
 SEAMCL_ANISO_GROUP_KERNEL(1)
 SEAMCL_ANISO_GROUP_KERNEL(2)
 SEAMCL_ANISO_GROUP_KERNEL(3)

@@ -59,7 +59,9 @@ TextureLookups::GroupedKernels& TextureLookups::grouped_kernels_for(const Sample
   if (it == grouped_kernels_.end()) {
     const cl::Program& program = runtime_.program(options);
     GroupedKernels k{cl::Kernel(program, "aniso_plan_batch"), {}};
-    for (int n = 1; n <= 16; ++n) k.groups.emplace_back(program, ("aniso_group_batch_" + std::to_string(n)).c_str());
+    for (int n = 1; n <= SEAMCL_MAX_PROBES; ++n) {
+      k.groups.emplace_back(program, ("aniso_group_batch_" + std::to_string(n)).c_str());
+    }
     it = grouped_kernels_.emplace(options, std::move(k)).first;
   }
   return it->second;
@@ -88,15 +90,15 @@ void TextureLookups::run_aniso_grouped(const SamplerParams& sampler) {
   queue.enqueueReadBuffer(probe_counts_, CL_TRUE, 0, count_, counts.data());
   // The lookups ordered by probe count (a counting sort; in order within a count, so that
   // neighbouring work-items keep their locality).
-  std::array<size_t, 18> first{};
-  for (cl_uchar n : counts) ++first[std::clamp<size_t>(n, 1, 16) + 1];
+  std::array<size_t, SEAMCL_MAX_PROBES + 2> first{};
+  for (cl_uchar n : counts) ++first[std::clamp<size_t>(n, 1, SEAMCL_MAX_PROBES) + 1];
   for (size_t n = 1; n < first.size(); ++n) first[n] += first[n - 1];
-  std::array<size_t, 18> next = first;
+  std::array<size_t, SEAMCL_MAX_PROBES + 2> next = first;
   std::vector<cl_uint> order(count_);
-  for (size_t i = 0; i < count_; ++i) order[next[std::clamp<size_t>(counts[i], 1, 16)]++] = static_cast<cl_uint>(i);
+  for (size_t i = 0; i < count_; ++i) order[next[std::clamp<size_t>(counts[i], 1, SEAMCL_MAX_PROBES)]++] = static_cast<cl_uint>(i);
   queue.enqueueWriteBuffer(order_, CL_TRUE, 0, count_ * sizeof(cl_uint), order.data());
   // Pass 2: each count's lookups through its kernel.
-  for (int n = 1; n <= 16; ++n) {
+  for (int n = 1; n <= SEAMCL_MAX_PROBES; ++n) {
     const size_t begin = first[static_cast<size_t>(n)], end = first[static_cast<size_t>(n) + 1];
     if (end == begin) continue;
     cl::Kernel& kernel = k.groups[static_cast<size_t>(n - 1)];

@@ -212,7 +212,7 @@ FilterSum cube_filter_reference(const std::vector<float>& texels, const CubeSamp
     const float ratio = minor2 > 0.0f   ? std::sqrt(major2 / minor2)
                         : major2 > 0.0f ? static_cast<float>(cube.max_aniso)
                                         : 1.0f;
-    probes = std::max(std::min(static_cast<int>(std::ceil(std::fmin(ratio, static_cast<float>(SEAMCL_MAX_PROBES)))), cube.max_aniso), 1);
+    probes = probe_count(ratio, cube.max_aniso);
     lod = lod_of(major2) - log2_probe_count(probes);
     step_u = (x_major ? ax_u : ay_u) / static_cast<float>(probes);
     step_v = (x_major ? ax_v : ay_v) / static_cast<float>(probes);

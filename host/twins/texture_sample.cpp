@@ -130,7 +130,7 @@ AnisoProbes aniso_probes(const FaceGpu& face, float u, float v, const Footprint&
   // A line footprint takes the most probes; a point footprint one.
   const float ratio = minor2 > 0.0f ? std::sqrt(major2 / minor2) : major2 > 0.0f ? static_cast<float>(max_aniso) : 1.0f;
   AnisoProbes p{};
-  p.probes = f.finite ? std::max(std::min(static_cast<int>(std::ceil(std::fmin(ratio, static_cast<float>(SEAMCL_MAX_PROBES)))), max_aniso), 1) : 1;
+  p.probes = f.finite ? probe_count(ratio, max_aniso) : 1;
   p.weight = 1.0f / static_cast<float>(p.probes);
   p.lod = f.finite ? lod_of(major2) - log2_probe_count(p.probes) : static_cast<float>(face.level_count - 1);
   p.step_u = (x_major ? f.ax_u : f.ay_u) * p.weight;
@@ -288,6 +288,11 @@ float log2_probe_count(int probes) {
   static constexpr float kLog2ProbeCounts[SEAMCL_MAX_PROBES] = SEAMCL_LOG2_PROBE_COUNTS;
   assert(probes >= 1 && probes <= SEAMCL_MAX_PROBES);
   return kLog2ProbeCounts[probes - 1];
+}
+
+int probe_count(float ratio, int max_aniso) {
+  const int ceiling = static_cast<int>(std::ceil(std::fmin(ratio, static_cast<float>(SEAMCL_MAX_PROBES))));
+  return std::max(std::min(ceiling, max_aniso), 1);
 }
 
 FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, const SamplerParams& sampler, int address,

@@ -17,6 +17,9 @@ float approx_log2(float x);
 // log2 of an aniso probe count 1..SEAMCL_MAX_PROBES as the kernels read it
 // (SEAMCL_LOG2_PROBE_COUNTS: approx_log2's bits for each count).
 float log2_probe_count(int probes);
+// An aniso lookup's probe count for a footprint's major / minor ratio, as the kernels'
+// probe_count: ceil(ratio), at most SEAMCL_MAX_PROBES and max_aniso, at least 1.
+int probe_count(float ratio, int max_aniso);
 
 FilterSum filter_texture_reference(const TextureView& textures, uint32_t face, const SamplerParams& sampler,
                                    int address, float u, float v, float dudx, float dvdx, float dudy, float dvdy);
