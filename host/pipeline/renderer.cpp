@@ -101,12 +101,12 @@ struct Renderer::Impl {
     // The old packing goes first, so a repack never holds two scenes' textures at once.
     release_scene_buffers();
     packed = pack_scene(*scene, format, guard_band);
-    positions = upload(packed.positions);
-    faces = upload(packed.faces);
-    neighbors = upload(packed.neighbors);
-    level_offsets = upload(packed.level_offsets);
+    positions = upload_shared(packed.positions);
+    faces = upload_shared(packed.faces);
+    neighbors = upload_shared(packed.neighbors);
+    level_offsets = upload_shared(packed.level_offsets);
     texels = format == TexelFormat::Rgba8 ? upload_shared(packed.texels8) : upload_shared(packed.texels32);
-    reflective_faces = upload(packed.reflective_faces);
+    reflective_faces = upload_shared(packed.reflective_faces);
     uploaded = true;
   }
 
@@ -146,7 +146,7 @@ struct Renderer::Impl {
       cube_host = pack_cube_texels(
           bake_cube_map(environment_function(environment), environment.cube_size, *bake, environment.bake_samples));
     }
-    cube_texels = upload(cube_host);
+    cube_texels = upload_shared(cube_host);
     cube_bake_uploaded = bake;
   }
 
@@ -173,10 +173,12 @@ struct Renderer::Impl {
     return buffer;
   }
 
-  // The packed texels, the largest array: on a device that shares the host's memory (PoCL on the
-  // CPU) the buffer is the packed array itself (CL_MEM_USE_HOST_PTR), so the texels are held once
-  // rather than twice (issue 14); `packed` outlives it (release_scene_buffers drops the buffers
-  // first, and renders wait for their commands). Elsewhere a device copy, as upload() makes.
+  // A packed array that stays on the host (every array of `packed`, the cube's texels): on a device
+  // that shares the host's memory (PoCL on the CPU) the buffer is the array itself
+  // (CL_MEM_USE_HOST_PTR), so it is held once rather than twice (issue 14: at 99,037 faces the
+  // adjacency and face records alone were 30 MB a copy); the array outlives the buffer
+  // (release_scene_buffers and upload_cube drop the buffers first, and renders wait for their
+  // commands). Elsewhere a device copy, as upload() makes.
   template <typename T>
   cl::Buffer upload_shared(const std::vector<T>& data) {
     if (data.empty() || runtime.device().getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>() != CL_TRUE) return upload(data);
