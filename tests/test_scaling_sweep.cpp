@@ -134,6 +134,46 @@ TEST(Sweep, JsonHasOnePointPerRateWithEveryMethodTimed) {
   EXPECT_GT(out.at("memory").at("peak_rss_bytes").get<size_t>(), 0u);
 }
 
+// A point with a scene of its own (faces, texels) is timed against the first point rendered in
+// turn with it, not against the first point's own block; points that share a scene (msaa) are not.
+// make_scene ignores the face count here (quad2 for every point), so the faces axis stays cheap.
+TEST(Sweep, OwnScenePointsAreTimedAgainstTheFirstPointRenderedBesideThem) {
+  SweepSettings settings;
+  settings.base.scene = "paper";  // the faces axis is refused on other scenes
+  settings.base.width = 64;
+  settings.base.height = 48;
+  settings.methods = {"discard"};
+  settings.repeats = 3;
+  int scenes_made = 0;
+  settings.make_scene = [&](GeneratorOptions o) {
+    ++scenes_made;
+    o.faces.reset();  // quad2 takes no face count
+    return generate_scene("quad2", o);
+  };
+  const json out = run_scaling_sweeps(seamcl_tests::shared_runtime(), {SweepAxis::Faces, SweepAxis::Msaa}, settings);
+  ASSERT_EQ(out.at("sweeps").size(), 2u);
+  const json& faces = out.at("sweeps")[0];
+  ASSERT_EQ(faces.at("axis"), "faces");
+  EXPECT_EQ(scenes_made, static_cast<int>(faces.at("points").size()) + 1);  // one per point, one for msaa
+  ASSERT_EQ(faces.at("ratios").size(), 1u);  // no point reaches 40x the faces: the last one only
+  const json& ratio = faces.at("ratios")[0];
+  EXPECT_TRUE(ratio.at("from_renders_beside").get<bool>());
+  const double from_ms = ratio.at("from_ms").get<double>();
+  EXPECT_GT(from_ms, 0.0);
+  const json& last = faces.at("points").back().at("results")[0].at("ms");
+  EXPECT_EQ(last.at("frames"), 3);
+  EXPECT_DOUBLE_EQ(ratio.at("time_ratio").get<double>(), last.at("median").get<double>() / from_ms);
+  // The first point keeps its own block's statistics.
+  EXPECT_EQ(faces.at("points")[0].at("results")[0].at("ms").at("frames"), 3);
+
+  const json& msaa = out.at("sweeps")[1];
+  ASSERT_EQ(msaa.at("axis"), "msaa");
+  for (const json& r : msaa.at("ratios")) {
+    EXPECT_FALSE(r.at("from_renders_beside").get<bool>());
+    EXPECT_DOUBLE_EQ(r.at("from_ms").get<double>(), msaa.at("points")[0].at("results")[0].at("ms").at("median").get<double>());
+  }
+}
+
 TEST(PaperScaling, FaceCountIsWithinTwoPercentAndKeepsAboutTheTexels) {
   GeneratorOptions defer;
   defer.defer_textures = true;

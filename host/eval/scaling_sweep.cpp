@@ -170,7 +170,13 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
     };
     // Points that share a scene (pixels, msaa: all of them) are measured together, the repeats
     // interleaved (every point and method once per round), so that the machine's load, which
-    // drifts, falls on all of them alike; a point with a scene of its own (faces, texels) alone.
+    // drifts, falls on all of them alike. A point with a scene of its own (faces, texels) is
+    // measured with the first point's renderer kept loaded beside it, the two rendered in turn, so
+    // that its ratio to the first point is of renders side by side (a slow spell during one point
+    // no longer skews its ratio): paired_first[i][m] holds those renders of the first point.
+    std::unique_ptr<Scene> first_scene;
+    std::unique_ptr<Renderer> first_renderer;
+    std::vector<std::vector<std::vector<double>>> paired_first(points.size(), std::vector<std::vector<double>>(method_count));
     for (size_t begin = 0; begin < points.size();) {
       const auto key_of = [](const SweepPoint& p) { return std::pair{p.faces, p.texture_scale_log2}; };
       size_t end = begin;
@@ -184,7 +190,8 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
         generator.texture_scale_log2 = points[begin].texture_scale_log2;
         scene = std::make_unique<Scene>(settings.make_scene(generator));
       }
-      Renderer renderer(runtime);
+      auto held = std::make_unique<Renderer>(runtime);
+      Renderer& renderer = *held;
       renderer.load_scene(*scene, settings.base.texels);
       for (size_t i = begin; i < end; ++i) {
         for (size_t m = 0; m < method_count; ++m) {
@@ -199,9 +206,13 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
       }
       std::vector<std::vector<std::vector<StageTimes>>> runs(end - begin, std::vector<std::vector<StageTimes>>(method_count));
       std::vector<unsigned> fragments(end - begin, 0);
+      const bool paired = first_renderer != nullptr;
       for (int r = 0; r < settings.repeats; ++r) {
         for (size_t i = begin; i < end; ++i) {
           for (size_t m = 0; m < method_count; ++m) {
+            if (paired) {
+              paired_first[i][m].push_back(first_renderer->render(first_scene->camera, options_of(points[0], m)).ms.total);
+            }
             const RenderResult result = renderer.render(scene->camera, options_of(points[i], m));
             runs[i - begin][m].push_back(result.ms);
             fragments[i - begin] = result.stats.fragments;
@@ -242,8 +253,15 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
                          {"texture_scale_log2", point.texture_scale_log2 ? json(*point.texture_scale_log2) : json(nullptr)},
                          {"results", results}};
       }
+      // The first point's scene and renderer stay for the points after it, when each has its own.
+      if (begin == 0 && end < points.size()) {
+        first_scene = std::move(scene);
+        first_renderer = std::move(held);
+      }
       begin = end;
     }
+    first_renderer.reset();
+    first_scene.reset();
     const json point_list = point_json;
     // Ratios from the first point: to the target's point (the first at or past its x ratio) and
     // to the last.
@@ -262,7 +280,11 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
       if (xs.size() > 1 && (ends.empty() || ends.back() != xs.size() - 1)) ends.push_back(xs.size() - 1);
       for (size_t i : ends) {
         const double x_ratio = xs[i] / xs[0];
-        const double time_ratio = totals[m][i] / totals[m][0];
+        // Against the first point's renders beside this point's where it had its own scene.
+        const std::vector<double>& beside = paired_first[i][m];
+        const double first_median = beside.empty() ? totals[m][0] : median_of(beside);
+        const double first_minimum = beside.empty() ? minima[m][0] : *std::min_element(beside.begin(), beside.end());
+        const double time_ratio = totals[m][i] / first_median;
         const bool has_target = target && std::abs(x_ratio / target->x_ratio - 1.0) < 0.05;
         ratios.push_back({{"method", settings.methods[m]},
                           {"from_x", xs[0]},
@@ -270,7 +292,10 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
                           {"x_ratio", x_ratio},
                           {"time_ratio", time_ratio},
                           // The fastest renders' ratio: the least disturbed by a shared machine.
-                          {"time_ratio_of_minima", minima[m][i] / minima[m][0]},
+                          {"time_ratio_of_minima", minima[m][i] / first_minimum},
+                          // The first point's median over the renders this ratio divides by.
+                          {"from_ms", first_median},
+                          {"from_renders_beside", !beside.empty()},
                           {"max_time_ratio", has_target ? json(target->max_time_ratio) : json(nullptr)},
                           {"met", has_target ? json(time_ratio <= target->max_time_ratio) : json(nullptr)}});
       }

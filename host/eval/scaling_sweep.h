@@ -63,7 +63,11 @@ void validate_sweep(const std::vector<SweepAxis>& axes, const SweepSettings& set
 //               "triangles", "texels", "packed_texel_bytes", "fragments",
 //               "results": [{"method", "ms": {median, min, max, ...}, "stages": {setup, ...}}]}],
 //              "ratios": [{"method", "from_x", "to_x", "x_ratio", "time_ratio" (of the medians),
-//                          "time_ratio_of_minima", "max_time_ratio" (null: no target),
+//                          "time_ratio_of_minima", "from_ms" (the first point's median it divides
+//                          by), "from_renders_beside" (true where the point has a scene of its own,
+//                          faces and texels: the first point re-rendered in turn with it, its
+//                          renderer kept loaded, rather than its own point's median),
+//                          "max_time_ratio" (null: no target),
 //                          "met" (null: no target; judged on the medians)}]}],
 //  "memory": {"peak_rss_bytes"}, "wall_s"}
 nlohmann::json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, const SweepSettings& settings);
