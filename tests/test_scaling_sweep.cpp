@@ -155,14 +155,18 @@ TEST(Sweep, OwnScenePointsAreTimedAgainstTheFirstPointRenderedBesideThem) {
   const json& faces = out.at("sweeps")[0];
   ASSERT_EQ(faces.at("axis"), "faces");
   EXPECT_EQ(scenes_made, static_cast<int>(faces.at("points").size()) + 1);  // one per point, one for msaa
-  ASSERT_EQ(faces.at("ratios").size(), 1u);  // no point reaches 40x the faces: the last one only
+  ASSERT_EQ(faces.at("ratios").size(), 1u);  // every point has quad2's 2 faces: x ratio 1, the last point only
   const json& ratio = faces.at("ratios")[0];
   EXPECT_TRUE(ratio.at("from_renders_beside").get<bool>());
   const double from_ms = ratio.at("from_ms").get<double>();
   EXPECT_GT(from_ms, 0.0);
+  EXPECT_EQ(ratio.at("from_frames"), 3);  // one render of the first point per render of the last
   const json& last = faces.at("points").back().at("results")[0].at("ms");
   EXPECT_EQ(last.at("frames"), 3);
   EXPECT_DOUBLE_EQ(ratio.at("time_ratio").get<double>(), last.at("median").get<double>() / from_ms);
+  // The minima's ratio divides by the paired renders' minimum, which is at most their median.
+  EXPECT_GE(last.at("min").get<double>() / ratio.at("time_ratio_of_minima").get<double>(), 0.0);
+  EXPECT_LE(last.at("min").get<double>() / ratio.at("time_ratio_of_minima").get<double>(), from_ms * (1 + 1e-12));
   // The first point keeps its own block's statistics.
   EXPECT_EQ(faces.at("points")[0].at("results")[0].at("ms").at("frames"), 3);
 
@@ -170,6 +174,7 @@ TEST(Sweep, OwnScenePointsAreTimedAgainstTheFirstPointRenderedBesideThem) {
   ASSERT_EQ(msaa.at("axis"), "msaa");
   for (const json& r : msaa.at("ratios")) {
     EXPECT_FALSE(r.at("from_renders_beside").get<bool>());
+    EXPECT_EQ(r.at("from_frames"), 3);
     EXPECT_DOUBLE_EQ(r.at("from_ms").get<double>(), msaa.at("points")[0].at("results")[0].at("ms").at("median").get<double>());
   }
 }

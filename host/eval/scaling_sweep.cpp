@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/bench_merge.h>
@@ -174,7 +175,7 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
     // measured with the first point's renderer kept loaded beside it, the two rendered in turn, so
     // that its ratio to the first point is of renders side by side (a slow spell during one point
     // no longer skews its ratio): paired_first[i][m] holds those renders of the first point.
-    std::unique_ptr<Scene> first_scene;
+    std::optional<Camera> first_camera;  // the renderer holds its own copy of the scene
     std::unique_ptr<Renderer> first_renderer;
     std::vector<std::vector<std::vector<double>>> paired_first(points.size(), std::vector<std::vector<double>>(method_count));
     for (size_t begin = 0; begin < points.size();) {
@@ -211,7 +212,7 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
         for (size_t i = begin; i < end; ++i) {
           for (size_t m = 0; m < method_count; ++m) {
             if (paired) {
-              paired_first[i][m].push_back(first_renderer->render(first_scene->camera, options_of(points[0], m)).ms.total);
+              paired_first[i][m].push_back(first_renderer->render(*first_camera, options_of(points[0], m)).ms.total);
             }
             const RenderResult result = renderer.render(scene->camera, options_of(points[i], m));
             runs[i - begin][m].push_back(result.ms);
@@ -255,13 +256,12 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
       }
       // The first point's scene and renderer stay for the points after it, when each has its own.
       if (begin == 0 && end < points.size()) {
-        first_scene = std::move(scene);
+        first_camera = scene->camera;
         first_renderer = std::move(held);
       }
       begin = end;
     }
     first_renderer.reset();
-    first_scene.reset();
     const json point_list = point_json;
     // Ratios from the first point: to the target's point (the first at or past its x ratio) and
     // to the last.
@@ -296,6 +296,7 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
                           // The first point's median over the renders this ratio divides by.
                           {"from_ms", first_median},
                           {"from_renders_beside", !beside.empty()},
+                          {"from_frames", beside.empty() ? static_cast<size_t>(settings.repeats) : beside.size()},
                           {"max_time_ratio", has_target ? json(target->max_time_ratio) : json(nullptr)},
                           {"met", has_target ? json(time_ratio <= target->max_time_ratio) : json(nullptr)}});
       }

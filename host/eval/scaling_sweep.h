@@ -67,6 +67,7 @@ void validate_sweep(const std::vector<SweepAxis>& axes, const SweepSettings& set
 //                          by), "from_renders_beside" (true where the point has a scene of its own,
 //                          faces and texels: the first point re-rendered in turn with it, its
 //                          renderer kept loaded, rather than its own point's median),
+//                          "from_frames" (how many renders from_ms is the median of),
 //                          "max_time_ratio" (null: no target),
 //                          "met" (null: no target; judged on the medians)}]}],
 //  "memory": {"peak_rss_bytes"}, "wall_s"}

@@ -148,8 +148,8 @@ struct MeasuredMemory {
   size_t packed_texels = 0;         // stored texels of every level of every face, guard bands included
   size_t packed_texel_bytes = 0;    // their bytes (PackedScene::texture_bytes)
   size_t host_packed_bytes = 0;     // every packed array the Renderer holds (texels, tables, positions, faces)
-  // The Renderer's device buffers (Renderer::device_bytes). On a device sharing host memory the
-  // texel buffer is the packed array itself, so these bytes overlap host_packed_bytes there.
+  // The Renderer's device buffers (Renderer::device_bytes). On a device sharing host memory every
+  // scene buffer is the packed array itself, so these bytes overlap host_packed_bytes there.
   size_t device_bytes = 0;
   size_t scene_float_texel_bytes = 0;     // float RGBA texels the caller's Scene holds (0: deferred)
   size_t renderer_float_texel_bytes = 0;  // the same in the Renderer's copy of the scene

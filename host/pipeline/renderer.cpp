@@ -44,13 +44,15 @@ struct Renderer::Impl {
   cl::Kernel setup_kernel, bin_count_kernel, bin_scan_kernel, bin_fill_kernel, raster_kernel, shade_kernel;
 
   std::unique_ptr<Scene> scene;
+  // Declared before the buffers that may be these arrays themselves (upload_shared), so that they
+  // are destroyed after them.
   PackedScene packed;
+  std::vector<float> cube_host;
   bool uploaded = false;  // packed and its buffers are current (a failed pack leaves neither)
   cl::Buffer positions, faces, neighbors, level_offsets, texels, srgb_table;
   // The environment: reflective faces (with the scene) and the cube map baked for the method.
   cl::Buffer reflective_faces, cube_texels;
   std::optional<CubeBake> cube_bake_uploaded;
-  std::vector<float> cube_host;
 
   // Frame buffers, grown on demand.
   cl::Buffer frame_params, stats, setups, slot_counts, tile_counts, tile_offsets, tile_cursors, tile_lists, tile_entry_rows,
@@ -124,9 +126,21 @@ struct Renderer::Impl {
     tile_lists = tile_entry_rows = cl::Buffer();
   }
 
+  // Waits for queued commands, which may read the shared arrays (upload_shared), before one is
+  // freed: a frame that threw part-way may have left kernels queued.
+  void drain_queue() { runtime.queue().finish(); }
+
+  ~Impl() {
+    try {
+      drain_queue();
+    } catch (...) {  // a failing device cannot be waited for; nothing else to do in a destructor
+    }
+  }
+
   void release_scene_buffers() {
+    drain_queue();
     uploaded = false;
-    // The buffers first: the texel buffer may be the packed array itself (upload_shared).
+    // The buffers first: they may be the packed arrays themselves (upload_shared).
     positions = faces = neighbors = level_offsets = texels = reflective_faces = cube_texels = cl::Buffer();
     packed = PackedScene{};
     cube_bake_uploaded.reset();
@@ -139,6 +153,7 @@ struct Renderer::Impl {
   // without an environment gets a one-element stand-in (the kernels never read it).
   void upload_cube(std::optional<CubeBake> bake) {
     if (cube_texels() != nullptr && cube_bake_uploaded == bake) return;
+    drain_queue();
     cube_texels = cl::Buffer();
     cube_host = {};
     if (bake) {
