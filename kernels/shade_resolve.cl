@@ -125,29 +125,41 @@ SEAMCL_INLINE float3 shade_sky(__constant FrameParams* frame, __global const flo
 }
 #endif
 
-/* Shading a fragment reads its record, its face and the face's level table, each found through
- * the one before: at 99,037 faces every pixel's are new to the cache, and the misses came one
- * after another. So each work-item starts them for the pixels after it in its row, one step of the
- * chain each: the line at offset 64 of pixel x + 3's record (its face, and the planes or part of
- * them: a 112-byte record starts 0, 16, 32 or 48 bytes into a line), pixel x + 2's face (whose
- * record that line brought), pixel x + 1's level table (whose face). PoCL runs a group's
- * work-items in x order. Prefetches change no result; this took 4-7% off this stage's CPU time
- * (paper at 2,474 and 99,037 faces), about 3% at 16x, nothing with traverse. */
+/* Shading a fragment reads its record, its face, the face's level table and then texels, each
+ * found through the one before: at 99,037 faces every pixel's are new to the cache, and the misses
+ * came one after another. So each work-item starts them for the pixels after it in its row, one
+ * step of the chain each: the line at offset 64 of pixel x + 4's record (its face, and the planes
+ * or part of them: a 112-byte record starts 0, 16, 32 or 48 bytes into a line), pixel x + 3's face
+ * (whose record that line brought), pixel x + 2's level table (whose face), and the first line of
+ * each of pixel x + 1's four finest levels (whose table). The lod is not known yet; at 99,037 faces
+ * a face's levels are a few lines each (8x16 texels at level 0), so the lines a lookup reads are
+ * mostly these. PoCL runs a group's work-items in x order. Prefetches change no result; the first
+ * three steps took 4-7% off this stage's CPU time (paper at 2,474 and 99,037 faces), about 3% at
+ * 16x, nothing with traverse; the texel step a further 2-7% at 99,037 faces (eight alternating
+ * runs, median of the pairs 4.6%), nothing measurable on paper, at 16x or with traverse. */
 SEAMCL_INLINE void prefetch_ahead(__constant FrameParams* frame, __global const TriangleSetup* setups,
                                   __global const FaceGpu* faces, __global const uint* level_offsets,
-                                  __global const uint* ids, int x) {
+                                  TEXEL_BUFFER texels, __global const uint* ids, int x) {
   const int samples = frame->sample_count;
+  if (x + 4 < frame->width) {
+    const uint slot = ids[4 * samples];
+    if (slot != SEAMCL_NO_TRIANGLE) SEAMCL_PREFETCH((__global const char*)(setups + slot) + 64);
+  }
   if (x + 3 < frame->width) {
     const uint slot = ids[3 * samples];
-    if (slot != SEAMCL_NO_TRIANGLE) SEAMCL_PREFETCH((__global const char*)(setups + slot) + 64);
+    if (slot != SEAMCL_NO_TRIANGLE) SEAMCL_PREFETCH(faces + setups[slot].face);
   }
   if (x + 2 < frame->width) {
     const uint slot = ids[2 * samples];
-    if (slot != SEAMCL_NO_TRIANGLE) SEAMCL_PREFETCH(faces + setups[slot].face);
+    if (slot != SEAMCL_NO_TRIANGLE) SEAMCL_PREFETCH(level_offsets + faces[setups[slot].face].level_table);
   }
   if (x + 1 < frame->width) {
     const uint slot = ids[samples];
-    if (slot != SEAMCL_NO_TRIANGLE) SEAMCL_PREFETCH(level_offsets + faces[setups[slot].face].level_table);
+    if (slot != SEAMCL_NO_TRIANGLE) {
+      __global const FaceGpu* face = faces + setups[slot].face;
+      const int levels = min(face->level_count, 4);
+      for (int l = 0; l < levels; ++l) SEAMCL_PREFETCH(texels + TEXEL_WORDS * level_offsets[face->level_table + (uint)l]);
+    }
   }
 }
 
@@ -297,7 +309,7 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
     const int samples = frame->sample_count;
     const int row = sample_pattern_row(samples);
     __global const uint* ids = sample_triangle + ((size_t)y * (size_t)frame->width + (size_t)x) * (size_t)samples;
-    prefetch_ahead(frame, setups, faces, level_offsets, ids, x);
+    prefetch_ahead(frame, setups, faces, level_offsets, texels, ids, x);
     const float3 background = (float3)(frame->background[0], frame->background[1], frame->background[2]);
     float3 sum = (float3)(0.0f);
     int uncovered = 0;

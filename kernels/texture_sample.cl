@@ -79,8 +79,10 @@
 
 #if SEAMCL_TEXELS_F32
 #define TEXEL_BUFFER __global const float*
+#define TEXEL_WORDS 4 /* buffer elements per texel */
 #else
 #define TEXEL_BUFFER __global const uint*
+#define TEXEL_WORDS 1
 #endif
 
 typedef struct {
