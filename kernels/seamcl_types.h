@@ -37,7 +37,8 @@ typedef float cl_float;
 #define SEAMCL_SUBPIXEL_ONE 256
 #define SEAMCL_MAX_SAMPLES 16
 #define SEAMCL_CLIP_SLOTS 6          /* a triangle clipped by 5 planes is a fan of at most 6 */
-#define SEAMCL_SETUP_GROUP 64        /* triangle_setup's work-group size (it sums visible slots per group) */
+#define SEAMCL_SETUP_LANES 16        /* triangles per work-item of triangle_setup (vectors) */
+#define SEAMCL_SETUP_GROUP 4         /* triangle_setup's work-group size (it sums visible slots per group) */
 #define SEAMCL_MAX_PROBES 16         /* an aniso lookup's most probes (max_aniso's bound) */
 /* approx_log2(N) for N = 1..SEAMCL_MAX_PROBES probes, the bits its polynomial gives without
  * contraction (kernels and twins alike; Sampler.ProbeCountLog2TableIsTheKernelsPolynomial checks
@@ -233,7 +234,7 @@ typedef struct {
   cl_uint bin_entries;      /* tile-list entries needed (may exceed bin_capacity: then re-run) */
   cl_uint fragments;        /* (pixel, triangle) pairs shaded; samples in SEAMCL_SHADE_SAMPLE */
   cl_uint visible_triangles;/* clip slots that produced a non-empty triangle */
-  cl_uint early_culled;     /* input triangles triangle_setup's early cull stopped (setup_may_be_visible) */
+  cl_uint early_culled;     /* input triangles triangle_setup's early cull stopped */
 } FrameStats;
 
 /* ---- Displacement (kernels/tessellate.cl; host/pipeline/displacement_packing.h) ---- */

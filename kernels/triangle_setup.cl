@@ -1,6 +1,7 @@
-/* Stage 1: triangle setup. One work-item per input triangle t (face t/2; t even: quad corners
- * 0,1,2, t odd: 0,2,3), owning SEAMCL_CLIP_SLOTS TriangleSetup records, slot k at
- * k * input_triangles + t (slot-major, kernels/seamcl_types.h: unclipped triangles' records dense).
+/* Stage 1: triangle setup. One work-item per SEAMCL_SETUP_LANES input triangles t (face t/2; t
+ * even: quad corners 0,1,2, t odd: 0,2,3), side by side in vectors; each triangle owns
+ * SEAMCL_CLIP_SLOTS TriangleSetup records, slot k at k * input_triangles + t (slot-major,
+ * kernels/seamcl_types.h: unclipped triangles' records dense).
  *
  * slot_counts[t]: how many of t's slots were written (0 .. SEAMCL_CLIP_SLOTS; later ones hold
  * stale data and count as empty): 1 or 0 for a triangle that needs no clipping, the size of its
@@ -13,12 +14,10 @@
  * 1/SEAMCL_SUBPIXEL_ONE pixel; cull back faces (front = counter-clockwise in NDC, y up), zero
  * area and triangles whose bounding box holds no sample position of the frame's pattern; build
  * edge functions with the top-left rule and perspective-correct attribute planes.
- * An early cull (setup_may_be_visible: back faces, zero area, boxes past an image side, for
- * triangles inside all planes; triangles wholly outside one plane) runs first for every triangle,
- * in a work-item loop of its own;
- * the full setup runs only for the others, with the same result as without the early cull: a
- * survivor inside all planes takes its snapped vertices and 1/w from the cull (SnappedTriangle,
- * the same float steps) into setup_snapped_triangle, so the transform and snapping run once.
+ * An early cull (back faces, zero area, boxes past an image side, for triangles inside all
+ * planes; triangles wholly outside one plane) and the whole setup of triangles inside all planes
+ * (the common case) run on the vectors, with the same steps as the scalar setup_snapped_triangle;
+ * only triangles that cross a plane take the scalar clip_and_setup, one by one.
  * stats->early_culled counts the triangles the early cull stopped (its twin:
  * early_culled_reference), stats->visible_triangles the visible slots.
  * A new vertex on an edge is always computed from the edge's inside end, so two triangles that
@@ -145,8 +144,8 @@ SEAMCL_INLINE void setup_plane(__global float* plane, float a0, float a1, float 
 
 /* Setup of one screen triangle from its snapped vertices (X, Y in 1/SEAMCL_SUBPIXEL_ONE pixels),
  * their 1/w and uv, written to *out field by field; returns whether it is visible. A culled one
- * writes the empty record if write_empty, else nothing. The early cull's survivors come here with
- * the vertices it snapped; setup_screen_triangle snaps clipped ones the same way. Scalars and
+ * writes the empty record if write_empty, else nothing. setup_screen_triangle snaps clipped
+ * triangles and comes here; triangle_setup's vectors take the same steps for the others. Scalars and
  * direct stores only: PoCL keeps a private array or struct that lives in a work-item loop in
  * memory, and narrow stores read back by wider loads stalled (a vertex swap through private
  * arrays, then the record copied whole from a private struct: 24% and 43% of this stage's
@@ -290,74 +289,84 @@ SEAMCL_INLINE uint setup_input_triangle(__constant FrameParams* frame, __global 
   return visible;
 }
 
-/* What the early cull learns of a triangle, for the full setup of a survivor that needs no
- * clipping: its snapped vertices (valid where inside) and their 1/w. */
-typedef struct {
-  int inside; /* all three vertices inside the near plane and the guard band */
-  int X0, Y0, X1, Y1, X2, Y2;
-  float inv_w0, inv_w1, inv_w2;
-} SnappedTriangle;
+/* The early cull and the setup of triangles that need no clipping, SEAMCL_SETUP_LANES triangles
+ * side by side in vectors (lane i: input triangle t0 + i). Written with vectors because PoCL's
+ * work-item loop left this stage scalar: LLVM's SLP pass paired the x and y of each vertex into
+ * 2-wide vectors, which the loop vectoriser cannot widen, and the sample test is a loop of its
+ * own. Every lane takes the scalar path's steps in the same order (setup_snapped_triangle,
+ * box_holds_sample; floor_div_subpixel is an arithmetic shift for the power-of-two
+ * SEAMCL_SUBPIXEL_ONE), so the records are those of the twin bit for bit. */
+#if SEAMCL_SETUP_LANES != 16
+#error "SETUP_LANES_OF lists 16 lanes"
+#endif
+#if SEAMCL_SUBPIXEL_ONE != (1 << SEAMCL_SUBPIXEL_BITS)
+#error "the vector setup divides by SEAMCL_SUBPIXEL_ONE with a shift"
+#endif
+#define SETUP_LANES_OF(F) (F(0), F(1), F(2), F(3), F(4), F(5), F(6), F(7), F(8), F(9), F(10), F(11), F(12), F(13), F(14), F(15))
 
-/* Snapped screen position (1/SEAMCL_SUBPIXEL_ONE pixels) of a world position, for the early cull;
- * *inside &= whether it lies inside the near plane and the guard band. The clip transform, the five
- * plane tests (clip_distance's, spelled out, without its switch) and the
- * rounding are those of setup_input_triangle and setup_screen_triangle, so the early cull sees the
- * vertices setup snaps. Outside the planes (or NaN) the position is 0 and unused. p: x, y, z (read as
- * floats). */
-SEAMCL_INLINE void cull_vertex(__constant FrameParams* frame, __global const float* p, int* inside,
-                               int* outside_all, int* X, int* Y, float* inv_w_out) {
+/* One vertex of every lane: snapped screen position (1/SEAMCL_SUBPIXEL_ONE pixels; 0 where the
+ * vertex lies outside the near plane or the guard band, or is NaN) and 1/w; *inside &= lies inside
+ * all five planes (mask), *outside_all &= bit k set where it lies outside plane k (clip_distance
+ * < 0, clip_and_setup's test: NaN is not outside). The transform and snapping are those of
+ * setup_input_triangle and setup_screen_triangle. */
+SEAMCL_INLINE void cull_vertices(__constant FrameParams* frame, float16 px, float16 py, float16 pz, int16* inside,
+                                 int16* outside_all, int16* X, int16* Y, float16* inv_w_out) {
   const __constant float* m = frame->view_proj;
-  const float x = m[0] * p[0] + m[4] * p[1] + m[8] * p[2] + m[12];
-  const float y = m[1] * p[0] + m[5] * p[1] + m[9] * p[2] + m[13];
-  const float w = m[3] * p[0] + m[7] * p[1] + m[11] * p[2] + m[15];
-  const int in = (w - frame->near_w >= 0.0f) & (frame->guard_x * w - x >= 0.0f) & (frame->guard_x * w + x >= 0.0f) &
-                 (frame->guard_y * w - y >= 0.0f) & (frame->guard_y * w + y >= 0.0f);
+  /* column-major: clip = M * (p, 1) */
+  const float16 x = m[0] * px + m[4] * py + m[8] * pz + m[12];
+  const float16 y = m[1] * px + m[5] * py + m[9] * pz + m[13];
+  const float16 w = m[3] * px + m[7] * py + m[11] * pz + m[15];
+  const int16 in = (w - frame->near_w >= 0.0f) & (frame->guard_x * w - x >= 0.0f) & (frame->guard_x * w + x >= 0.0f) &
+                   (frame->guard_y * w - y >= 0.0f) & (frame->guard_y * w + y >= 0.0f);
   *inside &= in;
-  /* Bit k: outside plane k (clip_distance < 0, clip_and_setup's test; NaN is not outside). */
-  *outside_all &= (w - frame->near_w < 0.0f) | (frame->guard_x * w - x < 0.0f) << 1 |
-                  (frame->guard_x * w + x < 0.0f) << 2 | (frame->guard_y * w - y < 0.0f) << 3 |
-                  (frame->guard_y * w + y < 0.0f) << 4;
-  const float inv_w = 1.0f / w;
-  /* rint, as setup rounds (the builtin: no library call). Inside the guard band the
-   * snapped coordinates lie in [-W, 2W] pixels: 25 bits. */
-  *X = in ? (int)__builtin_rintf(subpixel_x(x, inv_w, frame)) : 0;
-  *Y = in ? (int)__builtin_rintf(subpixel_y(y, inv_w, frame)) : 0;
+  *outside_all &= ((w - frame->near_w < 0.0f) & 1) | ((frame->guard_x * w - x < 0.0f) & 2) |
+                  ((frame->guard_x * w + x < 0.0f) & 4) | ((frame->guard_y * w - y < 0.0f) & 8) |
+                  ((frame->guard_y * w + y < 0.0f) & 16);
+  const float16 inv_w = 1.0f / w;
+  /* subpixel_x and subpixel_y, lane by lane. Inside the guard band the snapped coordinates lie in
+   * [-W, 2W] pixels: 25 bits. */
+  const float16 sx = ((x * inv_w * 0.5f + 0.5f) * (float)frame->width) * (float)SEAMCL_SUBPIXEL_ONE;
+  const float16 sy = ((0.5f - y * inv_w * 0.5f) * (float)frame->height) * (float)SEAMCL_SUBPIXEL_ONE;
+  *X = select((int16)(0), convert_int16(rint(sx)), in);
+  *Y = select((int16)(0), convert_int16(rint(sy)), in);
   *inv_w_out = inv_w;
 }
 
-/* Whether input triangle t may leave a visible slot: 0 only where setup_input_triangle would cull
- * it whole: for triangles that need no clipping (the common case), a back face or zero area (the
- * same snapped vertices and area sign as setup_screen_triangle), or a bounding box past an image
- * side, where no sample lies; for the others, all three vertices outside one clip plane. Others
- * return 1 and the full setup decides.
- * Straight-line code over a few loads: on paper at 99,037 faces a setup that stops here for every
- * triangle took under 1 ms for 198,074 triangles (PoCL does not vectorise it: a few
- * scalar operations per vertex). *v receives the snapped vertices, their 1/w and whether all three
- * lie inside the planes, for the full setup. */
-SEAMCL_INLINE int setup_may_be_visible(__constant FrameParams* frame, __global const float4* positions,
-                                       __global const FaceGpu* faces, int t, SnappedTriangle* v) {
-  __global const FaceGpu* face = faces + t / 2;
-  const int odd = t & 1;
-  int inside = 1, outside_all = 31;
-  int X0, Y0, X1, Y1, X2, Y2;
-  __global const float* xyzw = (__global const float*)positions;
-  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[0], &inside, &outside_all, &X0, &Y0, &v->inv_w0);
-  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[odd ? 2 : 1], &inside, &outside_all, &X1, &Y1, &v->inv_w1);
-  cull_vertex(frame, xyzw + 4 * (size_t)face->vertex[odd ? 3 : 2], &inside, &outside_all, &X2, &Y2, &v->inv_w2);
-  v->X0 = X0; v->Y0 = Y0; v->X1 = X1; v->Y1 = Y1; v->X2 = X2; v->Y2 = Y2;
-  v->inside = inside;
-  const long area2 = (long)(X1 - X0) * (long)(Y2 - Y0) - (long)(Y1 - Y0) * (long)(X2 - X0);
-  /* Samples of pixel p lie in [p*ONE, p*ONE + ONE - 16]. */
-  const int last_x = (frame->width - 1) * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE - 16;
-  const int last_y = (frame->height - 1) * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE - 16;
-  const int off_image = (X0 < 0 && X1 < 0 && X2 < 0) | (Y0 < 0 && Y1 < 0 && Y2 < 0) |
-                        (X0 > last_x && X1 > last_x && X2 > last_x) | (Y0 > last_y && Y1 > last_y && Y2 > last_y);
-  /* Clipped triangles go to the full setup, unless all three vertices lie outside one plane:
-   * then clipping leaves nothing (the near plane is clipped first, so its test is exact; a guard
-   * plane's clipped vertices could only round back onto the plane, an image width or height
-   * beyond the image, where no sample lies). */
-  if (!inside) return outside_all == 0;
-  return area2 < 0 && !off_image;
+/* box_holds_sample for every lane, with int arithmetic (the boxes of snapped vertices inside the
+ * guard band fit 27 bits). */
+SEAMCL_INLINE int16 boxes_hold_sample(int16 min_x, int16 max_x, int16 min_y, int16 max_y, __constant FrameParams* frame) {
+  const int row = sample_pattern_row(frame->sample_count);
+  int16 found = (int16)(0);
+  for (int s = 0; s < frame->sample_count; ++s) {
+    const int centre_x = SEAMCL_SUBPIXEL_ONE / 2 + sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16);
+    const int centre_y = SEAMCL_SUBPIXEL_ONE / 2 + sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
+    const int16 first_x = max(-((centre_x - min_x) >> SEAMCL_SUBPIXEL_BITS), 0);
+    const int16 last_x = min((max_x - centre_x) >> SEAMCL_SUBPIXEL_BITS, frame->width - 1);
+    const int16 first_y = max(-((centre_y - min_y) >> SEAMCL_SUBPIXEL_BITS), 0);
+    const int16 last_y = min((max_y - centre_y) >> SEAMCL_SUBPIXEL_BITS, frame->height - 1);
+    found |= (first_x <= last_x) & (first_y <= last_y);
+  }
+  return found;
+}
+
+/* Edge function from vertex (Xi, Yi) to (Xj, Yj) for every lane, the top-left rule folded in
+ * (setup_edge). */
+SEAMCL_INLINE void edges_of(int16 Xi, int16 Yi, int16 Xj, int16 Yj, int16* a, int16* b, long16* c) {
+  *a = Yi - Yj;
+  *b = Xj - Xi;
+  const int16 top_left = (*a > 0) | ((*a == 0) & (*b > 0));
+  *c = -(convert_long16(*a) * convert_long16(Xi) + convert_long16(*b) * convert_long16(Yi)) -
+       convert_long16(select((int16)(1), (int16)(0), top_left));
+}
+
+/* setup_plane for every lane. */
+SEAMCL_INLINE void planes_of(float16 a0, float16 a1, float16 a2, float16 dx1, float16 dy1, float16 dx2, float16 dy2,
+                             float16 inv_det, float16* p0, float16* p1, float16* p2) {
+  const float16 d1 = a1 - a0;
+  const float16 d2 = a2 - a0;
+  *p0 = a0;
+  *p1 = (d1 * dy2 - d2 * dy1) * inv_det;
+  *p2 = (d2 * dx1 - d1 * dx2) * inv_det;
 }
 
 __kernel __attribute__((reqd_work_group_size(SEAMCL_SETUP_GROUP, 1, 1)))
@@ -368,46 +377,165 @@ void triangle_setup(__constant FrameParams* frame, __global const float4* positi
    * stage. */
   __local uint group_visible[SEAMCL_SETUP_GROUP];
   __local uint group_early_culled[SEAMCL_SETUP_GROUP];
-  const int t = (int)get_global_id(0);
-  const int in_range = t < frame->input_triangles;
-  /* The early cull runs in a work-item loop of its own (PoCL splits the loop at a barrier); the
-   * full setup, branchy and longer, then runs for the survivors only (about half
-   * of a closed mesh's triangles are back faces). */
-  SnappedTriangle snapped = {0, 0, 0, 0, 0, 0, 0, 0.0f, 0.0f, 0.0f};
-  const int may_be_visible = in_range && setup_may_be_visible(frame, positions, faces, t, &snapped);
-  group_early_culled[get_local_id(0)] = in_range && !may_be_visible;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  uint visible = 0;
-  /* Two of the (up to three) record lines of the triangle 8 ahead, to be written; neighbouring
-   * work-items cover the rest. The record stores missed the cache (a 22 MB array at 99,037
-   * faces), and this stage took 675-1,093 samples from one run to the next; with the prefetch
-   * 677-691. */
-  if (t + 8 < frame->input_triangles) {
-    SEAMCL_PREFETCH_WRITE(out + t + 8);
-    SEAMCL_PREFETCH_WRITE((__global const char*)(out + t + 8) + 64);
+  const int triangles = frame->input_triangles; /* > 0: the host runs no setup without triangles */
+  const int t0 = (int)get_global_id(0) * SEAMCL_SETUP_LANES;
+  const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const int16 t = t0 + lane;
+  const int16 in_range = t < triangles;
+  /* Lanes past the last triangle read the last one and count for nothing. */
+  const int16 read_t = min(t, triangles - 1);
+  const int16 odd = read_t & 1;
+  const int16 face = read_t >> 1;
+#define SETUP_VERTEX0(i) faces[face[i]].vertex[0]
+#define SETUP_VERTEX1(i) faces[face[i]].vertex[odd[i] ? 2 : 1]
+#define SETUP_VERTEX2(i) faces[face[i]].vertex[odd[i] ? 3 : 2]
+  const uint16 vertex0 = (uint16)SETUP_LANES_OF(SETUP_VERTEX0);
+  const uint16 vertex1 = (uint16)SETUP_LANES_OF(SETUP_VERTEX1);
+  const uint16 vertex2 = (uint16)SETUP_LANES_OF(SETUP_VERTEX2);
+#undef SETUP_VERTEX0
+#undef SETUP_VERTEX1
+#undef SETUP_VERTEX2
+  /* The face records two work-items ahead (8 faces, 384 bytes), and the record lines this
+   * work-item may write. */
+  {
+    __global const char* ahead = (__global const char*)(faces + (t0 + 2 * SEAMCL_SETUP_LANES) / 2);
+    if (t0 + 3 * SEAMCL_SETUP_LANES <= triangles) {
+      for (int k = 0; k < 6; ++k) SEAMCL_PREFETCH(ahead + 64 * k);
+    }
+    __global const char* records = (__global const char*)(out + t0);
+    if (t0 + SEAMCL_SETUP_LANES <= triangles) {
+      for (int k = 0; k < 28; ++k) SEAMCL_PREFETCH_WRITE(records + 64 * k);
+    }
   }
-  if (may_be_visible && snapped.inside) {
-    /* setup_input_triangle's path for triangles inside all planes, from the cull's snapped
-     * vertices (corner uv: t even takes corners 0, 1, 2, odd 0, 2, 3). */
-    const int odd = t & 1;
-    visible = (uint)setup_snapped_triangle(out + t /* slot 0 */, 0, snapped.X0, snapped.Y0, snapped.X1, snapped.Y1,
-                                           snapped.X2, snapped.Y2, snapped.inv_w0, snapped.inv_w1, snapped.inv_w2, 0.0f,
-                                           0.0f, 1.0f, odd ? 1.0f : 0.0f, odd ? 0.0f : 1.0f, 1.0f, (uint)(t / 2), frame);
-    slot_counts[t] = visible;
-  } else if (may_be_visible) {
-    visible = setup_input_triangle(frame, positions, faces, out, slot_counts, t);
-  } else if (in_range) {
-    slot_counts[t] = 0;
+  __global const float* xyzw = (__global const float*)positions;
+  int16 inside = (int16)(-1), outside_all = (int16)(31);
+  int16 X0, Y0, X1, Y1, X2, Y2;
+  float16 inv_w0, inv_w1, inv_w2;
+#define SETUP_COORDINATE(v, k) (float16)SETUP_LANES_OF(SETUP_COORDINATE_##k##_OF_##v)
+#define SETUP_COORDINATE_0_OF_0(i) xyzw[4 * (size_t)vertex0[i]]
+#define SETUP_COORDINATE_1_OF_0(i) xyzw[4 * (size_t)vertex0[i] + 1]
+#define SETUP_COORDINATE_2_OF_0(i) xyzw[4 * (size_t)vertex0[i] + 2]
+#define SETUP_COORDINATE_0_OF_1(i) xyzw[4 * (size_t)vertex1[i]]
+#define SETUP_COORDINATE_1_OF_1(i) xyzw[4 * (size_t)vertex1[i] + 1]
+#define SETUP_COORDINATE_2_OF_1(i) xyzw[4 * (size_t)vertex1[i] + 2]
+#define SETUP_COORDINATE_0_OF_2(i) xyzw[4 * (size_t)vertex2[i]]
+#define SETUP_COORDINATE_1_OF_2(i) xyzw[4 * (size_t)vertex2[i] + 1]
+#define SETUP_COORDINATE_2_OF_2(i) xyzw[4 * (size_t)vertex2[i] + 2]
+  cull_vertices(frame, SETUP_COORDINATE(0, 0), SETUP_COORDINATE(0, 1), SETUP_COORDINATE(0, 2), &inside, &outside_all,
+                &X0, &Y0, &inv_w0);
+  cull_vertices(frame, SETUP_COORDINATE(1, 0), SETUP_COORDINATE(1, 1), SETUP_COORDINATE(1, 2), &inside, &outside_all,
+                &X1, &Y1, &inv_w1);
+  cull_vertices(frame, SETUP_COORDINATE(2, 0), SETUP_COORDINATE(2, 1), SETUP_COORDINATE(2, 2), &inside, &outside_all,
+                &X2, &Y2, &inv_w2);
+#undef SETUP_COORDINATE
+#undef SETUP_COORDINATE_0_OF_0
+#undef SETUP_COORDINATE_1_OF_0
+#undef SETUP_COORDINATE_2_OF_0
+#undef SETUP_COORDINATE_0_OF_1
+#undef SETUP_COORDINATE_1_OF_1
+#undef SETUP_COORDINATE_2_OF_1
+#undef SETUP_COORDINATE_0_OF_2
+#undef SETUP_COORDINATE_1_OF_2
+#undef SETUP_COORDINATE_2_OF_2
+  /* The early cull (the twin's early_culled_reference): for triangles inside all planes, a back
+   * face or zero area (the snapped vertices' area sign) or a bounding box past an image side, where
+   * no sample lies; for the others, all three vertices outside one plane (the near plane is
+   * clipped first, so its test is exact; a guard plane's clipped vertices could only round back
+   * onto the plane, an image width or height beyond the image). Survivors outside a plane take
+   * the scalar clipping path below. */
+  const long16 area2 = convert_long16(X1 - X0) * convert_long16(Y2 - Y0) - convert_long16(Y1 - Y0) * convert_long16(X2 - X0);
+  const int16 back_or_flat = convert_int16(area2 >= (long16)(0));
+  /* Samples of pixel p lie in [p*ONE, p*ONE + ONE - 16]. */
+  const int last_x = (frame->width - 1) * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE - 16;
+  const int last_y = (frame->height - 1) * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE - 16;
+  const int16 off_image = ((X0 < 0) & (X1 < 0) & (X2 < 0)) | ((Y0 < 0) & (Y1 < 0) & (Y2 < 0)) |
+                          ((X0 > last_x) & (X1 > last_x) & (X2 > last_x)) | ((Y0 > last_y) & (Y1 > last_y) & (Y2 > last_y));
+  const int16 may_be_visible = in_range & select(outside_all == 0, ~back_or_flat & ~off_image, inside);
+  const int16 clipped = may_be_visible & ~inside;
+
+  /* setup_snapped_triangle for the lanes inside all planes: vertices 0, 2, 1 in turn (a, b, c)
+   * make the interior positive for all three edge functions. */
+  const int16 min_x = min(min(X0, X2), X1), max_x = max(max(X0, X2), X1);
+  const int16 min_y = min(min(Y0, Y2), Y1), max_y = max(max(Y0, Y2), Y1);
+  const int16 visible = may_be_visible & inside & ~back_or_flat & boxes_hold_sample(min_x, max_x, min_y, max_y, frame);
+  int16 edge_a0, edge_a1, edge_a2, edge_b0, edge_b1, edge_b2;
+  long16 edge_c0, edge_c1, edge_c2;
+  edges_of(X0, Y0, X2, Y2, &edge_a0, &edge_b0, &edge_c0);
+  edges_of(X2, Y2, X1, Y1, &edge_a1, &edge_b1, &edge_c1);
+  edges_of(X1, Y1, X0, Y0, &edge_a2, &edge_b2, &edge_c2);
+  /* Samples of pixel p lie in [p*ONE, p*ONE + ONE - 16] (D3D offsets are -8..7 sixteenths). */
+  const int sample_span = SEAMCL_SUBPIXEL_ONE - 16;
+  const int16 bbox_min_x = max((min_x - sample_span + SEAMCL_SUBPIXEL_ONE - 1) >> SEAMCL_SUBPIXEL_BITS, 0);
+  const int16 bbox_min_y = max((min_y - sample_span + SEAMCL_SUBPIXEL_ONE - 1) >> SEAMCL_SUBPIXEL_BITS, 0);
+  const int16 bbox_max_x = min(max_x >> SEAMCL_SUBPIXEL_BITS, frame->width - 1);
+  const int16 bbox_max_y = min(max_y >> SEAMCL_SUBPIXEL_BITS, frame->height - 1);
+  /* Attribute planes over the snapped positions, relative to vertex a for precision. */
+  const float scale = 1.0f / (float)SEAMCL_SUBPIXEL_ONE;
+  const float16 dx1 = convert_float16(X2 - X0) * scale, dy1 = convert_float16(Y2 - Y0) * scale;
+  const float16 dx2 = convert_float16(X1 - X0) * scale, dy2 = convert_float16(Y1 - Y0) * scale;
+  const float16 inv_det = 1.0f / (convert_float16(-area2) * scale * scale);
+  const float16 ref_x = convert_float16(X0) * scale, ref_y = convert_float16(Y0) * scale;
+  /* Corner uv: t even takes corners 0, 1, 2 ((0,0), (1,0), (1,1)), odd 0, 2, 3 ((0,0), (1,1), (0,1)). */
+  const float16 u0 = (float16)(0.0f), v0 = (float16)(0.0f), u1 = (float16)(1.0f);
+  const float16 v1 = select((float16)(0.0f), (float16)(1.0f), odd != 0);
+  const float16 u2 = select((float16)(1.0f), (float16)(0.0f), odd != 0), v2 = (float16)(1.0f);
+  float16 w_p0, w_p1, w_p2, u_p0, u_p1, u_p2, v_p0, v_p1, v_p2;
+  planes_of(inv_w0, inv_w2, inv_w1, dx1, dy1, dx2, dy2, inv_det, &w_p0, &w_p1, &w_p2);
+  planes_of(u0 * inv_w0, u2 * inv_w2, u1 * inv_w1, dx1, dy1, dx2, dy2, inv_det, &u_p0, &u_p1, &u_p2);
+  planes_of(v0 * inv_w0, v2 * inv_w2, v1 * inv_w1, dx1, dy1, dx2, dy2, inv_det, &v_p0, &v_p1, &v_p2);
+
+  /* Only a visible triangle's record is written (slot 0); storing the empty slots was most of this
+   * stage's time (6 records of 112 bytes per triangle): binning reads no more than slot_counts[t]. */
+  uint visible_slots = 0;
+#pragma unroll
+  for (int i = 0; i < SEAMCL_SETUP_LANES; ++i) {
+    if (in_range[i] && !clipped[i]) slot_counts[t[i]] = visible[i] ? 1u : 0u;
+    if (!visible[i]) continue;
+    ++visible_slots;
+    __global TriangleSetup* r = out + t[i]; /* slot 0 */
+    r->edge_c[0] = edge_c0[i];
+    r->edge_c[1] = edge_c1[i];
+    r->edge_c[2] = edge_c2[i];
+    r->edge_a[0] = edge_a0[i];
+    r->edge_a[1] = edge_a1[i];
+    r->edge_a[2] = edge_a2[i];
+    r->edge_b[0] = edge_b0[i];
+    r->edge_b[1] = edge_b1[i];
+    r->edge_b[2] = edge_b2[i];
+    r->bbox_min_x = bbox_min_x[i];
+    r->bbox_min_y = bbox_min_y[i];
+    r->bbox_max_x = bbox_max_x[i];
+    r->bbox_max_y = bbox_max_y[i];
+    r->face = (uint)face[i];
+    r->ref_x = ref_x[i];
+    r->ref_y = ref_y[i];
+    r->inv_w[0] = w_p0[i];
+    r->inv_w[1] = w_p1[i];
+    r->inv_w[2] = w_p2[i];
+    r->u_over_w[0] = u_p0[i];
+    r->u_over_w[1] = u_p1[i];
+    r->u_over_w[2] = u_p2[i];
+    r->v_over_w[0] = v_p0[i];
+    r->v_over_w[1] = v_p1[i];
+    r->v_over_w[2] = v_p2[i];
   }
-  group_visible[get_local_id(0)] = visible;
+  /* Triangles that cross a plane (few): clipped one by one, only the fan's slots written. */
+  for (int i = 0; i < SEAMCL_SETUP_LANES; ++i) {
+    if (clipped[i]) visible_slots += setup_input_triangle(frame, positions, faces, out, slot_counts, t[i]);
+  }
+  const int16 early_culled = in_range & ~may_be_visible;
+  uint culled = 0;
+  for (int i = 0; i < SEAMCL_SETUP_LANES; ++i) culled += early_culled[i] ? 1u : 0u;
+  group_visible[get_local_id(0)] = visible_slots;
+  group_early_culled[get_local_id(0)] = culled;
   barrier(CLK_LOCAL_MEM_FENCE);
   if (get_local_id(0) == 0) {
-    uint sum = 0, culled = 0;
+    uint sum = 0, culled_sum = 0;
     for (int i = 0; i < SEAMCL_SETUP_GROUP; ++i) {
       sum += group_visible[i];
-      culled += group_early_culled[i];
+      culled_sum += group_early_culled[i];
     }
     if (sum > 0) atomic_add(&stats->visible_triangles, sum);
-    if (culled > 0) atomic_add(&stats->early_culled, culled);
+    if (culled_sum > 0) atomic_add(&stats->early_culled, culled_sum);
   }
 }

@@ -288,7 +288,7 @@ TEST(KernelVsTwin, SetupCullsOnlyTrianglesThatCoverNoSample) {
 
 TEST(KernelVsTwin, EarlyCullKeepsEveryTriangleTheFullSetupKeeps) {
   // triangle_setup.cl culls back faces, zero-area triangles, boxes past an image side and
-  // triangles wholly outside one clip plane before the full setup (setup_may_be_visible), and
+  // triangles wholly outside one clip plane before the full setup (its early cull), and
   // writes only a clipped triangle's fan, which the twin does not: every slot must still be the
   // twin's. Scenes where it matters: the paper scene subdivided (half its triangles face away),
   // zoomed in so that the image sides cut through its triangles inside the guard band (boxes just

@@ -260,7 +260,8 @@ struct Renderer::Impl {
       setup_kernel.setArg(3, setups);
       setup_kernel.setArg(4, slot_counts);
       setup_kernel.setArg(5, stats);
-      queue.enqueueNDRangeKernel(setup_kernel, cl::NullRange, cl::NDRange(round_up(input_triangles, SEAMCL_SETUP_GROUP)),
+      const size_t setup_items = (input_triangles + SEAMCL_SETUP_LANES - 1) / SEAMCL_SETUP_LANES;
+      queue.enqueueNDRangeKernel(setup_kernel, cl::NullRange, cl::NDRange(round_up(setup_items, SEAMCL_SETUP_GROUP)),
                                  cl::NDRange(SEAMCL_SETUP_GROUP), nullptr, next(ev.setup));
     }
     const size_t tiles = static_cast<size_t>(p.tiles_x) * p.tiles_y;

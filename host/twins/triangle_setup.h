@@ -17,7 +17,7 @@ namespace seamcl {
 std::vector<TriangleSetup> setup_triangles_reference(const PackedScene& scene, const FrameParams& frame,
                                                      bool cull_sampleless = true);
 
-// How many input triangles triangle_setup.cl's early cull (setup_may_be_visible) stops before the
+// How many input triangles triangle_setup.cl's early cull stops before the
 // full setup, by rule. FrameStats.early_culled must equal their total.
 struct EarlyCullCounts {
   size_t unclipped = 0;        // inside the near plane and the guard band, whose snapped vertices
