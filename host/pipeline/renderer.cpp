@@ -28,9 +28,27 @@ std::vector<T> read_buffer(cl::CommandQueue& queue, const cl::Buffer& buffer, si
 
 // Fixed local sizes: PoCL compiles a kernel once per local size, so a size that never changes is
 // compiled once (at warm-up) instead of once per new image or scene size.
-constexpr size_t kLinearGroup = 64;
 
 size_t round_up(size_t value, size_t multiple) { return (value + multiple - 1) / multiple * multiple; }
+
+// Binning's chunks (kernels/binning.cl): runs of about kBinChunkTriangles input triangles, each
+// counted by one work-item into counters of its own. At most kMaxBinChunks, and at most
+// kMaxBinCounters counters in all (chunks x tiles), which bin_scan walks one by one.
+constexpr size_t kBinChunkTriangles = 1024;
+constexpr size_t kMaxBinChunks = 64;
+constexpr size_t kMaxBinCounters = size_t{1} << 18;
+
+struct BinChunks {
+  size_t chunks = 0;           // 0 when there are no input triangles
+  size_t chunk_triangles = 0;  // triangles per chunk, the last one's fewer
+};
+
+BinChunks bin_chunks(size_t input_triangles, size_t tiles) {
+  if (input_triangles == 0) return {};
+  size_t chunks = std::min((input_triangles + kBinChunkTriangles - 1) / kBinChunkTriangles, kMaxBinChunks);
+  chunks = std::max<size_t>(std::min(chunks, kMaxBinCounters / std::max<size_t>(tiles, 1)), 1);
+  return {chunks, (input_triangles + chunks - 1) / chunks};
+}
 
 }  // namespace
 
@@ -55,10 +73,11 @@ struct Renderer::Impl {
   std::optional<CubeBake> cube_bake_uploaded;
 
   // Frame buffers, grown on demand.
-  cl::Buffer frame_params, stats, setups, slot_counts, tile_counts, tile_offsets, tile_cursors, tile_lists, tile_entry_rows,
+  cl::Buffer frame_params, stats, setups, slot_counts, tile_counts, tile_offsets, chunk_counts, tile_lists, tile_entry_rows,
       sample_triangle, image;
   cl::Buffer seam_mask;  // only once a render asks for the mask
-  size_t setups_capacity = 0, slot_counts_capacity = 0, tiles_capacity = 0, samples_capacity = 0, pixels_capacity = 0, mask_capacity = 0;
+  size_t setups_capacity = 0, slot_counts_capacity = 0, tiles_capacity = 0, chunk_counts_capacity = 0, samples_capacity = 0,
+         pixels_capacity = 0, mask_capacity = 0;
   uint32_t bin_capacity = 0;         // tile-list entries the next frame asks for
   uint32_t tile_lists_capacity = 0;  // entries allocated
   FrameParams last_params{};
@@ -166,9 +185,9 @@ struct Renderer::Impl {
   }
 
   void release_frame_buffers() {
-    setups = slot_counts = tile_counts = tile_offsets = tile_cursors = tile_lists = tile_entry_rows = sample_triangle = image =
+    setups = slot_counts = tile_counts = tile_offsets = chunk_counts = tile_lists = tile_entry_rows = sample_triangle = image =
         seam_mask = cl::Buffer();
-    setups_capacity = slot_counts_capacity = tiles_capacity = samples_capacity = pixels_capacity = mask_capacity = 0;
+    setups_capacity = slot_counts_capacity = tiles_capacity = chunk_counts_capacity = samples_capacity = pixels_capacity = mask_capacity = 0;
     tile_lists_capacity = 0;
     // The tessellated vertices are sized by the request too (packed again on the next render).
     tessellation.release();
@@ -216,8 +235,10 @@ struct Renderer::Impl {
       tiles_capacity = tiles;
       tile_counts = cl::Buffer(context, CL_MEM_READ_WRITE, tiles * sizeof(cl_uint));
       tile_offsets = cl::Buffer(context, CL_MEM_READ_WRITE, tiles * sizeof(cl_uint));
-      tile_cursors = cl::Buffer(context, CL_MEM_READ_WRITE, tiles * sizeof(cl_uint));
     }
+    grow(chunk_counts, chunk_counts_capacity,
+         std::max<size_t>(bin_chunks(static_cast<size_t>(p.input_triangles), tiles).chunks, 1) * tiles, sizeof(cl_uint),
+         context);
     grow(sample_triangle, samples_capacity, static_cast<size_t>(p.width) * p.height * p.sample_count, sizeof(cl_uint), context);
     grow(image, pixels_capacity, static_cast<size_t>(p.width) * p.height, sizeof(cl_float4), context);
     if (tile_lists() == nullptr || tile_lists_capacity < p.bin_capacity) {
@@ -265,29 +286,33 @@ struct Renderer::Impl {
                                  cl::NDRange(SEAMCL_SETUP_GROUP), nullptr, next(ev.setup));
     }
     const size_t tiles = static_cast<size_t>(p.tiles_x) * p.tiles_y;
-    queue.enqueueFillBuffer(tile_counts, cl_uint{0}, 0, tiles * sizeof(cl_uint), nullptr, next(ev.binning));
-    if (input_triangles > 0) {
+    const BinChunks chunks = bin_chunks(input_triangles, tiles);
+    const cl_int chunk_triangles = static_cast<cl_int>(chunks.chunk_triangles);
+    if (chunks.chunks > 0) {
       bin_count_kernel.setArg(0, frame_params);
       bin_count_kernel.setArg(1, setups);
       bin_count_kernel.setArg(2, slot_counts);
-      bin_count_kernel.setArg(3, tile_counts);
-      queue.enqueueNDRangeKernel(bin_count_kernel, cl::NullRange, cl::NDRange(round_up(input_triangles, kLinearGroup)), cl::NDRange(kLinearGroup), nullptr,
+      bin_count_kernel.setArg(3, chunk_counts);
+      bin_count_kernel.setArg(4, chunk_triangles);
+      queue.enqueueNDRangeKernel(bin_count_kernel, cl::NullRange, cl::NDRange(chunks.chunks), cl::NDRange(1), nullptr,
                                  next(ev.binning));
     }
     bin_scan_kernel.setArg(0, frame_params);
-    bin_scan_kernel.setArg(1, tile_counts);
-    bin_scan_kernel.setArg(2, tile_offsets);
-    bin_scan_kernel.setArg(3, tile_cursors);
-    bin_scan_kernel.setArg(4, stats);
+    bin_scan_kernel.setArg(1, chunk_counts);
+    bin_scan_kernel.setArg(2, static_cast<cl_int>(chunks.chunks));
+    bin_scan_kernel.setArg(3, tile_counts);
+    bin_scan_kernel.setArg(4, tile_offsets);
+    bin_scan_kernel.setArg(5, stats);
     queue.enqueueNDRangeKernel(bin_scan_kernel, cl::NullRange, cl::NDRange(1), cl::NDRange(1), nullptr, next(ev.binning));
-    if (input_triangles > 0) {
+    if (chunks.chunks > 0) {
       bin_fill_kernel.setArg(0, frame_params);
       bin_fill_kernel.setArg(1, setups);
       bin_fill_kernel.setArg(2, slot_counts);
-      bin_fill_kernel.setArg(3, tile_cursors);
-      bin_fill_kernel.setArg(4, tile_lists);
-      bin_fill_kernel.setArg(5, tile_entry_rows);
-      queue.enqueueNDRangeKernel(bin_fill_kernel, cl::NullRange, cl::NDRange(round_up(input_triangles, kLinearGroup)), cl::NDRange(kLinearGroup), nullptr,
+      bin_fill_kernel.setArg(3, chunk_counts);
+      bin_fill_kernel.setArg(4, chunk_triangles);
+      bin_fill_kernel.setArg(5, tile_lists);
+      bin_fill_kernel.setArg(6, tile_entry_rows);
+      queue.enqueueNDRangeKernel(bin_fill_kernel, cl::NullRange, cl::NDRange(chunks.chunks), cl::NDRange(1), nullptr,
                                  next(ev.binning));
     }
     const cl::NDRange tile_grid(static_cast<size_t>(p.tiles_x) * SEAMCL_TILE_SIZE, static_cast<size_t>(p.tiles_y) * SEAMCL_TILE_SIZE);
@@ -364,7 +389,7 @@ size_t Renderer::device_bytes() const {
   for (const cl::Buffer* buffer :
        {&i.positions, &i.faces, &i.neighbors, &i.level_offsets, &i.texels, &i.reflective_faces, &i.cube_texels,
         &i.srgb_table, &i.frame_params, &i.stats,
-        &i.setups, &i.slot_counts, &i.tile_counts, &i.tile_offsets, &i.tile_cursors, &i.tile_lists, &i.tile_entry_rows, &i.sample_triangle, &i.image,
+        &i.setups, &i.slot_counts, &i.tile_counts, &i.tile_offsets, &i.chunk_counts, &i.tile_lists, &i.tile_entry_rows, &i.sample_triangle, &i.image,
         &i.seam_mask}) {
     if ((*buffer)() != nullptr) bytes += buffer->getInfo<CL_MEM_SIZE>();
   }
