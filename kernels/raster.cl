@@ -311,10 +311,13 @@ __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup
     for (int w = 0; w < lanes * samples; w += 16) SEAMCL_PREFETCH_WRITE(out + w);
   }
   for (uint entry = begin; entry < end; ++entry) {
-    /* The record a few entries ahead: its first read misses the cache (records lie in input
-     * order, lists in tile order), and the walk's branches depend on it. */
+    /* The record a few entries ahead, both lines the walk reads (edges and box; the 1/w plane
+     * raster_plane_is_tame tests): its first read misses the cache (records lie in input order,
+     * lists in tile order), and the walk's branches depend on it. */
     if (entry + SEAMCL_RASTER_PREFETCH_AHEAD < end) {
-      SEAMCL_PREFETCH(setups + tile_lists[entry + SEAMCL_RASTER_PREFETCH_AHEAD]);
+      __global const char* ahead = (__global const char*)(setups + tile_lists[entry + SEAMCL_RASTER_PREFETCH_AHEAD]);
+      SEAMCL_PREFETCH(ahead);
+      SEAMCL_PREFETCH(ahead + 64);
     }
     /* The rows of the tile the entry's box covers (binning), cut to the record's box and the image
      * (a list may hold entries that miss the tile: the box decides). */
