@@ -233,7 +233,7 @@ __kernel void tessellate(__constant TessellationParams* params, __global const D
 
 __kernel void tessellated_setup(__constant FrameParams* frame, __constant TessellationParams* params,
                                 __global const TessVertex* vertices, __global TriangleSetup* out,
-                                __global FrameStats* stats) {
+                                __global uint* slot_counts, __global FrameStats* stats) {
   const int tri = (int)get_global_id(0);
   if (tri >= frame->input_triangles) return;
   const int t = params->tessellation;
@@ -261,8 +261,11 @@ __kernel void tessellated_setup(__constant FrameParams* frame, __constant Tessel
     polygon[k].u = tv.u;
     polygon[k].v = tv.v;
   }
-  /* Every slot written (the host fills slot_counts with SEAMCL_CLIP_SLOTS for tessellation). */
+  /* Only the fan's slots, as triangle_setup writes a clipped triangle's: binning reads no more than
+   * slot_counts[tri] (writing all six slots, and binning reading them, was most of the frame at T =
+   * 32). */
   uint fan = 0;
-  const uint visible = clip_and_setup(polygon, (uint)patch, frame, out + tri, (size_t)frame->input_triangles, 1, &fan);
+  const uint visible = clip_and_setup(polygon, (uint)patch, frame, out + tri, (size_t)frame->input_triangles, 0, &fan);
+  slot_counts[tri] = fan;
   if (visible > 0) atomic_add(&stats->visible_triangles, visible);
 }

@@ -5,8 +5,8 @@
  *
  * slot_counts[t]: how many of t's slots were written (0 .. SEAMCL_CLIP_SLOTS; later ones hold
  * stale data and count as empty): 1 or 0 for a triangle that needs no clipping, the size of its
- * fan for a clipped one; binning reads only those (the host fills it with SEAMCL_CLIP_SLOTS when
- * tessellate.cl writes every slot instead).
+ * fan for a clipped one; binning reads only those (tessellate.cl's tessellated_setup writes it the
+ * same way, its fan's size).
  * Inputs: positions (world, xyz of float4), faces, frame (view_proj, image size, clip planes).
  * Steps: transform to clip space; clip against w >= near_w and the guard band |x| <= guard_x w,
  * |y| <= guard_y w (Sutherland-Hodgman; the host sizes the guard band so that snapped coordinates

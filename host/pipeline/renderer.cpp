@@ -268,12 +268,7 @@ struct Renderer::Impl {
 
     const size_t input_triangles = static_cast<size_t>(p.input_triangles);
     if (displaced) {
-      tessellation.enqueue(program_key, frame_params, setups, stats, p.input_triangles, ev.tessellate, ev.setup);
-      // The tessellator writes every slot of a micro-triangle: binning reads them all.
-      if (input_triangles > 0) {
-        queue.enqueueFillBuffer(slot_counts, cl_uint{SEAMCL_CLIP_SLOTS}, 0, input_triangles * sizeof(cl_uint), nullptr,
-                                next(ev.setup));
-      }
+      tessellation.enqueue(program_key, frame_params, setups, slot_counts, stats, p.input_triangles, ev.tessellate, ev.setup);
     } else if (p.input_triangles > 0) {
       setup_kernel.setArg(0, frame_params);
       setup_kernel.setArg(1, positions);

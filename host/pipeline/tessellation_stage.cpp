@@ -62,7 +62,7 @@ void TessellationStage::enqueue_tessellate(Kernels& k, std::vector<cl::Event>* e
 }
 
 void TessellationStage::enqueue(const std::string& program_options, const cl::Buffer& frame_params, const cl::Buffer& setups,
-                                const cl::Buffer& stats, int input_triangles, std::vector<cl::Event>& tessellate_events,
+                                const cl::Buffer& slot_counts, const cl::Buffer& stats, int input_triangles, std::vector<cl::Event>& tessellate_events,
                                 std::vector<cl::Event>& setup_events) {
   Kernels& k = kernels(program_options);
   enqueue_tessellate(k, &tessellate_events);
@@ -71,7 +71,8 @@ void TessellationStage::enqueue(const std::string& program_options, const cl::Bu
   k.setup.setArg(1, params_);
   k.setup.setArg(2, vertices_);
   k.setup.setArg(3, setups);
-  k.setup.setArg(4, stats);
+  k.setup.setArg(4, slot_counts);
+  k.setup.setArg(5, stats);
   runtime_.queue().enqueueNDRangeKernel(k.setup, cl::NullRange, cl::NDRange(round_up(static_cast<size_t>(input_triangles), kGroup)),
                                         cl::NDRange(kGroup), nullptr, &setup_events.emplace_back());
 }

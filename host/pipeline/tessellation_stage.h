@@ -22,10 +22,10 @@ class TessellationStage {
   void release();
 
   // Queues tessellate and tessellated_setup (kernels of the program built with `options`),
-  // writing frame->input_triangles * SEAMCL_CLIP_SLOTS records into `setups`; one event each is
-  // appended to `tessellate_events` and `setup_events`.
+  // writing each micro-triangle's fan of records into `setups` and its size into `slot_counts`
+  // (as triangle_setup does); one event each is appended to `tessellate_events` and `setup_events`.
   void enqueue(const std::string& program_options, const cl::Buffer& frame_params, const cl::Buffer& setups,
-               const cl::Buffer& stats, int input_triangles, std::vector<cl::Event>& tessellate_events,
+               const cl::Buffer& slot_counts, const cl::Buffer& stats, int input_triangles, std::vector<cl::Event>& tessellate_events,
                std::vector<cl::Event>& setup_events);
 
   // Only tessellates (for the gap metric and the kernel tests), then reads the vertices back.
