@@ -231,41 +231,107 @@ __kernel void tessellate(__constant TessellationParams* params, __global const D
   out[id] = r;
 }
 
-__kernel void tessellated_setup(__constant FrameParams* frame, __constant TessellationParams* params,
-                                __global const TessVertex* vertices, __global TriangleSetup* out,
-                                __global uint* slot_counts, __global FrameStats* stats) {
-  const int tri = (int)get_global_id(0);
-  if (tri >= frame->input_triangles) return;
-  const int t = params->tessellation;
+/* Micro-triangle tri's vertex ids: cell (ci, cj) of its patch's (T+1)^2 grid; corners 0 = (ci, cj),
+ * 1 = (ci+1, cj), 2 = (ci+1, cj+1), 3 = (ci, cj+1); tri even takes corners 0, 1, 2, odd 0, 2, 3
+ * (corner_of_three 0, 1, 2 picks among them). */
+SEAMCL_INLINE int micro_triangle_vertex(int tri, int corner_of_three, int t) {
   const int side = t + 1;
   const int patch = tri / (2 * t * t);
   const int cell = (tri / 2) % (t * t);
-  const int ci = cell % t, cj = cell / t;
-  /* corners of the cell: 0 = (ci, cj), 1 = (ci+1, cj), 2 = (ci+1, cj+1), 3 = (ci, cj+1) */
-  const int base = patch * side * side;
-  int vid[4];
-  vid[0] = base + cj * side + ci;
-  vid[1] = vid[0] + 1;
-  vid[2] = vid[0] + side + 1;
-  vid[3] = vid[0] + side;
-  const int corner[3] = {0, (tri & 1) ? 2 : 1, (tri & 1) ? 3 : 2};
+  const int v0 = patch * side * side + (cell / t) * side + cell % t;
+  const int corner = corner_of_three == 0 ? 0 : corner_of_three + ((tri & 1) ? 1 : 0);
+  return corner == 0 ? v0 : corner == 1 ? v0 + 1 : corner == 2 ? v0 + side + 1 : v0 + side;
+}
 
-  /* From here on as triangle_setup (kernels/triangle_setup.cl), per micro-triangle. */
-  ClipVertex polygon[3 + 5];
-  for (int k = 0; k < 3; ++k) {
-    const TessVertex tv = vertices[vid[corner[k]]];
-    const __constant float* m = frame->view_proj;
-    polygon[k].x = m[0] * tv.position[0] + m[4] * tv.position[1] + m[8] * tv.position[2] + m[12];
-    polygon[k].y = m[1] * tv.position[0] + m[5] * tv.position[1] + m[9] * tv.position[2] + m[13];
-    polygon[k].w = m[3] * tv.position[0] + m[7] * tv.position[1] + m[11] * tv.position[2] + m[15];
-    polygon[k].u = tv.u;
-    polygon[k].v = tv.v;
+/* The setup of micro-triangles, SEAMCL_SETUP_LANES per work-item: the same cull and setup of the
+ * ones inside all planes on vectors as triangle_setup (setup_lanes), the clipped ones one by one
+ * through clip_and_setup, with the patch as the record's face. Each writes its fan's slots and
+ * slot_counts[tri] (its fan's size) as triangle_setup does; writing all six slots, and binning
+ * reading them, was most of the frame at T = 32. */
+__kernel __attribute__((reqd_work_group_size(SEAMCL_SETUP_GROUP, 1, 1)))
+void tessellated_setup(__constant FrameParams* frame, __constant TessellationParams* params,
+                       __global const TessVertex* vertices, __global TriangleSetup* out,
+                       __global uint* slot_counts, __global FrameStats* stats) {
+  __local uint group_visible[SEAMCL_SETUP_GROUP];
+  const int triangles = frame->input_triangles; /* > 0: the host runs no setup without triangles */
+  const int t = params->tessellation;
+  const int t0 = (int)get_global_id(0) * SEAMCL_SETUP_LANES;
+  const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const int16 tri = t0 + lane;
+  const int16 in_range = tri < triangles;
+  /* Lanes past the last micro-triangle read the last one and count for nothing. */
+  const int16 read_tri = min(tri, triangles - 1);
+#define TESS_VERTEX0(i) micro_triangle_vertex(read_tri[i], 0, t)
+#define TESS_VERTEX1(i) micro_triangle_vertex(read_tri[i], 1, t)
+#define TESS_VERTEX2(i) micro_triangle_vertex(read_tri[i], 2, t)
+  const int16 vertex0 = (int16)SETUP_LANES_OF(TESS_VERTEX0);
+  const int16 vertex1 = (int16)SETUP_LANES_OF(TESS_VERTEX1);
+  const int16 vertex2 = (int16)SETUP_LANES_OF(TESS_VERTEX2);
+#undef TESS_VERTEX0
+#undef TESS_VERTEX1
+#undef TESS_VERTEX2
+#define TESS_X0(i) vertices[vertex0[i]].position[0]
+#define TESS_Y0(i) vertices[vertex0[i]].position[1]
+#define TESS_Z0(i) vertices[vertex0[i]].position[2]
+#define TESS_U0(i) vertices[vertex0[i]].u
+#define TESS_V0(i) vertices[vertex0[i]].v
+#define TESS_X1(i) vertices[vertex1[i]].position[0]
+#define TESS_Y1(i) vertices[vertex1[i]].position[1]
+#define TESS_Z1(i) vertices[vertex1[i]].position[2]
+#define TESS_U1(i) vertices[vertex1[i]].u
+#define TESS_V1(i) vertices[vertex1[i]].v
+#define TESS_X2(i) vertices[vertex2[i]].position[0]
+#define TESS_Y2(i) vertices[vertex2[i]].position[1]
+#define TESS_Z2(i) vertices[vertex2[i]].position[2]
+#define TESS_U2(i) vertices[vertex2[i]].u
+#define TESS_V2(i) vertices[vertex2[i]].v
+  int16 clipped, early_culled;
+  uint visible = setup_lanes(
+      frame, tri, in_range, (float16)SETUP_LANES_OF(TESS_X0), (float16)SETUP_LANES_OF(TESS_Y0),
+      (float16)SETUP_LANES_OF(TESS_Z0), (float16)SETUP_LANES_OF(TESS_X1), (float16)SETUP_LANES_OF(TESS_Y1),
+      (float16)SETUP_LANES_OF(TESS_Z1), (float16)SETUP_LANES_OF(TESS_X2), (float16)SETUP_LANES_OF(TESS_Y2),
+      (float16)SETUP_LANES_OF(TESS_Z2), (float16)SETUP_LANES_OF(TESS_U0), (float16)SETUP_LANES_OF(TESS_V0),
+      (float16)SETUP_LANES_OF(TESS_U1), (float16)SETUP_LANES_OF(TESS_V1), (float16)SETUP_LANES_OF(TESS_U2),
+      (float16)SETUP_LANES_OF(TESS_V2), convert_uint16(read_tri / (2 * t * t)), out, slot_counts, &clipped,
+      &early_culled);
+#undef TESS_X0
+#undef TESS_Y0
+#undef TESS_Z0
+#undef TESS_U0
+#undef TESS_V0
+#undef TESS_X1
+#undef TESS_Y1
+#undef TESS_Z1
+#undef TESS_U1
+#undef TESS_V1
+#undef TESS_X2
+#undef TESS_Y2
+#undef TESS_Z2
+#undef TESS_U2
+#undef TESS_V2
+  /* Micro-triangles that cross a plane: clipped one by one, only the fan's slots written. */
+  for (int i = 0; i < SEAMCL_SETUP_LANES; ++i) {
+    if (!clipped[i]) continue;
+    const int id[3] = {vertex0[i], vertex1[i], vertex2[i]};
+    ClipVertex polygon[3 + 5];
+    for (int k = 0; k < 3; ++k) {
+      const TessVertex tv = vertices[id[k]];
+      const __constant float* m = frame->view_proj;
+      polygon[k].x = m[0] * tv.position[0] + m[4] * tv.position[1] + m[8] * tv.position[2] + m[12];
+      polygon[k].y = m[1] * tv.position[0] + m[5] * tv.position[1] + m[9] * tv.position[2] + m[13];
+      polygon[k].w = m[3] * tv.position[0] + m[7] * tv.position[1] + m[11] * tv.position[2] + m[15];
+      polygon[k].u = tv.u;
+      polygon[k].v = tv.v;
+    }
+    uint fan = 0;
+    visible += clip_and_setup(polygon, (uint)(tri[i] / (2 * t * t)), frame, out + tri[i], (size_t)triangles, 0, &fan);
+    slot_counts[tri[i]] = fan;
   }
-  /* Only the fan's slots, as triangle_setup writes a clipped triangle's: binning reads no more than
-   * slot_counts[tri] (writing all six slots, and binning reading them, was most of the frame at T =
-   * 32). */
-  uint fan = 0;
-  const uint visible = clip_and_setup(polygon, (uint)patch, frame, out + tri, (size_t)frame->input_triangles, 0, &fan);
-  slot_counts[tri] = fan;
-  if (visible > 0) atomic_add(&stats->visible_triangles, visible);
+  group_visible[get_local_id(0)] = visible;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (get_local_id(0) == 0) {
+    uint sum = 0;
+    for (int i = 0; i < SEAMCL_SETUP_GROUP; ++i) sum += group_visible[i];
+    if (sum > 0) atomic_add(&stats->visible_triangles, sum);
+  }
 }

@@ -369,80 +369,29 @@ SEAMCL_INLINE void planes_of(float16 a0, float16 a1, float16 a2, float16 dx1, fl
   *p2 = (d2 * dx1 - d1 * dx2) * inv_det;
 }
 
-__kernel __attribute__((reqd_work_group_size(SEAMCL_SETUP_GROUP, 1, 1)))
-void triangle_setup(__constant FrameParams* frame, __global const float4* positions, __global const FaceGpu* faces,
-                    __global TriangleSetup* out, __global uint* slot_counts, __global FrameStats* stats) {
-  /* Visible slots and early-culled triangles are summed per work-group, without atomics: a locked
-   * add per triangle waits for the triangle's record stores to drain, and cost a quarter of this
-   * stage. */
-  __local uint group_visible[SEAMCL_SETUP_GROUP];
-  __local uint group_early_culled[SEAMCL_SETUP_GROUP];
-  const int triangles = frame->input_triangles; /* > 0: the host runs no setup without triangles */
-  const int t0 = (int)get_global_id(0) * SEAMCL_SETUP_LANES;
-  const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-  const int16 t = t0 + lane;
-  const int16 in_range = t < triangles;
-  /* Lanes past the last triangle read the last one and count for nothing. */
-  const int16 read_t = min(t, triangles - 1);
-  const int16 odd = read_t & 1;
-  const int16 face = read_t >> 1;
-#define SETUP_VERTEX0(i) faces[face[i]].vertex[0]
-#define SETUP_VERTEX1(i) faces[face[i]].vertex[odd[i] ? 2 : 1]
-#define SETUP_VERTEX2(i) faces[face[i]].vertex[odd[i] ? 3 : 2]
-  const uint16 vertex0 = (uint16)SETUP_LANES_OF(SETUP_VERTEX0);
-  const uint16 vertex1 = (uint16)SETUP_LANES_OF(SETUP_VERTEX1);
-  const uint16 vertex2 = (uint16)SETUP_LANES_OF(SETUP_VERTEX2);
-#undef SETUP_VERTEX0
-#undef SETUP_VERTEX1
-#undef SETUP_VERTEX2
-  /* The face records two work-items ahead (8 faces, 384 bytes), and the record lines this
-   * work-item may write. */
-  {
-    __global const char* ahead = (__global const char*)(faces + (t0 + 2 * SEAMCL_SETUP_LANES) / 2);
-    if (t0 + 3 * SEAMCL_SETUP_LANES <= triangles) {
-      for (int k = 0; k < 6; ++k) SEAMCL_PREFETCH(ahead + 64 * k);
-    }
-    __global const char* records = (__global const char*)(out + t0);
-    if (t0 + SEAMCL_SETUP_LANES <= triangles) {
-      for (int k = 0; k < 28; ++k) SEAMCL_PREFETCH_WRITE(records + 64 * k);
-    }
-  }
-  __global const float* xyzw = (__global const float*)positions;
+/* The early cull and the setup of SEAMCL_SETUP_LANES triangles, lane i input triangle t[i], with
+ * vertices (p*0, p*1, p*2) (world space) and uv (u0, v0) .. (u2, v2), face `face` for the record
+ * (a patch for tessellate.cl). Lanes that are not in_range read valid data and count for nothing.
+ * For triangles inside all planes it writes the visible ones' records (slot 0) and slot_counts
+ * (0 or 1); it returns, in *clipped, the lanes that cross a plane and may be visible, which the
+ * caller sets up one by one (their slot_counts too), in *early_culled the lanes the cull stopped,
+ * and the visible slots it wrote. */
+SEAMCL_INLINE uint setup_lanes(__constant FrameParams* frame, int16 t, int16 in_range, float16 px0, float16 py0,
+                               float16 pz0, float16 px1, float16 py1, float16 pz1, float16 px2, float16 py2,
+                               float16 pz2, float16 u0, float16 v0, float16 u1, float16 v1, float16 u2, float16 v2,
+                               uint16 face, __global TriangleSetup* out, __global uint* slot_counts, int16* clipped,
+                               int16* early_culled) {
   int16 inside = (int16)(-1), outside_all = (int16)(31);
   int16 X0, Y0, X1, Y1, X2, Y2;
   float16 inv_w0, inv_w1, inv_w2;
-#define SETUP_COORDINATE(v, k) (float16)SETUP_LANES_OF(SETUP_COORDINATE_##k##_OF_##v)
-#define SETUP_COORDINATE_0_OF_0(i) xyzw[4 * (size_t)vertex0[i]]
-#define SETUP_COORDINATE_1_OF_0(i) xyzw[4 * (size_t)vertex0[i] + 1]
-#define SETUP_COORDINATE_2_OF_0(i) xyzw[4 * (size_t)vertex0[i] + 2]
-#define SETUP_COORDINATE_0_OF_1(i) xyzw[4 * (size_t)vertex1[i]]
-#define SETUP_COORDINATE_1_OF_1(i) xyzw[4 * (size_t)vertex1[i] + 1]
-#define SETUP_COORDINATE_2_OF_1(i) xyzw[4 * (size_t)vertex1[i] + 2]
-#define SETUP_COORDINATE_0_OF_2(i) xyzw[4 * (size_t)vertex2[i]]
-#define SETUP_COORDINATE_1_OF_2(i) xyzw[4 * (size_t)vertex2[i] + 1]
-#define SETUP_COORDINATE_2_OF_2(i) xyzw[4 * (size_t)vertex2[i] + 2]
-  cull_vertices(frame, SETUP_COORDINATE(0, 0), SETUP_COORDINATE(0, 1), SETUP_COORDINATE(0, 2), &inside, &outside_all,
-                &X0, &Y0, &inv_w0);
-  cull_vertices(frame, SETUP_COORDINATE(1, 0), SETUP_COORDINATE(1, 1), SETUP_COORDINATE(1, 2), &inside, &outside_all,
-                &X1, &Y1, &inv_w1);
-  cull_vertices(frame, SETUP_COORDINATE(2, 0), SETUP_COORDINATE(2, 1), SETUP_COORDINATE(2, 2), &inside, &outside_all,
-                &X2, &Y2, &inv_w2);
-#undef SETUP_COORDINATE
-#undef SETUP_COORDINATE_0_OF_0
-#undef SETUP_COORDINATE_1_OF_0
-#undef SETUP_COORDINATE_2_OF_0
-#undef SETUP_COORDINATE_0_OF_1
-#undef SETUP_COORDINATE_1_OF_1
-#undef SETUP_COORDINATE_2_OF_1
-#undef SETUP_COORDINATE_0_OF_2
-#undef SETUP_COORDINATE_1_OF_2
-#undef SETUP_COORDINATE_2_OF_2
+  cull_vertices(frame, px0, py0, pz0, &inside, &outside_all, &X0, &Y0, &inv_w0);
+  cull_vertices(frame, px1, py1, pz1, &inside, &outside_all, &X1, &Y1, &inv_w1);
+  cull_vertices(frame, px2, py2, pz2, &inside, &outside_all, &X2, &Y2, &inv_w2);
   /* The early cull (the twin's early_culled_reference): for triangles inside all planes, a back
    * face or zero area (the snapped vertices' area sign) or a bounding box past an image side, where
    * no sample lies; for the others, all three vertices outside one plane (the near plane is
    * clipped first, so its test is exact; a guard plane's clipped vertices could only round back
-   * onto the plane, an image width or height beyond the image). Survivors outside a plane take
-   * the scalar clipping path below. */
+   * onto the plane, an image width or height beyond the image). */
   const long16 area2 = convert_long16(X1 - X0) * convert_long16(Y2 - Y0) - convert_long16(Y1 - Y0) * convert_long16(X2 - X0);
   const int16 back_or_flat = convert_int16(area2 >= (long16)(0));
   /* Samples of pixel p lie in [p*ONE, p*ONE + ONE - 16]. */
@@ -451,7 +400,8 @@ void triangle_setup(__constant FrameParams* frame, __global const float4* positi
   const int16 off_image = ((X0 < 0) & (X1 < 0) & (X2 < 0)) | ((Y0 < 0) & (Y1 < 0) & (Y2 < 0)) |
                           ((X0 > last_x) & (X1 > last_x) & (X2 > last_x)) | ((Y0 > last_y) & (Y1 > last_y) & (Y2 > last_y));
   const int16 may_be_visible = in_range & select(outside_all == 0, ~back_or_flat & ~off_image, inside);
-  const int16 clipped = may_be_visible & ~inside;
+  *clipped = may_be_visible & ~inside;
+  *early_culled = in_range & ~may_be_visible;
 
   /* setup_snapped_triangle for the lanes inside all planes: vertices 0, 2, 1 in turn (a, b, c)
    * make the interior positive for all three edge functions. */
@@ -475,10 +425,6 @@ void triangle_setup(__constant FrameParams* frame, __global const float4* positi
   const float16 dx2 = convert_float16(X1 - X0) * scale, dy2 = convert_float16(Y1 - Y0) * scale;
   const float16 inv_det = 1.0f / (convert_float16(-area2) * scale * scale);
   const float16 ref_x = convert_float16(X0) * scale, ref_y = convert_float16(Y0) * scale;
-  /* Corner uv: t even takes corners 0, 1, 2 ((0,0), (1,0), (1,1)), odd 0, 2, 3 ((0,0), (1,1), (0,1)). */
-  const float16 u0 = (float16)(0.0f), v0 = (float16)(0.0f), u1 = (float16)(1.0f);
-  const float16 v1 = select((float16)(0.0f), (float16)(1.0f), odd != 0);
-  const float16 u2 = select((float16)(1.0f), (float16)(0.0f), odd != 0), v2 = (float16)(1.0f);
   float16 w_p0, w_p1, w_p2, u_p0, u_p1, u_p2, v_p0, v_p1, v_p2;
   planes_of(inv_w0, inv_w2, inv_w1, dx1, dy1, dx2, dy2, inv_det, &w_p0, &w_p1, &w_p2);
   planes_of(u0 * inv_w0, u2 * inv_w2, u1 * inv_w1, dx1, dy1, dx2, dy2, inv_det, &u_p0, &u_p1, &u_p2);
@@ -489,7 +435,7 @@ void triangle_setup(__constant FrameParams* frame, __global const float4* positi
   uint visible_slots = 0;
 #pragma unroll
   for (int i = 0; i < SEAMCL_SETUP_LANES; ++i) {
-    if (in_range[i] && !clipped[i]) slot_counts[t[i]] = visible[i] ? 1u : 0u;
+    if (in_range[i] && !(*clipped)[i]) slot_counts[t[i]] = visible[i] ? 1u : 0u;
     if (!visible[i]) continue;
     ++visible_slots;
     __global TriangleSetup* r = out + t[i]; /* slot 0 */
@@ -506,7 +452,7 @@ void triangle_setup(__constant FrameParams* frame, __global const float4* positi
     r->bbox_min_y = bbox_min_y[i];
     r->bbox_max_x = bbox_max_x[i];
     r->bbox_max_y = bbox_max_y[i];
-    r->face = (uint)face[i];
+    r->face = face[i];
     r->ref_x = ref_x[i];
     r->ref_y = ref_y[i];
     r->inv_w[0] = w_p0[i];
@@ -519,15 +465,86 @@ void triangle_setup(__constant FrameParams* frame, __global const float4* positi
     r->v_over_w[1] = v_p1[i];
     r->v_over_w[2] = v_p2[i];
   }
+  return visible_slots;
+}
+
+/* The number of set lanes of a mask. */
+SEAMCL_INLINE uint lanes_set(int16 mask) {
+  uint n = 0;
+  for (int i = 0; i < SEAMCL_SETUP_LANES; ++i) n += mask[i] ? 1u : 0u;
+  return n;
+}
+
+__kernel __attribute__((reqd_work_group_size(SEAMCL_SETUP_GROUP, 1, 1)))
+void triangle_setup(__constant FrameParams* frame, __global const float4* positions, __global const FaceGpu* faces,
+                    __global TriangleSetup* out, __global uint* slot_counts, __global FrameStats* stats) {
+  /* Visible slots and early-culled triangles are summed per work-group, without atomics: a locked
+   * add per triangle waits for the triangle's record stores to drain, and cost a quarter of this
+   * stage. */
+  __local uint group_visible[SEAMCL_SETUP_GROUP];
+  __local uint group_early_culled[SEAMCL_SETUP_GROUP];
+  const int triangles = frame->input_triangles; /* > 0: the host runs no setup without triangles */
+  const int t0 = (int)get_global_id(0) * SEAMCL_SETUP_LANES;
+  const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const int16 t = t0 + lane;
+  const int16 in_range = t < triangles;
+  /* Lanes past the last triangle read the last one and count for nothing. */
+  const int16 read_t = min(t, triangles - 1);
+  const int16 odd = read_t & 1;
+  const int16 face = read_t >> 1;
+  /* The face records two work-items ahead (8 faces, 384 bytes), and the record lines this
+   * work-item may write. */
+  if (t0 + 3 * SEAMCL_SETUP_LANES <= triangles) {
+    __global const char* ahead = (__global const char*)(faces + (t0 + 2 * SEAMCL_SETUP_LANES) / 2);
+    for (int k = 0; k < 6; ++k) SEAMCL_PREFETCH(ahead + 64 * k);
+  }
+  if (t0 + SEAMCL_SETUP_LANES <= triangles) {
+    __global const char* records = (__global const char*)(out + t0);
+    for (int k = 0; k < 28; ++k) SEAMCL_PREFETCH_WRITE(records + 64 * k);
+  }
+#define SETUP_VERTEX0(i) faces[face[i]].vertex[0]
+#define SETUP_VERTEX1(i) faces[face[i]].vertex[odd[i] ? 2 : 1]
+#define SETUP_VERTEX2(i) faces[face[i]].vertex[odd[i] ? 3 : 2]
+  const uint16 vertex0 = (uint16)SETUP_LANES_OF(SETUP_VERTEX0);
+  const uint16 vertex1 = (uint16)SETUP_LANES_OF(SETUP_VERTEX1);
+  const uint16 vertex2 = (uint16)SETUP_LANES_OF(SETUP_VERTEX2);
+#undef SETUP_VERTEX0
+#undef SETUP_VERTEX1
+#undef SETUP_VERTEX2
+  __global const float* xyzw = (__global const float*)positions;
+#define SETUP_X0(i) xyzw[4 * (size_t)vertex0[i]]
+#define SETUP_Y0(i) xyzw[4 * (size_t)vertex0[i] + 1]
+#define SETUP_Z0(i) xyzw[4 * (size_t)vertex0[i] + 2]
+#define SETUP_X1(i) xyzw[4 * (size_t)vertex1[i]]
+#define SETUP_Y1(i) xyzw[4 * (size_t)vertex1[i] + 1]
+#define SETUP_Z1(i) xyzw[4 * (size_t)vertex1[i] + 2]
+#define SETUP_X2(i) xyzw[4 * (size_t)vertex2[i]]
+#define SETUP_Y2(i) xyzw[4 * (size_t)vertex2[i] + 1]
+#define SETUP_Z2(i) xyzw[4 * (size_t)vertex2[i] + 2]
+  /* Corner uv: t even takes corners 0, 1, 2 ((0,0), (1,0), (1,1)), odd 0, 2, 3 ((0,0), (1,1), (0,1)). */
+  int16 clipped, early_culled;
+  uint visible_slots = setup_lanes(
+      frame, t, in_range, (float16)SETUP_LANES_OF(SETUP_X0), (float16)SETUP_LANES_OF(SETUP_Y0),
+      (float16)SETUP_LANES_OF(SETUP_Z0), (float16)SETUP_LANES_OF(SETUP_X1), (float16)SETUP_LANES_OF(SETUP_Y1),
+      (float16)SETUP_LANES_OF(SETUP_Z1), (float16)SETUP_LANES_OF(SETUP_X2), (float16)SETUP_LANES_OF(SETUP_Y2),
+      (float16)SETUP_LANES_OF(SETUP_Z2), (float16)(0.0f), (float16)(0.0f), (float16)(1.0f),
+      select((float16)(0.0f), (float16)(1.0f), odd != 0), select((float16)(1.0f), (float16)(0.0f), odd != 0),
+      (float16)(1.0f), convert_uint16(face), out, slot_counts, &clipped, &early_culled);
+#undef SETUP_X0
+#undef SETUP_Y0
+#undef SETUP_Z0
+#undef SETUP_X1
+#undef SETUP_Y1
+#undef SETUP_Z1
+#undef SETUP_X2
+#undef SETUP_Y2
+#undef SETUP_Z2
   /* Triangles that cross a plane (few): clipped one by one, only the fan's slots written. */
   for (int i = 0; i < SEAMCL_SETUP_LANES; ++i) {
     if (clipped[i]) visible_slots += setup_input_triangle(frame, positions, faces, out, slot_counts, t[i]);
   }
-  const int16 early_culled = in_range & ~may_be_visible;
-  uint culled = 0;
-  for (int i = 0; i < SEAMCL_SETUP_LANES; ++i) culled += early_culled[i] ? 1u : 0u;
   group_visible[get_local_id(0)] = visible_slots;
-  group_early_culled[get_local_id(0)] = culled;
+  group_early_culled[get_local_id(0)] = lanes_set(early_culled);
   barrier(CLK_LOCAL_MEM_FENCE);
   if (get_local_id(0) == 0) {
     uint sum = 0, culled_sum = 0;

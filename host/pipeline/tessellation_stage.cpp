@@ -73,8 +73,9 @@ void TessellationStage::enqueue(const std::string& program_options, const cl::Bu
   k.setup.setArg(3, setups);
   k.setup.setArg(4, slot_counts);
   k.setup.setArg(5, stats);
-  runtime_.queue().enqueueNDRangeKernel(k.setup, cl::NullRange, cl::NDRange(round_up(static_cast<size_t>(input_triangles), kGroup)),
-                                        cl::NDRange(kGroup), nullptr, &setup_events.emplace_back());
+  const size_t setup_items = (static_cast<size_t>(input_triangles) + SEAMCL_SETUP_LANES - 1) / SEAMCL_SETUP_LANES;
+  runtime_.queue().enqueueNDRangeKernel(k.setup, cl::NullRange, cl::NDRange(round_up(setup_items, SEAMCL_SETUP_GROUP)),
+                                        cl::NDRange(SEAMCL_SETUP_GROUP), nullptr, &setup_events.emplace_back());
 }
 
 std::vector<TessVertex> TessellationStage::tessellate(const std::string& program_options) {
