@@ -22,7 +22,7 @@
  * early_culled_reference), stats->visible_triangles the visible slots.
  * A new vertex on an edge is always computed from the edge's inside end, so two triangles that
  * share the edge create bit-identical vertices: clipping keeps the mesh watertight.
- * Twin: host/triangle_setup.cpp. */
+ * Twin: host/twins/triangle_setup.cpp. */
 
 typedef struct {
   float x, y, w; /* clip space (z is not needed: depth is 1/w) */
@@ -246,7 +246,7 @@ SEAMCL_INLINE uint clip_and_setup(ClipVertex* polygon, uint face_index, __consta
   return visible;
 }
 
-/* Sets up input triangle t (all its slots and slot_counts[t]); returns its visible slots. */
+/* Sets up input triangle t (the slots it fills, and slot_counts[t]: how many); returns its visible slots. */
 SEAMCL_INLINE uint setup_input_triangle(__constant FrameParams* frame, __global const float4* positions,
                                         __global const FaceGpu* faces, __global TriangleSetup* out,
                                         __global uint* slot_counts, int t) {

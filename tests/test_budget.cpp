@@ -186,6 +186,8 @@ TEST(Budget, RenderMemoryIsWhatAFreshRendererAllocates) {
       {"cube", options_of(Method::Traverse, TexelFormat::Rgba8, 8, 120, 90)},
       {"grid", options_of(Method::Guardband, TexelFormat::Rgba8, 2, 16, 16, 16)},
       {"grid", options_of(Method::Clamp, TexelFormat::Rgba32f, 16, 5, 3)},
+      // 4,948 triangles: binning's counters for five chunks (frame_params.h, bin_chunks).
+      {"paper", options_of(Method::Discard, TexelFormat::Rgba8, 1, 96, 64)},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(std::string(c.scene) + " " + to_json(c.options).dump());

@@ -7,6 +7,13 @@
 
 namespace seamcl {
 
+BinChunks bin_chunks(size_t input_triangles, size_t tiles) {
+  if (input_triangles == 0) return {};
+  size_t chunks = std::min((input_triangles + kBinChunkTriangles - 1) / kBinChunkTriangles, kMaxBinChunks);
+  chunks = std::max<size_t>(std::min(chunks, kMaxBinCounters / std::max<size_t>(tiles, 1)), 1);
+  return {chunks, (input_triangles + chunks - 1) / chunks};
+}
+
 glm::mat4 view_projection(const Camera& camera, int width, int height) {
   const float aspect = static_cast<float>(width) / static_cast<float>(height);
   // The far plane does not clip (depth is 1/w); it only has to be finite.

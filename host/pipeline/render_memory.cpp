@@ -7,6 +7,7 @@
 #include <seamcl/pipeline/gpu_types.h>
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/renderer.h>
+#include "pipeline/frame_params.h"
 
 #include <sys/resource.h>
 
@@ -139,7 +140,9 @@ RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options
   // and how many slots setup wrote per input triangle (Renderer's slot_counts, a uint each).
   m.setups = add(m.setups, device_array(slots / SEAMCL_CLIP_SLOTS, sizeof(cl_uint)));
   if (options.displacement) m.setups = add(m.setups, mul(mul(faces, mul(tess + 1, tess + 1)), 32));
-  m.tiles = mul(3 * sizeof(cl_uint), tile_count);
+  // Tile counts and offsets, and binning's counters: one per tile for each chunk of input triangles.
+  const size_t chunks = std::max<size_t>(bin_chunks(slots / SEAMCL_CLIP_SLOTS, tile_count).chunks, 1);
+  m.tiles = mul(mul(2 + chunks, sizeof(cl_uint)), tile_count);
   const size_t initial_entries = initial_tile_list_entries(scene.triangle_count());
   // A list entry: the slot (uint) and its rows in the tile (Renderer's tile_entry_rows, a ushort).
   constexpr size_t entry_bytes = sizeof(cl_uint) + sizeof(cl_ushort);

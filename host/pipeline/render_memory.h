@@ -77,7 +77,7 @@ struct RenderMemory {
   size_t constants = 0;      // sRGB table, FrameParams, FrameStats
   // Device: sized by the request (what release_frame_buffers frees).
   size_t setups = 0;         // TriangleSetup per clip slot (triangles x SEAMCL_CLIP_SLOTS)
-  size_t tiles = 0;          // tile counts, offsets and cursors: 3 uint per 16x16 tile
+  size_t tiles = 0;          // tile counts and offsets, and binning's per-chunk counters: uints per 16x16 tile
   size_t tile_lists = 0;     // uint per entry, initial_tile_list_entries
   size_t samples = 0;        // the winning triangle per sample: uint x width x height x msaa
   size_t image = 0;          // float4 per pixel

@@ -26,29 +26,7 @@ std::vector<T> read_buffer(cl::CommandQueue& queue, const cl::Buffer& buffer, si
   return out;
 }
 
-// Fixed local sizes: PoCL compiles a kernel once per local size, so a size that never changes is
-// compiled once (at warm-up) instead of once per new image or scene size.
-
 size_t round_up(size_t value, size_t multiple) { return (value + multiple - 1) / multiple * multiple; }
-
-// Binning's chunks (kernels/binning.cl): runs of about kBinChunkTriangles input triangles, each
-// counted by one work-item into counters of its own. At most kMaxBinChunks, and at most
-// kMaxBinCounters counters in all (chunks x tiles), which bin_scan walks one by one.
-constexpr size_t kBinChunkTriangles = 1024;
-constexpr size_t kMaxBinChunks = 64;
-constexpr size_t kMaxBinCounters = size_t{1} << 18;
-
-struct BinChunks {
-  size_t chunks = 0;           // 0 when there are no input triangles
-  size_t chunk_triangles = 0;  // triangles per chunk, the last one's fewer
-};
-
-BinChunks bin_chunks(size_t input_triangles, size_t tiles) {
-  if (input_triangles == 0) return {};
-  size_t chunks = std::min((input_triangles + kBinChunkTriangles - 1) / kBinChunkTriangles, kMaxBinChunks);
-  chunks = std::max<size_t>(std::min(chunks, kMaxBinCounters / std::max<size_t>(tiles, 1)), 1);
-  return {chunks, (input_triangles + chunks - 1) / chunks};
-}
 
 }  // namespace
 
@@ -260,8 +238,8 @@ struct Renderer::Impl {
       list.emplace_back();
       return &list.back();
     };
-    ev.setup.reserve(2);
-    ev.binning.reserve(5);
+    ev.setup.reserve(3);
+    ev.binning.reserve(3);
     queue.enqueueWriteBuffer(frame_params, CL_FALSE, 0, sizeof(FrameParams), &p, nullptr, next(ev.setup));
     const FrameStats zero_stats{};
     queue.enqueueWriteBuffer(stats, CL_FALSE, 0, sizeof(FrameStats), &zero_stats, nullptr, next(ev.setup));
@@ -524,7 +502,12 @@ std::vector<TriangleSetup> Renderer::read_setups() {
   if (slot_major.empty()) return {};
   // Setup writes only a triangle's first slot_counts[t] slots (the rest hold stale data): fill the
   // others with the empty record triangle_setup.cl's store_empty_setup writes, so every slot reads as before.
+  // Its face: t's face (two triangles each), or for micro-triangles their patch (2 T^2 each).
   const std::vector<uint32_t> written = read_buffer<uint32_t>(impl_->runtime.queue(), impl_->slot_counts, triangles);
+  const size_t triangles_per_face =
+      impl_->displaced && impl_->tessellation_settings
+          ? 2 * static_cast<size_t>(impl_->tessellation_settings->tessellation) * impl_->tessellation_settings->tessellation
+          : 2;
   std::vector<TriangleSetup> setups(slot_major.size());
   for (size_t t = 0; t < triangles; ++t) {
     const size_t filled = std::min<size_t>(written[t], SEAMCL_CLIP_SLOTS);
@@ -538,7 +521,7 @@ std::vector<TriangleSetup> Renderer::read_setups() {
       for (int i = 0; i < 3; ++i) s.edge_c[i] = -1;
       s.bbox_max_x = -1;
       s.bbox_max_y = -1;
-      s.face = static_cast<uint32_t>(t / 2);
+      s.face = static_cast<uint32_t>(t / triangles_per_face);
     }
   }
   return setups;
