@@ -492,15 +492,17 @@ void triangle_setup(__constant FrameParams* frame, __global const float4* positi
   const int16 read_t = min(t, triangles - 1);
   const int16 odd = read_t & 1;
   const int16 face = read_t >> 1;
-  /* The face records two work-items ahead (8 faces, 384 bytes), and the record lines this
-   * work-item may write. */
+  /* The face records two work-items ahead (8 faces: 6 lines), and the record lines this
+   * work-item may write (16 records: 28 lines). */
   if (t0 + 3 * SEAMCL_SETUP_LANES <= triangles) {
     __global const char* ahead = (__global const char*)(faces + (t0 + 2 * SEAMCL_SETUP_LANES) / 2);
-    for (int k = 0; k < 6; ++k) SEAMCL_PREFETCH(ahead + 64 * k);
+    for (int k = 0; k < (int)((SEAMCL_SETUP_LANES / 2 * sizeof(FaceGpu) + 63) / 64); ++k) SEAMCL_PREFETCH(ahead + 64 * k);
   }
   if (t0 + SEAMCL_SETUP_LANES <= triangles) {
     __global const char* records = (__global const char*)(out + t0);
-    for (int k = 0; k < 28; ++k) SEAMCL_PREFETCH_WRITE(records + 64 * k);
+    for (int k = 0; k < (int)((SEAMCL_SETUP_LANES * sizeof(TriangleSetup) + 63) / 64); ++k) {
+      SEAMCL_PREFETCH_WRITE(records + 64 * k);
+    }
   }
 #define SETUP_VERTEX0(i) faces[face[i]].vertex[0]
 #define SETUP_VERTEX1(i) faces[face[i]].vertex[odd[i] ? 2 : 1]
