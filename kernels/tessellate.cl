@@ -231,18 +231,6 @@ __kernel void tessellate(__constant TessellationParams* params, __global const D
   out[id] = r;
 }
 
-/* Micro-triangle tri's vertex ids: cell (ci, cj) of its patch's (T+1)^2 grid; corners 0 = (ci, cj),
- * 1 = (ci+1, cj), 2 = (ci+1, cj+1), 3 = (ci, cj+1); tri even takes corners 0, 1, 2, odd 0, 2, 3
- * (corner_of_three 0, 1, 2 picks among them). */
-SEAMCL_INLINE int micro_triangle_vertex(int tri, int corner_of_three, int t) {
-  const int side = t + 1;
-  const int patch = tri / (2 * t * t);
-  const int cell = (tri / 2) % (t * t);
-  const int v0 = patch * side * side + (cell / t) * side + cell % t;
-  const int corner = corner_of_three == 0 ? 0 : corner_of_three + ((tri & 1) ? 1 : 0);
-  return corner == 0 ? v0 : corner == 1 ? v0 + 1 : corner == 2 ? v0 + side + 1 : v0 + side;
-}
-
 /* The setup of micro-triangles, SEAMCL_SETUP_LANES per work-item: the same cull and setup of the
  * ones inside all planes on vectors as triangle_setup (setup_lanes), the clipped ones one by one
  * through clip_and_setup, with the patch as the record's face. Each writes its fan's slots and
@@ -261,15 +249,15 @@ void tessellated_setup(__constant FrameParams* frame, __constant TessellationPar
   const int16 in_range = tri < triangles;
   /* Lanes past the last micro-triangle read the last one and count for nothing. */
   const int16 read_tri = min(tri, triangles - 1);
-#define TESS_VERTEX0(i) micro_triangle_vertex(read_tri[i], 0, t)
-#define TESS_VERTEX1(i) micro_triangle_vertex(read_tri[i], 1, t)
-#define TESS_VERTEX2(i) micro_triangle_vertex(read_tri[i], 2, t)
-  const int16 vertex0 = (int16)SETUP_LANES_OF(TESS_VERTEX0);
-  const int16 vertex1 = (int16)SETUP_LANES_OF(TESS_VERTEX1);
-  const int16 vertex2 = (int16)SETUP_LANES_OF(TESS_VERTEX2);
-#undef TESS_VERTEX0
-#undef TESS_VERTEX1
-#undef TESS_VERTEX2
+  /* Cell (ci, cj) of the patch's (T+1)^2 grid, corners 0 = (ci, cj), 1 = (ci+1, cj),
+   * 2 = (ci+1, cj+1), 3 = (ci, cj+1); an even micro-triangle takes corners 0, 1, 2, an odd one 0, 2, 3. */
+  const int side = t + 1;
+  const int16 patch = read_tri / (2 * t * t);
+  const int16 cell = (read_tri / 2) % (t * t);
+  const int16 odd = (read_tri & 1) != 0;
+  const int16 vertex0 = patch * (side * side) + (cell / t) * side + cell % t;
+  const int16 vertex1 = vertex0 + select((int16)(1), (int16)(side + 1), odd);
+  const int16 vertex2 = vertex0 + select((int16)(side + 1), (int16)(side), odd);
 #define TESS_X0(i) vertices[vertex0[i]].position[0]
 #define TESS_Y0(i) vertices[vertex0[i]].position[1]
 #define TESS_Z0(i) vertices[vertex0[i]].position[2]
@@ -292,7 +280,7 @@ void tessellated_setup(__constant FrameParams* frame, __constant TessellationPar
       (float16)SETUP_LANES_OF(TESS_Z1), (float16)SETUP_LANES_OF(TESS_X2), (float16)SETUP_LANES_OF(TESS_Y2),
       (float16)SETUP_LANES_OF(TESS_Z2), (float16)SETUP_LANES_OF(TESS_U0), (float16)SETUP_LANES_OF(TESS_V0),
       (float16)SETUP_LANES_OF(TESS_U1), (float16)SETUP_LANES_OF(TESS_V1), (float16)SETUP_LANES_OF(TESS_U2),
-      (float16)SETUP_LANES_OF(TESS_V2), convert_uint16(read_tri / (2 * t * t)), out, slot_counts, &clipped,
+      (float16)SETUP_LANES_OF(TESS_V2), convert_uint16(patch), out, slot_counts, &clipped,
       &early_culled);
 #undef TESS_X0
 #undef TESS_Y0
@@ -324,7 +312,7 @@ void tessellated_setup(__constant FrameParams* frame, __constant TessellationPar
       polygon[k].v = tv.v;
     }
     uint fan = 0;
-    visible += clip_and_setup(polygon, (uint)(tri[i] / (2 * t * t)), frame, out + tri[i], (size_t)triangles, 0, &fan);
+    visible += clip_and_setup(polygon, (uint)patch[i], frame, out + tri[i], (size_t)triangles, 0, &fan);
     slot_counts[tri[i]] = fan;
   }
   group_visible[get_local_id(0)] = visible;
