@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -264,6 +265,63 @@ TEST(Budget, RepackInAnotherFormatOrBandHoldsOnlyTheNewPacking) {
   EXPECT_EQ(renderer.device_bytes(), render_memory(scene, plain).device_bytes());
 }
 
+TEST(Budget, TheAdjacencyIsPackedOnlyForTheRendersThatReadIt) {
+  // 256 bytes a face (25 MB at 99,037 faces): discard, clamp and black never read it.
+  const Scene scene = generate_scene("paper", {});
+  const RenderOptions discard = options_of(Method::Discard, TexelFormat::Rgba8, 4, 64, 48);
+  RenderOptions traverse = discard;
+  traverse.method = Method::Traverse;
+  RenderOptions black = discard;
+  black.method = Method::Black;
+  Renderer renderer(seamcl_tests::shared_runtime());
+  renderer.load_scene(scene);
+  renderer.render(scene.camera, discard);
+  EXPECT_TRUE(renderer.packed_scene().neighbors.empty());
+  const RenderMemory without = render_memory(scene, discard);
+  EXPECT_EQ(without.neighbors, sizeof(FaceNeighbors));  // OpenCL's one-element minimum
+  EXPECT_EQ(renderer.device_bytes(), without.device_bytes());
+  EXPECT_EQ(packed_host_bytes(renderer.packed_scene()), without.host_packed);
+
+  // A seam mask reads it: the first such render adds it to the packing, as the estimate says.
+  const RenderResult masked = renderer.render(scene.camera, black, true);
+  ASSERT_EQ(renderer.packed_scene().neighbors.size(), scene.faces.size());
+  const RenderMemory with_mask = render_memory(scene, black, true);
+  EXPECT_EQ(with_mask.neighbors, scene.faces.size() * sizeof(FaceNeighbors));
+  EXPECT_EQ(with_mask.seam_mask, size_t{64 * 48});
+  EXPECT_EQ(renderer.device_bytes(), with_mask.device_bytes());
+  EXPECT_EQ(packed_host_bytes(renderer.packed_scene()), with_mask.host_packed);
+
+  // Added later or packed from the start, it is the same adjacency: traverse renders identically,
+  // and the mask is the same as a fresh Renderer's.
+  const RenderResult later = renderer.render(scene.camera, traverse);
+  Renderer fresh(seamcl_tests::shared_runtime());
+  fresh.load_scene(scene);
+  const RenderResult first = fresh.render(scene.camera, traverse);
+  EXPECT_EQ(fresh.device_bytes(), render_memory(scene, traverse).device_bytes());
+  ASSERT_EQ(later.pixels.size(), first.pixels.size());
+  EXPECT_EQ(std::memcmp(later.pixels.data(), first.pixels.data(), first.pixels.size() * sizeof(glm::vec4)), 0);
+  EXPECT_TRUE(std::memcmp(fresh.packed_scene().neighbors.data(), renderer.packed_scene().neighbors.data(),
+                          scene.faces.size() * sizeof(FaceNeighbors)) == 0);
+  EXPECT_EQ(fresh.render(scene.camera, black, true).seam_mask, masked.seam_mask);
+
+  // A repack for a method without it leaves it out again.
+  RenderOptions discard32 = discard;
+  discard32.texels = TexelFormat::Rgba32f;
+  renderer.release_frame_buffers();
+  renderer.render(scene.camera, discard32);
+  EXPECT_TRUE(renderer.packed_scene().neighbors.empty());
+  EXPECT_EQ(renderer.device_bytes(), render_memory(scene, discard32).device_bytes());
+
+  // Guardband builds it for its bands and keeps none (its kernels never read it); its bands are
+  // those of a packing made with it.
+  const RenderOptions banded = options_of(Method::Guardband, TexelFormat::Rgba8, 1, 64, 48, 4);
+  renderer.release_frame_buffers();
+  renderer.render(scene.camera, banded);
+  EXPECT_TRUE(renderer.packed_scene().neighbors.empty());
+  EXPECT_EQ(renderer.device_bytes(), render_memory(scene, banded).device_bytes());
+  EXPECT_TRUE(renderer.packed_scene().texels8 == pack_scene(scene, TexelFormat::Rgba8, 4).texels8);
+}
+
 // `count` screen-filling quads stacked towards the camera: every triangle lands on every tile, so
 // the tile lists outgrow their initial size.
 Scene stacked_quads(int count) {
@@ -345,6 +403,15 @@ TEST(Budget, CompareMemoryBoundsWhatTheCompareHolds) {
   size_t phase1 = renderer.device_bytes();
   const std::vector<uint8_t> mask = seam_mask(render_face_map(renderer, scene.camera, frame));
   phase1 = std::max(phase1, renderer.device_bytes());
+  // prepare_targets' footprint masks, one per rate: they pack the adjacency (discard's packing has none).
+  EXPECT_EQ(renderer.packed_scene().neighbors.size(), 0u);
+  std::set<int> masked_rates;
+  for (const MethodEntry& entry : entries) {
+    if (!masked_rates.insert(entry.options.msaa).second) continue;
+    EXPECT_EQ(footprint_seam_mask(renderer, scene.camera, entry.options).size(), size_t{24 * 16});
+    phase1 = std::max(phase1, renderer.device_bytes());
+  }
+  EXPECT_EQ(renderer.packed_scene().neighbors.size(), scene.faces.size());
   const ReferenceImage reference = reference_image(scene, scene.camera, frame, settings, [&](const RenderOptions& high) {
     RenderResult r = renderer.render(scene.camera, high);
     phase1 = std::max(phase1, renderer.device_bytes());

@@ -13,7 +13,8 @@ size_t mul(size_t a, size_t b) { return saturating_mul(a, b); }
 
 // What a phase of one Renderer holds at most: the largest packing, each frame buffer at its max.
 struct PhaseDevice {
-  size_t scene = 0, constants = 0, setups = 0, tiles = 0, tile_lists = 0, tile_lists_bound = 0, samples = 0, image = 0;
+  size_t scene = 0, constants = 0, setups = 0, tiles = 0, tile_lists = 0, tile_lists_bound = 0, samples = 0, image = 0,
+         seam_mask = 0;
   void include(const RenderMemory& m) {
     scene = std::max(scene, m.scene_device_bytes());
     constants = std::max(constants, m.constants);
@@ -23,10 +24,11 @@ struct PhaseDevice {
     tile_lists_bound = std::max(tile_lists_bound, m.tile_lists_bound);
     samples = std::max(samples, m.samples);
     image = std::max(image, m.image);
+    seam_mask = std::max(seam_mask, m.seam_mask);
   }
   size_t bytes(bool bound) const {
     return add(add(add(scene, constants), add(setups, tiles)),
-               add(add(bound ? tile_lists_bound : tile_lists, samples), image));
+               add(add(bound ? tile_lists_bound : tile_lists, samples), add(image, seam_mask)));
   }
 };
 
@@ -58,11 +60,23 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   RenderOptions loaded = frame;  // load_scene packs the frame's format without a band, as any method but guardband
   loaded.method = Method::Discard;
   phase1.include(render_memory(scene, loaded));
+  PhaseDevice phase3;
+  // prepare_targets' footprint masks, one per rate (footprint_seam_mask): they pack the adjacency,
+  // which the Renderer keeps through the references and, unless a method repacks, the methods; the
+  // mask buffer goes with the references' frame buffers.
+  size_t largest_packed = std::max(out.face_map.host_packed, out.reference.host_packed);
+  for (const MethodEntry& entry : entries) {
+    RenderOptions mask_options = entry.options;
+    mask_options.method = Method::Black;
+    RenderMemory mask = render_memory(scene, mask_options, true);
+    largest_packed = std::max(largest_packed, mask.host_packed);
+    phase1.include(mask);
+    mask.seam_mask = 0;
+    phase3.include(mask);
+  }
   phase1.include(out.face_map);
   if (high_res) phase1.include(out.reference);
   if (analytic) phase1.include(out.analytic);
-  PhaseDevice phase3;
-  size_t largest_packed = std::max(out.face_map.host_packed, out.reference.host_packed);
   int largest_rate = 1;
   std::vector<int> rates;
   for (const MethodEntry& entry : entries) {

@@ -13,6 +13,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace seamcl {
 namespace {
@@ -185,11 +186,17 @@ void fill_edge_reach(const std::vector<FaceGpu>& faces, std::vector<FaceNeighbor
 }
 
 PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band) {
+  return pack_scene(scene, format, guard_band, build_adjacency(scene));
+}
+
+PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band, std::vector<FaceNeighbors> adjacency) {
   if (guard_band < 0 || guard_band > kMaxGuardBand) throw std::invalid_argument("guard band out of range");
+  if (!adjacency.empty() && adjacency.size() != scene.faces.size()) throw std::logic_error("pack_scene: adjacency of another scene");
+  if (guard_band > 0 && adjacency.size() != scene.faces.size()) throw std::logic_error("pack_scene: guard bands need the adjacency");
   PackedScene out;
   out.format = format;
   out.guard_band = guard_band;
-  out.neighbors = build_adjacency(scene);
+  out.neighbors = std::move(adjacency);
   out.positions.reserve(scene.positions.size());
   for (const glm::vec3& p : scene.positions) out.positions.push_back({{p.x, p.y, p.z, 1.0f}});
   out.faces.reserve(scene.faces.size());

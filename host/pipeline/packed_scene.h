@@ -13,7 +13,7 @@ namespace seamcl {
 struct PackedScene {
   std::vector<cl_float4> positions;     // xyz, w = 1
   std::vector<FaceGpu> faces;
-  std::vector<FaceNeighbors> neighbors;  // edge adjacency, for traverse
+  std::vector<FaceNeighbors> neighbors;  // edge adjacency (traverse, guard bands, the seam mask); may be empty
   std::vector<uint32_t> level_offsets;  // per face, per level: first texel in `texels`; stored
                                         // level-major (level 0 of every face, then level 1, ...)
   TexelFormat format = TexelFormat::Rgba8;
@@ -47,5 +47,8 @@ void fill_edge_reach(const std::vector<FaceGpu>& faces, std::vector<FaceNeighbor
 // its neighbours' bands read are kept while those are packed), so that packing never holds the
 // float copy of every texture: the packed texels are what stays.
 PackedScene pack_scene(const Scene& scene, TexelFormat format = TexelFormat::Rgba8, int guard_band = 0);
+// The same with the adjacency given: build_adjacency(scene), or empty for a packing without one
+// (the Renderer's for methods that never read it; a guard band needs it: std::logic_error).
+PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band, std::vector<FaceNeighbors> adjacency);
 
 }  // namespace seamcl

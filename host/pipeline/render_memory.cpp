@@ -55,7 +55,9 @@ size_t saturating_mul(size_t a, size_t b) {
 size_t RenderMemory::scene_device_bytes() const {
   return add(add(add(add(positions, faces), add(neighbors, level_offsets)), texels), environment);
 }
-size_t RenderMemory::frame_device_bytes() const { return add(add(add(setups, tiles), add(tile_lists, samples)), image); }
+size_t RenderMemory::frame_device_bytes() const {
+  return add(add(add(setups, tiles), add(tile_lists, samples)), add(image, seam_mask));
+}
 size_t RenderMemory::device_bytes() const { return add(add(scene_device_bytes(), constants), frame_device_bytes()); }
 size_t RenderMemory::device_bytes_bound() const {
   return add(add(scene_device_bytes(), constants), add(add(add(setups, tiles), add(tile_lists_bound, samples)), image));
@@ -111,14 +113,15 @@ size_t scene_host_bytes(const SceneSizes& scene) {
 
 size_t scene_held_bytes(const Scene& scene) { return add(scene_host_bytes(scene_sizes(scene)), scene.texture_source_bytes); }
 
-RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options) {
+RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options, bool with_seam_mask) {
   RenderMemory m;
   m.textures = packed_texture_memory(scene, options.texels, sampler_params(options).guard_band);
 
   const size_t faces = scene.faces.size();
   m.positions = device_array(scene.vertices, sizeof(cl_float4));
   m.faces = device_array(faces, sizeof(FaceGpu));
-  m.neighbors = device_array(faces, sizeof(FaceNeighbors));
+  const size_t adjacency_faces = reads_adjacency(options.method) || with_seam_mask ? faces : 0;
+  m.neighbors = device_array(adjacency_faces, sizeof(FaceNeighbors));
   m.level_offsets = device_array(m.textures.levels, sizeof(uint32_t));
   m.texels = device_array(m.textures.texels, options.texels == TexelFormat::Rgba8 ? sizeof(uint32_t) : 4 * sizeof(float));
   const size_t cube_side = static_cast<size_t>(std::max(scene.cube_size, 0));
@@ -149,21 +152,23 @@ RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options
   m.tile_lists = mul(initial_entries, entry_bytes);
   m.samples = device_array(mul(pixels, static_cast<size_t>(std::max(options.msaa, 1))), sizeof(cl_uint));
   m.image = device_array(pixels, sizeof(cl_float4));
+  m.seam_mask = with_seam_mask ? device_array(pixels, sizeof(cl_uchar)) : 0;
   // Render grows the lists to bin_entries * 5/4 + 1024 (at most 2^31), and bin_entries is at most
   // one per slot per tile.
   const size_t grown_entries = std::min<size_t>(add(mul(mul(slots, tile_count) / 4 + 1, 5), 1024), size_t{1} << 31);
   m.tile_lists_bound = mul(std::max(initial_entries, grown_entries), entry_bytes);
 
   m.host_scene = scene_host_bytes(scene);
-  m.host_packed = add(add(mul(scene.vertices, sizeof(cl_float4)), mul(faces, sizeof(FaceGpu) + sizeof(FaceNeighbors))),
+  m.host_packed = add(add(mul(scene.vertices, sizeof(cl_float4)),
+                          add(mul(faces, sizeof(FaceGpu)), mul(adjacency_faces, sizeof(FaceNeighbors)))),
                       add(add(mul(m.textures.levels, sizeof(uint32_t)), m.textures.texture_bytes),
                           add(mul(scene.reflective_faces, sizeof(ReflectiveFace)), mul(cube_texels, 4 * sizeof(float)))));
-  m.host_image = mul(pixels, sizeof(glm::vec4));
+  m.host_image = add(mul(pixels, sizeof(glm::vec4)), with_seam_mask ? pixels : 0);
   return m;
 }
 
-RenderMemory render_memory(const Scene& scene, const RenderOptions& options) {
-  return render_memory(scene_sizes(scene), options);
+RenderMemory render_memory(const Scene& scene, const RenderOptions& options, bool with_seam_mask) {
+  return render_memory(scene_sizes(scene), options, with_seam_mask);
 }
 
 RenderMemory scene_render_memory(const SceneSizes& scene, const RenderOptions& options) {

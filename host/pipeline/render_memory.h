@@ -56,7 +56,8 @@ struct PackedTextureMemory {
   size_t band_texels = 0;      // of those, the ones in guard bands
   size_t texture_bytes = 0;    // == PackedScene::texture_bytes()
   size_t padding_bytes = 0;    // == PackedScene::padding_bytes() (part of texture_bytes)
-  size_t adjacency_bytes = 0;  // == PackedScene::adjacency_bytes(); packed and uploaded for every method
+  size_t adjacency_bytes = 0;  // == PackedScene::adjacency_bytes() of pack_scene(scene, format, band);
+                               // a Renderer keeps it only where it is read (RenderMemory::neighbors)
 };
 
 // Exact. Throws std::invalid_argument for a band outside 0..kMaxGuardBand, as pack_scene does.
@@ -69,7 +70,8 @@ struct RenderMemory {
   // Device: the scene, as uploaded (each buffer at least one element).
   size_t positions = 0;      // float4 per vertex
   size_t faces = 0;          // FaceGpu per face
-  size_t neighbors = 0;      // FaceNeighbors per face (adjacency_bytes)
+  size_t neighbors = 0;      // FaceNeighbors per face (adjacency_bytes) for a method that reads_adjacency
+                             // or a seam-mask render; one element otherwise
   size_t level_offsets = 0;  // uint per level
   size_t texels = 0;         // texture_bytes
   size_t environment = 0;    // ReflectiveFace per reflective face + the cube map's RGBA32F texels
@@ -81,6 +83,7 @@ struct RenderMemory {
   size_t tile_lists = 0;     // uint per entry, initial_tile_list_entries
   size_t samples = 0;        // the winning triangle per sample: uint x width x height x msaa
   size_t image = 0;          // float4 per pixel
+  size_t seam_mask = 0;      // a byte per pixel, for a render with the seam mask only
   size_t tile_lists_bound = 0;  // upper bound of tile_lists after growth (see above)
 
   // Host.
@@ -88,11 +91,11 @@ struct RenderMemory {
   // textures are deferred (Scene::texture_source) holds none of those texels: an upper bound then.
   size_t host_scene = 0;
   size_t host_packed = 0;  // PackedScene's arrays (the device scene buffers without their minimum)
-  size_t host_image = 0;   // RenderResult::pixels, float4 per pixel
+  size_t host_image = 0;   // RenderResult::pixels, float4 per pixel (and seam_mask, a byte per pixel)
 
   // The sums saturate at SIZE_MAX like every figure here.
   size_t scene_device_bytes() const;  // positions + faces + neighbors + level_offsets + texels + environment
-  size_t frame_device_bytes() const;  // setups + tiles + tile_lists + samples + image
+  size_t frame_device_bytes() const;  // setups + tiles + tile_lists + samples + image + seam_mask
   // Exact as described above (tile lists at their initial size).
   size_t device_bytes() const;        // scene + constants + frame
   // The same with the tile lists at their bound: no render of this request can need more.
@@ -102,9 +105,10 @@ struct RenderMemory {
 
 // The request's own options decide everything: size, msaa, texels, and the guard band when the
 // method is guardband (sampler_params). The scene must be non-empty in the sense of validate_scene
-// only for the render itself; the estimate takes any sizes.
-RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options);
-RenderMemory render_memory(const Scene& scene, const RenderOptions& options);
+// only for the render itself; the estimate takes any sizes. with_seam_mask: as Renderer::render's
+// (the mask's buffers and the adjacency it reads).
+RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options, bool with_seam_mask = false);
+RenderMemory render_memory(const Scene& scene, const RenderOptions& options, bool with_seam_mask = false);
 
 // What the scene alone makes a render of it cost, whatever frame is asked for: the request at 1x1
 // pixel without MSAA (the scene's arrays and packed textures, the setups and tile lists of its

@@ -122,6 +122,7 @@ std::string to_string(CubeMethod method) { return enum_name(method, kCubeMethods
 std::vector<std::string> cube_method_names() { return enum_names(kCubeMethods); }
 
 bool reads_adjacency(Method method) { return method == Method::Traverse || method == Method::TraverseEdges; }
+bool needs_adjacency(Method method) { return reads_adjacency(method) || method == Method::Guardband; }
 
 SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCoverage zero_coverage, int guard_band) {
   SamplerParams p{};

@@ -51,6 +51,10 @@ std::string to_string(Method method);
 std::vector<std::string> method_names();
 // Whether the method reads neighbouring faces through the adjacency (traverse, traverse-edges).
 bool reads_adjacency(Method method);
+// Whether the method needs the adjacency: the methods that read it, and guardband, whose bands are
+// copied from the neighbours while packing (a Renderer keeps it only for those that read it, and
+// for seam-mask renders: at 99,037 faces it is 25 MB). A mesh without shared edges refuses them.
+bool needs_adjacency(Method method);
 std::optional<ShadingMode> parse_shading_mode(std::string_view name);
 std::string to_string(ShadingMode mode);
 std::vector<std::string> shading_mode_names();

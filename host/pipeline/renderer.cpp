@@ -95,17 +95,30 @@ struct Renderer::Impl {
     shade_kernel = it->second.shade;
   }
 
-  // Packs and uploads the loaded scene in `format` with `guard_band` texels of band per level.
-  void pack_and_upload(TexelFormat format, int guard_band) {
+  // Packs and uploads the loaded scene in `format` with `guard_band` texels of band per level, from
+  // `adjacency` (build_adjacency, or empty: none), which is kept only if `keep_adjacency`.
+  void pack_and_upload(TexelFormat format, int guard_band, std::vector<FaceNeighbors> adjacency, bool keep_adjacency) {
     // The old packing goes first, so a repack never holds two scenes' textures at once.
     release_scene_buffers();
-    packed = pack_scene(*scene, format, guard_band);
+    packed = pack_scene(*scene, format, guard_band, std::move(adjacency));
+    if (!keep_adjacency) packed.neighbors = {};  // guardband's bands are made: its kernels never read it
     positions = upload_shared(packed.positions);
     faces = upload_shared(packed.faces);
     neighbors = upload_shared(packed.neighbors);
     level_offsets = upload_shared(packed.level_offsets);
     texels = format == TexelFormat::Rgba8 ? upload_shared(packed.texels8) : upload_shared(packed.texels32);
     reflective_faces = upload_shared(packed.reflective_faces);
+    uploaded = true;
+  }
+
+  // Adds the adjacency to a packing made without it (the first render that reads it).
+  void add_adjacency(std::vector<FaceNeighbors> adjacency) {
+    drain_queue();  // queued frames may read the one-element stand-in
+    uploaded = false;  // until the buffer is there: a failed upload repacks on the next render
+    neighbors = cl::Buffer();
+    packed.neighbors = std::move(adjacency);
+    fill_edge_reach(packed.faces, packed.neighbors);
+    neighbors = upload_shared(packed.neighbors);
     uploaded = true;
   }
 
@@ -117,7 +130,7 @@ struct Renderer::Impl {
     release_scene_buffers();
     scene.reset();
     scene = make_scene();
-    pack_and_upload(format, 0);
+    pack_and_upload(format, 0, {}, false);  // no adjacency until a render reads it
     // Start the tile lists at a few entries per triangle slot; render() grows them when needed.
     bin_capacity = std::max<uint32_t>(bin_capacity, initial_tile_list_entries(scene->triangle_count()));
     tile_lists = tile_entry_rows = cl::Buffer();
@@ -380,18 +393,31 @@ const std::vector<float>& Renderer::cube_texels() const { return impl_->cube_hos
 
 RenderResult Renderer::render(const Camera& camera, const RenderOptions& options, bool with_seam_mask) {
   if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
-  if ((reads_adjacency(options.method) || options.method == Method::Guardband) && !has_adjacency(impl_->packed.neighbors)) {
-    throw InputError("method", to_string(options.method) + " reads each face's edge neighbours, and no two of the " +
-                                   std::to_string(impl_->scene->faces.size()) + " faces of scene '" + impl_->scene->name +
-                                   "' share an edge (faces are neighbours through shared vertex indices)");
-  }
   if (with_seam_mask && options.method == Method::Guardband) {
     throw InputError("method", "the seam mask is measured on the faces' own texels; guardband's bands would count as "
                                "inside (any other method gives the same mask)");
   }
   const SamplerParams sampler = sampler_params(options);
-  if (!impl_->uploaded || options.texels != impl_->packed.format || sampler.guard_band != impl_->packed.guard_band) {
-    impl_->pack_and_upload(options.texels, sampler.guard_band);
+  const bool repack =
+      !impl_->uploaded || options.texels != impl_->packed.format || sampler.guard_band != impl_->packed.guard_band;
+  // The adjacency is built by the first render that reads it (held here, not packed, until the
+  // checks pass) and kept; a repack for a render that does not read it leaves it out, and
+  // guardband's packing builds it for its bands only.
+  const bool keep_adjacency = reads_adjacency(options.method) || with_seam_mask;
+  std::vector<FaceNeighbors> adjacency;
+  if ((keep_adjacency && (repack || impl_->packed.neighbors.empty())) || (repack && sampler.guard_band > 0)) {
+    adjacency = build_adjacency(*impl_->scene);
+  }
+  // Neither built nor kept: a banded packing, whose adjacency was checked when it was made.
+  if (needs_adjacency(options.method) && !has_adjacency(adjacency.empty() ? impl_->packed.neighbors : adjacency)) {
+    throw InputError("method", to_string(options.method) + " reads each face's edge neighbours, and no two of the " +
+                                   std::to_string(impl_->scene->faces.size()) + " faces of scene '" + impl_->scene->name +
+                                   "' share an edge (faces are neighbours through shared vertex indices)");
+  }
+  if (repack) {
+    impl_->pack_and_upload(options.texels, sampler.guard_band, std::move(adjacency), keep_adjacency);
+  } else if (!adjacency.empty()) {
+    impl_->add_adjacency(std::move(adjacency));
   }
   impl_->upload_cube(impl_->scene->environment ? std::optional(cube_bake(options.cube_method)) : std::nullopt);
   impl_->use_kernels(options.texels, sampler, with_seam_mask);

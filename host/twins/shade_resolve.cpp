@@ -143,7 +143,8 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
   constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
   ResolveReference out;
   out.pixels.resize(static_cast<size_t>(f.width) * f.height);
-  out.seam_mask.assign(out.pixels.size(), 0);
+  const bool with_mask = !scene.neighbors.empty();
+  if (with_mask) out.seam_mask.assign(out.pixels.size(), 0);
   const glm::vec3 background(f.background[0], f.background[1], f.background[2]);
   for (int y = 0; y < f.height; ++y) {
     for (int x = 0; x < f.width; ++x) {
@@ -162,14 +163,14 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
         const TriangleSetup& t = setups.at(slot);
         if (f.shading_mode == SEAMCL_SHADE_SAMPLE) {
           sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s), cube_texels);
-          crosses = merge_mask(crosses, footprint_class(scene, f, t, sample_x(s), sample_y(s)));
+          if (with_mask) crosses = merge_mask(crosses, footprint_class(scene, f, t, sample_x(s), sample_y(s)));
           ++out.fragments;
           continue;
         }
         if (std::find(ids, ids + s, slot) != ids + s) continue;  // shaded at its first sample
         const PixelFragment fragment = pixel_fragment(f, t, ids, slot, x, y);
         sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y, cube_texels) * static_cast<float>(fragment.covered);
-        crosses = merge_mask(crosses, footprint_class(scene, f, t, fragment.x, fragment.y));
+        if (with_mask) crosses = merge_mask(crosses, footprint_class(scene, f, t, fragment.x, fragment.y));
         ++out.fragments;
       }
       if (uncovered > 0 && f.environment.skybox) {
@@ -179,7 +180,7 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
         sum += background * static_cast<float>(uncovered);  // once: an empty pixel is exactly the background
       }
       out.pixels[static_cast<size_t>(y) * f.width + x] = glm::vec4(sum / static_cast<float>(samples), 1.0f);
-      out.seam_mask[static_cast<size_t>(y) * f.width + x] = crosses;
+      if (with_mask) out.seam_mask[static_cast<size_t>(y) * f.width + x] = crosses;
     }
   }
   return out;

@@ -49,7 +49,8 @@ uint8_t merge_mask(uint8_t a, uint8_t b);
 struct ResolveReference {
   std::vector<glm::vec4> pixels;  // linear RGBA
   uint32_t fragments = 0;
-  std::vector<uint8_t> seam_mask;  // per pixel, SEAMCL_MASK_* over its fragments
+  std::vector<uint8_t> seam_mask;  // per pixel, SEAMCL_MASK_* over its fragments; empty when the
+                                   // packing has no adjacency (the mask reads it)
 };
 ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& frame,
                                          const std::vector<TriangleSetup>& setups,
