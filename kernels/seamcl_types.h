@@ -24,6 +24,7 @@
 #define SEAMCL_PREFETCH(p) prefetch((__global const char*)(p), 64)
 #define SEAMCL_PREFETCH_WRITE(p) prefetch((__global const char*)(p), 64)
 #endif
+typedef uchar cl_uchar;
 typedef uint cl_uint;
 typedef int cl_int;
 typedef long cl_long;
@@ -99,32 +100,51 @@ typedef struct {
   cl_int pad0;
 } SamplerParams;
 
-/* A face's neighbours, for traverse. Edge k runs from corner k to corner k+1 (uv (0,0),
+/* A uv map from one face's unit square to another's, in one byte: (u', v') = (t0 u + t1 v + t2,
+ * t3 u + t4 v + t5), derivatives by the linear part. Both uv spaces are unit squares, so the linear
+ * part is a signed permutation (a rotation by a multiple of 90 degrees or a reflection) and the
+ * offset whole numbers, -1 to 2 for any face that touches this one (its square lies within one
+ * unit of this one's). SEAMCL_MAP_SWAP: u' reads v and v' reads u (t0 = t4 = 0); the NEGATE bits
+ * give the signs of u' and v''s term; bits 3-4 and 5-6 hold t2 + 1 and t5 + 1. The kernels and
+ * the host (host/pipeline/adjacency.h, uv_map) decode it to the same exact floats. */
+#define SEAMCL_MAP_SWAP 1
+#define SEAMCL_MAP_NEGATE_U 2
+#define SEAMCL_MAP_NEGATE_V 4
+#define SEAMCL_MAP_OFFSET_U_SHIFT 3
+#define SEAMCL_MAP_OFFSET_V_SHIFT 5
+
+/* A texture side for traverse's early-out (a power of two, as every face side is) in a byte:
+ * 2^(stored - SEAMCL_SIDE_BIAS); SEAMCL_SIDE_NONE (so a zeroed record too) stands for 0: not
+ * filled, or no face, never skips. */
+#define SEAMCL_SIDE_NONE 0
+#define SEAMCL_SIDE_BIAS 128
+
+/* A face's neighbours, for traverse (48 bytes: at 99,037 faces 4.75 MB, where six floats a map
+ * and float sides took 256 bytes a face). Edge k runs from corner k to corner k+1 (uv (0,0),
  * (1,0), (1,1), (0,1)): edge 0 is v = 0, 1 is u = 1, 2 is v = 1, 3 is u = 0. neighbor[k] is the
- * face across it (-1 at a boundary or a non-manifold edge); transform[k] maps this face's uv to
- * the neighbour's: (u', v') = (t0 u + t1 v + t2, t3 u + t4 v + t5), derivatives by the linear part.
- * Both uv spaces are unit squares, so the map is a rotation by a multiple of 90 degrees (or, for
- * a neighbour of opposite orientation, a reflection) and a translation.
+ * face across it (-1 at a boundary or a non-manifold edge); edge_map[k] maps this face's uv to the
+ * neighbour's (SEAMCL_MAP_*).
  * corner[k] is the diagonal face past corner k when that corner's vertex has valence 4 (four
  * faces around it, a closed ring), else -1: at any other valence, or at a mesh boundary, there is
  * no one face past the corner, and the part of a footprint there is dropped (renormalised away).
- * corner_transform[k] maps this face's uv to the diagonal face's, as the two edge maps composed
- * (host/pipeline/adjacency.h). */
+ * corner_map[k] maps this face's uv to the diagonal face's, as the two edge maps composed
+ * (host/pipeline/adjacency.h). A map without its face is 0 and never read.
+ * Traverse's early-out per edge k, filled when the scene is packed (fill_edge_reach): over the
+ * faces a lookup reaches across edge k (neighbor[k]) and past its two ends (corner[k],
+ * corner[(k + 1) & 3]), their sides as they lie in this face's uv (a map may swap u and v):
+ * reach_min_side[k] is the smallest side along the axis that crosses edge k (v for edges 0 and 2,
+ * u for 1 and 3), reach_max_side[k] that times the largest ratio of a face's side along the other
+ * axis to its side along this one (SEAMCL_SIDE_NONE: not filled, or no such face; never skips). A
+ * lookup too far inside edge k for faces of these sides skips all three without reading them
+ * (texture_sample.cl, accumulate_neighbors). They come first: an interior lookup reads nothing
+ * else of the record. */
 typedef struct {
+  cl_uchar reach_min_side[4];
+  cl_uchar reach_max_side[4];
+  cl_uchar edge_map[4];
+  cl_uchar corner_map[4];
   cl_int neighbor[4];
-  cl_float transform[4][6];
   cl_int corner[4];
-  cl_float corner_transform[4][6];
-  /* Traverse's early-out per edge k, filled when the scene is packed (fill_edge_reach): over the
-   * faces a lookup reaches across edge k (neighbor[k]) and past its two ends (corner[k],
-   * corner[(k + 1) & 3]), their sides as they lie in this face's uv (a map may swap u and v):
-   * reach_min_side[k] is the smallest side along the axis that crosses edge k (v for edges 0 and
-   * 2, u for 1 and 3), reach_max_side[k] that times the largest ratio of a face's side along the
-   * other axis to its side along this one (powers of two, exact). A lookup too far inside edge k
-   * for faces of these sides skips all three without reading them (texture_sample.cl,
-   * accumulate_neighbors). 0: not filled, or no such face; never skips. */
-  cl_float reach_min_side[4];
-  cl_float reach_max_side[4];
 } FaceNeighbors;
 
 /* CubeSampler.method: how a cube-map lookup treats its filter taps at the faces' edges. */

@@ -234,11 +234,13 @@ SEAMCL_INLINE float weight_inside(__constant FrameParams* frame, const FaceGpu* 
 }
 
 /* The weight the same filter puts inside face `other` at this point and footprint carried into its
- * uv by the map m (an edge's or a corner's transform), as traverse reads it there. */
+ * uv by the map (an edge's or a corner's), as traverse reads it there. */
 SEAMCL_INLINE float weight_carried(__constant FrameParams* frame, __global const FaceGpu* faces, int other,
-                                   __global const float* m, __global const uint* level_offsets, TEXEL_BUFFER texels,
+                                   uint map, __global const uint* level_offsets, TEXEL_BUFFER texels,
                                    __global const float* srgb_to_linear, const SurfaceUv* s) {
   const FaceGpu g = faces[other];
+  const UvMap decoded = decode_uv_map(map);
+  const float* m = decoded.t;
   return weight_inside(frame, &g, level_offsets, texels, srgb_to_linear, m[0] * s->u + m[1] * s->v + m[2],
                        m[3] * s->u + m[4] * s->v + m[5], m[0] * s->dudx + m[1] * s->dvdx,
                        m[3] * s->dudx + m[4] * s->dvdx, m[0] * s->dudy + m[1] * s->dvdy,
@@ -273,8 +275,7 @@ SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global cons
       boundary |= crosses;
       continue;
     }
-    __global const float* m = n->transform[k];
-    const float reach = weight_carried(frame, faces, other, m, level_offsets, texels, srgb_to_linear, &s);
+    const float reach = weight_carried(frame, faces, other, n->edge_map[k], level_offsets, texels, srgb_to_linear, &s);
     seam |= crosses | !(reach <= tolerance);
   }
   /* The diagonal face past each valence-4 corner, as traverse reads it: a coarser one's taps can
@@ -282,8 +283,7 @@ SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global cons
   for (int k = 0; k < 4; ++k) {
     const int other = n->corner[k];
     if (other < 0) continue;
-    __global const float* m = n->corner_transform[k];
-    const float reach = weight_carried(frame, faces, other, m, level_offsets, texels, srgb_to_linear, &s);
+    const float reach = weight_carried(frame, faces, other, n->corner_map[k], level_offsets, texels, srgb_to_linear, &s);
     seam |= !(reach <= tolerance);
   }
   /* Taps outside past a corner only (no edge's mirror saw them): a seam, to be safe. */

@@ -523,6 +523,32 @@ SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int swapped, int
            axis_rules_out(side_v, side_u, filter, max_aniso, distance_v, x_v, x_u, y_v, y_u));
 }
 
+/* A FaceNeighbors map byte as its coefficients: (u', v') = (t[0] u + t[1] v + t[2], t[3] u + t[4] v
+ * + t[5]) (SEAMCL_MAP_* in seamcl_types.h; the host decodes it to the same floats). */
+typedef struct {
+  float t[6];
+} UvMap;
+
+SEAMCL_INLINE UvMap decode_uv_map(uint code) {
+  const int swap = (code & SEAMCL_MAP_SWAP) != 0;
+  const float su = (code & SEAMCL_MAP_NEGATE_U) != 0 ? -1.0f : 1.0f;
+  const float sv = (code & SEAMCL_MAP_NEGATE_V) != 0 ? -1.0f : 1.0f;
+  UvMap m;
+  m.t[0] = swap ? 0.0f : su;
+  m.t[1] = swap ? su : 0.0f;
+  m.t[2] = (float)((int)((code >> SEAMCL_MAP_OFFSET_U_SHIFT) & 3u) - 1);
+  m.t[3] = swap ? sv : 0.0f;
+  m.t[4] = swap ? 0.0f : sv;
+  m.t[5] = (float)((int)((code >> SEAMCL_MAP_OFFSET_V_SHIFT) & 3u) - 1);
+  return m;
+}
+
+/* A FaceNeighbors reach side: 2^(stored - SEAMCL_SIDE_BIAS) built from its exponent bits (exact),
+ * 0 for SEAMCL_SIDE_NONE. */
+SEAMCL_INLINE float reach_side(uint stored) {
+  return stored == SEAMCL_SIDE_NONE ? 0.0f : as_float((int)(stored - SEAMCL_SIDE_BIAS + 127u) << 23);
+}
+
 /* The same filter, border-addressed, on face `other` at this lookup's point and footprint carried
  * into its uv by the map t, added to `sum`: the taps that fall inside `other`. Most lookups lie
  * too far inside their own face to reach it: first a test on the footprint's size against the
@@ -530,18 +556,19 @@ SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int swapped, int
  * the very probes the filter would take (their line and the coarser level's texel); either
  * skips the filter. EWA has only the first. */
 SEAMCL_INLINE void accumulate_across(FilterSum* sum, __global const FaceGpu* faces, int other,
-                                     __global const float* t, float distance_u, float distance_v,
+                                     uint map, float distance_u, float distance_v,
                                      __global const uint* level_offsets,
                                      TEXEL_BUFFER texels, __global const float* srgb_to_linear, int filter,
                                      int max_aniso, float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   if (other < 0) return;
   const FaceGpu g = faces[other];
   const int early_out = SEAMCL_TRAVERSE_EARLY_OUT;
-  /* A map whose linear part swaps u and v has t0 = 0 (it is a signed permutation). */
-  if (early_out && !neighbor_may_contribute(&g, t[0] == 0.0f, filter, max_aniso, distance_u, distance_v, dudx, dvdx,
-                                            dudy, dvdy)) {
+  if (early_out && !neighbor_may_contribute(&g, (map & SEAMCL_MAP_SWAP) != 0, filter, max_aniso, distance_u, distance_v,
+                                            dudx, dvdx, dudy, dvdy)) {
     return;
   }
+  const UvMap m = decode_uv_map(map);
+  const float* t = m.t;
   const float gu = t[0] * u + t[1] * v + t[2];
   const float gv = t[3] * u + t[4] * v + t[5];
   const float gdudx = t[0] * dudx + t[1] * dvdx, gdvdx = t[3] * dudx + t[4] * dvdx;
@@ -601,7 +628,8 @@ SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* 
     edge_may_reach = 0;
     for (int k = 0; k < 4; ++k) {
       const int along_v = (k & 1) == 0;
-      const int ruled_out = axis_rules_out(n->reach_min_side[k], n->reach_max_side[k], filter, max_aniso, inside[k],
+      const int ruled_out = axis_rules_out(reach_side(n->reach_min_side[k]), reach_side(n->reach_max_side[k]), filter,
+                                           max_aniso, inside[k],
                                            along_v ? x_v : x_u, along_v ? x_u : x_v, along_v ? y_v : y_u,
                                            along_v ? y_u : y_v);
       edge_may_reach |= (ruled_out ? 0 : 1) << k;
@@ -611,7 +639,7 @@ SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* 
   for (int k = 0; k < 4; ++k) {
     if (((edge_may_reach >> k) & 1) == 0) continue;
     const int along_v = (k & 1) == 0;
-    accumulate_across(sum, faces, n->neighbor[k], n->transform[k], along_v ? -1.0f : inside[k],
+    accumulate_across(sum, faces, n->neighbor[k], n->edge_map[k], along_v ? -1.0f : inside[k],
                       along_v ? inside[k] : -1.0f, level_offsets, texels, srgb_to_linear, filter, max_aniso, u, v,
                       dudx, dvdx, dudy, dvdy);
   }
@@ -621,7 +649,7 @@ SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* 
     if (((edge_may_reach >> k) & (edge_may_reach >> ((k + 3) & 3)) & 1) == 0) continue;
     const float a = inside[(k + 3) & 3], b = inside[k];
     const int b_along_v = (k & 1) == 0;
-    accumulate_across(sum, faces, n->corner[k], n->corner_transform[k], b_along_v ? a : b, b_along_v ? b : a,
+    accumulate_across(sum, faces, n->corner[k], n->corner_map[k], b_along_v ? a : b, b_along_v ? b : a,
                       level_offsets, texels, srgb_to_linear, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy);
   }
 }

@@ -45,6 +45,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Whether a FaceNeighbors map only translates (its linear part the identity).
+bool is_translation(uint8_t code) {
+  const std::array<float, 6> t = map_coefficients(code);
+  return t[0] == 1.0f && t[4] == 1.0f;
+}
+
 std::string sample(const std::string& name) { return std::string(SEAMCL_TEST_ASSETS_DIR) + "/ptex/" + name; }
 
 // The message of an InputError thrown by `run`, with its field checked.
@@ -179,7 +185,7 @@ TEST(Assets, SamplePairsLoadWithTheFilesAdjacencyAgreeingWithTheMesh) {
   const Scene& cube = sample_scene("cube.obj", "cube_text.ptx");
   int rotated = 0;
   for (const FaceNeighbors& n : build_adjacency(cube))
-    for (int k = 0; k < 4; ++k) rotated += n.neighbor[k] >= 0 && !(n.transform[k][0] == 1 && n.transform[k][4] == 1);
+    for (int k = 0; k < 4; ++k) rotated += n.neighbor[k] >= 0 && !is_translation(n.edge_map[k]);
   EXPECT_GT(rotated, 0);
 }
 
@@ -292,7 +298,7 @@ TEST(Assets, TraverseIsSeamlessAcrossCubeTextsRotatedNeighbours) {
     for (int k = 0; k < 4 && !used[f]; ++k) {
       const FaceNeighbors& n = adjacency[f];
       const int g = n.neighbor[k];
-      if (g < 0 || used[static_cast<size_t>(g)] || (n.transform[k][0] == 1 && n.transform[k][4] == 1)) continue;
+      if (g < 0 || used[static_cast<size_t>(g)] || is_translation(n.edge_map[k])) continue;
       used[f] = used[static_cast<size_t>(g)] = true;
       // f's uv frame in 3D (the cube's faces are squares): origin corner 0, axes to corners 1 and 3.
       const std::array<glm::vec3, 4> fc = scene.corners(scene.faces[f]);

@@ -152,6 +152,52 @@ TEST(KernelVsTwin, TraverseOnConnectedFacesOfMixedSizesAndOrientations) {
   }
 }
 
+TEST(Adjacency, MapsAndSidesRoundTripThroughTheirBytes) {
+  // Every signed permutation with every whole offset in -1..2: 128 maps, each its own byte, and
+  // back to the same exact coefficients (the kernels decode the same bits: decode_uv_map).
+  std::set<uint8_t> codes;
+  int swaps = 0;
+  for (int linear = 0; linear < 8; ++linear) {
+    for (int ou = -1; ou <= 2; ++ou) {
+      for (int ov = -1; ov <= 2; ++ov) {
+        const float su = (linear & 2) != 0 ? -1.0f : 1.0f, sv = (linear & 4) != 0 ? -1.0f : 1.0f;
+        UvMap map;
+        map.linear = (linear & 1) != 0 ? glm::mat2(0.0f, sv, su, 0.0f) : glm::mat2(su, 0.0f, 0.0f, sv);
+        map.offset = glm::vec2(static_cast<float>(ou), static_cast<float>(ov));
+        const uint8_t code = encode_uv_map(map);
+        codes.insert(code);
+        const UvMap back = uv_map(code);
+        EXPECT_TRUE(back.linear == map.linear && back.offset == map.offset) << "code " << int(code);
+        // A point lands where the map puts it: u' = su (u or v) + ou.
+        const glm::vec2 p = back.point({0.25f, 0.75f});
+        EXPECT_EQ(p.x, su * ((linear & 1) != 0 ? 0.75f : 0.25f) + static_cast<float>(ou));
+        EXPECT_EQ(p.y, sv * ((linear & 1) != 0 ? 0.25f : 0.75f) + static_cast<float>(ov));
+        const std::array<float, 6> t = map_coefficients(code);
+        swaps += map_swaps_axes(t.data());
+        EXPECT_EQ(map_swaps_axes(t.data()), (linear & 1) != 0);
+      }
+    }
+  }
+  EXPECT_EQ(codes.size(), 128u);
+  EXPECT_EQ(swaps, 64);
+  UvMap sheared;
+  sheared.linear = glm::mat2(1.0f, 1.0f, 0.0f, 1.0f);
+  EXPECT_THROW(encode_uv_map(sheared), std::logic_error);
+  UvMap far_away;
+  far_away.offset = glm::vec2(3.0f, 0.0f);
+  EXPECT_THROW(encode_uv_map(far_away), std::logic_error);
+  UvMap halfway;
+  halfway.offset = glm::vec2(0.5f, 0.0f);
+  EXPECT_THROW(encode_uv_map(halfway), std::logic_error);
+
+  // Reach sides: powers of two exactly; 0 and anything else read back as 0 (never skips).
+  for (int e = -126; e <= 127; ++e) EXPECT_EQ(reach_side(encode_reach_side(std::ldexp(1.0f, e))), std::ldexp(1.0f, e));
+  for (float other : {0.0f, 3.0f, 0.75f, -2.0f, INFINITY, NAN, std::ldexp(1.0f, -130)}) {
+    EXPECT_EQ(encode_reach_side(other), SEAMCL_SIDE_NONE) << other;
+  }
+  EXPECT_EQ(reach_side(SEAMCL_SIDE_NONE), 0.0f);
+}
+
 TEST(Traverse, ContinuesAcrossTheEdgeWhereDiscardStops) {
   // Two faces of quad2, texture content continuous across the shared edge. A footprint centred
   // exactly on the edge: discard sees only its own face's half; traverse sees both halves, which
@@ -249,7 +295,7 @@ TEST(Adjacency, DiagonalMapIsTheEdgeMapsComposedEitherWayRound) {
         const int diagonal = adjacency[f].corner[k];
         if (diagonal < 0) continue;
         ++checked;
-        const UvMap stored = uv_map(adjacency[f].corner_transform[k]);
+        const UvMap stored = uv_map(adjacency[f].corner_map[k]);
         const VertexRing ring = corner_ring(scene, adjacency, f, k);
         ASSERT_EQ(ring.valence(), 4);
         EXPECT_TRUE(same_map(stored, corner_map(k, ring.faces[1].corner, corner_swap(scene, ring.faces[1]))))
@@ -260,7 +306,7 @@ TEST(Adjacency, DiagonalMapIsTheEdgeMapsComposedEitherWayRound) {
         bool found = false;
         for (int e = 0; e < 4 && !found; ++e) {
           if (adjacency[side].neighbor[e] != diagonal) continue;
-          const UvMap other_way = compose(uv_map(adjacency[side].transform[e]), uv_map(adjacency[f].transform[before]));
+          const UvMap other_way = compose(uv_map(adjacency[side].edge_map[e]), uv_map(adjacency[f].edge_map[before]));
           found = same_map(other_way, stored);
         }
         EXPECT_TRUE(found) << "face " << f << " corner " << k;
@@ -349,14 +395,14 @@ TEST(Traverse, SkipsOnlyNeighboursThatWouldAddNothing) {
       const bool k_along_v = k % 2 == 0;
       const float a = j < 4 ? -1.0f : inside[(k + 3) % 4], b = inside[k];
       const float distance_u = k_along_v ? a : b, distance_v = k_along_v ? b : a;
-      const float* transform = j < 4 ? n.transform[k] : n.corner_transform[k];
-      if (neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], map_swaps_axes(transform), sampler.filter,
+      const uint8_t code = j < 4 ? n.edge_map[k] : n.corner_map[k];
+      if (neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], map_swaps_axes(map_coefficients(code).data()), sampler.filter,
                                   sampler.max_aniso, 0, distance_u, distance_v, dudx, dvdx, dudy, dvdy)) {
         ++kept;
         continue;
       }
       ++skipped;
-      const UvMap map = uv_map(transform);
+      const UvMap map = uv_map(code);
       const glm::vec2 p = map.point({u, v}), dx = map.direction({dudx, dvdx}), dy = map.direction({dudy, dvdy});
       const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER,
                                                    p.x, p.y, dx.x, dx.y, dy.x, dy.y);
@@ -426,7 +472,7 @@ TEST(Traverse, ReachTestSkipsOnlyNeighboursThatWouldAddNothing) {
       const int k = j % 4;
       const int other = j < 4 ? n.neighbor[k] : n.corner[k];
       if (other < 0) continue;
-      const UvMap map = uv_map(j < 4 ? n.transform[k] : n.corner_transform[k]);
+      const UvMap map = uv_map(j < 4 ? n.edge_map[k] : n.corner_map[k]);
       const glm::vec2 p = map.point({l.u, l.v}), dx = map.direction({l.dudx, l.dvdx}), dy = map.direction({l.dudy, l.dvdy});
       const FaceGpu& g = packed.faces[static_cast<size_t>(other)];
       const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER,
@@ -486,12 +532,12 @@ TEST(Traverse, EdgeReachTestSkipsOnlyFacesThatWouldAddNothing) {
           if (other < 0) continue;
           const bool c_along_v = c % 2 == 0;
           const float a = j < 4 ? -1.0f : inside[(c + 3) % 4], b = inside[c];
-          const float* transform = j < 4 ? n.transform[c] : n.corner_transform[c];
-          ASSERT_FALSE(neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], map_swaps_axes(transform),
+          const uint8_t code = j < 4 ? n.edge_map[c] : n.corner_map[c];
+          ASSERT_FALSE(neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], map_swaps_axes(map_coefficients(code).data()),
                                                sampler.filter, sampler.max_aniso, 0, c_along_v ? a : b,
                                                c_along_v ? b : a, l.dudx, l.dvdx, l.dudy, l.dvdy))
               << "edge " << k << " skips face " << other << " that the per-face test keeps";
-          const UvMap map = uv_map(transform);
+          const UvMap map = uv_map(code);
           const glm::vec2 p = map.point({l.u, l.v}), dx = map.direction({l.dudx, l.dvdx}),
                           dy = map.direction({l.dudy, l.dvdy});
           const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler,
@@ -512,7 +558,8 @@ TEST(Traverse, EdgeReachRecordsBoundTheFacesAround) {
   // its ends, their sides as they lie in this face's uv: the smallest side along the axis that
   // crosses the edge, and that times the largest ratio of the other axis's side to it. Checked
   // through the maps themselves: the other face's extent along this face's axis is its side
-  // mapped back. An edge with no face around keeps 0, and a record of zeros rules nothing out.
+  // mapped back. An edge with no face around keeps 0, and a record of zeros (SEAMCL_SIDE_NONE)
+  // rules nothing out.
   Scene prism = seamcl_tests::split_pentagonal_prism();
   seamcl_tests::set_textures(prism, seamcl_tests::mixed_texture_sizes(), seamcl_tests::distinct_texel);
   const PackedScene packed = pack_scene(prism, TexelFormat::Rgba32f);
@@ -523,7 +570,7 @@ TEST(Traverse, EdgeReachRecordsBoundTheFacesAround) {
       const bool along_v = k % 2 == 0;
       float side = 0.0f, ratio = 0.0f;
       const int across[3] = {n.neighbor[k], n.corner[k], n.corner[(k + 1) % 4]};
-      const float* maps[3] = {n.transform[k], n.corner_transform[k], n.corner_transform[(k + 1) % 4]};
+      const uint8_t maps[3] = {n.edge_map[k], n.corner_map[k], n.corner_map[(k + 1) % 4]};
       for (int i = 0; i < 3; ++i) {
         if (across[i] < 0) continue;
         const FaceGpu& g = packed.faces[static_cast<size_t>(across[i])];
@@ -537,8 +584,8 @@ TEST(Traverse, EdgeReachRecordsBoundTheFacesAround) {
         side = side == 0.0f ? along : std::min(side, along);
         ratio = std::max(ratio, cross / along);
       }
-      EXPECT_EQ(n.reach_min_side[k], side) << "face " << f << " edge " << k;
-      EXPECT_EQ(n.reach_max_side[k], side * ratio) << "face " << f << " edge " << k;
+      EXPECT_EQ(reach_side(n.reach_min_side[k]), side) << "face " << f << " edge " << k;
+      EXPECT_EQ(reach_side(n.reach_max_side[k]), side * ratio) << "face " << f << " edge " << k;
       filled += side > 0.0f;
     }
   }

@@ -1,6 +1,8 @@
 #include "pipeline/adjacency.h"
 
 #include <cassert>
+#include <cmath>
+#include <stdexcept>
 #include <map>
 #include <utility>
 
@@ -60,7 +62,17 @@ UvMap compose(const UvMap& second, const UvMap& first) {
   return {second.linear * first.linear, second.linear * first.offset + second.offset};
 }
 
-UvMap uv_map(const float t[6]) {
+std::array<float, 6> map_coefficients(uint8_t code) {
+  const bool swap = (code & SEAMCL_MAP_SWAP) != 0;
+  const float su = (code & SEAMCL_MAP_NEGATE_U) != 0 ? -1.0f : 1.0f;
+  const float sv = (code & SEAMCL_MAP_NEGATE_V) != 0 ? -1.0f : 1.0f;
+  const float ou = static_cast<float>(((code >> SEAMCL_MAP_OFFSET_U_SHIFT) & 3) - 1);
+  const float ov = static_cast<float>(((code >> SEAMCL_MAP_OFFSET_V_SHIFT) & 3) - 1);
+  return {swap ? 0.0f : su, swap ? su : 0.0f, ou, swap ? sv : 0.0f, swap ? 0.0f : sv, ov};
+}
+
+UvMap uv_map(uint8_t code) {
+  const std::array<float, 6> t = map_coefficients(code);
   UvMap map;
   // glm is column-major: linear[c][r].
   map.linear[0][0] = t[0];
@@ -72,13 +84,35 @@ UvMap uv_map(const float t[6]) {
   return map;
 }
 
-void store(const UvMap& map, float t[6]) {
-  t[0] = map.linear[0][0];
-  t[1] = map.linear[1][0];
-  t[2] = map.offset.x;
-  t[3] = map.linear[0][1];
-  t[4] = map.linear[1][1];
-  t[5] = map.offset.y;
+uint8_t encode_uv_map(const UvMap& map) {
+  const float t0 = map.linear[0][0], t1 = map.linear[1][0], t3 = map.linear[0][1], t4 = map.linear[1][1];
+  const auto unit = [](float x) { return x == 1.0f || x == -1.0f; };
+  unsigned code = 0;
+  if (t0 == 0.0f && t4 == 0.0f && unit(t1) && unit(t3)) {
+    code = SEAMCL_MAP_SWAP | (t1 < 0.0f ? SEAMCL_MAP_NEGATE_U : 0u) | (t3 < 0.0f ? SEAMCL_MAP_NEGATE_V : 0u);
+  } else if (t1 == 0.0f && t3 == 0.0f && unit(t0) && unit(t4)) {
+    code = (t0 < 0.0f ? SEAMCL_MAP_NEGATE_U : 0u) | (t4 < 0.0f ? SEAMCL_MAP_NEGATE_V : 0u);
+  } else {
+    throw std::logic_error("encode_uv_map: the linear part is not a signed permutation");
+  }
+  for (const auto& [offset, shift] : {std::pair{map.offset.x, SEAMCL_MAP_OFFSET_U_SHIFT}, {map.offset.y, SEAMCL_MAP_OFFSET_V_SHIFT}}) {
+    if (!(offset >= -1.0f && offset <= 2.0f) || offset != std::floor(offset)) {
+      throw std::logic_error("encode_uv_map: an offset is not a whole number in -1..2");
+    }
+    code |= static_cast<unsigned>(static_cast<int>(offset) + 1) << shift;
+  }
+  return static_cast<uint8_t>(code);
+}
+
+uint8_t encode_reach_side(float side) {
+  int exponent = 0;
+  const float mantissa = std::frexp(side, &exponent);  // side = mantissa 2^exponent, mantissa in [0.5, 1)
+  if (!(mantissa == 0.5f) || exponent - 1 < -126 || exponent - 1 > 127) return SEAMCL_SIDE_NONE;
+  return static_cast<uint8_t>(exponent - 1 + SEAMCL_SIDE_BIAS);
+}
+
+float reach_side(uint8_t stored) {
+  return stored == SEAMCL_SIDE_NONE ? 0.0f : std::ldexp(1.0f, static_cast<int>(stored) - SEAMCL_SIDE_BIAS);
 }
 
 UvMap corner_map(int k, int j, bool swap) {
@@ -153,7 +187,8 @@ std::vector<FaceNeighbors> build_adjacency(const Scene& scene) {
     for (int k = 0; k < 4; ++k) {
       n.neighbor[k] = -1;
       n.corner[k] = -1;
-      for (int i = 0; i < 6; ++i) n.transform[k][i] = n.corner_transform[k][i] = 0.0f;
+      n.edge_map[k] = n.corner_map[k] = 0;
+      n.reach_min_side[k] = n.reach_max_side[k] = SEAMCL_SIDE_NONE;  // fill_edge_reach fills them
       const uint32_t a = scene.faces[f].vertices[k], b = scene.faces[f].vertices[(k + 1) % 4];
       const auto& sharing = edges.at({std::min(a, b), std::max(a, b)});
       if (sharing.size() != 2) continue;
@@ -162,7 +197,7 @@ std::vector<FaceNeighbors> build_adjacency(const Scene& scene) {
       const Face& g = scene.faces[static_cast<size_t>(other.face)];
       const bool reversed = g.vertices[other.edge] == b;  // consistently oriented neighbours run the edge backwards
       n.neighbor[k] = other.face;
-      store(edge_map(k, other.edge, reversed), n.transform[k]);
+      n.edge_map[k] = encode_uv_map(edge_map(k, other.edge, reversed));
     }
   }
   // Corners, once every edge is linked: the diagonal face of a valence-4 vertex, reached across
@@ -184,9 +219,9 @@ std::vector<FaceNeighbors> build_adjacency(const Scene& scene) {
         if (at_vertex && to_entry && out[beside.face].neighbor[e] == static_cast<int>(diagonal.face)) across = e;
       }
       assert(across >= 0);
-      const UvMap map = compose(uv_map(out[beside.face].transform[across]), uv_map(out[f].transform[k]));
+      const UvMap map = compose(uv_map(out[beside.face].edge_map[across]), uv_map(out[f].edge_map[k]));
       out[f].corner[k] = static_cast<int>(diagonal.face);
-      store(map, out[f].corner_transform[k]);
+      out[f].corner_map[k] = encode_uv_map(map);
     }
   }
   return out;
@@ -201,7 +236,7 @@ bool has_adjacency(const std::vector<FaceNeighbors>& adjacency) {
 }
 
 glm::vec2 transform_uv(const FaceNeighbors& n, int edge, glm::vec2 uv, bool translate) {
-  const UvMap map = uv_map(n.transform[edge]);
+  const UvMap map = uv_map(n.edge_map[edge]);
   return translate ? map.point(uv) : map.direction(uv);
 }
 

@@ -2,6 +2,7 @@
 // (McDonald 2013, with Ptex's corners) and the guard bands read. Built once per scene from the
 // shared vertex indices: the edge neighbours, and the ring of faces around each corner's vertex.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -21,8 +22,17 @@ struct UvMap {
   glm::vec2 direction(glm::vec2 d) const { return linear * d; }
 };
 UvMap compose(const UvMap& second, const UvMap& first);  // first, then second
-UvMap uv_map(const float stored[6]);                     // as FaceNeighbors stores it
-void store(const UvMap& map, float stored[6]);
+// As FaceNeighbors stores a map (SEAMCL_MAP_* in kernels/seamcl_types.h): decoded to the same exact
+// floats as the kernels decode it, and encoded (std::logic_error for a map that is not a signed
+// permutation with whole offsets in -1..2).
+UvMap uv_map(uint8_t code);
+uint8_t encode_uv_map(const UvMap& map);
+// The map's coefficients as the kernels apply them: (t0 u + t1 v + t2, t3 u + t4 v + t5).
+std::array<float, 6> map_coefficients(uint8_t code);
+// A reach side as FaceNeighbors stores it: a power of two 2^-126..2^127 exactly, anything else
+// (0 included) as SEAMCL_SIDE_NONE, which reads back as 0 (never skips).
+uint8_t encode_reach_side(float side);
+float reach_side(uint8_t stored);
 
 // Per face, as the kernels read it (FaceNeighbors in kernels/seamcl_types.h). An edge shared by
 // exactly two faces links them; an edge of one face, or of three or more, has no neighbour. A

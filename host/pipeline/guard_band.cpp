@@ -130,13 +130,13 @@ void for_each_band_texel(const Scene& scene, const std::vector<FaceNeighbors>& a
   auto across_edge = [&](int e, const UvRect& rect) {
     const int other = adjacency[face].neighbor[e];
     if (other < 0) return filtered(scene, texels, face, rect);
-    return filtered(scene, texels, static_cast<uint32_t>(other), mapped(uv_map(adjacency[face].transform[e]), rect));
+    return filtered(scene, texels, static_cast<uint32_t>(other), mapped(uv_map(adjacency[face].edge_map[e]), rect));
   };
   // Past corner k (both of its edges continued).
   auto past_corner = [&](int k, const UvRect& rect) {
     const VertexRing& ring = rings[k];
     if (ring.valence() == 4) {
-      return filtered(scene, texels, ring.faces[1].face, mapped(uv_map(adjacency[face].corner_transform[k]), rect));
+      return filtered(scene, texels, ring.faces[1].face, mapped(uv_map(adjacency[face].corner_map[k]), rect));
     }
     glm::vec4 sum(0.0f);
     float count = 0.0f;

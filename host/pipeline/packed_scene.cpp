@@ -156,7 +156,7 @@ void fill_edge_reach(const std::vector<FaceGpu>& faces, std::vector<FaceNeighbor
     for (int k = 0; k < 4; ++k) {
       // The faces a lookup reaches across edge k: the neighbour and the diagonal faces past its ends.
       const int across[3] = {n.neighbor[k], n.corner[k], n.corner[(k + 1) % 4]};
-      const float* maps[3] = {n.transform[k], n.corner_transform[k], n.corner_transform[(k + 1) % 4]};
+      const uint8_t maps[3] = {n.edge_map[k], n.corner_map[k], n.corner_map[(k + 1) % 4]};
       // Edges 0 and 2 are crossed along v, 1 and 3 along u (this face's uv).
       const bool along_v = k % 2 == 0;
       float side = 0.0f, ratio = 0.0f;
@@ -167,8 +167,7 @@ void fill_edge_reach(const std::vector<FaceGpu>& faces, std::vector<FaceNeighbor
           break;
         }
         const FaceGpu& g = faces[static_cast<size_t>(across[i])];
-        // The maps are signed permutations: t0 = 0 when the other face's u runs along this face's v.
-        const bool swapped = maps[i][0] == 0.0f;
+        const bool swapped = (maps[i] & SEAMCL_MAP_SWAP) != 0;  // the other face's u runs along this face's v
         const float side_u = static_cast<float>(swapped ? g.height : g.width);
         const float side_v = static_cast<float>(swapped ? g.width : g.height);
         const float along = along_v ? side_v : side_u, cross = along_v ? side_u : side_v;
@@ -179,8 +178,11 @@ void fill_edge_reach(const std::vector<FaceGpu>& faces, std::vector<FaceNeighbor
         side = side == 0.0f ? along : std::min(side, along);
         ratio = std::max(ratio, cross / along);  // powers of two: exact
       }
-      n.reach_min_side[k] = side;
-      n.reach_max_side[k] = side * ratio;  // powers of two: exact
+      const uint8_t min_side = encode_reach_side(side), max_side = encode_reach_side(side * ratio);  // powers of two: exact
+      // Both or neither: a max side read as 0 would understate the reach.
+      const bool stored = min_side != SEAMCL_SIDE_NONE && max_side != SEAMCL_SIDE_NONE;
+      n.reach_min_side[k] = stored ? min_side : SEAMCL_SIDE_NONE;
+      n.reach_max_side[k] = stored ? max_side : SEAMCL_SIDE_NONE;
     }
   }
 }

@@ -7,6 +7,8 @@
 #include "twins/shade_reflection.h"
 #include "twins/texture_sample.h"
 
+#include "pipeline/adjacency.h"
+
 namespace seamcl {
 
 SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y) {
@@ -71,14 +73,14 @@ uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const Tr
       continue;
     }
     // The same filter on the neighbour, as traverse carries it there.
-    const float reach = weight_carried(n.neighbor[k], n.transform[k]);
+    const float reach = weight_carried(n.neighbor[k], map_coefficients(n.edge_map[k]).data());
     seam = seam || crosses || !(reach <= tolerance);
   }
   // The diagonal face past each valence-4 corner, as traverse reads it: a coarser one's taps can
   // reach back over the corner although no edge's footprint crosses.
   for (int k = 0; k < 4; ++k) {
     if (n.corner[k] < 0) continue;
-    const float reach = weight_carried(n.corner[k], n.corner_transform[k]);
+    const float reach = weight_carried(n.corner[k], map_coefficients(n.corner_map[k]).data());
     seam = seam || !(reach <= tolerance);
   }
   seam = seam || (!any_edge && !(own >= 1.0f - tolerance));  // past a corner only

@@ -1,6 +1,7 @@
 #include "twins/texture_sample.h"
 
 #include "core/srgb.h"
+#include "pipeline/adjacency.h"
 
 #include <algorithm>
 #include <bit>
@@ -398,7 +399,7 @@ int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, int guard
   for (int k = 0; k < 4; ++k) {
     // Edges 0 and 2 are crossed along v, 1 and 3 along u.
     const bool along_v = k % 2 == 0;
-    const bool ruled_out = axis_rules_out(n.reach_min_side[k], n.reach_max_side[k], filter, max_aniso, guard_band,
+    const bool ruled_out = axis_rules_out(reach_side(n.reach_min_side[k]), reach_side(n.reach_max_side[k]), filter, max_aniso, guard_band,
                                           inside[k], along_v ? x_v : x_u, along_v ? x_u : x_v, along_v ? y_v : y_u,
                                           along_v ? y_u : y_v);
     mask |= (ruled_out ? 0 : 1) << k;
@@ -463,7 +464,7 @@ FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const Samp
   for (int k = 0; k < 4; ++k) {
     if (((edge_may_reach >> k) & 1) == 0) continue;
     const bool along_v = k % 2 == 0;
-    add_across(n.neighbor[k], n.transform[k], along_v ? -1.0f : inside[k], along_v ? inside[k] : -1.0f);
+    add_across(n.neighbor[k], map_coefficients(n.edge_map[k]).data(), along_v ? -1.0f : inside[k], along_v ? inside[k] : -1.0f);
   }
   if (sampler.traverse != SEAMCL_TRAVERSE_CORNERS) return sum;
   // Past a valence-4 corner, the diagonal face (corner k lies between edges k-1 and k): past both.
@@ -472,7 +473,7 @@ FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const Samp
     if (((edge_may_reach >> k) & (edge_may_reach >> ((k + 3) % 4)) & 1) == 0) continue;
     const float a = inside[(k + 3) % 4], b = inside[k];
     const bool b_along_v = k % 2 == 0;
-    add_across(n.corner[k], n.corner_transform[k], b_along_v ? a : b, b_along_v ? b : a);
+    add_across(n.corner[k], map_coefficients(n.corner_map[k]).data(), b_along_v ? a : b, b_along_v ? b : a);
   }
   return sum;
 }

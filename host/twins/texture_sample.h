@@ -31,8 +31,8 @@ FilterSum filter_texture_reference(const TextureView& textures, uint32_t face, c
 // other face's u and v run along this face's v and u (map_swaps_axes of the map to it).
 bool neighbor_may_contribute(const FaceGpu& other, bool swapped, int filter, int max_aniso, int guard_band,
                              float distance_u, float distance_v, float dudx, float dvdx, float dudy, float dvdy);
-// Whether a FaceNeighbors uv map (transform or corner_transform) swaps u and v (a signed
-// permutation with t0 = 0).
+// Whether a uv map's coefficients (map_coefficients of FaceNeighbors' edge_map or corner_map)
+// swap u and v (a signed permutation with t0 = 0).
 bool map_swaps_axes(const float transform[6]);
 // EWA's bound, for any face whose shorter side is no less than min_side and whose aspect is no
 // more than max_side / min_side; min_side 0 (not known) never rules out.
