@@ -223,6 +223,30 @@ TEST(Assets, TraverseAndGuardbandRefuseAMeshWithoutSharedEdgesSingleQuadsStillRe
   }
   options.method = Method::Discard;
   EXPECT_TRUE(all_finite(renderer.render(scene.camera, options).pixels));
+  // Whatever came before: a discard render (no adjacency packed), a seam-mask render (the empty
+  // adjacency packed and kept), a guardband band that is not 1..16.
+  for (Method method : {Method::Guardband, Method::Traverse, Method::TraverseEdges}) {
+    options.method = method;
+    EXPECT_NE(input_error([&] { renderer.render(scene.camera, options); }, "method").find("share an edge"),
+              std::string::npos);
+  }
+  options.method = Method::Black;
+  EXPECT_EQ(renderer.render(scene.camera, options, true).seam_mask.size(), size_t{32 * 32});
+  EXPECT_EQ(renderer.packed_scene().neighbors.size(), 2u);
+  for (Method method : {Method::Traverse, Method::Guardband}) {
+    options.method = method;
+    EXPECT_NE(input_error([&] { renderer.render(scene.camera, options); }, "method").find("share an edge"),
+              std::string::npos);
+  }
+  options.method = Method::Guardband;
+  for (int band : {0, -1, 17}) {
+    options.guard_band = band;
+    EXPECT_NE(input_error([&] { renderer.render(scene.camera, options); }, "guard_band").find("1..16"),
+              std::string::npos);
+  }
+  options.guard_band = 4;
+  options.method = Method::Discard;
+  EXPECT_TRUE(all_finite(renderer.render(scene.camera, options).pixels));  // still usable
   const Scene quad = load_scene_source(unit_quad_obj(dir));
   renderer.load_scene(quad);
   options.method = Method::Traverse;

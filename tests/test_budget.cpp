@@ -266,7 +266,7 @@ TEST(Budget, RepackInAnotherFormatOrBandHoldsOnlyTheNewPacking) {
 }
 
 TEST(Budget, TheAdjacencyIsPackedOnlyForTheRendersThatReadIt) {
-  // 256 bytes a face (25 MB at 99,037 faces): discard, clamp and black never read it.
+  // 48 bytes a face (4.75 MB at 99,037 faces): discard, clamp and black never read it.
   const Scene scene = generate_scene("paper", {});
   const RenderOptions discard = options_of(Method::Discard, TexelFormat::Rgba8, 4, 64, 48);
   RenderOptions traverse = discard;
@@ -291,13 +291,18 @@ TEST(Budget, TheAdjacencyIsPackedOnlyForTheRendersThatReadIt) {
   EXPECT_EQ(renderer.device_bytes(), with_mask.device_bytes());
   EXPECT_EQ(packed_host_bytes(renderer.packed_scene()), with_mask.host_packed);
 
-  // Added later or packed from the start, it is the same adjacency: traverse renders identically,
-  // and the mask is the same as a fresh Renderer's.
+  // Added later or packed with the textures (a Renderer loaded in RGBA32F repacks for this RGBA8
+  // render), it is pack_scene's adjacency: traverse renders identically, and the mask is the same.
   const RenderResult later = renderer.render(scene.camera, traverse);
   Renderer fresh(seamcl_tests::shared_runtime());
-  fresh.load_scene(scene);
+  fresh.load_scene(scene, TexelFormat::Rgba32f);
   const RenderResult first = fresh.render(scene.camera, traverse);
   EXPECT_EQ(fresh.device_bytes(), render_memory(scene, traverse).device_bytes());
+  const std::vector<FaceNeighbors> packed_with_textures = pack_scene(scene).neighbors;
+  ASSERT_EQ(packed_with_textures.size(), scene.faces.size());
+  EXPECT_EQ(std::memcmp(packed_with_textures.data(), renderer.packed_scene().neighbors.data(),
+                        scene.faces.size() * sizeof(FaceNeighbors)),
+            0);
   ASSERT_EQ(later.pixels.size(), first.pixels.size());
   EXPECT_EQ(std::memcmp(later.pixels.data(), first.pixels.data(), first.pixels.size() * sizeof(glm::vec4)), 0);
   EXPECT_TRUE(std::memcmp(fresh.packed_scene().neighbors.data(), renderer.packed_scene().neighbors.data(),
@@ -412,6 +417,7 @@ TEST(Budget, CompareMemoryBoundsWhatTheCompareHolds) {
     phase1 = std::max(phase1, renderer.device_bytes());
   }
   EXPECT_EQ(renderer.packed_scene().neighbors.size(), scene.faces.size());
+  renderer.release_frame_buffers();  // as prepare_targets does before the references
   const ReferenceImage reference = reference_image(scene, scene.camera, frame, settings, [&](const RenderOptions& high) {
     RenderResult r = renderer.render(scene.camera, high);
     phase1 = std::max(phase1, renderer.device_bytes());

@@ -26,6 +26,11 @@ struct PhaseDevice {
     image = std::max(image, m.image);
     seam_mask = std::max(seam_mask, m.seam_mask);
   }
+  // The scene's buffers only: a packing held over from an earlier phase.
+  void include_scene(const RenderMemory& m) {
+    scene = std::max(scene, m.scene_device_bytes());
+    constants = std::max(constants, m.constants);
+  }
   size_t bytes(bool bound) const {
     return add(add(add(scene, constants), add(setups, tiles)),
                add(add(bound ? tile_lists_bound : tile_lists, samples), add(image, seam_mask)));
@@ -56,25 +61,27 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
     out.analytic = render_memory(scene, reference_render_options(frame, one_sample));
   }
 
-  PhaseDevice phase1;
+  // Phase 0, the masks: prepare_targets' footprint masks, one per rate (footprint_seam_mask), after
+  // the scene is loaded (and a face map, where one is made). They pack the adjacency, which the
+  // Renderer keeps through the references and, unless a method repacks, the methods; their frame
+  // buffers and the mask are released before the references.
+  PhaseDevice phase0, phase1, phase3;
   RenderOptions loaded = frame;  // load_scene packs the frame's format without a band, as any method but guardband
   loaded.method = Method::Discard;
-  phase1.include(render_memory(scene, loaded));
-  PhaseDevice phase3;
-  // prepare_targets' footprint masks, one per rate (footprint_seam_mask): they pack the adjacency,
-  // which the Renderer keeps through the references and, unless a method repacks, the methods; the
-  // mask buffer goes with the references' frame buffers.
+  phase0.include(render_memory(scene, loaded));
+  phase0.include(out.face_map);
   size_t largest_packed = std::max(out.face_map.host_packed, out.reference.host_packed);
   for (const MethodEntry& entry : entries) {
     RenderOptions mask_options = entry.options;
     mask_options.method = Method::Black;
-    RenderMemory mask = render_memory(scene, mask_options, true);
+    const RenderMemory mask = render_memory(scene, mask_options, true);
     largest_packed = std::max(largest_packed, mask.host_packed);
-    phase1.include(mask);
-    mask.seam_mask = 0;
-    phase3.include(mask);
+    phase0.include(mask);
+    phase1.include_scene(mask);
+    phase3.include_scene(mask);
   }
-  phase1.include(out.face_map);
+  // Phase 1, the references.
+  phase1.include(render_memory(scene, loaded));
   if (high_res) phase1.include(out.reference);
   if (analytic) phase1.include(out.analytic);
   int largest_rate = 1;
@@ -100,8 +107,8 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
     out.seamless = render_memory(*seamless_scene, seamless_frame);
     phase2_device = add(add(phase1.scene, phase1.constants), out.seamless.device_bytes_bound());
   }
-  out.device_bytes = std::max({phase1.bytes(false), phase2_device, phase3.bytes(false)});
-  out.device_bytes_bound = std::max({phase1.bytes(true), phase2_device, phase3.bytes(true)});
+  out.device_bytes = std::max({phase0.bytes(false), phase1.bytes(false), phase2_device, phase3.bytes(false)});
+  out.device_bytes_bound = std::max({phase0.bytes(true), phase1.bytes(true), phase2_device, phase3.bytes(true)});
 
   const size_t pixels = mul(static_cast<size_t>(std::max(frame.width, 1)), static_cast<size_t>(std::max(frame.height, 1)));
   const size_t frame_image = mul(pixels, sizeof(glm::vec4));

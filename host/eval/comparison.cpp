@@ -193,6 +193,8 @@ ComparisonTargets prepare_targets(ClRuntime& runtime, Renderer& renderer, const 
     say("seam mask at msaa " + std::to_string(entry.options.msaa));
     targets.masks[entry.options.msaa] = footprint_seam_mask(renderer, camera, entry.options);
   }
+  // The masks' frame buffers go before the references' (compare_memory counts them apart).
+  renderer.release_frame_buffers();
   if (!high_res_kinds.empty()) {
     const RenderOptions high = reference_render_options(frame, settings);
     std::string names;

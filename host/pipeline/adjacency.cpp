@@ -115,7 +115,8 @@ uint8_t encode_reach_side(float side) {
 }
 
 float reach_side(uint8_t stored) {
-  return stored == SEAMCL_SIDE_NONE ? 0.0f : std::ldexp(1.0f, static_cast<int>(stored) - SEAMCL_SIDE_BIAS);
+  // Below 2 (never encoded) 0, as the kernels' exponent bits give it.
+  return stored < 2 ? 0.0f : std::ldexp(1.0f, static_cast<int>(stored) - SEAMCL_SIDE_BIAS);
 }
 
 UvMap corner_map(int k, int j, bool swap) {

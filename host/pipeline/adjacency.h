@@ -45,7 +45,7 @@ std::vector<FaceNeighbors> build_adjacency(const Scene& scene);
 // discard or clamp.
 bool has_adjacency(const std::vector<FaceNeighbors>& adjacency);
 
-// Applies transform k of `n` to a uv point (or, with translate = false, to a derivative).
+// Applies edge map k of `n` to a uv point (or, with translate = false, to a derivative).
 glm::vec2 transform_uv(const FaceNeighbors& n, int edge, glm::vec2 uv, bool translate = true);
 
 // A face of the ring around a vertex: which of its corners is the vertex, and the vertex at the

@@ -37,8 +37,8 @@ inline constexpr int kMaxGuardBand = 16;
 
 // Fills FaceNeighbors' reach_min_side / reach_max_side (traverse's per-edge early-out) from the
 // sizes of the faces across each edge and past its ends, as they lie in the face's own uv (see
-// seamcl_types.h); pack_scene calls it. An edge with no such face, or one of a size below 1,
-// keeps 0 (never skips).
+// seamcl_types.h); pack_scene calls it, and the Renderer when it adds the adjacency later. An edge
+// with no such face, or one of a size below 1, keeps SEAMCL_SIDE_NONE (never skips).
 void fill_edge_reach(const std::vector<FaceGpu>& faces, std::vector<FaceNeighbors>& neighbors);
 
 // With guard_band > 0 every level is stored with that many band texels each side (guard_band.h).

@@ -60,7 +60,8 @@ size_t RenderMemory::frame_device_bytes() const {
 }
 size_t RenderMemory::device_bytes() const { return add(add(scene_device_bytes(), constants), frame_device_bytes()); }
 size_t RenderMemory::device_bytes_bound() const {
-  return add(add(scene_device_bytes(), constants), add(add(add(setups, tiles), add(tile_lists_bound, samples)), image));
+  return add(add(scene_device_bytes(), constants),
+             add(add(add(setups, tiles), add(tile_lists_bound, samples)), add(image, seam_mask)));
 }
 size_t RenderMemory::host_bytes() const { return add(add(host_scene, host_packed), host_image); }
 

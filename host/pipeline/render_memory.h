@@ -12,7 +12,8 @@
 //   touch more tiles than that. `tile_lists_bound` is the upper bound after any growth: every
 //   clip slot of every triangle on every tile; Renderer::set_device_byte_limit refuses growth past
 //   a limit (OverBudget) instead. A Renderer that keeps its buffers between
-//   requests holds, per buffer, the largest size any of them needed.
+//   requests holds, per buffer, the largest size any of them needed (the adjacency too: once a
+//   request read it, it stays until a repack for one that does not).
 // - Host bytes are the payload of the arrays the Renderer holds (its Scene copy, the packed
 //   arrays, the read-back image): exact in element bytes; vector headers, capacity beyond size
 //   and heap overhead are not counted. The caller's own Scene is not counted either

@@ -398,6 +398,10 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
                                "inside (any other method gives the same mask)");
   }
   const SamplerParams sampler = sampler_params(options);
+  if (options.method == Method::Guardband && !(sampler.guard_band >= 1 && sampler.guard_band <= kMaxGuardBand)) {
+    throw InputError("guard_band", "must be 1.." + std::to_string(kMaxGuardBand) + " texels for guardband, got " +
+                                       std::to_string(sampler.guard_band));
+  }
   const bool repack =
       !impl_->uploaded || options.texels != impl_->packed.format || sampler.guard_band != impl_->packed.guard_band;
   // The adjacency is built by the first render that reads it (held here, not packed, until the
@@ -406,7 +410,9 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   const bool keep_adjacency = reads_adjacency(options.method) || with_seam_mask;
   std::vector<FaceNeighbors> adjacency;
   if ((keep_adjacency && (repack || impl_->packed.neighbors.empty())) || (repack && sampler.guard_band > 0)) {
-    adjacency = build_adjacency(*impl_->scene);
+    // A repack in another format or band keeps the same adjacency: a copy of the one held (the
+    // held one stays until the checks pass), else built.
+    adjacency = impl_->packed.neighbors.empty() ? build_adjacency(*impl_->scene) : impl_->packed.neighbors;
   }
   // Neither built nor kept: a banded packing, whose adjacency was checked when it was made.
   if (needs_adjacency(options.method) && !has_adjacency(adjacency.empty() ? impl_->packed.neighbors : adjacency)) {

@@ -64,6 +64,8 @@ class Renderer {
   // again (scene() gives it back) holds no second copy of its float texels (image faces).
   void load_scene(Scene&& scene, TexelFormat format = TexelFormat::Rgba8);
   const Scene& scene() const;
+  // What the kernels read. Its adjacency (neighbors) is empty until a render reads it (traverse,
+  // traverse-edges, a seam mask), and again after a repack for one that does not.
   const PackedScene& packed_scene() const;
   // The cube map of the last render's cube method as uploaded (pack_cube_texels), for the twins;
   // empty for a scene without an environment.

@@ -16,7 +16,7 @@ enum class TexelFormat { Rgba8, Rgba32f };
 // texel arrays is used, as `format` says.
 struct TextureView {
   const std::vector<FaceGpu>* faces;
-  const std::vector<FaceNeighbors>* neighbors;  // read by traverse only
+  const std::vector<FaceNeighbors>* neighbors;  // read by traverse and the seam mask; may be empty
   const std::vector<uint32_t>* level_offsets;
   TexelFormat format;
   const std::vector<uint32_t>* texels8;   // RGBA8 sRGB
