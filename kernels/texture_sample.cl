@@ -688,6 +688,16 @@ SEAMCL_INLINE float4 sample_texture(__global const FaceGpu* faces, __global cons
   return resolve_sum(sum, &face, level_offsets, texels, srgb_to_linear, sampler, u, v, dudx, dvdx, dudy, dvdy);
 }
 
+/* FaceNeighbors' bytes as the kernels decode them, for the test against the host's decoding:
+ * out[7 b ..] = decode_uv_map(b)'s six coefficients, reach_side(b), for every byte b. */
+__kernel void neighbor_bytes_decoded(__global float* out) {
+  const uint b = get_global_id(0);
+  if (b > 255u) return;
+  const UvMap m = decode_uv_map(b);
+  for (int k = 0; k < 6; ++k) out[7 * b + (uint)k] = m.t[k];
+  out[7 * b + 6] = reach_side(b);
+}
+
 /* Lookups for tests and benchmarks, one per work-item: lookups[7 i ..] = face (as a float), u, v,
  * dudx, dvdx, dudy, dvdy; out[i] = the lookup's colour. */
 __kernel void texture_lookup_batch(__global const FaceGpu* faces, __global const FaceNeighbors* neighbors,

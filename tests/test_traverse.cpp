@@ -198,6 +198,24 @@ TEST(Adjacency, MapsAndSidesRoundTripThroughTheirBytes) {
   EXPECT_EQ(reach_side(SEAMCL_SIDE_NONE), 0.0f);
 }
 
+TEST(Adjacency, KernelsDecodeEveryByteAsTheHostDoes) {
+  // Every byte as a map and as a reach side, decoded by the kernels' decode_uv_map and reach_side:
+  // the same floats, bit for bit (signed zeros included), as map_coefficients and reach_side.
+  cl::Kernel kernel(shared_runtime().program(), "neighbor_bytes_decoded");
+  cl::Buffer out(shared_runtime().context(), CL_MEM_WRITE_ONLY, sizeof(float) * 7 * 256);
+  kernel.setArg(0, out);
+  shared_runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(256));
+  std::vector<float> device(7 * 256);
+  shared_runtime().queue().enqueueReadBuffer(out, CL_TRUE, 0, sizeof(float) * device.size(), device.data());
+  for (int b = 0; b < 256; ++b) {
+    const std::array<float, 6> host = map_coefficients(static_cast<uint8_t>(b));
+    EXPECT_EQ(std::memcmp(host.data(), &device[7 * static_cast<size_t>(b)], sizeof(float) * 6), 0) << "map byte " << b;
+    const float side = reach_side(static_cast<uint8_t>(b));
+    EXPECT_EQ(std::memcmp(&side, &device[7 * static_cast<size_t>(b) + 6], sizeof(float)), 0)
+        << "side byte " << b << ": host " << side << ", kernel " << device[7 * static_cast<size_t>(b) + 6];
+  }
+}
+
 TEST(Traverse, ContinuesAcrossTheEdgeWhereDiscardStops) {
   // Two faces of quad2, texture content continuous across the shared edge. A footprint centred
   // exactly on the edge: discard sees only its own face's half; traverse sees both halves, which
