@@ -1,9 +1,9 @@
 #include "pipeline/adjacency.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <stdexcept>
-#include <algorithm>
 #include <tuple>
 #include <utility>
 
@@ -186,8 +186,8 @@ std::vector<FaceNeighbors> build_adjacency(const Scene& scene) {
     }
   }
   // Every face's edges by their undirected vertex pair, sorted: the faces that share an edge lie
-  // side by side. 16 bytes an edge (a tree of them held about 40 MB at 99,037 faces, while the
-  // packed texels were already there).
+  // side by side. 16 bytes an edge: a std::map of vectors, held while the packed texels were
+  // already there, took traverse's peak at 99,037 faces 4.8 MB higher.
   std::vector<EdgeRef> edges;
   edges.reserve(scene.faces.size() * 4);
   for (size_t f = 0; f < scene.faces.size(); ++f) {
