@@ -6,7 +6,8 @@
 
 #ifdef __OPENCL_C_VERSION__
 /* No fused multiply-add contraction: the scalar C++ twins (built with -ffp-contract=off) then
- * round exactly as the kernels do. */
+ * round exactly as the kernels do. Where a kernel wants a fused multiply-add it calls fma(), and
+ * its twin std::fma (texture_sample.cl's add_texel). */
 #pragma OPENCL FP_CONTRACT OFF
 /* Every helper inlined: a helper left as a call (LLVM's inliner gives up on the larger sampler
  * functions) stops PoCL from vectorising the work-group loop around it. */

@@ -44,7 +44,8 @@ void add_texel(FilterSum& sum, const TextureView& tex, uint32_t index, float wei
   } else {
     texel = decode_srgb8(tex.texels8->at(index));
   }
-  sum.color += weight * texel;
+  // One rounding per channel, as the kernel's fma (the library builds with contraction off).
+  for (int c = 0; c < 4; ++c) sum.color[c] = std::fma(weight, texel[c], sum.color[c]);
   sum.weight += weight;
 }
 
