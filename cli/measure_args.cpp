@@ -4,6 +4,7 @@
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/pipeline/displacement_method.h>
+#include <seamcl/pipeline/render_options.h>
 
 namespace seamcl::cli {
 void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& default_methods) {
@@ -13,11 +14,16 @@ void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& d
   command->add_option("--methods", a.methods, "Comma list of seam methods [" + default_methods + "]");
   command->add_option("--msaa", a.msaa, "Comma list of MSAA rates (1, 2, 4, 8, 16) [1,2,4,8]");
   command->add_option("--aniso", a.aniso, "Maximum anisotropy, 1..16 [16]");
+  command->add_option("--guard-band", a.guard_band, "guardband: band texels per side of every level, 1..16 [4]");
+  command->add_option("--cube-method", a.cube_method,
+                      "Cube-map seam method of scenes with an environment (envmap): " + join_names(cube_method_names()) +
+                          " [cube-seamless]");
   command->add_option("--filter", a.filter, "Texture filter [aniso]");
   command->add_option("--zero-coverage", a.zero_coverage, "discard with every tap outside: clamp or nan [clamp]");
   command->add_option("--texels", a.texels, "Texel storage: rgba8 or rgba32f [rgba8]");
   command->add_option("--size", a.size, "Image size WIDTHxHEIGHT [480x540]");
   command->add_option("--shading", a.shading, "Where to shade: pixel, centroid or sample [pixel]");
+  command->add_flag("--centroid", a.centroid, "Shade at the centroid of the covered samples (same as --shading centroid)");
   command->add_option("--displacement-method", a.displacement_method,
                       "Tessellate and displace with this method: " + join_names(displacement_method_names()) + " [off]");
   command->add_option("--tessellation", a.tessellation, "Displacement: each patch a (T+1)^2 grid, T 1..64 [8]");
@@ -45,6 +51,9 @@ nlohmann::json measure_request(const MeasureArgs& a) {
   if (a.zero_coverage) request["zero_coverage"] = *a.zero_coverage;
   if (a.texels) request["texels"] = *a.texels;
   if (a.aniso) request["aniso"] = *a.aniso;
+  if (a.guard_band) request["guard_band"] = *a.guard_band;
+  if (a.cube_method) request["cube_method"] = *a.cube_method;
+  if (a.centroid) request["centroid"] = true;
   if (a.size) request["size"] = *a.size;
   if (a.shading) request["shading"] = *a.shading;
   if (a.tint) request["tint"] = true;

@@ -12,13 +12,14 @@
 namespace seamcl::cli {
 
 struct MeasureArgs {
-  std::optional<std::string> scene, texture, filter, zero_coverage, texels, size, shading;
-  std::optional<int> aniso;
+  std::optional<std::string> scene, texture, filter, zero_coverage, texels, size, shading, cube_method;
+  std::optional<int> aniso, guard_band;
   std::optional<std::string> displacement_method;
   std::optional<int> tessellation, displacement_level;
   std::string methods;
   std::string msaa = "1,2,4,8";
   bool tint = false;
+  bool centroid = false;
   std::string reference_method;
   int reference_msaa = 0;
   std::string cache_dir;

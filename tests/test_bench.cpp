@@ -238,13 +238,28 @@ TEST_F(Bench, BadInputExits2NamingTheField) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"--methods discard,bogus", "methods"}, {"--methods ''", "methods"},   {"--msaa 1,3", "msaa"},
       {"--msaa 1,x", "msaa"},                 {"--frames 0", "frames"},     {"--frames abc", "frames"},
-      {"--reference-frames 0", "reference"},  {"--size 0x10", "size"}};
+      {"--reference-frames 0", "reference"},  {"--size 0x10", "size"},      {"--guard-band 0", "guard_band"},
+      {"--cube-method bogus", "cube_method"}};
   for (const auto& [flags, field] : cases) {
     const BenchProcess p = run_cli(*dir_, "bench --scene quad2 --size 32x32 --frames 2 --no-errors " + flags);
     EXPECT_EQ(p.exit_code, 2) << flags << ": " << p.err;
     EXPECT_NE(p.err.find(field), std::string::npos) << flags << ": " << p.err;
     EXPECT_TRUE(p.out.empty()) << flags;
   }
+}
+
+// compare and bench take render's frame options; these three once were render's alone.
+TEST_F(Bench, CompareTakesGuardBandCubeMethodAndCentroid) {
+  const BenchProcess c = run_cli(*dir_, "compare --scene quad2 --methods guardband --msaa 4 --size 32x32 --repeat 1 "
+                                        "--guard-band 2 --cube-method cube-clamp --centroid --json --no-progress");
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const json options = json::parse(c.out).at("options");
+  EXPECT_EQ(options.at("guard_band"), 2);
+  EXPECT_EQ(options.at("cube_method"), "cube-clamp");
+  EXPECT_EQ(options.at("shading"), "centroid");
+  const BenchProcess bad = run_cli(*dir_, "compare --scene quad2 --methods guardband --size 32x32 --guard-band 17");
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("guard_band"), std::string::npos) << bad.err;
 }
 
 // compare's loop moved into host/eval/comparison.cpp; this is the loop as it stood in

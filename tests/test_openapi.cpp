@@ -84,6 +84,12 @@ TEST(OpenApi, EnumsAreTheParsersNames) {
       EXPECT_EQ(option.at("default"), to_json(RenderOptions{}).at(key)) << where;
     }
   }
+  // displacement_method has no default (absent: no displacement), in every place it is described.
+  for (const auto& [where, option] : option_schemas("displacement_method")) {
+    ASSERT_TRUE(option.contains("enum")) << where << " has no enum";
+    EXPECT_EQ(option.at("enum").get<std::vector<std::string>>(), displacement_method_names()) << where;
+    EXPECT_FALSE(option.contains("default")) << where;
+  }
   // format is the server's own option: exactly the names parse_image_format takes.
   for (const auto& [where, option] : option_schemas("format")) {
     ASSERT_TRUE(option.contains("enum")) << where;
@@ -132,7 +138,7 @@ TEST(OpenApi, MsaaIsTheAllowedRates) {
 }
 
 TEST(OpenApi, IntegerOptionsHaveTheParsersBounds) {
-  for (const std::string key : {"aniso", "guard_band", "frame", "frames"}) {
+  for (const std::string key : {"aniso", "guard_band", "frame", "frames", "tessellation", "displacement_level"}) {
     for (const auto& [where, option] : option_schemas(key)) {
       EXPECT_EQ(option.value("type", ""), "integer") << where;
       ASSERT_TRUE(option.contains("minimum") && option.contains("maximum")) << where << ": " << option.dump();

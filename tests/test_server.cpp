@@ -483,6 +483,21 @@ TEST_F(Server, MethodsListsOptionsRangesAndTextureMemory) {
   EXPECT_THROW(parse_render_options({{"aniso", aniso.at("maximum").get<int>() + 1}}), InputError);
   EXPECT_THROW(parse_render_options({{"aniso", aniso.at("minimum").get<int>() - 1}}), InputError);
   for (const json& msaa : body.at("options").at("msaa").at("enum")) EXPECT_NO_THROW(parse_render_options({{"msaa", msaa}}));
+  // Every option the parser takes is listed (the displacement ones and texture too), with its bounds.
+  for (const char* key : {"texture", "displacement_method", "tessellation", "displacement_level"}) {
+    EXPECT_TRUE(body.at("options").contains(key)) << key;
+  }
+  EXPECT_EQ(body.at("options").at("displacement_method").at("enum").get<std::vector<std::string>>(),
+            displacement_method_names());
+  EXPECT_EQ(body.at("options").at("tessellation").at("default"), RenderOptions{}.tessellation);
+  EXPECT_EQ(body.at("options").at("displacement_level").at("default"), RenderOptions{}.displacement_level);
+  for (const char* key : {"tessellation", "displacement_level"}) {
+    const json& range = body.at("options").at(key);
+    EXPECT_NO_THROW(parse_render_options({{key, range.at("minimum")}})) << key;
+    EXPECT_NO_THROW(parse_render_options({{key, range.at("maximum")}})) << key;
+    EXPECT_THROW(parse_render_options({{key, range.at("minimum").get<int>() - 1}}), InputError) << key;
+    EXPECT_THROW(parse_render_options({{key, range.at("maximum").get<int>() + 1}}), InputError) << key;
+  }
   // The size pattern is the document's (tests/test_openapi.cpp holds that one to the parser).
   EXPECT_EQ(body.at("options").at("size").at("pattern"),
             openapi().at("components").at("schemas").at("RenderRequest").at("properties").at("size").at("pattern"));

@@ -206,7 +206,7 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
     } else if (key == "tessellation") {
       options.tessellation = int_field(value, key, 1, SEAMCL_MAX_TESSELLATION);
     } else if (key == "displacement_level") {
-      options.displacement_level = int_field(value, key, 0, 16);
+      options.displacement_level = int_field(value, key, 0, kMaxDisplacementLevel);
     } else if (key == "cube_method") {
       options.cube_method = enum_field(value, key, "cube method", kCubeMethods);
     } else {
