@@ -18,6 +18,7 @@
 
 #include <sys/wait.h>
 
+#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include "assets/environment_file.h"
@@ -231,6 +232,17 @@ TEST(EnvironmentFile, HostileInputsAreRefusedNamingTheField) {
   expect_input_error(load(R"({"file": "sky.exr", "layout": "cross"})"), "options.environment.file", "'cross' needs");
   expect_input_error(load(R"({"file": "nan.exr"})"), "options.environment.file", "texel (3, 2) is not finite");
   expect_input_error(load(R"({"file": "inf.exr"})"), "options.environment.file", "texel (5, 0) is not finite");
+  // Finite but past kMaxColorMagnitude (a float EXR: write_image stores half, whose largest is 65504).
+  {
+    std::vector<glm::vec4> huge = equirect_pixels(16, 8);
+    huge[16 + 7].b = 3e9f;
+    auto out = OIIO::ImageOutput::create(dir.file("huge.exr"));
+    ASSERT_TRUE(out);
+    ASSERT_TRUE(out->open(dir.file("huge.exr"), OIIO::ImageSpec(16, 8, 4, OIIO::TypeDesc::FLOAT)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, huge.data()));
+    ASSERT_TRUE(out->close());
+  }
+  expect_input_error(load(R"({"file": "huge.exr"})"), "options.environment.file", "texel (7, 1) has a magnitude over 1e9");
   expect_input_error(load(R"({"file": ""})"), "options.environment.file", "non-empty");
   expect_input_error(load(R"({"file": 3})"), "options.environment.file", "string");
   expect_input_error(load(R"({"layout": "cross"})"), "options.environment.layout", "goes with file");

@@ -720,6 +720,14 @@ TEST(SceneJson, RejectsBadDocumentsNamingTheField) {
       {"light.ambient", "/light", R"({"ambient": 2})"},
       {"orbit.radius", "/orbit", R"({"center": [0, 0, 0], "radius": -1})"},
       {"background[0]", "/background", R"([-1, 0, 0])"},
+      // colours past kMaxColorMagnitude (1e9), which could overflow a render to NaN
+      {"faces[1].texture.color[0]", "/faces/1/texture/color/0", R"(2e9)"},
+      {"background[2]", "/background", R"([1, 1, 3e38])"},
+      {"light.color[1]", "/light", R"({"color": [1, 1e10, 1]})"},
+      {"options.constant_color[0]", "", R"({"generator": "quad2", "options": {"constant_color": [1e38, 1, 1]}})"},
+      {"options.environment.constant[0]", "",
+       R"({"generator": "envmap", "options": {"environment": {"constant": [3e38, 3e38, 3e38]}}})"},
+      {"faces[0].vertices", "/positions/1", R"([3e38, -3e38, 0])"},  // the quad's area overflows
       // generator documents (any other field is unknown: the first, alphabetically, is named)
       {"generator", "", R"({"generator": "teapot"})"},
       {"generator", "", R"({"generator": 3})"},

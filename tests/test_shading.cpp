@@ -17,6 +17,7 @@
 #include <glm/glm.hpp>
 
 #include <seamcl/cl/cl_runtime.h>
+#include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
@@ -237,6 +238,54 @@ TEST(Shading, BackgroundIsExactAtEverySampleCount) {
       EXPECT_GT(background_pixels, 0u);
       EXPECT_EQ(wrong, 0u) << "msaa " << msaa << ": " << wrong << " of " << background_pixels
                            << " background pixels differ, first " << first;
+    }
+  }
+}
+
+// Colour values as large as a scene may hold them (kMaxColorMagnitude: textures, the light, the
+// background, a constant environment) render without NaN or infinity with the default settings
+// (zero_coverage clamp) under the seam methods and filters, at 1x and 4x: 1e9 * 1e9 stays far from a float's
+// range, where a light of 3e38 on such a texture once put NaN (infinity times a zero n.l) in the
+// image.
+TEST(Shading, ColoursAtTheirBoundRenderFinite) {
+  const glm::vec3 largest(kMaxColorMagnitude);
+  GeneratorOptions generator_options;
+  generator_options.constant_color = largest;
+  for (const char* name : {"mixed", "envmap"}) {
+    Scene scene = generate_scene(name, generator_options);
+    scene.light.color = largest;
+    scene.background = largest;
+    ASSERT_NO_THROW(validate_scene(scene)) << name;
+    if (std::string(name) == "envmap") {
+      ASSERT_TRUE(scene.environment && scene.environment->constant) << "envmap's environment is the constant colour";
+    }
+    Renderer renderer(seamcl_tests::shared_runtime());
+    renderer.load_scene(scene, TexelFormat::Rgba32f);
+    // One filter per method (each pair a program variant to build): the renormalising methods,
+    // the one with bands and a plain one.
+    for (const auto& [method, filter] : {std::pair{Method::Discard, Filter::Aniso}, std::pair{Method::Traverse, Filter::Ewa},
+                                         std::pair{Method::Guardband, Filter::Aniso}, std::pair{Method::Clamp, Filter::Trilinear}}) {
+      {
+        for (const int msaa : {1, 4}) {
+          RenderOptions options;
+          options.method = method;
+          options.filter = filter;
+          options.msaa = msaa;
+          options.texels = TexelFormat::Rgba32f;
+          options.width = 48;
+          options.height = 40;
+          SCOPED_TRACE(std::string(name) + " " + to_string(method) + " " + to_string(filter) + " " + std::to_string(msaa) + "x");
+          const RenderResult result = renderer.render(scene.camera, options);
+          size_t nonfinite = 0;
+          float brightest = 0.0f;
+          for (const glm::vec4& p : result.pixels) {
+            nonfinite += !(std::isfinite(p.r) && std::isfinite(p.g) && std::isfinite(p.b));
+            brightest = std::max({brightest, p.r, p.g, p.b});
+          }
+          EXPECT_EQ(nonfinite, 0u);
+          EXPECT_GT(brightest, 1e8f);  // the large values reached the image
+        }
+      }
     }
   }
 }

@@ -7,6 +7,7 @@
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/scene/cube_map.h>
+#include <seamcl/scene/scene.h>
 
 namespace seamcl {
 
@@ -93,6 +94,9 @@ EnvironmentImage environment_image_from_pixels(EnvironmentLayout layout, const s
       if (!std::isfinite(v.r) || !std::isfinite(v.g) || !std::isfinite(v.b))
         throw InputError(fields[k], "texel (" + std::to_string(p % image.width) + ", " +
                                         std::to_string(p / image.width) + ") is not finite");
+      if (std::fabs(v.r) > kMaxColorMagnitude || std::fabs(v.g) > kMaxColorMagnitude || std::fabs(v.b) > kMaxColorMagnitude)
+        throw InputError(fields[k], "texel (" + std::to_string(p % image.width) + ", " +
+                                        std::to_string(p / image.width) + ") has a magnitude over 1e9");
     }
   }
   EnvironmentImage out;
@@ -191,6 +195,10 @@ void validate_environment(const Environment& e) {
   }
   auto finite = [](glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
   if (e.constant && !finite(*e.constant)) throw InputError("environment.constant", "must be finite");
+  if (e.constant && (glm::any(glm::lessThan(*e.constant, glm::vec3(0.0f))) ||
+                     glm::any(glm::greaterThan(*e.constant, glm::vec3(kMaxColorMagnitude))))) {
+    throw InputError("environment.constant", "each component must be in [0, 1e9]");
+  }
   if (e.files) {
     if (e.constant) throw InputError("environment.constant", "cannot go with an image environment (file or faces)");
     const size_t expected = e.files->layout == EnvironmentLayout::Faces ? 6 : 1;
@@ -199,7 +207,7 @@ void validate_environment(const Environment& e) {
                        "must name " + std::to_string(expected) + " file(s)");
   }
   const AnalyticEnvironment& a = e.analytic;
-  if (!finite(a.sun_direction) || glm::length(a.sun_direction) < 1e-6f) {
+  if (!finite(a.sun_direction) || glm::length(glm::dvec3(a.sun_direction)) < 1e-6) {
     throw InputError("environment.sun_direction", "must be a finite, non-zero vector");
   }
   if (!(a.sun_radius > 0.0f && a.sun_radius <= 3.2f)) {

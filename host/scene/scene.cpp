@@ -53,6 +53,12 @@ void check_vec3(glm::vec3 v, const std::string& field) {
   if (!is_finite(v)) throw InputError(field, "must be finite");
 }
 
+void check_color(glm::vec3 c, const std::string& field) {
+  check_vec3(c, field);
+  if (glm::any(glm::lessThan(c, glm::vec3(0.0f)))) throw InputError(field, "must not be negative");
+  if (glm::any(glm::greaterThan(c, glm::vec3(kMaxColorMagnitude)))) throw InputError(field, "must be at most 1e9");
+}
+
 void check_texture(const MipChain& chain, const std::string& field, bool may_defer) {
   if (chain.levels.empty()) throw InputError(field, "has no mip levels");
   const int width = chain.width();
@@ -85,7 +91,7 @@ void check_texture(const MipChain& chain, const std::string& field, bool may_def
                                   size_text(expected_width, expected_height));
     }
   }
-  check_finite_texels(chain, field);
+  check_texel_magnitudes(chain, field);
 }
 
 }  // namespace
@@ -357,10 +363,14 @@ void check_reflective_face(const Scene& scene, const Face& face, const std::stri
 
 }  // namespace
 
-void check_finite_texels(const MipChain& chain, const std::string& field) {
+void check_texel_magnitudes(const MipChain& chain, const std::string& field) {
   for (size_t k = 0; k < chain.levels.size(); ++k)
     for (const glm::vec4& texel : chain.levels[k].texels)
-      if (!is_finite(texel)) throw InputError(field, "mip level " + std::to_string(k) + " has a non-finite texel");
+      if (!is_finite(texel)) {
+        throw InputError(field, "mip level " + std::to_string(k) + " has a non-finite texel");
+      } else if (glm::any(glm::greaterThan(glm::abs(texel), glm::vec4(kMaxColorMagnitude)))) {
+        throw InputError(field, "mip level " + std::to_string(k) + " has a texel of magnitude over 1e9");
+      }
 }
 
 void validate_scene(const Scene& scene) {
@@ -381,8 +391,9 @@ void validate_scene(const Scene& scene) {
     const auto [p0, p1, p2, p3] = scene.corners(face);
     const glm::vec3 diagonal_cross = glm::cross(p2 - p0, p3 - p1);
     const float area_measure = glm::length(diagonal_cross);
-    if (!(area_measure > 0.0f) || !std::isfinite(area_measure))
-      throw InputError(face_field + ".vertices", "the quad is degenerate (zero area)");
+    if (!std::isfinite(area_measure))
+      throw InputError(face_field + ".vertices", "the quad's corners are too far apart (its area overflows a float)");
+    if (!(area_measure > 0.0f)) throw InputError(face_field + ".vertices", "the quad is degenerate (zero area)");
     check_texture(face.texture, face_field + ".texture", static_cast<bool>(scene.texture_source));
     check_reflective_face(scene, face, face_field);
   }
@@ -421,14 +432,10 @@ void validate_scene(const Scene& scene) {
   check_vec3(light.to_light, "light.to_light");
   if (std::abs(glm::length(light.to_light) - 1.0f) > 1e-3f)
     throw InputError("light.to_light", "must be a unit vector");
-  check_vec3(light.color, "light.color");
-  if (glm::any(glm::lessThan(light.color, glm::vec3(0.0f))))
-    throw InputError("light.color", "must not be negative");
+  check_color(light.color, "light.color");
   if (!std::isfinite(light.ambient) || light.ambient < 0.0f || light.ambient > 1.0f)
     throw InputError("light.ambient", "must be in [0, 1]");
-  check_vec3(scene.background, "background");
-  if (glm::any(glm::lessThan(scene.background, glm::vec3(0.0f))))
-    throw InputError("background", "must not be negative");
+  check_color(scene.background, "background");
 }
 
 }  // namespace seamcl

@@ -148,10 +148,16 @@ Camera orbit_camera(const Scene& scene, int frame, int frames);
 // field on the first violation.
 void validate_scene(const Scene& scene);
 
-// Throws InputError(field) naming the first mip level that holds a NaN or infinite texel: what
-// validate_scene checks of a stored chain, and what a deferred chain's source checks when it makes
-// one (an image may hold NaN or infinity, and large finite values may overflow in the box filter).
-void check_finite_texels(const MipChain& chain, const std::string& field);
+// The largest magnitude of a colour value a scene may hold: texels (of textures and environment
+// images) and the colours of lights, backgrounds and environments. Larger finite values can
+// overflow a filter's weighted sum or the light's product to infinity, and infinity times a zero
+// weight is NaN in the image. The .ptx reader's bound is the same (PtexLimits::max_texel_magnitude).
+inline constexpr float kMaxColorMagnitude = 1e9f;
+
+// Throws InputError(field) naming the first mip level that holds a NaN, infinite or larger than
+// kMaxColorMagnitude texel: what validate_scene checks of a stored chain, and what a deferred
+// chain's source checks when it makes one (an image may hold any float).
+void check_texel_magnitudes(const MipChain& chain, const std::string& field);
 
 }  // namespace seamcl
 

@@ -136,9 +136,10 @@ glm::vec3 read_vec3(const json& value, const std::string& path) {
 
 glm::vec3 read_color(const json& value, const std::string& path) {
   const glm::vec3 color = read_vec3(value, path);
-  for (int c = 0; c < 3; ++c)
-    if (color[c] < 0.0f)
-      throw InputError(element_path(path, static_cast<size_t>(c)), "must not be negative");
+  for (int c = 0; c < 3; ++c) {
+    if (color[c] < 0.0f) throw InputError(element_path(path, static_cast<size_t>(c)), "must not be negative");
+    if (color[c] > kMaxColorMagnitude) throw InputError(element_path(path, static_cast<size_t>(c)), "must be at most 1e9");
+  }
   return color;
 }
 
@@ -456,7 +457,7 @@ Scene read_explicit_scene(const json& doc, const std::string& default_name, cons
     scene.texture_source = [recipes = std::make_shared<const std::vector<FaceRecipe>>(recipes)](size_t f) {
       const FaceRecipe& recipe = recipes->at(f);
       MipChain chain = make_face_chain(recipe);
-      check_finite_texels(chain, recipe.field);
+      check_texel_magnitudes(chain, recipe.field);
       return chain;
     };
   } else {
