@@ -171,6 +171,74 @@ TEST(Assets, ObjRefusesAFaceThatIsNotAQuadNamingItsIndexAndLine) {
   EXPECT_NE(input_error([] { read_obj_file("/nonexistent/x.obj"); }, "scene").find("no such file"), std::string::npos);
 }
 
+// tinyobjloader reads an index with atoi (which wraps) and a number as its longest numeric prefix or 0;
+// the reader's own pre-scan refuses them first, naming the line and the word.
+TEST(Assets, ObjRefusesBadNumbersAndIndicesNamingTheLineAndTheWord) {
+  const std::string quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+  struct Case {
+    std::string text, expected;
+  };
+  for (const Case& c : {
+           Case{quad + "f 99999999999999999999 2 3 4\n",
+                "'bad.obj': face 0 (0-based; line 5) names a vertex that does not exist: '99999999999999999999'; "
+                "the file has 4 vertices"},
+           Case{quad + "f 4294967297 2 3 4\n",
+                "'bad.obj': face 0 (0-based; line 5) names a vertex that does not exist: '4294967297'; the file has 4 vertices"},
+           Case{"v nan 0 0\n" + quad + "f 1 2 3 4\n", "'bad.obj': vertex 0 (0-based; line 1): 'nan' is not a finite number"},
+           Case{quad + "v inf 0 0\nf 1 2 3 4\n", "'bad.obj': vertex 4 (0-based; line 5): 'inf' is not a finite number"},
+           Case{quad + "v 0x10 0 0\nf 1 2 3 4\n", "'bad.obj': vertex 4 (0-based; line 5): '0x10' is not a decimal number"},
+           Case{quad + "v 1,5 0 0\nf 1 2 3 4\n", "'bad.obj': vertex 4 (0-based; line 5): '1,5' is not a decimal number"},
+           // More of the same kind.
+           Case{quad + "v 0 -INF 0\nf 1 2 3 4\n", "vertex 4 (0-based; line 5): '-INF' is not a finite number"},
+           Case{quad + "v 0 0 1e39\nf 1 2 3 4\n", "vertex 4 (0-based; line 5): '1e39' is out of the range of a 32-bit float"},
+           Case{quad + "v 1 2\nf 1 2 3 4\n", "vertex 4 (0-based; line 5) has 2 numbers"},
+           Case{quad + "f 1 2 3 0\n", "face 0 (0-based; line 5) names vertex '0'; OBJ indices start at 1"},
+           Case{quad + "f 1 2 3 4.0\n", "face 0 (0-based; line 5) has a vertex index '4.0' that is not an integer"},
+           Case{quad + "f 1 2 3 -5\n", "face 0 (0-based; line 5) names a vertex that does not exist: '-5' counts back past the 4 "
+                                       "vertices before line 5"},
+           Case{quad + "f 1 2 3 4\nf 1 2 3 -4294967295\n", "face 1 (0-based; line 6) names a vertex that does not exist: '-4294967295'"},
+           Case{quad + "f 1/2 2 3 4\n", "face 0 (0-based; line 5) names a texture coordinate that does not exist: '2' in corner "
+                                        "'1/2'; the file has 0 texture coordinates"},
+           Case{"vn 0 0 1\n" + quad + "f 1//x 2 3 4\n", "face 0 (0-based; line 6) has a normal index 'x' in corner '1//x'"},
+           Case{quad + "f 1/1/1/1 2 3 4\n", "face 0 (0-based; line 5) has a corner '1/1/1/1' that is not i, i/j, i//k or i/j/k"},
+           // A lone carriage return ends a line for tinyobjloader, so it does here: no line hides behind a comment.
+           Case{"# a comment\rv nan 0 0\r\n" + quad + "f 1 2 3 4\n", "vertex 0 (0-based; line 2): 'nan' is not a finite number"},
+       }) {
+    SCOPED_TRACE(c.text);
+    const std::string message = input_error([&] { parse_obj(c.text, "bad.obj"); }, "scene");
+    EXPECT_NE(message.find(c.expected), std::string::npos) << message;
+  }
+  // A hostile word is quoted cut short and without control characters, so the message stays one short line.
+  const std::string long_word = input_error([&] { parse_obj(quad + "v 1 2 3" + std::string(1000, '\x01') + "\nf 1 2 3 4\n", "bad.obj"); }, "scene");
+  EXPECT_NE(long_word.find("vertex 4 (0-based; line 5): '3???"), std::string::npos) << long_word;
+  EXPECT_LT(long_word.size(), 200u) << long_word;
+  // Through read_obj_file and the field a scene file names, as a mesh on disk is read.
+  TempDir dir;
+  const std::string path = dir.write("nan.obj", quad + "v nan 0 0\nf 1 2 3 4\n");
+  const std::string message = input_error([&] { read_obj_file(path, "mesh"); }, "mesh");
+  EXPECT_NE(message.find("'" + path + "': vertex 4 (0-based; line 5): 'nan' is not a finite number"), std::string::npos) << message;
+}
+
+TEST(Assets, ObjStillReadsSlashedRelativeAndForwardIndicesWAndVertexColours) {
+  // w, vertex colours, a comment after a vertex, '+' and exponents; i/j/k, i/j, i//k, negative
+  // (relative) indices in every part, and a forward reference to a vertex defined further on.
+  const std::string text = "vt 0 0\nvt 1 0\nvn 0 0 1\n"
+                           "v +1 +.5 -.5e-3 1.\n"
+                           "v 1 2 3 0.5 0.5 0.5 # coloured\n"
+                           "v 1e-5 2.5E+2 -0 \t\r\n"
+                           "v .25 1. 7\n"
+                           "f 1/1/1 2/2/1 3//1 4/1\n"
+                           "f -4 -3/-2 -2//-1 -1/-1/-1\n"
+                           "f 4 3 2 1\n"
+                           "f 1 2 3 5\n"
+                           "v 9 9 9\n";
+  const ObjMesh mesh = parse_obj(text, "forms.obj");
+  const std::vector<glm::vec3> positions{{1.0f, 0.5f, -0.5e-3f}, {1, 2, 3}, {1e-5f, 250, -0.0f}, {0.25f, 1, 7}, {9, 9, 9}};
+  EXPECT_EQ(mesh.positions, positions);
+  const std::vector<std::array<uint32_t, 4>> faces{{0, 1, 2, 3}, {0, 1, 2, 3}, {3, 2, 1, 0}, {0, 1, 2, 4}};
+  EXPECT_EQ(mesh.faces, faces);
+}
+
 TEST(Assets, SamplePairsLoadWithTheFilesAdjacencyAgreeingWithTheMesh) {
   for (const SamplePair& pair : kPairs) {
     SCOPED_TRACE(pair.texture);

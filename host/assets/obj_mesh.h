@@ -23,7 +23,12 @@ inline constexpr size_t kMaxObjBytes = size_t{1} << 28;
 // Parses OBJ text. Lines whose first word is `version` or `surface` (written by the tools that
 // made the Ptex samples; not OBJ) are skipped. A face that is not a quad, an index out of range
 // or a non-finite position is InputError(field, ...) naming `source` and the face by its 0-based
-// index among the file's faces (the Ptex face id) and its 1-based line number.
+// index among the file's faces (the Ptex face id) and its 1-based line number. Every `v` line must
+// hold x y z, x y z w or x y z r g b, each a whole decimal number that is a finite float; every face
+// corner must be i, i/j, i//k or i/j/k of whole non-zero integers naming elements that exist (a
+// positive index counts from the file's first element, so forward references are allowed; a negative
+// one counts back from the line). A bad one is InputError naming `source`, the vertex or face, its
+// line and the word at fault. Lines end at "\n", "\r\n" or a lone "\r", as tinyobjloader reads them.
 ObjMesh parse_obj(const std::string& text, const std::string& source = "mesh",
                   const std::string& field = "scene");
 
