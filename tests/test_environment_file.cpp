@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <OpenImageIO/imageio.h>
@@ -243,6 +244,9 @@ TEST(EnvironmentFile, HostileInputsAreRefusedNamingTheField) {
     ASSERT_TRUE(out->close());
   }
   expect_input_error(load(R"({"file": "huge.exr"})"), "options.environment.file", "texel (7, 1) has a magnitude over 1e9");
+  // A FIFO would block the read until something wrote to it.
+  ASSERT_EQ(::mkfifo(dir.file("fifo.exr").c_str(), 0600), 0);
+  expect_input_error(load(R"({"file": "fifo.exr"})"), "options.environment.file", "not a regular file");
   expect_input_error(load(R"({"file": ""})"), "options.environment.file", "non-empty");
   expect_input_error(load(R"({"file": 3})"), "options.environment.file", "string");
   expect_input_error(load(R"({"layout": "cross"})"), "options.environment.layout", "goes with file");

@@ -12,7 +12,10 @@
 #include <map>
 #include <set>
 #include <nlohmann/json.hpp>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <seamcl/assets/obj_mesh.h>
 #include <seamcl/assets/ptex_file.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/scene/scene.h>
@@ -469,7 +472,23 @@ TEST(Ptex, NamesThePartAtFault) {
 
 TEST(Ptex, ReadFileNamesThePath) {
   const std::string missing = ptex_assets_dir() + "/no-such-file.ptx";
-  EXPECT_NE(expect_input_error([&] { read_ptex_file(missing); }).find(missing + ": cannot be read"), std::string::npos);
+  EXPECT_NE(expect_input_error([&] { read_ptex_file(missing); }).find(missing + ": no such file"), std::string::npos);
+  // A FIFO would block the open until something wrote to it; a directory reads as a huge size.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("seamcl_ptex_special_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "folder.ptx");
+  const std::string fifo = (dir / "fifo.ptx").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(expect_input_error([&] { read_ptex_file(fifo); }).find(fifo + ": not a regular file"), std::string::npos);
+  const std::string folder = (dir / "folder.ptx").string();
+  EXPECT_NE(expect_input_error([&] { read_ptex_file(folder); }).find(folder + ": not a regular file"), std::string::npos);
+  try {
+    read_obj_file(fifo);
+    ADD_FAILURE() << "a FIFO read as a mesh";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "scene");
+    EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
   const std::filesystem::path obj = ptex_assets_dir() + "/plane.obj";
   EXPECT_NE(expect_input_error([&] { read_ptex_file(obj.string()); }).find(obj.string() + ": header: not a Ptex file"),
             std::string::npos);

@@ -281,8 +281,10 @@ ObjMesh parse_obj(const std::string& text, const std::string& source, const std:
 
 ObjMesh read_obj_file(const std::string& path, const std::string& field) {
   std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error))
+  if (!std::filesystem::exists(path, error))
     throw InputError(field, "cannot read mesh file '" + path + "': no such file");
+  if (!std::filesystem::is_regular_file(path, error))
+    throw InputError(field, "cannot read mesh file '" + path + "': not a regular file");
   const std::uintmax_t size = std::filesystem::file_size(path, error);
   if (error || size > kMaxObjBytes)
     throw InputError(field, "mesh file '" + path + "' is larger than " + std::to_string(kMaxObjBytes >> 20) + " MiB");

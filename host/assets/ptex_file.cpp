@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <memory>
@@ -817,6 +818,11 @@ PtexFile parse_ptex(std::span<const uint8_t> bytes, const PtexLimits& limits, bo
 }
 
 PtexFile read_ptex_file(const std::string& path, const PtexLimits& limits, bool defer_textures) {
+  // A FIFO or a device would block the open or the read until something wrote to it; a directory
+  // opens and reads as an enormous size.
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) throw InputError("texture", path + ": no such file");
+  if (!std::filesystem::is_regular_file(path, error)) throw InputError("texture", path + ": not a regular file");
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw InputError("texture", path + ": cannot be read (" + std::strerror(errno) + ")");
   const std::streamoff size = in.tellg();

@@ -100,6 +100,10 @@ namespace {
 
 // The file opened for reading: its header is read, none of its pixels yet.
 std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path) {
+  // A FIFO or a device would block the open or the read until something wrote to it.
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) throw std::runtime_error("cannot read " + path + ": no such file");
+  if (!std::filesystem::is_regular_file(path, error)) throw std::runtime_error("cannot read " + path + ": not a regular file");
   auto input = OIIO::ImageInput::open(path);
   if (!input) throw std::runtime_error("cannot read " + path + ": " + OIIO::geterror());
   return input;
