@@ -861,3 +861,33 @@ TEST(Assets, TheAssetDirectoryRefusesNamesThatLeaveItAndCachesWhatItLoads) {
   uncached.load("plane.obj", "", {});
   EXPECT_EQ(uncached.cached_entries(), 0u);
 }
+
+// A mesh without a .ptx gets the surface pattern at 64 x 64 a face, fewer texels a face when its
+// faces would hold more than kMaxMeshTexels in all (a 1.6 MB OBJ of 40,000 faces once packed 218 M
+// texels and peaked at 1.1 GB), and is refused when even one texel a face is too many.
+TEST(Assets, MeshTexturesStayWithinTheTexelBound) {
+  EXPECT_EQ(mesh_texture_side(1, 64), 64);
+  EXPECT_EQ(mesh_texture_side(16384, 64), 64);  // 2^14 faces x 2^12 texels = 2^26
+  EXPECT_EQ(mesh_texture_side(16385, 64), 32);
+  EXPECT_EQ(mesh_texture_side(40000, 64), 32);
+  EXPECT_EQ(mesh_texture_side(kMaxMeshTexels, 64), 1);
+  for (const size_t faces : {size_t{1}, size_t{1000}, size_t{40000}, kMaxMeshTexels / 4, kMaxMeshTexels}) {
+    const size_t side = static_cast<size_t>(mesh_texture_side(faces, 64));
+    EXPECT_LE(faces * side * side, kMaxMeshTexels) << faces;
+    EXPECT_TRUE(side == 64 || faces * (2 * side) * (2 * side) > kMaxMeshTexels) << faces << ": the largest side that fits";
+  }
+  // A 200 x 100 grid of quads: 20,000 faces get 32 x 32 each.
+  ObjMesh grid;
+  constexpr int kColumns = 200, kRows = 100;
+  for (int y = 0; y <= kRows; ++y)
+    for (int x = 0; x <= kColumns; ++x) grid.positions.push_back(glm::vec3(x, y, 0));
+  for (int y = 0; y < kRows; ++y)
+    for (int x = 0; x < kColumns; ++x) {
+      const uint32_t v = static_cast<uint32_t>(y * (kColumns + 1) + x);
+      grid.faces.push_back({v, v + 1, v + kColumns + 2, v + kColumns + 1});
+    }
+  const Scene scene = scene_from_mesh(grid, 64, "grid.obj", /*defer_textures=*/true);
+  ASSERT_EQ(scene.faces.size(), 20000u);
+  EXPECT_EQ(scene.faces[0].texture.width(), 32);
+  EXPECT_EQ(scene.faces.back().texture.height(), 32);
+}

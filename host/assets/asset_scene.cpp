@@ -41,9 +41,19 @@ Scene scene_from_ptex(ObjMesh mesh, PtexFile ptex, const std::string& mesh_name,
   return scene;
 }
 
+int mesh_texture_side(size_t faces, int texture_size) {
+  int side = texture_size;
+  while (side > 1 && faces * static_cast<size_t>(side) * static_cast<size_t>(side) > kMaxMeshTexels) side /= 2;
+  return side;
+}
+
 Scene scene_from_mesh(ObjMesh mesh, int texture_size, const std::string& mesh_name, bool defer_textures) {
   if (texture_size < 1 || (texture_size & (texture_size - 1)) != 0)
     throw std::invalid_argument("scene_from_mesh: texture_size must be a power of two");
+  if (mesh.faces.size() > kMaxMeshTexels)
+    throw InputError("scene", "'" + mesh_name + "' has " + std::to_string(mesh.faces.size()) + " faces; a mesh without a "
+                              ".ptx may have at most " + std::to_string(kMaxMeshTexels) + " (one texel each)");
+  texture_size = mesh_texture_side(mesh.faces.size(), texture_size);
   Scene scene = scene_of_mesh(std::move(mesh), mesh_name);
   if (defer_textures) {
     // The source keeps its own copy of the corners, so it stays right in any copy of the scene.

@@ -18,7 +18,15 @@ Scene scene_from_ptex(ObjMesh mesh, PtexFile ptex, const std::string& mesh_name,
 // Every face the surface pattern (surface_pattern), baked at texture_size x texture_size texels
 // (a power of two): for a mesh without textures of its own. With defer_textures, baked by
 // Scene::texture_source when packed instead (the faces hold their sizes only).
+// At most kMaxMeshTexels level-0 texels in all (the bound of scene files' textures): a mesh with
+// more faces than texture_size^2 texels each would fit gets smaller textures (a power of two a side,
+// mesh_texture_side), one of more faces than kMaxMeshTexels is refused (InputError "scene").
 Scene scene_from_mesh(ObjMesh mesh, int texture_size, const std::string& mesh_name, bool defer_textures = false);
+
+inline constexpr size_t kMaxMeshTexels = size_t{1} << 26;
+// The side of each face's texture for a mesh of `faces` faces: texture_size, halved until the
+// faces' texels fit kMaxMeshTexels (at least 1).
+int mesh_texture_side(size_t faces, int texture_size);
 
 // The mesh a .ptx carries in its metadata, as an ObjMesh; InputError(field) when it has none.
 ObjMesh ptex_mesh(const PtexFile& ptex, const std::string& ptex_name, const std::string& field = "scene");
