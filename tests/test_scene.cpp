@@ -798,6 +798,17 @@ TEST(SceneJson, FileErrorsNameThePath) {
       expect_input_error([&] { load_scene_file(bad_content.path()); }, "faces[1].texture.width");
   EXPECT_NE(message.find(bad_content.path()), std::string::npos) << message;
 
+  // Past the bound the text is not parsed (sparse: the file reads as zeros); a file that fails
+  // mid-read is an input error, not an I/O exception.
+  {
+    const TemporaryFile huge("{}");
+    std::filesystem::resize_file(huge.path(), (std::uintmax_t{64} << 20) + 1);
+    message = expect_input_error([&] { load_scene_file(huge.path()); }, "scene");
+    EXPECT_NE(message.find("larger than 64 MiB"), std::string::npos) << message;
+  }
+  message = expect_input_error([&] { load_scene_file("/proc/self/mem"); }, "scene");
+  EXPECT_NE(message.find("/proc/self/mem"), std::string::npos) << message;
+
   const TemporaryFile good(minimal_document().dump());
   EXPECT_EQ(load_scene_file(good.path()).name, std::filesystem::path(good.path()).stem().string())
       << "an unnamed scene is named after its file";

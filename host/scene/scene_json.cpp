@@ -26,6 +26,8 @@ constexpr int kMaxTextureSide = 4096;
 // Level-0 texels over all faces (a full scene then takes ~1.4 GB): a bound that keeps a small
 // file from asking for more memory than the machine has.
 constexpr size_t kMaxSceneTexels = size_t{1} << 26;
+// A scene file's text: 64 MiB holds some 500,000 explicit faces.
+constexpr size_t kMaxSceneFileBytes = size_t{64} << 20;
 
 std::string member_path(const std::string& parent, std::string_view key) {
   return parent.empty() ? std::string(key) : parent + "." + std::string(key);
@@ -508,9 +510,19 @@ SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load
     throw InputError("scene", "cannot read scene file '" + path + "': not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError("scene", "cannot read scene file '" + path + "'");
+  // Read whole, in chunks and no further than the bound (the parsed document takes some 40 times
+  // the text), so that neither a huge file nor one that fails mid-read reaches the parser.
+  std::string text;
+  std::array<char, 1 << 16> chunk;
+  while (in.read(chunk.data(), chunk.size()) || in.gcount() > 0) {
+    text.append(chunk.data(), static_cast<size_t>(in.gcount()));
+    if (text.size() > kMaxSceneFileBytes)
+      throw InputError("scene", "scene file '" + path + "' is larger than " + std::to_string(kMaxSceneFileBytes >> 20) + " MiB");
+  }
+  if (in.bad()) throw InputError("scene", "cannot read scene file '" + path + "': a read failed");
   json doc;
   try {
-    doc = json::parse(in);
+    doc = json::parse(text);
   } catch (const json::exception& error) {
     throw InputError("scene", "scene file '" + path + "' is not valid JSON: " + error.what());
   }
