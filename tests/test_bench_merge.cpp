@@ -10,9 +10,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -256,6 +259,77 @@ TEST_F(BenchMerge, RefusesPartsThatDoNotMakeOneBatch) {
   other[0].json.erase("shard");
   EXPECT_EQ(field_of(other).rfind("shard | shard: part1.json: missing", 0), 0u) << field_of(other);
   EXPECT_EQ(field_of({}).rfind("parts", 0), 0u);
+}
+
+// Every field the merge reads is checked for its type and range before it is used: a corrupted
+// part is refused naming the field and the part, never merged with a value cut down to fit.
+TEST_F(BenchMerge, RefusesCorruptedFieldsNamingTheFieldAndThePart) {
+  const std::vector<BenchPart> parts = library_parts();
+  // The field and the message of the merge's InputError, or "merged".
+  auto refusal = [](const std::vector<BenchPart>& p) -> std::pair<std::string, std::string> {
+    try {
+      (void)merge_bench_parts(p);
+    } catch (const InputError& e) {
+      return {e.field(), e.what()};
+    }
+    return {"merged", ""};
+  };
+  // Unchanged parts still merge, to what the command wrote.
+  EXPECT_EQ(refusal(parts).first, "merged");
+  EXPECT_EQ(merge_bench_parts(parts), merged());
+
+  // The probe's case: frames beyond an int in every part (once merged as frames 4294967298 with
+  // shard.end_frame 2).
+  std::vector<BenchPart> other = parts;
+  for (BenchPart& p : other) p.json["frames"] = 4294967298ull;
+  auto [field, message] = refusal(other);
+  EXPECT_EQ(field, "frames");
+  EXPECT_EQ(message, "frames: part1.json: must be in 1..1000000, got 4294967298");
+
+  struct Corruption {
+    std::string what;             // for the failure message
+    std::function<void(json&)> corrupt;  // applied to part2.json only
+    std::string field;            // the field the refusal must name
+  };
+  const std::vector<Corruption> corruptions = {
+      {"frames 0", [](json& j) { j["frames"] = 0; }, "frames"},
+      {"frames -5", [](json& j) { j["frames"] = -5; }, "frames"},
+      {"frames 5.0", [](json& j) { j["frames"] = 5.0; }, "frames"},
+      {"nan_pixels \"x\"", [](json& j) { j["results"][0]["nan_pixels"] = "x"; }, "results[0].nan_pixels"},
+      {"nan_pixels -1", [](json& j) { j["results"][0]["nan_pixels"] = -1; }, "results[0].nan_pixels"},
+      {"nan_pixels not the per-frame sum", [](json& j) { j["results"][0]["nan_pixels"] = 7; }, "results[0].nan_pixels"},
+      {"results []", [](json& j) { j["results"] = json::array(); }, "results"},
+      {"device null", [](json& j) { j["device"] = nullptr; }, "device"},
+      {"shard.end_frame beyond an int", [](json& j) { j["shard"]["end_frame"] = 4294967298ull; }, "shard.end_frame"},
+      {"shard.index beyond an int", [](json& j) { j["shard"]["index"] = 4294967298ull; }, "shard.index"},
+      {"msaa beyond an int", [](json& j) { j["results"][1]["msaa"] = 4294967297ull; }, "results[1].msaa"},
+      {"no frame times", [](json& j) { j["results"][0]["ms_per_frame"] = json::array(); }, "results[0].ms_per_frame"},
+      {"a negative time", [](json& j) { j["results"][2]["ms_per_frame"][0] = -1.0; }, "results[2].ms_per_frame"},
+      {"an error frame outside the part", [](json& j) { j["error_frames"] = {99}; }, "error_frames"},
+      {"pixels beyond 2^53", [](json& j) { j["results"][0]["error"]["pixels"] = 18446744073709551615ull; },
+       "results[0].error.pixels"},
+      {"a temporal frame outside the part", [](json& j) { j["results"][0]["temporal_per_frame"][0]["frame"] = 0; },
+       "results[0].temporal_per_frame.frame"},
+      {"differences[0].a null", [](json& j) { j["differences"][0]["a"] = nullptr; }, "differences[0].a"},
+      {"wall_s a string", [](json& j) { j["wall_s"] = "1s"; }, "wall_s"},
+  };
+  for (const Corruption& c : corruptions) {
+    other = parts;
+    c.corrupt(other[1].json);
+    std::tie(field, message) = refusal(other);
+    EXPECT_EQ(field, c.field) << c.what << ": " << message;
+    EXPECT_EQ(message.rfind(c.field + ": part2.json: ", 0), 0u) << c.what << ": " << message;
+  }
+}
+
+TEST_F(BenchMerge, MergeCommandRefusesACorruptedPartAndWritesNothing) {
+  json bad = part(2);
+  bad["frames"] = 4294967298ull;
+  std::ofstream(*dir_ / "bad2.json") << bad.dump();
+  const CliRun r = seamcl(*dir_, "merge part1.json bad2.json part3.json -o corrupt_merged.json");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err.rfind("seamcl: frames: bad2.json: must be in 1..1000000, got 4294967298", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(*dir_ / "corrupt_merged.json"));
 }
 
 TEST_F(BenchMerge, MergeCommandRefusesFilesThatAreNotParts) {

@@ -7,6 +7,8 @@
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
+#include <seamcl/eval/shard.h>
+#include <seamcl/pipeline/render_options.h>
 
 namespace seamcl {
 
@@ -43,8 +45,18 @@ double mean_in_order(const std::vector<double>& values) {
 
 namespace {
 
-// Reading a part defensively: every missing key or wrong type is an InputError naming the key's
-// path and the part.
+// A value as an error shows it: its JSON, cut short.
+std::string shown(const json& value) {
+  const std::string text = value.dump(-1, ' ', false, json::error_handler_t::replace);
+  return text.size() > 40 ? text.substr(0, 40) + "..." : text;
+}
+
+// Counts (pixels, frames, bytes) are at most 2^53: exact in a double, and sums over the parts
+// cannot overflow.
+constexpr int64_t kMaxCount = int64_t{1} << 53;
+
+// Reading a part defensively: every missing key, wrong type or value out of range is an
+// InputError naming the key's path and the part.
 class Reader {
  public:
   explicit Reader(const BenchPart& part) : part_(part) {}
@@ -63,6 +75,16 @@ class Reader {
     if (!a.is_array()) refuse(path, "expected an array");
     return a;
   }
+  const json& object_field(const json& object, const std::string& key, const std::string& path) const {
+    const json& o = at(object, key, path);
+    if (!o.is_object()) refuse(path, "expected an object");
+    return o;
+  }
+  const std::string& string(const json& object, const std::string& key, const std::string& path) const {
+    const json& v = at(object, key, path);
+    if (!v.is_string()) refuse(path, "expected a string, got " + shown(v));
+    return v.get_ref<const std::string&>();
+  }
   double number(const json& value, const std::string& path) const {
     if (!value.is_number()) refuse(path, "expected a number");
     const double d = value.get<double>();
@@ -72,24 +94,63 @@ class Reader {
   double number(const json& object, const std::string& key, const std::string& path) const {
     return number(at(object, key, path), path);
   }
-  uint64_t count(const json& object, const std::string& key, const std::string& path) const {
-    const json& v = at(object, key, path);
-    if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<int64_t>() >= 0)) {
-      refuse(path, "expected a count (an integer >= 0)");
-    }
-    return v.get<uint64_t>();
+  // A measurement (a time, an error distance): a finite number >= 0.
+  double measure(const json& value, const std::string& path) const {
+    const double d = number(value, path);
+    if (d < 0) refuse(path, "expected a number >= 0, got " + shown(value));
+    return d;
   }
-  int integer(const json& object, const std::string& key, const std::string& path) const {
-    const json& v = at(object, key, path);
-    if (!v.is_number_integer() || v.get<int64_t>() < INT32_MIN || v.get<int64_t>() > INT32_MAX) {
-      refuse(path, "expected an integer");
-    }
-    return static_cast<int>(v.get<int64_t>());
+  double measure(const json& object, const std::string& key, const std::string& path) const {
+    return measure(at(object, key, path), path);
+  }
+  // The one way an integer is read: a JSON integer in lo..hi, never a fraction, a string or a
+  // value cut down to fit.
+  int64_t integer(const json& value, const std::string& path, int64_t lo, int64_t hi) const {
+    const std::string range = std::to_string(lo) + ".." + std::to_string(hi);
+    if (!value.is_number_integer()) refuse(path, "expected an integer in " + range + ", got " + shown(value));
+    const bool in_range = value.is_number_unsigned()
+                              ? hi >= 0 && value.get<uint64_t>() <= static_cast<uint64_t>(hi) &&
+                                    static_cast<int64_t>(value.get<uint64_t>()) >= lo
+                              : value.get<int64_t>() >= lo && value.get<int64_t>() <= hi;
+    if (!in_range) refuse(path, "must be in " + range + ", got " + shown(value));
+    return value.is_number_unsigned() ? static_cast<int64_t>(value.get<uint64_t>()) : value.get<int64_t>();
+  }
+  int64_t integer(const json& object, const std::string& key, const std::string& path, int64_t lo, int64_t hi) const {
+    return integer(at(object, key, path), path, lo, hi);
+  }
+  uint64_t count(const json& value, const std::string& path) const {
+    return static_cast<uint64_t>(integer(value, path, 0, kMaxCount));
+  }
+  uint64_t count(const json& object, const std::string& key, const std::string& path) const {
+    return count(at(object, key, path), path);
   }
   const std::string& name() const { return part_.name; }
 
+  // The part's frames [first, end), once its shard is checked.
+  void set_frames(int first, int end) {
+    first_ = first;
+    end_ = end;
+  }
+  int first_frame() const { return first_; }
+  int end_frame() const { return end_; }
+  // A frame index of this part.
+  int frame(const json& object, const std::string& key, const std::string& path) const {
+    return static_cast<int>(integer(object, key, path, first_, end_ - 1));
+  }
+  // object[key]: one value per frame of the part, each passed to check(value).
+  template <class Check>
+  const json& per_frame(const json& object, const std::string& key, const std::string& path, Check check) const {
+    const json& a = array(object, key, path);
+    if (a.size() != static_cast<size_t>(end_ - first_)) {
+      refuse(path, std::to_string(a.size()) + " values for the part's " + std::to_string(end_ - first_) + " frames");
+    }
+    for (const json& v : a) check(v);
+    return a;
+  }
+
  private:
   const BenchPart& part_;
+  int first_ = 0, end_ = 0;
 };
 
 // Appends a[key] of every part, in part order (the parts are sorted by their frames).
@@ -203,9 +264,9 @@ json merge_errors(const std::vector<Reader>& readers, const std::vector<const js
     for (size_t i = 0; i < objects.size(); ++i) {
       const Reader& r = readers[i];
       const uint64_t n = r.count(*objects[i], pixels_key, prefix + pixels_key);
-      const double mean = r.number(*objects[i], pool + "mean", prefix + pool + "mean");
-      const double max = r.number(*objects[i], pool + "max", prefix + pool + "max");
-      const double p99 = r.number(*objects[i], pool + "p99", prefix + pool + "p99");
+      const double mean = r.measure(*objects[i], pool + "mean", prefix + pool + "mean");
+      const double max = r.measure(*objects[i], pool + "max", prefix + pool + "max");
+      const double p99 = r.measure(*objects[i], pool + "p99", prefix + pool + "p99");
       if (n == 0) continue;
       weighted += mean * static_cast<double>(n);
       pixels += n;
@@ -218,12 +279,12 @@ json merge_errors(const std::vector<Reader>& readers, const std::vector<const js
   }
   // bench's pooled seam_coverage: kept when the parts agree, else pixel-weighted.
   {
-    const double first = readers[0].number(*objects[0], "seam_coverage", prefix + "seam_coverage");
+    const double first = readers[0].measure(*objects[0], "seam_coverage", prefix + "seam_coverage");
     bool same = true;
     double weighted = 0;
     uint64_t pixels = 0;
     for (size_t i = 0; i < objects.size(); ++i) {
-      const double c = readers[i].number(*objects[i], "seam_coverage", prefix + "seam_coverage");
+      const double c = readers[i].measure(*objects[i], "seam_coverage", prefix + "seam_coverage");
       const uint64_t n = readers[i].count(*objects[i], "pixels", prefix + "pixels");
       same = same && c == first;
       weighted += c * static_cast<double>(n);
@@ -234,27 +295,70 @@ json merge_errors(const std::vector<Reader>& readers, const std::vector<const js
   return out;
 }
 
+// One part's results[e], every key the merge reads, checked before any of it is used.
+void check_result(const Reader& r, const json& item, bool with_errors, const std::string& prefix) {
+  (void)r.string(item, "method", prefix + "method");
+  (void)r.string(item, "filter", prefix + "filter");
+  (void)r.integer(item, "msaa", prefix + "msaa", 1, 16);
+  (void)r.integer(item, "aniso", prefix + "aniso", 1, 16);
+  for (const char* key : {"texture_bytes", "padding_bytes", "adjacency_bytes"}) (void)r.count(item, key, prefix + key);
+  const auto measures = [&r](const std::string& path) {
+    return [&r, path](const json& v) { (void)r.measure(v, path); };
+  };
+  r.per_frame(item, "ms_per_frame", prefix + "ms_per_frame", measures(prefix + "ms_per_frame"));
+  const json& stages = r.object_field(item, "ms_stages_per_frame", prefix + "ms_stages_per_frame");
+  for (const auto& [stage, unused] : stages.items()) {
+    (void)unused;
+    const std::string path = prefix + "ms_stages_per_frame." + stage;
+    r.per_frame(stages, stage, path, measures(path));
+  }
+  const std::string nan_path = prefix + "nan_pixels_per_frame";
+  uint64_t nan_sum = 0;
+  r.per_frame(item, "nan_pixels_per_frame", nan_path, [&](const json& v) { nan_sum += r.count(v, nan_path); });
+  if (r.count(item, "nan_pixels", prefix + "nan_pixels") != nan_sum) {
+    r.refuse(prefix + "nan_pixels", "is not the sum of nan_pixels_per_frame (" + std::to_string(nan_sum) + ")");
+  }
+  const std::string temporal = prefix + "temporal_per_frame";
+  for (const json& pair : r.array(item, "temporal_per_frame", temporal)) {
+    (void)r.frame(pair, "frame", temporal + ".frame");
+    (void)r.measure(pair, "mean", temporal + ".mean");
+    const json& seam = r.at(pair, "seam_mean", temporal + ".seam_mean");
+    if (!seam.is_null()) (void)r.measure(seam, temporal + ".seam_mean");
+  }
+  if (with_errors) {
+    (void)r.object_field(item, "error", prefix + "error");
+    const std::string errors = prefix + "error_per_frame";
+    for (const json& e : r.array(item, "error_per_frame", errors)) {
+      (void)r.frame(e, "frame", errors + ".frame");
+      for (const char* key : {"mean", "p99", "seam_mean"}) (void)r.measure(e, key, errors + "." + key);
+      (void)r.count(e, "nan_pixels", errors + ".nan_pixels");
+    }
+  }
+}
+
 json merge_result(const std::vector<Reader>& readers, const std::vector<const json*>& items, bool with_errors,
                   const std::string& prefix) {
+  for (size_t i = 0; i < items.size(); ++i) check_result(readers[i], *items[i], with_errors, prefix);
   json out = json::object();
   require_same(readers, items, {"method", "msaa", "aniso", "filter", "texture_bytes", "padding_bytes", "adjacency_bytes"},
                prefix, out);
   // Times: the samples of every frame, then their statistics as one run computes them.
   out["ms_per_frame"] = concat(readers, items, "ms_per_frame", prefix + "ms_per_frame");
   std::vector<double> total;
-  for (const json& v : out["ms_per_frame"]) total.push_back(readers[0].number(v, prefix + "ms_per_frame"));
-  if (total.empty()) readers[0].refuse(prefix + "ms_per_frame", "no frames in any part");
+  for (const json& v : out["ms_per_frame"]) total.push_back(v.get<double>());  // checked per part above
   json ms = bench_timing_stats(total);
   json stages_per_frame = json::object();
   json stage_medians = json::object();
-  const json& first_stages = readers[0].at(*items[0], "ms_stages_per_frame", prefix + "ms_stages_per_frame");
-  if (!first_stages.is_object()) readers[0].refuse(prefix + "ms_stages_per_frame", "expected an object");
+  const json& first_stages = (*items[0])["ms_stages_per_frame"];
+  std::vector<const json*> stage_objects;
+  for (size_t i = 0; i < items.size(); ++i) {
+    stage_objects.push_back(&(*items[i])["ms_stages_per_frame"]);
+    if (stage_objects.back()->size() != first_stages.size()) {
+      readers[i].refuse(prefix + "ms_stages_per_frame", "has other stages than " + readers[0].name() + "'s");
+    }
+  }
   for (const auto& [stage, unused] : first_stages.items()) {
     (void)unused;
-    std::vector<const json*> stage_objects;
-    for (size_t i = 0; i < items.size(); ++i) {
-      stage_objects.push_back(&readers[i].at(*items[i], "ms_stages_per_frame", prefix + "ms_stages_per_frame"));
-    }
     stages_per_frame[stage] = concat(readers, stage_objects, stage, prefix + "ms_stages_per_frame." + stage);
     stage_medians[stage] = median_of(numbers(readers[0], stages_per_frame[stage], prefix + "ms_stages_per_frame." + stage));
   }
@@ -264,22 +368,16 @@ json merge_result(const std::vector<Reader>& readers, const std::vector<const js
 
   out["nan_pixels_per_frame"] = concat(readers, items, "nan_pixels_per_frame", prefix + "nan_pixels_per_frame");
   uint64_t nan_total = 0;
-  for (const json& v : out["nan_pixels_per_frame"]) {
-    if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<int64_t>() >= 0)) {
-      readers[0].refuse(prefix + "nan_pixels_per_frame", "expected counts");
-    }
-    nan_total += v.get<uint64_t>();
-  }
+  for (const json& v : out["nan_pixels_per_frame"]) nan_total += v.get<uint64_t>();  // counts, checked per part
   out["nan_pixels"] = nan_total;
 
   // Temporal: the per-pair values in frame order (each part carries the pair across its first
   // frame), averaged as one run averages them; pairs without seam pixels have seam_mean null.
   out["temporal_per_frame"] = concat(readers, items, "temporal_per_frame", prefix + "temporal_per_frame");
   std::vector<double> all, seam;
-  for (const json& pair : out["temporal_per_frame"]) {
-    all.push_back(readers[0].number(pair, "mean", prefix + "temporal_per_frame.mean"));
-    const json& s = readers[0].at(pair, "seam_mean", prefix + "temporal_per_frame.seam_mean");
-    if (!s.is_null()) seam.push_back(readers[0].number(s, prefix + "temporal_per_frame.seam_mean"));
+  for (const json& pair : out["temporal_per_frame"]) {  // checked per part above
+    all.push_back(pair["mean"].get<double>());
+    if (!pair["seam_mean"].is_null()) seam.push_back(pair["seam_mean"].get<double>());
   }
   out["temporal"] = {{"seam_mean", finite_or_zero(mean_in_order(seam))},
                      {"mean", finite_or_zero(mean_in_order(all))},
@@ -298,6 +396,11 @@ json merge_result(const std::vector<Reader>& readers, const std::vector<const js
 
 json merge_difference(const std::vector<Reader>& readers, const std::vector<const json*>& items,
                       const std::string& prefix) {
+  for (size_t i = 0; i < items.size(); ++i) {
+    (void)readers[i].string(*items[i], "a", prefix + "a");
+    (void)readers[i].string(*items[i], "b", prefix + "b");
+    (void)readers[i].integer(*items[i], "msaa", prefix + "msaa", 1, 16);
+  }
   json out = json::object();
   require_same(readers, items, {"a", "b", "msaa"}, prefix, out);
   out = merge_errors(readers, items, prefix, out);
@@ -329,6 +432,50 @@ json merge_notes() {
         "wall_s, reference.ms: sums over the parts (work done, not the batch's wall time)"}}};
 }
 
+// A part's own top-level keys (results and differences are checked entry by entry as they are
+// merged): types, and the ranges bench itself allows. The parts come in shard order, and their
+// frames must tile 0..frames-1 in order: this one's start at expected_first, which moves to its
+// end. Sets the reader's frames.
+void check_part(Reader& r, const json& top, int& expected_first) {
+  for (const char* key : {"scene", "size", "order", "device"}) (void)r.string(top, key, key);
+  if (top.contains("seam_mask")) (void)r.string(top, "seam_mask", "seam_mask");
+  const int frames = static_cast<int>(r.integer(top, "frames", "frames", 1, kMaxFrames));
+  (void)r.integer(top, "reference_frames", "reference_frames", 1, INT32_MAX);
+  const json& errors = r.at(top, "errors", "errors");
+  if (!errors.is_boolean()) r.refuse("errors", "expected true or false");
+  (void)r.integer(top, "seam_radius", "seam_radius", 0, INT32_MAX);
+  (void)r.object_field(top, "options", "options");
+  (void)r.measure(top, "wall_s", "wall_s");
+  const json& shard = r.at(top, "shard", "shard");
+  const int first = static_cast<int>(r.integer(shard, "first_frame", "shard.first_frame", 0, frames - 1));
+  const int end = static_cast<int>(r.integer(shard, "end_frame", "shard.end_frame", 1, frames));
+  if (first != expected_first || end <= first) {
+    r.refuse("shard.first_frame", "frames [" + std::to_string(first) + ", " + std::to_string(end) +
+                                      ") do not continue the parts before it at frame " +
+                                      std::to_string(expected_first));
+  }
+  expected_first = end;
+  r.set_frames(first, end);
+  for (const json& k : r.array(top, "error_frames", "error_frames")) (void)r.integer(k, "error_frames", first, end - 1);
+  r.per_frame(top, "seam_pixels_per_frame", "seam_pixels_per_frame",
+              [&r](const json& v) { (void)r.count(v, "seam_pixels_per_frame"); });
+  if (r.array(top, "results", "results").empty()) {
+    r.refuse("results", "no entries (a part measures one method at least)");
+  }
+  (void)r.array(top, "differences", "differences");
+  if (errors.get<bool>()) {
+    // A part without an error frame made no reference: its method is "" and its msaa 0.
+    const json& reference = r.object_field(top, "reference", "reference");
+    const std::string prefix = "reference.";
+    for (const char* key : {"method", "filter"}) (void)r.string(reference, key, prefix + key);
+    (void)r.integer(reference, "msaa", prefix + "msaa", 0, 16);
+    for (const char* key : {"scale", "filter_width", "B", "C"}) (void)r.number(reference, key, prefix + key);
+    (void)r.count(reference, "cached", "reference.cached");
+    (void)r.count(reference, "rendered", "reference.rendered");
+    (void)r.measure(reference, "ms", "reference.ms");
+  }
+}
+
 }  // namespace
 
 json merge_bench_parts(const std::vector<BenchPart>& input) {
@@ -342,9 +489,11 @@ json merge_bench_parts(const std::vector<BenchPart>& input) {
     Reader r(input[i]);
     if (!input[i].json.is_object()) r.refuse("parts", "not a JSON object");
     const json& shard = r.at(input[i].json, "shard", "shard");
-    const int index = r.integer(shard, "index", "shard.index");
-    const int n = r.integer(shard, "count", "shard.count");
-    if (n < 1 || index < 1 || index > n) r.refuse("shard", "index must be in 1..count");
+    const int index = static_cast<int>(r.integer(shard, "index", "shard.index", 1, kMaxShards));
+    const int n = static_cast<int>(r.integer(shard, "count", "shard.count", 1, kMaxShards));
+    if (index > n) {
+      r.refuse("shard.index", "must be in 1..count (" + std::to_string(n) + "), got " + std::to_string(index));
+    }
     if (i == 0) count = n;
     if (n != count) r.refuse("shard.count", "is " + std::to_string(n) + ", " + input[0].name + "'s is " + std::to_string(count));
     const auto [it, fresh] = seen.emplace(index, input[i].name);
@@ -361,10 +510,12 @@ json merge_bench_parts(const std::vector<BenchPart>& input) {
   }
   std::sort(order.begin(), order.end());
   std::vector<const json*> tops;
+  int expected_first = 0;  // where the next part's frames start
   for (const auto& [index, i] : order) {
     (void)index;
     readers.emplace_back(input[i]);
     tops.push_back(&input[i].json);
+    check_part(readers.back(), input[i].json, expected_first);
   }
 
   json out = json::object();
@@ -378,32 +529,21 @@ json merge_bench_parts(const std::vector<BenchPart>& input) {
     }
   }
   out["seam_mask"] = mask_of(*tops[0]);
-  const json& errors_flag = out["errors"];
-  if (!errors_flag.is_boolean()) readers[0].refuse("errors", "expected true or false");
-  const bool with_errors = errors_flag.get<bool>();
-  if (!out["frames"].is_number_integer()) readers[0].refuse("frames", "expected an integer");
-  const int frames = out["frames"].get<int>();
+  const bool with_errors = out["errors"].get<bool>();  // checked by check_part, as frames
+  const int frames = static_cast<int>(out["frames"].get<int64_t>());
 
-  // The parts' frames must tile 0..frames-1 in order.
-  int expected_first = 0;
   json parts_info = json::array();
   for (size_t i = 0; i < tops.size(); ++i) {
     const Reader& r = readers[i];
-    const json& shard = r.at(*tops[i], "shard", "shard");
-    const int first = r.integer(shard, "first_frame", "shard.first_frame");
-    const int end = r.integer(shard, "end_frame", "shard.end_frame");
-    if (first != expected_first || end <= first || end > frames) {
-      r.refuse("shard.first_frame", "frames [" + std::to_string(first) + ", " + std::to_string(end) +
-                                        ") do not continue the parts before it at frame " + std::to_string(expected_first));
-    }
-    expected_first = end;
+    const json& top = *tops[i];  // every key checked by check_part
     parts_info.push_back({{"name", r.name()},
-                          {"shard", std::to_string(r.integer(shard, "index", "shard.index")) + "/" + std::to_string(count)},
-                          {"first_frame", first},
-                          {"end_frame", end},
-                          {"wall_s", r.number(*tops[i], "wall_s", "wall_s")},
-                          {"device", r.at(*tops[i], "device", "device")}});
+                          {"shard", std::to_string(top["shard"]["index"].get<int64_t>()) + "/" + std::to_string(count)},
+                          {"first_frame", r.first_frame()},
+                          {"end_frame", r.end_frame()},
+                          {"wall_s", top["wall_s"].get<double>()},
+                          {"device", top["device"]}});
   }
+  // check_part saw the parts' frames tile 0..expected_first-1 in order: they must reach the end.
   if (expected_first != frames) {
     readers.back().refuse("shard.end_frame", "the parts end at frame " + std::to_string(expected_first) + " of " +
                                                  std::to_string(frames));
@@ -412,7 +552,7 @@ json merge_bench_parts(const std::vector<BenchPart>& input) {
   // One device for all, or the distinct ones named together.
   std::vector<std::string> devices;
   for (const json& p : parts_info) {
-    const std::string d = p["device"].is_string() ? p["device"].get<std::string>() : p["device"].dump();
+    const std::string d = p["device"].get<std::string>();
     if (std::find(devices.begin(), devices.end(), d) == devices.end()) devices.push_back(d);
   }
   std::string device;
@@ -472,7 +612,7 @@ json merge_bench_parts(const std::vector<BenchPart>& input) {
       const uint64_t r = readers[i].count(ref, "rendered", "reference.rendered");
       cached += c;
       rendered += r;
-      ms += readers[i].number(ref, "ms", "reference.ms");
+      ms += readers[i].measure(ref, "ms", "reference.ms");
       if (c + r > 0) {
         makers.push_back(readers[i]);
         made.push_back(&ref);

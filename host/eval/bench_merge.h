@@ -38,8 +38,10 @@ struct BenchPart {
 };
 
 // The parts (any order) -> the unsharded run's JSON, plus `merge` (the parts and the lists
-// above). InputError naming the key at fault and the part's name when a part is not a bench part,
-// the parts are of different batches (scene, options, methods, rates, frames...), a part appears
+// above). InputError naming the key at fault and the part's name when a part is not a bench part
+// (a key missing, of the wrong type, or out of the range bench writes: integers in range, never
+// cut down to fit; measurements finite and >= 0; one result entry and one frame at least), the
+// parts are of different batches (scene, options, methods, rates, frames...), a part appears
 // twice, or parts are missing.
 nlohmann::json merge_bench_parts(const std::vector<BenchPart>& parts);
 

@@ -194,7 +194,7 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
     } else if (key == "frame") {
       options.frame = int_field(value, key, 0, 1000000);
     } else if (key == "frames") {
-      options.frames = int_field(value, key, 1, 1000000);
+      options.frames = int_field(value, key, 1, kMaxFrames);
     } else if (key == "tint") {
       options.tint = bool_field(value, key);
     } else if (key == "displacement_method") {

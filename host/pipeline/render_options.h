@@ -77,6 +77,7 @@ std::vector<std::string> cube_method_names();
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr long long kMaxSamplesPerImage = 1LL << 28;  // width * height * msaa
 inline constexpr int kMaxDisplacementLevel = 16;              // displacement_level's bound
+inline constexpr int kMaxFrames = 1000000;                    // frames' bound (an orbit of 1..kMaxFrames)
 
 struct RenderOptions {
   std::string scene = "paper";  // built-in name or scene file (.json, .obj mesh, .ptx with its mesh)
