@@ -2,11 +2,15 @@
 // app and returns it with the function main() runs when that subcommand was given. Errors follow main's rules:
 // throw InputError for bad input (exit 2), anything else for other failures (exit 1).
 #pragma once
+#include <filesystem>
 #include <functional>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+
+#include <seamcl/core/input_error.h>
 
 namespace seamcl::cli {
 
@@ -16,6 +20,23 @@ inline std::string join_names(const std::vector<std::string>& names, const std::
   std::string out;
   for (const std::string& name : names) out += (out.empty() ? "" : separator) + name;
   return out;
+}
+
+// Where output goes, checked before any work so that a bad path fails at once and names its option:
+// the directory of an output file must exist (InputError(field) otherwise)...
+inline void check_output_parent(const std::string& path, const std::string& field) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code error;
+  if (!parent.empty() && !std::filesystem::is_directory(parent, error))
+    throw InputError(field, "the directory '" + parent.string() + "' of '" + path + "' does not exist");
+}
+
+// ... and an output directory is made (with its parents) or is refused (InputError(field)).
+inline void make_output_directory(const std::string& dir, const std::string& field) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error || !std::filesystem::is_directory(dir))
+    throw InputError(field, "cannot make the directory '" + dir + "'" + (error ? ": " + error.message() : ""));
 }
 
 struct GlobalOptions {

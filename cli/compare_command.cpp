@@ -100,7 +100,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   const Scene scene = load_scene_source(frame.scene, frame.texture, source);
   const Camera camera = frame.frame ? orbit_camera(scene, *frame.frame, frame.frames) : scene.camera;
   if (ref_settings.use_cache) ref_settings.scene_hash = scene_content_hash(scene);  // once for every reference kind
-  if (!args.images_dir.empty()) fs::create_directories(args.images_dir);
+  if (!args.images_dir.empty()) make_output_directory(args.images_dir, "images");
   auto progress = [&](const std::string& line) {
     if (!args.no_progress) std::fprintf(stderr, "compare: %s\n", line.c_str());
   };

@@ -95,7 +95,7 @@ int run(const CubeArgs& args, const GlobalOptions& global) {
   Scene scene = load_scene_source(base.scene);
   if (!scene.environment) throw InputError("scene", "'" + base.scene + "' has no environment (try envmap)");
   const Camera camera = scene.orbit ? orbit_camera(scene, args.frame, args.frames) : scene.camera;
-  if (!args.images_dir.empty()) std::filesystem::create_directories(args.images_dir);
+  if (!args.images_dir.empty()) make_output_directory(args.images_dir, "images");
 
   ClRuntime runtime(global.device);
   Renderer renderer(runtime);

@@ -86,7 +86,7 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
   }
   check_tessellation_levels(scene, levels);  // the triangle bound of every level, before any render
   const bool closed = is_closed_mesh(scene);
-  if (!args.images_dir.empty()) fs::create_directories(args.images_dir);
+  if (!args.images_dir.empty()) make_output_directory(args.images_dir, "images");
   auto progress = [&](const std::string& line) {
     if (!args.no_progress) std::fprintf(stderr, "displacement-metrics: %s\n", line.c_str());
   };

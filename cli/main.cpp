@@ -77,10 +77,14 @@ json render_request(const RenderArgs& a) {
 int run_render(const RenderArgs& args, const std::string& device) {
   // Validate everything before any work, so bad input changes nothing.
   const RenderOptions options = parse_render_options(render_request(args));
-  if (!args.output.empty()) image_format_for_path(args.output, "output");
+  if (!args.output.empty()) {
+    image_format_for_path(args.output, "output");
+    cli::check_output_parent(args.output, "output");
+  }
   if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
   if (args.crack_orbit < 0 || args.crack_orbit > 3600) throw InputError("crack_orbit", "must be in 0..3600");
 
+  ClRuntime runtime(device);  // a --device that matches none is bad input too: refused before any work
   const auto scene_start = std::chrono::steady_clock::now();
   SceneSourceOptions source;
   source.generator.tint = options.tint;
@@ -90,7 +94,6 @@ int run_render(const RenderArgs& args, const std::string& device) {
   const Camera camera = options.frame ? orbit_camera(scene, *options.frame, options.frames) : scene.camera;
   const double scene_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - scene_start).count();
 
-  ClRuntime runtime(device);
   Renderer renderer(runtime);
   // Handed over, not copied: image faces' float chains exist once (scene() reads them back).
   renderer.load_scene(std::move(scene), options.texels);

@@ -61,6 +61,7 @@ void write_atomically(const std::string& path, const std::string& text) {
 }
 
 int run_merge(const MergeArgs& args) {
+  if (!args.output.empty() && args.output != "-") check_output_parent(args.output, "output");
   std::vector<BenchPart> parts;
   for (const std::string& path : args.parts) parts.push_back(read_part(path));
   const nlohmann::json merged = merge_bench_parts(parts);

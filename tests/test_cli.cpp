@@ -138,6 +138,25 @@ TEST_F(Cli, BadAnisoIsInputError) {
 
 TEST_F(Cli, BadOutputExtensionIsInputError) { expect_input_error("render --scene quad2 --size 16x16 -o x.bmp", "output"); }
 
+// Where output goes is checked before any work, naming its option.
+TEST_F(Cli, OutputInAMissingDirectoryIsInputError) {
+  expect_input_error("render --scene quad2 --size 16x16 -o no-such-dir/x.png", "output");
+}
+
+TEST_F(Cli, ImagesDirectoryThatCannotBeMadeIsInputError) {
+  write("plain-file", "x");
+  const std::set<std::string> before = listing();
+  const Process r = run("compare --scene quad2 --methods discard --msaa 1 --size 16x16 --repeat 1 --no-progress "
+                        "--images plain-file/images");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("images"), std::string::npos) << r.err;
+  EXPECT_EQ(listing(), before);
+}
+
+TEST_F(Cli, DeviceThatMatchesNoneIsInputError) {
+  expect_input_error("--device no-such-device-anywhere render --scene quad2 --size 16x16 -o x.png", "device");
+}
+
 TEST_F(Cli, FrameOutsideOrbitIsInputError) {
   expect_input_error("render --scene quad2 --size 16x16 --frame 5 --frames 5 -o x.png", "frame");
 }

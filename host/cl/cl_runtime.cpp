@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <seamcl/core/input_error.h>
 #include "cl/kernel_sources.h"
 
 namespace seamcl {
@@ -179,7 +180,7 @@ ClRuntime::ClRuntime(const std::string& device_filter) {
     if (chosen == nullptr) {
       std::string known;
       for (const Candidate& c : candidates) known += (known.empty() ? "" : ", ") + c.info.name;
-      throw std::runtime_error("device: no OpenCL device matches '" + filter + "' (devices: " + known + ")");
+      throw InputError("device", "no OpenCL device matches '" + filter + "' (devices: " + known + ")");
     }
   } else {
     for (const char* wanted : {"GPU", "CPU"}) {

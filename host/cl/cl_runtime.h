@@ -32,7 +32,7 @@ class ClRuntime {
  public:
   // device_filter: case-insensitive substring of "platform device" to pick; empty means
   // $SEAMCL_DEVICE, and when that is empty too the first GPU, else the first CPU device.
-  // Throws std::runtime_error naming the filter when nothing matches.
+  // Throws InputError("device") naming the filter when nothing matches (bad input: exit 2 in the CLI).
   explicit ClRuntime(const std::string& device_filter = "");
 
   const cl::Context& context() const { return context_; }
