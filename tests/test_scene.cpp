@@ -274,6 +274,16 @@ TEST(Scene, OrbitCameraErrors) {
   expect_input_error([&] { orbit_camera(scene, 0, 0); }, "frames");
   expect_input_error([&] { orbit_camera(scene, -1, 4); }, "frame");
   expect_input_error([&] { orbit_camera(scene, 4, 4); }, "frame");
+  // An orbit whose eye sits (next to) on the vertical through the centre looks along world up:
+  // refused like such a static camera, not rendered blank.
+  const Orbit kept = *scene.orbit;
+  scene.orbit->radius = 1e-30f;
+  scene.orbit->height = 5.0f;
+  EXPECT_NE(expect_input_error([&] { orbit_camera(scene, 0, 4); }, "orbit").find("parallel"), std::string::npos);
+  scene.orbit->height = 0.0f;  // the eye on the centre
+  EXPECT_NE(expect_input_error([&] { orbit_camera(scene, 1, 4); }, "orbit").find("differ"), std::string::npos);
+  *scene.orbit = kept;
+  EXPECT_NO_THROW(orbit_camera(scene, 3, 4));
   scene.orbit.reset();
   const std::string message = expect_input_error([&] { orbit_camera(scene, 0, 4); }, "frame");
   EXPECT_NE(message.find("no orbit"), std::string::npos) << message;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <exception>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -51,6 +52,20 @@ inline float smooth_sine(float x) {
 
 void check_vec3(glm::vec3 v, const std::string& field) {
   if (!is_finite(v)) throw InputError(field, "must be finite");
+}
+
+// Why a camera's eye, target and up give no view ("eye must differ from camera.target", "up is
+// parallel to the view direction", ...: the member at fault first), or nothing when they do.
+std::optional<std::string> camera_problem(const Camera& camera) {
+  const glm::vec3 view = camera.target - camera.eye;
+  const float view_length = glm::length(view);
+  const float scale = glm::length(camera.eye) + glm::length(camera.target);
+  if (!(view_length > 1e-6f * scale) || !std::isfinite(view_length)) return "eye must differ from camera.target";
+  const float up_length = glm::length(camera.up);
+  if (!(up_length > 0.0f) || !std::isfinite(up_length)) return "up must be non-zero";
+  const float sine_between = glm::length(glm::cross(view / view_length, camera.up / up_length));
+  if (!(sine_between > 1e-4f)) return "up is parallel to the view direction";
+  return std::nullopt;
 }
 
 void check_color(glm::vec3 c, const std::string& field) {
@@ -335,8 +350,12 @@ Camera orbit_camera(const Scene& scene, int frame, int frames) {
       orbit.center + glm::vec3(orbit.radius * static_cast<float>(std::sin(radians)), orbit.height,
                                orbit.radius * static_cast<float>(std::cos(radians)));
   camera.target = orbit.center;
-  // The orbit circles the vertical axis, so world up can never be parallel to the view direction.
+  // The orbit circles the vertical axis, so world up is parallel to the view direction only when
+  // the radius is (next to) nothing beside the height: such an orbit is refused here, as a static
+  // camera is in validate_scene, rather than rendered blank.
   camera.up = glm::vec3(0, 1, 0);
+  if (const std::optional<std::string> problem = camera_problem(camera))
+    throw InputError("orbit", "frame " + std::to_string(frame) + "'s camera: " + *problem);
   return camera;
 }
 
@@ -407,16 +426,11 @@ void validate_scene(const Scene& scene) {
       !(camera.fov_y_degrees < 180.0f))
     throw InputError("camera.fov_y_degrees",
                      "must be in (0, 180), got " + std::to_string(camera.fov_y_degrees));
-  const glm::vec3 view = camera.target - camera.eye;
-  const float view_length = glm::length(view);
-  const float scale = glm::length(camera.eye) + glm::length(camera.target);
-  if (!(view_length > 1e-6f * scale) || !std::isfinite(view_length))
-    throw InputError("camera.eye", "must differ from camera.target");
-  const float up_length = glm::length(camera.up);
-  if (!(up_length > 0.0f) || !std::isfinite(up_length))
-    throw InputError("camera.up", "must be non-zero");
-  const float sine_between = glm::length(glm::cross(view / view_length, camera.up / up_length));
-  if (!(sine_between > 1e-4f)) throw InputError("camera.up", "is parallel to the view direction");
+  if (const std::optional<std::string> problem = camera_problem(camera)) {
+    // "eye must differ ..." / "up is parallel ...": the field is the problem's first word.
+    const std::string field = problem->substr(0, problem->find(' '));
+    throw InputError("camera." + field, problem->substr(field.size() + 1));
+  }
 
   if (scene.orbit) {
     const Orbit& orbit = *scene.orbit;
