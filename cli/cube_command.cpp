@@ -140,12 +140,18 @@ int run(const CubeArgs& args, const GlobalOptions& global) {
                          {"environment_first_order_jump", edges.environment_first_order_jump},
                          {"ms", {{"median", ms[ms.size() / 2]}, {"min", ms.front()}, {"max", ms.back()}}},
                          {"cube_bytes", cube_bytes},
-                         {"error", {{"mean", errors.all.mean}, {"p99", errors.all.p99}, {"max", errors.all.max}}},
+                         // The statistics skip NaN pixels; their counts say whether there were any.
+                         {"error",
+                          {{"mean", errors.all.mean},
+                           {"p99", errors.all.p99},
+                           {"max", errors.all.max},
+                           {"nan_pixels", errors.nan_pixels}}},
                          {"edge_error",
                           {{"mean", errors.seam.mean},
                            {"p99", errors.seam.p99},
                            {"max", errors.seam.max},
-                           {"pixels", errors.seam.pixels}}}});
+                           {"pixels", errors.seam.pixels},
+                           {"nan_pixels", errors.seam_nan_pixels}}}});
     }
   }
   if (args.json_out) {

@@ -311,6 +311,8 @@ TEST(EnvironmentFile, CubeMetricsRunOnAnImageEnvironmentFromASceneFile) {
   for (const auto& entry : image.at("results")) {
     for (const auto& step : entry.at("seam_step")) EXPECT_LT(step.get<double>(), 1e-5) << entry.at("cube_method");
     EXPECT_LT(entry.at("error").at("max").get<double>(), 1e-3) << entry.at("cube_method");
+    EXPECT_EQ(entry.at("error").at("nan_pixels"), 0) << entry.at("cube_method");
+    EXPECT_EQ(entry.at("edge_error").at("nan_pixels"), 0) << entry.at("cube_method");
   }
   ASSERT_EQ(run_seamcl(dir, "cube-metrics --scene envmap --cube-methods cube-clamp" + common, out, err), 0) << err;
   const nlohmann::json analytic = nlohmann::json::parse(out);
