@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/json_document.h>
 #include <seamcl/eval/bench_merge.h>
 #include "commands.h"
 
@@ -43,9 +44,11 @@ BenchPart read_part(const std::string& path) {
   if (!in) throw InputError("parts", path + ": cannot be opened");
   std::ostringstream text;
   text << in.rdbuf();
-  BenchPart part{path, nlohmann::json::parse(text.str(), nullptr, false)};
-  if (part.json.is_discarded()) throw InputError("parts", path + ": not valid JSON");
-  return part;
+  try {
+    return BenchPart{path, parse_json_document(text.str())};
+  } catch (const std::exception& error) {
+    throw InputError("parts", path + ": not valid JSON: " + error.what());
+  }
 }
 
 // Written next to the target and renamed over it, so a reader never sees half a file.

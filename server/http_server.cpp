@@ -22,6 +22,7 @@
 
 #include <seamcl/core/cancelled.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/json_document.h>
 #include <seamcl/core/over_budget.h>
 #include <seamcl/eval/compare_memory.h>
 #include <seamcl/eval/comparison.h>
@@ -877,21 +878,16 @@ json HttpServer::parse_body(const httplib::Request& req) const {
   if (!is_json_media_type(type)) {
     throw HttpError{415, "Content-Type", "must be application/json, got '" + echo(type) + "'"};
   }
-  // Parse with a depth limit: the library's error messages print values, recursively.
-  bool too_deep = false;
-  const int max_depth = options_.max_json_depth;
-  json body;
+  // Parse with a depth limit (the library's error messages print values, recursively), and
+  // without a key given twice or a NUL byte (either would pass unseen).
   try {
-    body = json::parse(req.body, [&](int depth, json::parse_event_t, json&) {
-      if (depth > max_depth) too_deep = true;
-      return !too_deep;
-    });
+    return parse_json_document(req.body, options_.max_json_depth);
   } catch (const json::exception& e) {
     // The parser's message quotes what it last read: bounded_message cuts it (send_error).
     throw HttpError{400, "body", std::string("not valid JSON: ") + e.what()};
+  } catch (const std::invalid_argument& e) {
+    throw HttpError{400, "body", e.what()};
   }
-  if (too_deep) throw HttpError{400, "body", "nested deeper than " + std::to_string(max_depth) + " levels"};
-  return body;
 }
 
 // POST /v1/compare: seamcl compare's loop (host/eval/comparison.h) on one frame, answered as the JSON
@@ -945,7 +941,8 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   const std::vector<std::string> methods = split_list(methods_text, "methods");
   const std::vector<int> rates = parse_int_list(msaa_text, "msaa");
   if (methods.size() * rates.size() > static_cast<size_t>(options_.max_compare_entries)) {
-    throw HttpError{400, "methods",
+    // Named after the longer list: the one to shorten.
+    throw HttpError{400, rates.size() > methods.size() ? "msaa" : "methods",
                     std::to_string(methods.size()) + " methods x " + std::to_string(rates.size()) +
                         " msaa rates = " + std::to_string(methods.size() * rates.size()) +
                         " renders exceeds this server's limit of " + std::to_string(options_.max_compare_entries)};

@@ -12,6 +12,7 @@
 #include <random>
 #include <set>
 
+#include <seamcl/assets/scene_source.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
@@ -816,6 +817,15 @@ TEST(SceneJson, FileErrorsNameThePath) {
     message = expect_input_error([&] { load_scene_file(huge.path()); }, "scene");
     EXPECT_NE(message.find("larger than 64 MiB"), std::string::npos) << message;
   }
+  // What the JSON parser would let through unseen: a key given twice, bytes after a NUL.
+  const TemporaryFile repeated(R"({"name": "a", "name": "b", "positions": []})");
+  message = expect_input_error([&] { load_scene_file(repeated.path()); }, "scene");
+  EXPECT_NE(message.find("key 'name' is given twice"), std::string::npos) << message;
+  const TemporaryFile after_nul(minimal_document().dump() + std::string(1, '\0') + "{\"garbage\"");
+  message = expect_input_error([&] { load_scene_file(after_nul.path()); }, "scene");
+  EXPECT_NE(message.find("NUL byte"), std::string::npos) << message;
+  message = expect_input_error([&] { load_scene_source("/proc/self/mem"); }, "scene");
+  EXPECT_NE(message.find("/proc/self/mem"), std::string::npos) << message;
   message = expect_input_error([&] { load_scene_file("/proc/self/mem"); }, "scene");
   EXPECT_NE(message.find("/proc/self/mem"), std::string::npos) << message;
 

@@ -108,9 +108,15 @@ struct Loader {
   Scene scene_file(const std::string& path) const {
     json doc;  // stays discarded (not an object) when the file is missing or not JSON: load_scene says why
     std::error_code ignored;
-    if (fs::is_regular_file(path, ignored)) {
-      std::ifstream in(path, std::ios::binary);
-      doc = json::parse(in, nullptr, false);
+    // Only a file the scene reader would read whole is looked into here (a larger one, or one
+    // that fails mid-read, is refused by that reader, naming why).
+    if (fs::is_regular_file(path, ignored) && fs::file_size(path, ignored) <= kMaxSceneFileBytes) {
+      try {
+        std::ifstream in(path, std::ios::binary);
+        doc = json::parse(in, nullptr, false);
+      } catch (const std::exception&) {
+        doc = json(json::value_t::discarded);
+      }
     }
     const bool mesh_form = doc.is_object() && (doc.contains("mesh") || (doc.contains("texture") && doc.at("texture").is_string()));
     if (!mesh_form) {

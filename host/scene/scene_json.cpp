@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <seamcl/core/json_document.h>
 #include <string_view>
 #include <variant>
 #include <vector>
@@ -26,8 +27,6 @@ constexpr int kMaxTextureSide = 4096;
 // Level-0 texels over all faces (a full scene then takes ~1.4 GB): a bound that keeps a small
 // file from asking for more memory than the machine has.
 constexpr size_t kMaxSceneTexels = size_t{1} << 26;
-// A scene file's text: 64 MiB holds some 500,000 explicit faces.
-constexpr size_t kMaxSceneFileBytes = size_t{64} << 20;
 
 std::string member_path(const std::string& parent, std::string_view key) {
   return parent.empty() ? std::string(key) : parent + "." + std::string(key);
@@ -522,8 +521,10 @@ SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load
   if (in.bad()) throw InputError("scene", "cannot read scene file '" + path + "': a read failed");
   json doc;
   try {
-    doc = json::parse(text);
+    doc = parse_json_document(text);
   } catch (const json::exception& error) {
+    throw InputError("scene", "scene file '" + path + "' is not valid JSON: " + error.what());
+  } catch (const std::invalid_argument& error) {
     throw InputError("scene", "scene file '" + path + "' is not valid JSON: " + error.what());
   }
   try {

@@ -1,6 +1,7 @@
 // Scenes from JSON files; the format is documented in docs/scene-format.md. Every error is an
 // InputError whose field is the JSON path of the value at fault (e.g. "faces[2].texture.width").
 #pragma once
+#include <cstddef>
 #include <functional>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
@@ -11,6 +12,10 @@
 #include <seamcl/scene/scene_generators.h>
 
 namespace seamcl {
+
+// A scene file's text is read only up to this (64 MiB holds some 500,000 explicit faces): the
+// parsed document takes some 40 times the text.
+inline constexpr size_t kMaxSceneFileBytes = size_t{64} << 20;
 
 // A face's image as the loader found it while the scene was read: its size (from the file's
 // header; powers of two) and how to read its pixels as level 0 (width x height texels), at once
