@@ -83,6 +83,12 @@ int run_render(const RenderArgs& args, const std::string& device) {
   }
   if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
   if (args.crack_orbit < 0 || args.crack_orbit > 3600) throw InputError("crack_orbit", "must be in 0..3600");
+  // Options that would otherwise be ignored without a word.
+  if (args.crack_orbit > 0 && (!options.displacement || !args.json_out))
+    throw InputError("crack_orbit", "counts the cracks of a displaced render in --json's displacement block: give "
+                                    "--displacement-method and --json too");
+  if (!args.displacement_map.empty() && !options.displacement)
+    throw InputError("displacement_map", "displaces only a render with --displacement-method");
 
   ClRuntime runtime(device);  // a --device that matches none is bad input too: refused before any work
   const auto scene_start = std::chrono::steady_clock::now();

@@ -153,6 +153,13 @@ TEST_F(Cli, ImagesDirectoryThatCannotBeMadeIsInputError) {
   EXPECT_EQ(listing(), before);
 }
 
+TEST_F(Cli, DisplacementOptionsWithoutDisplacementAreInputErrors) {
+  expect_input_error("render --scene quad2 --size 16x16 --crack-orbit 4 --json -o x.png", "crack_orbit");
+  expect_input_error("render --scene displaced --displacement-method zipper --size 16x16 --crack-orbit 4 -o x.png",
+                     "crack_orbit");
+  expect_input_error("render --scene quad2 --size 16x16 --displacement-map d.ptx -o x.png", "displacement_map");
+}
+
 TEST_F(Cli, DeviceThatMatchesNoneIsInputError) {
   expect_input_error("--device no-such-device-anywhere render --scene quad2 --size 16x16 -o x.png", "device");
 }
