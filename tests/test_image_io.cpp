@@ -53,6 +53,25 @@ TEST(ImageIo, InMemoryEncodingEqualsTheFile) {
   std::filesystem::remove_all(dir);
 }
 
+// EXR stores half floats, whose largest is 65504; an image with a larger value (a bright light on
+// a bright texture) is stored as float instead, so it reads back rather than turning infinite.
+TEST(ImageIo, ExrKeepsValuesBeyondHalfRange) {
+  const auto dir = std::filesystem::temp_directory_path() / ("seamcl-image-io-hdr-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::vector<glm::vec4> pixels = gradient(8, 4);
+  pixels[5] = glm::vec4(1e6f, 70000.0f, 3.25f, 1.0f);
+  const std::string path = (dir / "bright.exr").string();
+  write_image(path, 8, 4, pixels);
+  int w = 0, h = 0;
+  const std::vector<glm::vec4> back = read_image(path, w, h);
+  ASSERT_EQ(back.size(), pixels.size());
+  EXPECT_EQ(back[5].x, 1e6f);
+  EXPECT_EQ(back[5].y, 70000.0f);
+  for (size_t i = 0; i < pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(back[i][c], pixels[i][c]) << i << " " << c;  // float: exact
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ImageIo, FormatComesFromTheExtension) {
   EXPECT_EQ(image_format_for_path("a/b.PNG"), ImageFormat::Png);
   EXPECT_EQ(image_format_for_path("x.exr"), ImageFormat::Exr);

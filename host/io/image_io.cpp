@@ -1,6 +1,7 @@
 #include <seamcl/io/image_io.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -19,7 +20,8 @@ namespace {
 
 // The pixels as a format stores them: sRGB 8-bit for PNG (encoded with encode_srgb8, the one
 // sRGB encoding of the project: a table, where OIIO's per-pixel colour conversion took several
-// times as long), linear float for EXR (stored as half).
+// times as long), linear float for EXR (stored as half, or as float when some value lies beyond
+// half's range, 65504, which half would store as infinity).
 struct Encoded {
   OIIO::ImageSpec spec;
   std::vector<uint8_t> srgb8;  // PNG
@@ -33,7 +35,12 @@ Encoded encode_pixels(ImageFormat format, int width, int height, const std::vect
   if (pixels.size() != static_cast<size_t>(width) * height) throw std::logic_error("image size mismatch");
   Encoded out;
   if (format == ImageFormat::Exr) {
-    out.spec = OIIO::ImageSpec(width, height, 4, OIIO::TypeDesc::HALF);
+    constexpr float kLargestHalf = 65504.0f;
+    const bool fits_half = std::all_of(pixels.begin(), pixels.end(), [](const glm::vec4& p) {
+      return !(std::fabs(p.x) > kLargestHalf || std::fabs(p.y) > kLargestHalf || std::fabs(p.z) > kLargestHalf ||
+               std::fabs(p.w) > kLargestHalf);
+    });
+    out.spec = OIIO::ImageSpec(width, height, 4, fits_half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
     out.linear = &pixels.front().x;
     return out;
   }
