@@ -140,7 +140,8 @@ TEST(DisplacementPtex, RefusesFilesThatAreNotOneChannelMapsOfThisMesh) {
   Scene cube = load_scene_source(kAssets + "cube.obj");
   EXPECT_EQ(field_of([&] { attach_ptex_displacement(cube, kAssets + "rand_lo.ptx"); }, &message), "displacement_map");
   EXPECT_NE(message.find("faces"), std::string::npos) << message;
-  EXPECT_EQ(field_of([&] { attach_ptex_displacement(plane, kAssets + "no_such_file.ptx"); }), "displacement_map");
+  EXPECT_EQ(field_of([&] { attach_ptex_displacement(plane, kAssets + "no_such_file.ptx"); }, &message), "displacement_map");
+  EXPECT_EQ(message.find("texture"), std::string::npos) << "one field name, this one: " << message;
   // A truncated file.
   const fs::path cut = fs::temp_directory_path() / "seamcl_disp_truncated.ptx";
   {

@@ -14,7 +14,10 @@ void attach_ptex_displacement(Scene& scene, const std::string& path, const PtexL
   try {
     file = read_ptex_file(path, limits);
   } catch (const InputError& e) {
-    throw InputError("displacement_map", e.what());
+    // The reader names its own field ("texture: ..."); the message without it, under this one.
+    const std::string message = e.what();
+    const std::string own = e.field() + ": ";
+    throw InputError("displacement_map", message.starts_with(own) ? message.substr(own.size()) : message);
   }
   if (file.channels != 1) {
     throw InputError("displacement_map", path + ": a displacement map has 1 channel, this file has " + std::to_string(file.channels));
