@@ -100,7 +100,11 @@ int run_render(const RenderArgs& args, const std::string& device) {
   const Camera camera = options.frame ? orbit_camera(scene, *options.frame, options.frames) : scene.camera;
   const double scene_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - scene_start).count();
 
+  // A render this machine cannot hold is refused before it allocates (a mesh's triangles drive it:
+  // each takes about 700 bytes of setup records).
+  refuse_beyond_machine(render_memory(scene, options), runtime.info(), "this render");
   Renderer renderer(runtime);
+  renderer.set_device_byte_limit(device_memory_bound(runtime.info()));  // the tile lists grow with the frame: bounded too
   // Handed over, not copied: image faces' float chains exist once (scene() reads them back).
   renderer.load_scene(std::move(scene), options.texels);
   const Scene& loaded = renderer.scene();

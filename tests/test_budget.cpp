@@ -686,3 +686,42 @@ TEST(Cancel, CompareMethodsStopsBetweenEntriesAndRepeats) {
 }
 
 }  // namespace
+
+// The command line's bound: a render is refused before it allocates when it would not fit the
+// machine (physical memory; a separate device's own memory for its buffers), naming size when the
+// frame drives it and scene otherwise.
+TEST(Budget, CommandLineRendersMustFitTheMachine) {
+  const size_t machine = physical_memory_bytes();
+  ASSERT_GT(machine, size_t{1} << 26) << "sysconf reports the physical memory";
+  DeviceInfo cpu;
+  cpu.host_unified_memory = true;
+  RenderMemory small;
+  small.texels = 1 << 20;
+  small.image = 1 << 20;
+  EXPECT_NO_THROW(refuse_beyond_machine(small, cpu, "this render"));
+  RenderMemory big_scene = small;
+  big_scene.setups = machine;  // a mesh's setup records
+  try {
+    refuse_beyond_machine(big_scene, cpu, "this render");
+    ADD_FAILURE() << "a render larger than the machine was let through";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "size");  // setups are frame buffers
+    EXPECT_EQ(e.limit_bytes(), machine);
+    EXPECT_GT(e.needed_bytes(), machine);
+  }
+  RenderMemory big_textures = small;
+  big_textures.texels = machine;
+  EXPECT_THROW(refuse_beyond_machine(big_textures, cpu, "this render"), OverBudget);
+  // A separate device: its buffers against its own memory, the host's bytes against the machine's.
+  DeviceInfo gpu;
+  gpu.global_memory_bytes = size_t{1} << 24;
+  try {
+    refuse_beyond_machine(big_textures, gpu, "this render");
+    ADD_FAILURE() << "device bytes past the device's memory were let through";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "scene");
+    EXPECT_EQ(e.limit_bytes(), gpu.global_memory_bytes);
+  }
+  EXPECT_EQ(device_memory_bound(cpu), machine);
+  EXPECT_EQ(device_memory_bound(gpu), gpu.global_memory_bytes);
+}

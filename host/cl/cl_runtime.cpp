@@ -60,6 +60,8 @@ std::vector<Candidate> all_devices() {
       info.type = device_type_name(device.getInfo<CL_DEVICE_TYPE>());
       info.version = trimmed(device.getInfo<CL_DEVICE_VERSION>());
       info.compute_units = static_cast<int>(device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>());
+      info.global_memory_bytes = static_cast<size_t>(device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>());
+      info.host_unified_memory = device.getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>() == CL_TRUE;
       out.push_back({platform, device, info});
     }
   }

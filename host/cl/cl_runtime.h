@@ -17,6 +17,8 @@ struct DeviceInfo {
   std::string type;     // "GPU", "CPU", ...
   std::string version;  // OpenCL version string
   int compute_units = 0;
+  size_t global_memory_bytes = 0;  // CL_DEVICE_GLOBAL_MEM_SIZE
+  bool host_unified_memory = false;  // CL_DEVICE_HOST_UNIFIED_MEMORY: its buffers are host memory
 };
 
 // Every device of every platform, in platform order.

@@ -4,12 +4,14 @@
 #include <limits>
 #include <stdexcept>
 
+#include <seamcl/core/over_budget.h>
 #include <seamcl/pipeline/gpu_types.h>
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/renderer.h>
 #include "pipeline/frame_params.h"
 
 #include <sys/resource.h>
+#include <unistd.h>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -201,6 +203,29 @@ void return_large_blocks_at_once() {
 #if defined(__GLIBC__)
   mallopt(M_MMAP_THRESHOLD, 1 << 20);
 #endif
+}
+
+size_t physical_memory_bytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page <= 0) return 0;
+  return mul(static_cast<size_t>(pages), static_cast<size_t>(page));
+}
+
+size_t device_memory_bound(const DeviceInfo& device) {
+  return device.host_unified_memory ? physical_memory_bytes() : device.global_memory_bytes;
+}
+
+void refuse_beyond_machine(const RenderMemory& memory, const DeviceInfo& device, const std::string& what) {
+  const std::string field = memory.frame_device_bytes() >= memory.scene_device_bytes() ? "size" : "scene";
+  const size_t host = physical_memory_bytes(), device_bound = device_memory_bound(device);
+  if (device.host_unified_memory) {
+    const size_t needed = saturating_add(memory.device_bytes(), memory.host_bytes());
+    if (host != 0 && needed > host) throw OverBudget(field, what, needed, host);
+    return;
+  }
+  if (host != 0 && memory.host_bytes() > host) throw OverBudget(field, what + " (host memory)", memory.host_bytes(), host);
+  if (device_bound != 0 && memory.device_bytes() > device_bound)
+    throw OverBudget(field, what + " (device memory)", memory.device_bytes(), device_bound);
 }
 
 ProcessMemory process_memory() {

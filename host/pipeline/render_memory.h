@@ -26,6 +26,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <seamcl/cl/cl_runtime.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/scene/scene.h>
 
@@ -137,6 +138,20 @@ struct ProcessMemory {
   size_t rss_bytes = 0;
 };
 ProcessMemory process_memory();
+
+// The machine's physical memory (sysconf), 0 when it cannot be told: what a command-line render
+// may use at most, where the service has a budget of its own.
+size_t physical_memory_bytes();
+
+// The most device bytes a render may take on `device`: physical memory on a device that shares
+// the host's (a CPU), else the device's global memory (0: unknown, no bound).
+size_t device_memory_bound(const DeviceInfo& device);
+
+// OverBudget when `memory` would not fit this machine: on a device that shares the host's memory,
+// device and host bytes together against physical_memory_bytes(); elsewhere the host bytes against
+// it and the device bytes against the device's. Field "size" when the frame's buffers drive it,
+// else "scene". For the command line, before any allocation (the service has a budget of its own).
+void refuse_beyond_machine(const RenderMemory& memory, const DeviceInfo& device, const std::string& what);
 
 // Makes the allocator give blocks of 1 MiB and more back to the system as soon as they are freed
 // (glibc: a fixed mmap threshold; nothing elsewhere). glibc raises its threshold to the largest
