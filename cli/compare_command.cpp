@@ -97,6 +97,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   SceneSourceOptions source;
   source.generator = generator_options;
   source.generator.defer_textures = true;  // each Renderer packs face by face: no float copy of the textures
+  ClRuntime runtime(global.device);  // a --device that matches none: refused before any work
   const Scene scene = load_scene_source(frame.scene, frame.texture, source);
   const Camera camera = frame.frame ? orbit_camera(scene, *frame.frame, frame.frames) : scene.camera;
   if (ref_settings.use_cache) ref_settings.scene_hash = scene_content_hash(scene);  // once for every reference kind
@@ -105,7 +106,6 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
     if (!args.no_progress) std::fprintf(stderr, "compare: %s\n", line.c_str());
   };
 
-  ClRuntime runtime(global.device);
   Renderer renderer(runtime);
   renderer.load_scene(scene, frame.texels);
   const ComparisonTargets targets =

@@ -92,12 +92,12 @@ int run(const CubeArgs& args, const GlobalOptions& global) {
   if (args.repeat < 1 || args.repeat > 100) throw InputError("repeat", "must be in 1..100");
   if (args.reference_scale < 1 || args.reference_scale > 16) throw InputError("reference_scale", "must be in 1..16");
   // Through host/assets, so that a scene file's environment may be an image file.
+  ClRuntime runtime(global.device);  // a --device that matches none: refused before any work
   Scene scene = load_scene_source(base.scene);
   if (!scene.environment) throw InputError("scene", "'" + base.scene + "' has no environment (try envmap)");
   const Camera camera = scene.orbit ? orbit_camera(scene, args.frame, args.frames) : scene.camera;
   if (!args.images_dir.empty()) make_output_directory(args.images_dir, "images");
 
-  ClRuntime runtime(global.device);
   Renderer renderer(runtime);
   renderer.load_scene(scene);
   // The reference does not depend on the cube: it is the environment itself.

@@ -75,6 +75,7 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
                                                    {"msaa", args.msaa},
                                                    {"displacement_method", to_string(methods.front())},
                                                    {"displacement_level", args.level}});
+  ClRuntime runtime(global.device);  // a --device that matches none: refused before any work
   Scene scene = load_scene_source(base.scene);
   if (!args.displacement_map.empty()) attach_ptex_displacement(scene, args.displacement_map);
   if (args.frames > 0 && !scene.orbit) {
@@ -91,7 +92,6 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
     if (!args.no_progress) std::fprintf(stderr, "displacement-metrics: %s\n", line.c_str());
   };
 
-  ClRuntime runtime(global.device);
   json results = json::array();
   const size_t total = methods.size() * levels.size();
   size_t done = 0;

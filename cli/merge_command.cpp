@@ -46,7 +46,9 @@ BenchPart read_part(const std::string& path) {
   text << in.rdbuf();
   try {
     return BenchPart{path, parse_json_document(text.str())};
-  } catch (const std::exception& error) {
+  } catch (const nlohmann::json::exception& error) {
+    throw InputError("parts", path + ": not valid JSON: " + error.what());
+  } catch (const std::invalid_argument& error) {  // parse_json_document's refusals
     throw InputError("parts", path + ": not valid JSON: " + error.what());
   }
 }

@@ -197,8 +197,9 @@ TEST(Assets, ObjRefusesBadNumbersAndIndicesNamingTheLineAndTheWord) {
            Case{quad + "f 1 2 3 -5\n", "face 0 (0-based; line 5) names a vertex that does not exist: '-5' counts back past the 4 "
                                        "vertices before line 5"},
            Case{quad + "f 1 2 3 4\nf 1 2 3 -4294967295\n", "face 1 (0-based; line 6) names a vertex that does not exist: '-4294967295'"},
-           Case{quad + "f 1/2 2 3 4\n", "face 0 (0-based; line 5) names a texture coordinate that does not exist: '2' in corner "
-                                        "'1/2'; the file has 0 texture coordinates"},
+           Case{quad + "f 1/x 2 3 4\n", "face 0 (0-based; line 5) has a texture coordinate index 'x' in corner '1/x' "
+                                        "that is not an integer"},
+           Case{quad + "f 1/0 2 3 4\n", "face 0 (0-based; line 5) names texture coordinate '0' in corner '1/0'"},
            Case{"vn 0 0 1\n" + quad + "f 1//x 2 3 4\n", "face 0 (0-based; line 6) has a normal index 'x' in corner '1//x'"},
            Case{quad + "f 1/1/1/1 2 3 4\n", "face 0 (0-based; line 5) has a corner '1/1/1/1' that is not i, i/j, i//k or i/j/k"},
            // A lone carriage return ends a line for tinyobjloader, so it does here: no line hides behind a comment.
@@ -231,11 +232,12 @@ TEST(Assets, ObjStillReadsSlashedRelativeAndForwardIndicesWAndVertexColours) {
                            "f -4 -3/-2 -2//-1 -1/-1/-1\n"
                            "f 4 3 2 1\n"
                            "f 1 2 3 5\n"
+                           "f 1/7 2/8 3/9 4//5\n"  // texture coordinates and normals a careless exporter left out
                            "v 9 9 9\n";
   const ObjMesh mesh = parse_obj(text, "forms.obj");
   const std::vector<glm::vec3> positions{{1.0f, 0.5f, -0.5e-3f}, {1, 2, 3}, {1e-5f, 250, -0.0f}, {0.25f, 1, 7}, {9, 9, 9}};
   EXPECT_EQ(mesh.positions, positions);
-  const std::vector<std::array<uint32_t, 4>> faces{{0, 1, 2, 3}, {0, 1, 2, 3}, {3, 2, 1, 0}, {0, 1, 2, 4}};
+  const std::vector<std::array<uint32_t, 4>> faces{{0, 1, 2, 3}, {0, 1, 2, 3}, {3, 2, 1, 0}, {0, 1, 2, 4}, {0, 1, 2, 3}};
   EXPECT_EQ(mesh.faces, faces);
 }
 
@@ -490,6 +492,9 @@ TEST(Assets, MeshSceneFilesNamePathsRelativeToTheFile) {
   EXPECT_NE(input_error([&] { load_scene_source(unknown); }, "lights").find("unknown field"), std::string::npos);
   const std::string missing = dir.write("scenes/missing.json", R"({"mesh": "nowhere.obj"})");
   EXPECT_NE(input_error([&] { load_scene_source(missing); }, "mesh").find("(in '"), std::string::npos);
+  // As strict as every scene file: a repeated key (the last would win unseen) is refused.
+  const std::string twice = dir.write("scenes/twice.json", R"({"mesh": ")" + mesh + R"(", "mesh": "nowhere.obj"})");
+  EXPECT_NE(input_error([&] { load_scene_source(twice); }, "scene").find("key 'mesh' is given twice"), std::string::npos);
   EXPECT_NE(input_error([&] { load_scene_source("paper", sample("wave_lo.ptx")); }, "texture").find("goes with an .obj scene"),
             std::string::npos);
 }

@@ -312,6 +312,12 @@ TEST_F(BenchMerge, RefusesCorruptedFieldsNamingTheFieldAndThePart) {
        "results[0].temporal_per_frame.frame"},
       {"differences[0].a null", [](json& j) { j["differences"][0]["a"] = nullptr; }, "differences[0].a"},
       {"wall_s a string", [](json& j) { j["wall_s"] = "1s"; }, "wall_s"},
+      // Each count within 2^53, their sum past it (it would wrap past 2^64 over enough frames).
+      {"per-frame counts that sum past 2^53",
+       [](json& j) {
+         for (json& v : j["results"][0]["nan_pixels_per_frame"]) v = uint64_t{1} << 53;
+       },
+       "results[0].nan_pixels_per_frame"},
   };
   for (const Corruption& c : corruptions) {
     other = parts;

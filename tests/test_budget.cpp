@@ -705,9 +705,17 @@ TEST(Budget, CommandLineRendersMustFitTheMachine) {
     refuse_beyond_machine(big_scene, cpu, "this render");
     ADD_FAILURE() << "a render larger than the machine was let through";
   } catch (const OverBudget& e) {
-    EXPECT_EQ(e.field(), "size");  // setups are frame buffers
+    EXPECT_EQ(e.field(), "scene");  // the triangles' setups: a smaller image would not help
     EXPECT_EQ(e.limit_bytes(), machine);
     EXPECT_GT(e.needed_bytes(), machine);
+  }
+  RenderMemory big_image = small;
+  big_image.samples = machine;  // a huge --size at 16x
+  try {
+    refuse_beyond_machine(big_image, cpu, "this render");
+    ADD_FAILURE() << "a frame larger than the machine was let through";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "size");
   }
   RenderMemory big_textures = small;
   big_textures.texels = machine;

@@ -233,9 +233,9 @@ TEST(EnvironmentFile, HostileInputsAreRefusedNamingTheField) {
   expect_input_error(load(R"({"file": "sky.exr", "layout": "cross"})"), "options.environment.file", "'cross' needs");
   expect_input_error(load(R"({"file": "nan.exr"})"), "options.environment.file", "texel (3, 2) is not finite");
   expect_input_error(load(R"({"file": "inf.exr"})"), "options.environment.file", "texel (5, 0) is not finite");
-  // Finite but past kMaxColorMagnitude (a float EXR: write_image stores half, whose largest is 65504).
+  // Finite but past kMaxColorMagnitude, written as a float EXR here.
   {
-    std::vector<glm::vec4> huge = equirect_pixels(16, 8);
+    std::vector<glm::vec4> huge = equirect_pixels(16, 8);  // (float: half could not hold 3e9)
     huge[16 + 7].b = 3e9f;
     auto out = OIIO::ImageOutput::create(dir.file("huge.exr"));
     ASSERT_TRUE(out);

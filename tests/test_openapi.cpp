@@ -20,6 +20,7 @@
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/pipeline/render_options.h>
+#include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
 #include "http_server.h"
 
@@ -415,6 +416,8 @@ TEST(OpenApi, SceneFormConstraintsMatchTheFormat) {
   EXPECT_EQ(radius.value("exclusiveMinimum", false), true);
   for (const char* colour : {"faces[i].texture.color", "light.color", "background"}) {
     EXPECT_EQ(resolve(schema_at(explicit_form, colour).first.at("items")).value("minimum", -1.0), 0.0) << colour;
+    EXPECT_EQ(resolve(schema_at(explicit_form, colour).first.at("items")).value("maximum", -1.0),
+              static_cast<double>(kMaxColorMagnitude)) << colour;
   }
 }
 

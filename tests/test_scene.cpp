@@ -280,9 +280,11 @@ TEST(Scene, OrbitCameraErrors) {
   const Orbit kept = *scene.orbit;
   scene.orbit->radius = 1e-30f;
   scene.orbit->height = 5.0f;
-  EXPECT_NE(expect_input_error([&] { orbit_camera(scene, 0, 4); }, "orbit").find("parallel"), std::string::npos);
+  EXPECT_NE(expect_input_error([&] { orbit_camera(scene, 0, 4); }, "orbit.radius").find("straight along the vertical"),
+            std::string::npos);
   scene.orbit->height = 0.0f;  // the eye on the centre
-  EXPECT_NE(expect_input_error([&] { orbit_camera(scene, 1, 4); }, "orbit").find("differ"), std::string::npos);
+  EXPECT_NE(expect_input_error([&] { orbit_camera(scene, 1, 4); }, "orbit.radius").find("frame 1's eye on the centre"),
+            std::string::npos);
   *scene.orbit = kept;
   EXPECT_NO_THROW(orbit_camera(scene, 3, 4));
   scene.orbit.reset();

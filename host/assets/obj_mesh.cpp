@@ -192,31 +192,39 @@ class Prescanner {
     // Only the texture coordinate of i//k may be left out.
     const bool empty_part = parts[0].empty() || (count == 2 && parts[1].empty()) || (count == 3 && parts[2].empty());
     if (empty_part) refuse(face + " has a corner " + quoted(corner) + " that is not i, i/j, i//k or i/j/k");
-    check_index(parts[0], corner, face, kPosition, so_far_.positions, total_.positions);
-    if (count >= 2 && !parts[1].empty()) check_index(parts[1], corner, face, kTexcoord, so_far_.texcoords, total_.texcoords);
-    if (count == 3) check_index(parts[2], corner, face, kNormal, so_far_.normals, total_.normals);
+    check_index(parts[0], corner, face, kPosition, so_far_.positions, total_.positions, true);
+    // Texture coordinates and normals are never read (only positions are): their indices must be
+    // integers, but may name lines a careless exporter left out, as tinyobjloader allows.
+    if (count >= 2 && !parts[1].empty()) check_index(parts[1], corner, face, kTexcoord, so_far_.texcoords, total_.texcoords, false);
+    if (count == 3) check_index(parts[2], corner, face, kNormal, so_far_.normals, total_.normals, false);
   }
 
   // A whole integer, not 0: a positive one names the file's element of that number (forward references
-  // are allowed, as tinyobjloader allows them), a negative one counts back from the elements before the line.
+  // are allowed, as tinyobjloader allows them), a negative one counts back from the elements before the
+  // line; with must_exist, the element must be there. Messages are made only for a refusal (a large
+  // file has tens of millions of indices).
   void check_index(std::string_view part, std::string_view corner, const std::string& face, ElementKind kind,
-                   size_t before, size_t total) const {
-    const std::string in_corner = part.size() == corner.size() ? "" : " in corner " + quoted(corner);
+                   size_t before, size_t total, bool must_exist) const {
+    const auto in_corner = [&] { return part.size() == corner.size() ? std::string() : " in corner " + quoted(corner); };
     const std::string_view digits = without_plus(part);
     const char* const last = digits.data() + digits.size();
     long long index = 0;
     const auto [end, error] = std::from_chars(digits.data(), last, index);
     if (error == std::errc::invalid_argument || end != last)
-      refuse(face + " has a " + kind.one + " index " + quoted(part) + in_corner + " that is not an integer");
-    const bool negative = digits.front() == '-';
+      refuse(face + " has a " + kind.one + " index " + quoted(part) + in_corner() + " that is not an integer");
     if (error == std::errc{} && index == 0)
-      refuse(face + " names " + kind.one + " " + quoted(part) + in_corner + "; OBJ indices start at 1, or at -1 counting back");
-    const std::string missing = face + " names a " + kind.one + " that does not exist: " + quoted(part) + in_corner;
+      refuse(face + " names " + kind.one + " " + quoted(part) + in_corner() + "; OBJ indices start at 1, or at -1 counting back");
+    if (!must_exist) {
+      if (error != std::errc{}) refuse(face + " has a " + kind.one + " index " + quoted(part) + in_corner() + " out of range");
+      return;
+    }
+    const bool negative = digits.front() == '-';
+    const auto missing = [&] { return face + " names a " + kind.one + " that does not exist: " + quoted(part) + in_corner(); };
     if (negative && (error != std::errc{} || static_cast<unsigned long long>(-(index + 1)) >= before))
-      refuse(missing + " counts back past the " + std::to_string(before) + " " + (before == 1 ? kind.one : kind.many) +
+      refuse(missing() + " counts back past the " + std::to_string(before) + " " + (before == 1 ? kind.one : kind.many) +
              " before line " + std::to_string(line_number_));
     if (!negative && (error != std::errc{} || static_cast<unsigned long long>(index) > total))
-      refuse(missing + "; the file has " + std::to_string(total) + " " + (total == 1 ? kind.one : kind.many));
+      refuse(missing() + "; the file has " + std::to_string(total) + " " + (total == 1 ? kind.one : kind.many));
   }
 
   const std::string& source_;

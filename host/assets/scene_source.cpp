@@ -5,6 +5,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <utility>
 
@@ -13,6 +14,7 @@
 #include <seamcl/assets/face_image.h>
 #include <seamcl/assets/obj_mesh.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/json_document.h>
 #include <seamcl/scene/scene_json.h>
 
 namespace seamcl {
@@ -111,9 +113,13 @@ struct Loader {
     // Only a file the scene reader would read whole is looked into here (a larger one, or one
     // that fails mid-read, is refused by that reader, naming why).
     if (fs::is_regular_file(path, ignored) && fs::file_size(path, ignored) <= kMaxSceneFileBytes) {
+      // Parsed as strictly as the scene reader parses (no repeated key, no NUL byte), since a mesh
+      // form is read from this document alone.
       try {
         std::ifstream in(path, std::ios::binary);
-        doc = json::parse(in, nullptr, false);
+        std::ostringstream text;
+        text << in.rdbuf();
+        doc = parse_json_document(text.str());
       } catch (const std::exception&) {
         doc = json(json::value_t::discarded);
       }

@@ -124,6 +124,13 @@ class Reader {
   uint64_t count(const json& object, const std::string& key, const std::string& path) const {
     return count(at(object, key, path), path);
   }
+  // total + n for counts summed over frames or parts, refused (naming this part) past the bound of
+  // a count: each is at most 2^53, so a sum of many could pass 2^64 and wrap.
+  uint64_t add(uint64_t total, uint64_t n, const std::string& path) const {
+    if (total > static_cast<uint64_t>(kMaxCount) || n > static_cast<uint64_t>(kMaxCount) - total)
+      refuse(path, "sums past 2^53 with the counts before it");
+    return total + n;
+  }
   const std::string& name() const { return part_.name; }
 
   // The part's frames [first, end), once its shard is checked.
@@ -214,9 +221,9 @@ json merge_curve(const std::vector<Reader>& readers, const std::vector<const jso
       if (fraction < 0 || fraction > 1 || std::abs(c - rounded) > 1e-6 * std::max(1.0, c)) {
         r.refuse(path, "a fraction that is not a count of the " + std::to_string(n) + " pixels");
       }
-      counts[j] += static_cast<uint64_t>(rounded);
+      counts[j] = r.add(counts[j], static_cast<uint64_t>(rounded), path);
     }
-    total_pixels += n;
+    total_pixels = r.add(total_pixels, n, path);
   }
   json out = json::array();
   for (size_t j = 0; j < counts.size(); ++j) {
@@ -247,12 +254,13 @@ json merge_errors(const std::vector<Reader>& readers, const std::vector<const js
                   const std::string& prefix, json out) {
   for (const char* key : {"pixels", "seam_pixels", "off_seam_pixels", "nan_pixels", "seam_nan_pixels"}) {
     uint64_t sum = 0;
-    for (size_t i = 0; i < objects.size(); ++i) sum += readers[i].count(*objects[i], key, prefix + key);
+    for (size_t i = 0; i < objects.size(); ++i) sum = readers[i].add(sum, readers[i].count(*objects[i], key, prefix + key), prefix + key);
     out[key] = sum;
   }
   if (objects[0]->contains("frames")) {
     uint64_t sum = 0;
-    for (size_t i = 0; i < objects.size(); ++i) sum += readers[i].count(*objects[i], "frames", prefix + "frames");
+    for (size_t i = 0; i < objects.size(); ++i)
+      sum = readers[i].add(sum, readers[i].count(*objects[i], "frames", prefix + "frames"), prefix + "frames");
     out["frames"] = sum;
   }
   // (statistic prefix, its pixel count)
@@ -269,7 +277,7 @@ json merge_errors(const std::vector<Reader>& readers, const std::vector<const js
       const double p99 = r.measure(*objects[i], pool + "p99", prefix + pool + "p99");
       if (n == 0) continue;
       weighted += mean * static_cast<double>(n);
-      pixels += n;
+      pixels = r.add(pixels, n, prefix + pixels_key);
       largest = std::max(largest, max);
       largest_p99 = std::max(largest_p99, p99);
     }
@@ -288,7 +296,7 @@ json merge_errors(const std::vector<Reader>& readers, const std::vector<const js
       const uint64_t n = readers[i].count(*objects[i], "pixels", prefix + "pixels");
       same = same && c == first;
       weighted += c * static_cast<double>(n);
-      pixels += n;
+      pixels = readers[i].add(pixels, n, prefix + "pixels");
     }
     out["seam_coverage"] = same ? first : (pixels == 0 ? 0.0 : weighted / static_cast<double>(pixels));
   }
@@ -314,7 +322,7 @@ void check_result(const Reader& r, const json& item, bool with_errors, const std
   }
   const std::string nan_path = prefix + "nan_pixels_per_frame";
   uint64_t nan_sum = 0;
-  r.per_frame(item, "nan_pixels_per_frame", nan_path, [&](const json& v) { nan_sum += r.count(v, nan_path); });
+  r.per_frame(item, "nan_pixels_per_frame", nan_path, [&](const json& v) { nan_sum = r.add(nan_sum, r.count(v, nan_path), nan_path); });
   if (r.count(item, "nan_pixels", prefix + "nan_pixels") != nan_sum) {
     r.refuse(prefix + "nan_pixels", "is not the sum of nan_pixels_per_frame (" + std::to_string(nan_sum) + ")");
   }
@@ -368,7 +376,8 @@ json merge_result(const std::vector<Reader>& readers, const std::vector<const js
 
   out["nan_pixels_per_frame"] = concat(readers, items, "nan_pixels_per_frame", prefix + "nan_pixels_per_frame");
   uint64_t nan_total = 0;
-  for (const json& v : out["nan_pixels_per_frame"]) nan_total += v.get<uint64_t>();  // counts, checked per part
+  for (size_t i = 0; i < items.size(); ++i)  // each part's sum, checked there, summed checked
+    nan_total = readers[i].add(nan_total, readers[i].count(*items[i], "nan_pixels", prefix + "nan_pixels"), prefix + "nan_pixels");
   out["nan_pixels"] = nan_total;
 
   // Temporal: the per-pair values in frame order (each part carries the pair across its first
@@ -593,7 +602,8 @@ json merge_bench_parts(const std::vector<BenchPart>& input) {
     }
     json merged = merge_difference(readers, items, prefix);
     uint64_t frames_sum = 0;
-    for (size_t i = 0; i < items.size(); ++i) frames_sum += readers[i].count(*items[i], "frames", prefix + "frames");
+    for (size_t i = 0; i < items.size(); ++i)
+      frames_sum = readers[i].add(frames_sum, readers[i].count(*items[i], "frames", prefix + "frames"), prefix + "frames");
     merged["frames"] = frames_sum;
     differences.push_back(merged);
   }
@@ -610,8 +620,8 @@ json merge_bench_parts(const std::vector<BenchPart>& input) {
       const json& ref = readers[i].at(*tops[i], "reference", "reference");
       const uint64_t c = readers[i].count(ref, "cached", "reference.cached");
       const uint64_t r = readers[i].count(ref, "rendered", "reference.rendered");
-      cached += c;
-      rendered += r;
+      cached = readers[i].add(cached, c, "reference.cached");
+      rendered = readers[i].add(rendered, r, "reference.rendered");
       ms += readers[i].measure(ref, "ms", "reference.ms");
       if (c + r > 0) {
         makers.push_back(readers[i]);

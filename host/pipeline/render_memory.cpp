@@ -216,7 +216,11 @@ size_t device_memory_bound(const DeviceInfo& device) {
 }
 
 void refuse_beyond_machine(const RenderMemory& memory, const DeviceInfo& device, const std::string& what) {
-  const std::string field = memory.frame_device_bytes() >= memory.scene_device_bytes() ? "size" : "scene";
+  // The pixels' buffers against what the scene's triangles and textures drive (setups and tile
+  // lists grow with the triangles): the field to change is the larger one's.
+  const size_t pixel_driven = saturating_add(saturating_add(memory.samples, memory.image), memory.seam_mask);
+  const size_t scene_driven = saturating_add(memory.scene_device_bytes(), saturating_add(memory.setups, memory.tile_lists));
+  const std::string field = pixel_driven >= scene_driven ? "size" : "scene";
   const size_t host = physical_memory_bytes(), device_bound = device_memory_bound(device);
   if (device.host_unified_memory) {
     const size_t needed = saturating_add(memory.device_bytes(), memory.host_bytes());

@@ -149,8 +149,8 @@ size_t device_memory_bound(const DeviceInfo& device);
 
 // OverBudget when `memory` would not fit this machine: on a device that shares the host's memory,
 // device and host bytes together against physical_memory_bytes(); elsewhere the host bytes against
-// it and the device bytes against the device's. Field "size" when the frame's buffers drive it,
-// else "scene". For the command line, before any allocation (the service has a budget of its own).
+// it and the device bytes against the device's. Field "size" when the pixels' buffers (samples,
+// image) drive it, else "scene" (its textures, or its triangles' setups and tile lists). For the command line, before any allocation (the service has a budget of its own).
 void refuse_beyond_machine(const RenderMemory& memory, const DeviceInfo& device, const std::string& what);
 
 // Makes the allocator give blocks of 1 MiB and more back to the system as soon as they are freed

@@ -354,8 +354,13 @@ Camera orbit_camera(const Scene& scene, int frame, int frames) {
   // the radius is (next to) nothing beside the height: such an orbit is refused here, as a static
   // camera is in validate_scene, rather than rendered blank.
   camera.up = glm::vec3(0, 1, 0);
-  if (const std::optional<std::string> problem = camera_problem(camera))
-    throw InputError("orbit", "frame " + std::to_string(frame) + "'s camera: " + *problem);
+  if (const std::optional<std::string> problem = camera_problem(camera)) {
+    // Said in the orbit's terms: its camera's members are not the user's to set.
+    const bool on_centre = problem->starts_with("eye");
+    throw InputError("orbit.radius", on_centre ? "and orbit.height put frame " + std::to_string(frame) + "'s eye on the centre"
+                                               : "is too small beside orbit.height: frame " + std::to_string(frame) +
+                                                     "'s eye would look straight along the vertical");
+  }
   return camera;
 }
 
