@@ -194,11 +194,7 @@ void validate_environment(const Environment& e) {
     throw InputError("environment.bake_samples", "must be in 1..8, got " + std::to_string(e.bake_samples));
   }
   auto finite = [](glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-  if (e.constant && !finite(*e.constant)) throw InputError("environment.constant", "must be finite");
-  if (e.constant && (glm::any(glm::lessThan(*e.constant, glm::vec3(0.0f))) ||
-                     glm::any(glm::greaterThan(*e.constant, glm::vec3(kMaxColorMagnitude))))) {
-    throw InputError("environment.constant", "each component must be in [0, 1e9]");
-  }
+  if (e.constant) check_color(*e.constant, "environment.constant");
   if (e.files) {
     if (e.constant) throw InputError("environment.constant", "cannot go with an image environment (file or faces)");
     const size_t expected = e.files->layout == EnvironmentLayout::Faces ? 6 : 1;

@@ -68,11 +68,6 @@ std::optional<std::string> camera_problem(const Camera& camera) {
   return std::nullopt;
 }
 
-void check_color(glm::vec3 c, const std::string& field) {
-  check_vec3(c, field);
-  if (glm::any(glm::lessThan(c, glm::vec3(0.0f)))) throw InputError(field, "must not be negative");
-  if (glm::any(glm::greaterThan(c, glm::vec3(kMaxColorMagnitude)))) throw InputError(field, "must be at most 1e9");
-}
 
 void check_texture(const MipChain& chain, const std::string& field, bool may_defer) {
   if (chain.levels.empty()) throw InputError(field, "has no mip levels");
@@ -386,6 +381,12 @@ void check_reflective_face(const Scene& scene, const Face& face, const std::stri
 }
 
 }  // namespace
+
+void check_color(glm::vec3 c, const std::string& field) {
+  if (!is_finite(c)) throw InputError(field, "must be finite");
+  if (glm::any(glm::lessThan(c, glm::vec3(0.0f)))) throw InputError(field, "must not be negative");
+  if (glm::any(glm::greaterThan(c, glm::vec3(kMaxColorMagnitude)))) throw InputError(field, "must be at most 1e9");
+}
 
 void check_texel_magnitudes(const MipChain& chain, const std::string& field) {
   for (size_t k = 0; k < chain.levels.size(); ++k)

@@ -154,6 +154,10 @@ void validate_scene(const Scene& scene);
 // weight is NaN in the image. The .ptx reader's bound is the same (PtexLimits::max_texel_magnitude).
 inline constexpr float kMaxColorMagnitude = 1e9f;
 
+// Throws InputError(field) unless every component of the colour is finite and in [0, kMaxColorMagnitude]:
+// the light's, the background's, a constant environment's.
+void check_color(glm::vec3 color, const std::string& field);
+
 // Throws InputError(field) naming the first mip level that holds a NaN, infinite or larger than
 // kMaxColorMagnitude texel: what validate_scene checks of a stored chain, and what a deferred
 // chain's source checks when it makes one (an image may hold any float).
