@@ -1,0 +1,78 @@
+#!/usr/bin/python3
+"""scripts/speed-targets against this build, --quick: every target of issue 14 gets a row with a
+measured value and a verdict, each command's output is kept, and bad options are refused.
+
+    tests/speed_targets_test.py --build build
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPT = os.path.join(ROOT, "scripts", "speed-targets")
+
+EXPECTED_TARGETS = [
+    "discard 16x / 1x", "discard 8x / 1x", "traverse / discard, every rate",
+    "pixels x32.0*", "faces x40.0*", "peak RSS of render --scene paper",
+    "peak RSS of paper <= floor + 2x packed", "peak RSS of paper_99k <= floor + 2x packed",
+]
+LOOKUP_TARGETS = [f"{what}, {texels}" for texels in ("rgba8", "rgba32f")
+                  for what in ("aniso16 / OIIO aniso", "trilinear / OIIO trilinear", "aniso16 / (trilinear / *")]
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", required=True)
+    args = ap.parse_args()
+    failures = []
+
+    def check(cond, what):
+        if not cond:
+            failures.append(what)
+            print("FAIL:", what)
+
+    def speed_targets(*options):
+        r = subprocess.run([sys.executable, SCRIPT, *options], capture_output=True, text=True, cwd=ROOT)
+        return r.returncode, r.stdout + r.stderr
+
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "targets")
+        rc, text = speed_targets("--build", args.build, "--out", out, "--quick", "--compare-runs", "1")
+        check(rc == 0, f"a quick run exits 0 (got {rc}): {text[-2000:]}")
+        if rc == 0:
+            with open(os.path.join(out, "targets.json")) as f:
+                report = json.load(f)
+            check(report["kind"] == "speed_targets" and report["quick"] is True, f"report header: {report.keys()}")
+            rows = {r["target"]: r for r in report["targets"]}
+            expected = list(EXPECTED_TARGETS)
+            if os.path.exists(os.path.join(args.build, "seamcl_bench_lookups")):
+                expected += LOOKUP_TARGETS
+            for name in expected:
+                prefix, _, suffix = name.partition("*")  # "*": the mean probe count
+                matches = [r for t, r in rows.items() if t.startswith(prefix) and t.endswith(suffix)]
+                check(len(matches) == 1, f"one row for {name!r}: {sorted(rows)}")
+                for r in matches:
+                    check(len(r["values"]) >= 1 and all(isinstance(v, (int, float)) and v > 0 for v in r["values"]),
+                          f"{name}: positive measured values, got {r['values']}")
+                    check(isinstance(r["met"], bool), f"{name}: a verdict, got {r['met']}")
+            paper = rows.get("peak RSS of render --scene paper")
+            if paper:
+                # The verdict follows the value, not the other way round.
+                check(paper["met"] == (paper["values"][0] <= 350), f"paper RSS verdict: {paper}")
+            for name in ("compare_1.json", "sweep.json", "render_quad2.json", "render_paper.json"):
+                check(os.path.getsize(os.path.join(out, name)) > 0, f"{name} kept under --out")
+            check("MISSED" in text or "met" in text, "the table names verdicts")
+        rc, text = speed_targets("--build", os.path.join(d, "nowhere"), "--out", out)
+        check(rc == 2 and "--build: no seamcl binary" in text, f"a build folder without seamcl: {rc} {text}")
+        rc, text = speed_targets("--build", args.build, "--compare-runs", "0", "--out", out)
+        check(rc == 2 and "--compare-runs must be at least 1" in text, f"--compare-runs 0: {rc} {text}")
+
+    print("speed_targets_test:", "FAILED" if failures else "ok")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
