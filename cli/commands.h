@@ -4,6 +4,7 @@
 #pragma once
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -37,6 +38,16 @@ inline void make_output_directory(const std::string& dir, const std::string& fie
   std::filesystem::create_directories(dir, error);
   if (error || !std::filesystem::is_directory(dir))
     throw InputError(field, "cannot make the directory '" + dir + "'" + (error ? ": " + error.message() : ""));
+}
+
+// An output option given an empty value (a shell variable that expanded to nothing, say) is refused
+// rather than read as the option left out, which would quietly write nothing where a file was
+// meant. Returns the path given, "" when the option was left out; `without_it` says what leaving
+// it out does.
+inline std::string given_output_path(const std::optional<std::string>& given, const std::string& field,
+                                     const std::string& without_it) {
+  if (given && given->empty()) throw InputError(field, "must not be empty (" + without_it + ")");
+  return given.value_or("");
 }
 
 struct GlobalOptions {

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -29,7 +30,7 @@ constexpr std::uintmax_t kMaxPartBytes = 256ull << 20;
 
 struct MergeArgs {
   std::vector<std::string> parts;
-  std::string output;
+  std::optional<std::string> output;
 };
 
 BenchPart read_part(const std::string& path) {
@@ -66,15 +67,16 @@ void write_atomically(const std::string& path, const std::string& text) {
 }
 
 int run_merge(const MergeArgs& args) {
-  if (!args.output.empty() && args.output != "-") check_output_parent(args.output, "output");
+  const std::string output = given_output_path(args.output, "output", "give - or leave out -o for stdout");
+  if (!output.empty() && output != "-") check_output_parent(output, "output");
   std::vector<BenchPart> parts;
   for (const std::string& path : args.parts) parts.push_back(read_part(path));
   const nlohmann::json merged = merge_bench_parts(parts);
   const std::string text = merged.dump(2) + "\n";
-  if (args.output.empty() || args.output == "-") {
+  if (output.empty() || output == "-") {
     std::cout << text;
   } else {
-    write_atomically(args.output, text);
+    write_atomically(output, text);
   }
   return 0;
 }

@@ -283,3 +283,18 @@ TEST_F(Cli, UnknownFlagIsUsageError) {
   EXPECT_FALSE(r.err.empty());
   EXPECT_TRUE(listing().empty());
 }
+
+// An empty output path is a mistake (a shell variable that expanded to nothing, say), not the
+// option left out: taken for none, it quietly wrote nothing, or wrote merge's JSON to stdout.
+TEST_F(Cli, EmptyOutputPathsAreInputErrors) {
+  expect_input_error("render --scene quad2 --size 16x16 -o ''", "output: must not be empty");
+  write("part.json", "{}");
+  expect_input_error("merge part.json -o ''", "output: must not be empty");
+  expect_input_error("compare --scene quad2 --methods discard --msaa 1 --size 16x16 --repeat 1 --no-progress "
+                     "--no-cache --images ''",
+                     "images: must not be empty");
+  expect_input_error("cube-metrics --cube-sizes 16 --size 16x16 --repeat 1 --images ''", "images: must not be empty");
+  expect_input_error("displacement-metrics --tessellation 1 --size 16x16 --frames 0 --repeat 1 --no-progress "
+                     "--images ''",
+                     "images: must not be empty");
+}
