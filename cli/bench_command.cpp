@@ -45,7 +45,7 @@ struct BenchArgs : MeasureArgs {
   std::string shard = "1/1";  // part K of N of the orbit's frames (host/eval/shard.h)
   bool check_only = false;    // validate the options and the scene, render nothing
   std::string seam_mask = "band";  // parse_seam_mask_kind: band (the committed results') or footprint (compare's)
-  std::string sweep;          // scaling sweeps instead of the orbit (host/eval/scaling_sweep.h)
+  std::optional<std::string> sweep;  // scaling sweeps instead of the orbit (host/eval/scaling_sweep.h); empty is refused
   int sweep_repeats = 5;
 };
 
@@ -142,7 +142,7 @@ class Progress {
 
 // --sweep: the scaling sweeps (one JSON, the chart's input: examples/scaling_chart.py).
 int run_sweep(const BenchArgs& args, const GlobalOptions& global) {
-  const std::vector<SweepAxis> axes = parse_sweep(args.sweep);
+  const std::vector<SweepAxis> axes = parse_sweep(*args.sweep);
   SweepSettings settings;
   settings.base = parse_render_options(measure_request(args));
   settings.methods = split_list(args.methods, "methods");
@@ -155,7 +155,7 @@ int run_sweep(const BenchArgs& args, const GlobalOptions& global) {
   settings.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };  // stdout stays JSON
   validate_sweep(axes, settings);
   if (args.check_only) {
-    std::printf("sweep options valid: %s\n", args.sweep.c_str());
+    std::printf("sweep options valid: %s\n", args.sweep->c_str());
     return 0;
   }
   ClRuntime runtime(global.device);
@@ -174,8 +174,22 @@ int run_sweep(const BenchArgs& args, const GlobalOptions& global) {
   return 0;
 }
 
-int run_bench(const BenchArgs& args, const GlobalOptions& global) {
-  if (!args.sweep.empty()) return run_sweep(args, global);
+// The orbit's options, which a sweep never reads. (The reference cache's options are not refused:
+// a wrapper may pass them to every bench, and without references they do nothing.)
+const std::vector<std::string> kOrbitOnlyOptions = {"--msaa", "--frames", "--no-errors", "--reference-frames",
+                                                     "--reference-method", "--reference-msaa", "--shard", "--seam-mask"};
+
+int run_bench(const BenchArgs& args, const CLI::App& command, const GlobalOptions& global) {
+  if (args.sweep) {
+    if (args.sweep->empty()) throw InputError("sweep", "must not be empty (leave out --sweep to run the orbit)");
+    refuse_ignored_options(command, kOrbitOnlyOptions, "with --sweep (a sweep renders no orbit)");
+    return run_sweep(args, global);
+  }
+  refuse_ignored_options(command, {"--sweep-repeats"}, "without --sweep");
+  if (args.no_errors) {
+    refuse_ignored_options(command, {"--reference-frames", "--reference-method", "--reference-msaa"},
+                           "with --no-errors (no reference is rendered)");
+  }
   // Validate everything before any work.
   const json base = base_request(args);
   const RenderOptions frame = parse_render_options(base);
@@ -489,7 +503,7 @@ Command add_bench_command(CLI::App& app) {
                   "Scaling sweeps instead of the orbit: a comma list of " + join_names(sweep_axis_names()) +
                       ", or all (time against image pixels, paper's face count at equal pixels, MSAA rate, texels)");
   cmd->add_option("--sweep-repeats", args->sweep_repeats, "Timed renders per method and sweep point (median) [5]");
-  return Command{cmd, [args](const GlobalOptions& global) { return run_bench(*args, global); }};
+  return Command{cmd, [args, cmd](const GlobalOptions& global) { return run_bench(*args, *cmd, global); }};
 }
 
 }  // namespace seamcl::cli

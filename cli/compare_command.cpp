@@ -88,6 +88,8 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   const std::vector<int> rates = parse_int_list(args.msaa, "msaa");
   const std::vector<MethodEntry> entries = method_entries(base, methods, rates);
   if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
+  // Ignored otherwise: without --frame the scene's own camera renders.
+  if (args.frames && !args.frame) throw InputError("frames", "--frames is ignored without --frame: leave it out");
   const std::vector<ReferenceKind> kinds = reference_kinds(args.references);
   ReferenceSettings ref_settings = reference_settings(args);
   (void)reference_render_options(frame, ref_settings);  // size and reference settings checked now

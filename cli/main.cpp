@@ -88,6 +88,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
   if (args.crack_orbit > 0 && (!options.displacement || !args.json_out))
     throw InputError("crack_orbit", "counts the cracks of a displaced render in --json's displacement block: give "
                                     "--displacement-method and --json too");
+  if (args.frames && !args.frame) throw InputError("frames", "--frames is ignored without --frame: leave it out");
   if (!args.displacement_map.empty() && !options.displacement)
     throw InputError("displacement_map", "displaces only a render with --displacement-method");
 
