@@ -3,6 +3,7 @@
 // merge exactly, which are recomputed from the merged samples and which are not exact).
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +18,7 @@
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/json_document.h>
+#include <seamcl/core/regular_file.h>
 #include <seamcl/eval/bench_merge.h>
 #include "commands.h"
 
@@ -34,19 +36,16 @@ struct MergeArgs {
 };
 
 BenchPart read_part(const std::string& path) {
-  std::error_code ec;
-  const std::uintmax_t bytes = fs::file_size(path, ec);
-  if (ec || !fs::is_regular_file(path)) throw InputError("parts", path + ": not a readable file");
-  if (bytes > kMaxPartBytes) {
-    throw InputError("parts", path + ": " + std::to_string(bytes >> 20) + " MiB, over the " +
-                                  std::to_string(kMaxPartBytes >> 20) + " MiB a part may have");
+  RegularFile file(path);  // opened and checked as one file: a FIFO swapped in cannot block the read
+  if (file.refusal() != RegularFile::Refusal::None) throw InputError("parts", path + ": not a readable file");
+  std::string text;
+  if (!file.read_all(text, kMaxPartBytes)) throw InputError("parts", path + ": not a readable file");
+  if (text.size() > kMaxPartBytes) {
+    throw InputError("parts", path + ": " + std::to_string(std::max<std::uintmax_t>(file.size(), text.size()) >> 20) +
+                                  " MiB, over the " + std::to_string(kMaxPartBytes >> 20) + " MiB a part may have");
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("parts", path + ": cannot be opened");
-  std::ostringstream text;
-  text << in.rdbuf();
   try {
-    return BenchPart{path, parse_json_document(text.str())};
+    return BenchPart{path, parse_json_document(text)};
   } catch (const nlohmann::json::exception& error) {
     throw InputError("parts", path + ": not valid JSON: " + error.what());
   } catch (const std::invalid_argument& error) {  // parse_json_document's refusals
