@@ -17,11 +17,13 @@
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/eval/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/io/image_io.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
@@ -103,6 +105,12 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   ClRuntime runtime(global.device);  // a --device that matches none: refused before any work
   const Scene scene = load_scene_source(frame.scene, frame.texture, source);
   const Camera camera = frame.frame ? orbit_camera(scene, *frame.frame, frame.frames) : scene.camera;
+  // A compare this machine cannot hold is refused before it allocates, as render refuses one.
+  const bool seamless = std::find(kinds.begin(), kinds.end(), ReferenceKind::Seamless) != kinds.end();
+  const CompareMemory memory = compare_memory(scene_sizes(scene), frame, entries, ref_settings, kinds,
+                                              seamless ? std::optional(seamless_scene_sizes(scene)) : std::nullopt);
+  refuse_beyond_machine(memory.device_bytes, memory.host_bytes, runtime.info(), compare_memory_field(memory),
+                        "this compare");
   if (ref_settings.use_cache) ref_settings.scene_hash = scene_content_hash(scene);  // once for every reference kind
   if (!images_dir.empty()) make_output_directory(images_dir, "images");
   auto progress = [&](const std::string& line) {

@@ -327,3 +327,15 @@ TEST_F(Cli, OptionsThatWouldBeIgnoredAreInputErrors) {
     EXPECT_EQ(r.exit_code, 0) << args << ": " << r.err;
   }
 }
+
+// compare and bench refuse a run this machine cannot hold before they allocate, as render does
+// (tests/test_budget.cpp holds the refusal to the machine's memory). A bench pools every error
+// frame's distances: a million frames at 1024x1024 need terabytes, so it names frames.
+TEST_F(Cli, BenchTheMachineCannotHoldIsRefusedNamingFrames) {
+  expect_input_error("bench --scene quad2 --methods discard,traverse --msaa 1,4 --size 1024x1024 --frames 1000000 "
+                     "--no-cache",
+                     "frames: this bench needs");
+  // A small bench is let through.
+  const Process r = run("bench --scene quad2 --methods discard --msaa 1 --size 16x16 --frames 3 --no-errors --no-cache");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
