@@ -22,11 +22,13 @@
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/bench_merge.h>
+#include <seamcl/eval/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/eval/scaling_sweep.h>
 #include <seamcl/eval/shard.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
@@ -45,7 +47,7 @@ struct BenchArgs : MeasureArgs {
   std::string shard = "1/1";  // part K of N of the orbit's frames (host/eval/shard.h)
   bool check_only = false;    // validate the options and the scene, render nothing
   std::string seam_mask = "band";  // parse_seam_mask_kind: band (the committed results') or footprint (compare's)
-  std::string sweep;          // scaling sweeps instead of the orbit (host/eval/scaling_sweep.h)
+  std::optional<std::string> sweep;  // scaling sweeps instead of the orbit (host/eval/scaling_sweep.h); empty is refused
   int sweep_repeats = 5;
 };
 
@@ -140,9 +142,55 @@ class Progress {
   bool tty_, quiet_;
 };
 
+// A bench this machine cannot hold is refused before it allocates, as render and compare refuse
+// theirs. It holds at once: the face-map and reference Renderer, one Renderer per method (with its
+// largest entry's buffers), every entry's last two images, and the error distances and seam masks
+// pooled over every error frame, which grow with the frames: field "frames" when they are most of
+// it, else "scene" or "size", whichever drives the Renderers' buffers.
+void refuse_beyond_machine(const Scene& scene, const RenderOptions& frame, const std::vector<MethodEntry>& entries,
+                           const ReferenceSettings& settings, bool with_errors, int error_frames, const DeviceInfo& device) {
+  const SceneSizes sizes = scene_sizes(scene);
+  RenderOptions face_map = frame;  // as render_face_map renders it
+  face_map.msaa = 1;
+  face_map.shading = ShadingMode::Pixel;
+  size_t device_bytes = 0, host_bytes = 0, scene_driven = 0, frame_driven = 0;
+  const auto add_renderer = [&](const RenderMemory& m) {
+    device_bytes = saturating_add(device_bytes, m.device_bytes());
+    host_bytes = saturating_add(host_bytes, m.host_bytes());
+    scene_driven = saturating_add(scene_driven, saturating_add(m.scene_device_bytes(), saturating_add(m.setups, m.tile_lists)));
+    frame_driven = saturating_add(frame_driven, saturating_add(m.samples, m.image));
+  };
+  if (with_errors) {
+    const CompareMemory references = compare_memory(sizes, frame, {}, settings);
+    device_bytes = references.device_bytes;
+    host_bytes = references.host_bytes;
+    frame_driven = saturating_add(references.reference.samples, references.reference.image);
+    scene_driven = saturating_add(references.reference.scene_device_bytes(),
+                                  saturating_add(references.reference.setups, references.reference.tile_lists));
+  } else {
+    add_renderer(render_memory(sizes, face_map));
+  }
+  std::map<std::string, RenderMemory> largest_per_method;
+  for (const MethodEntry& entry : entries) {
+    const RenderMemory m = render_memory(sizes, entry.options);
+    const auto [held, inserted] = largest_per_method.try_emplace(entry.method_name, m);
+    if (!inserted && m.device_bytes() > held->second.device_bytes()) held->second = m;
+  }
+  for (const auto& [method, m] : largest_per_method) add_renderer(m);
+  const size_t pixels = static_cast<size_t>(frame.width) * static_cast<size_t>(frame.height);
+  const size_t images = saturating_mul(saturating_mul(pixels, 2 * sizeof(glm::vec4)), entries.size());
+  const size_t pools = saturating_mul(saturating_mul(pixels, sizeof(float) + 1),
+                                      saturating_mul(entries.size(), static_cast<size_t>(error_frames)));
+  host_bytes = saturating_add(host_bytes, saturating_add(images, pools));
+  const std::string field = pools >= std::max(scene_driven, frame_driven) ? "frames"
+                            : scene_driven > frame_driven                  ? "scene"
+                                                                           : "size";
+  refuse_beyond_machine(device_bytes, host_bytes, device, field, "this bench");
+}
+
 // --sweep: the scaling sweeps (one JSON, the chart's input: examples/scaling_chart.py).
 int run_sweep(const BenchArgs& args, const GlobalOptions& global) {
-  const std::vector<SweepAxis> axes = parse_sweep(args.sweep);
+  const std::vector<SweepAxis> axes = parse_sweep(*args.sweep);
   SweepSettings settings;
   settings.base = parse_render_options(measure_request(args));
   settings.methods = split_list(args.methods, "methods");
@@ -155,7 +203,7 @@ int run_sweep(const BenchArgs& args, const GlobalOptions& global) {
   settings.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };  // stdout stays JSON
   validate_sweep(axes, settings);
   if (args.check_only) {
-    std::printf("sweep options valid: %s\n", args.sweep.c_str());
+    std::printf("sweep options valid: %s\n", args.sweep->c_str());
     return 0;
   }
   ClRuntime runtime(global.device);
@@ -174,8 +222,22 @@ int run_sweep(const BenchArgs& args, const GlobalOptions& global) {
   return 0;
 }
 
-int run_bench(const BenchArgs& args, const GlobalOptions& global) {
-  if (!args.sweep.empty()) return run_sweep(args, global);
+// The orbit's options, which a sweep never reads. (The reference cache's options are not refused:
+// a wrapper may pass them to every bench, and without references they do nothing.)
+const std::vector<std::string> kOrbitOnlyOptions = {"--msaa", "--frames", "--no-errors", "--reference-frames",
+                                                     "--reference-method", "--reference-msaa", "--shard", "--seam-mask"};
+
+int run_bench(const BenchArgs& args, const CLI::App& command, const GlobalOptions& global) {
+  if (args.sweep) {
+    if (args.sweep->empty()) throw InputError("sweep", "must not be empty (leave out --sweep to run the orbit)");
+    refuse_ignored_options(command, kOrbitOnlyOptions, "with --sweep (a sweep renders no orbit)");
+    return run_sweep(args, global);
+  }
+  refuse_ignored_options(command, {"--sweep-repeats"}, "without --sweep");
+  if (args.no_errors) {
+    refuse_ignored_options(command, {"--reference-frames", "--reference-method", "--reference-msaa"},
+                           "with --no-errors (no reference is rendered)");
+  }
   // Validate everything before any work.
   const json base = base_request(args);
   const RenderOptions frame = parse_render_options(base);
@@ -204,11 +266,14 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
                 range.first, range.end - 1, frame.frames);
     return 0;
   }
+  int error_frames = 0;
+  for (int k = range.first; k < range.end; ++k) error_frames += with_errors && k % args.reference_frames == 0 ? 1 : 0;
   const auto wall_start = std::chrono::steady_clock::now();
+  ClRuntime runtime(global.device);
+  refuse_beyond_machine(scene, frame, entries, ref_settings, with_errors, error_frames, runtime.info());
   // Once, not per reference frame: hashing bakes every face.
   if (with_errors && ref_settings.use_cache) ref_settings.scene_hash = scene_content_hash(scene);
 
-  ClRuntime runtime(global.device);
   // One renderer for the face maps and references, one per method (a method's packing, e.g. the
   // guard bands, then stays uploaded instead of being rebuilt on every switch).
   Renderer base_renderer(runtime);
@@ -238,8 +303,6 @@ int run_bench(const BenchArgs& args, const GlobalOptions& global) {
   }
 
   const int frames = frame.frames;
-  int error_frames = 0;
-  for (int k = range.first; k < range.end; ++k) error_frames += with_errors && k % args.reference_frames == 0 ? 1 : 0;
   const bool lead_in = range.first > 0;
   Progress progress(static_cast<size_t>(range.size() + (lead_in ? 1 : 0)) * entries.size() +
                         static_cast<size_t>(error_frames),
@@ -489,7 +552,7 @@ Command add_bench_command(CLI::App& app) {
                   "Scaling sweeps instead of the orbit: a comma list of " + join_names(sweep_axis_names()) +
                       ", or all (time against image pixels, paper's face count at equal pixels, MSAA rate, texels)");
   cmd->add_option("--sweep-repeats", args->sweep_repeats, "Timed renders per method and sweep point (median) [5]");
-  return Command{cmd, [args](const GlobalOptions& global) { return run_bench(*args, global); }};
+  return Command{cmd, [args, cmd](const GlobalOptions& global) { return run_bench(*args, *cmd, global); }};
 }
 
 }  // namespace seamcl::cli

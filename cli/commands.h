@@ -4,6 +4,7 @@
 #pragma once
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -37,6 +38,29 @@ inline void make_output_directory(const std::string& dir, const std::string& fie
   std::filesystem::create_directories(dir, error);
   if (error || !std::filesystem::is_directory(dir))
     throw InputError(field, "cannot make the directory '" + dir + "'" + (error ? ": " + error.message() : ""));
+}
+
+// An output option given an empty value (a shell variable that expanded to nothing, say) is refused
+// rather than read as the option left out, which would quietly write nothing where a file was
+// meant. Returns the path given, "" when the option was left out; `without_it` says what leaving
+// it out does.
+inline std::string given_output_path(const std::optional<std::string>& given, const std::string& field,
+                                     const std::string& without_it) {
+  if (given && given->empty()) throw InputError(field, "must not be empty (" + without_it + ")");
+  return given.value_or("");
+}
+
+// An option that acts only in another mode (with or without some other option) is refused where it
+// would be parsed and then ignored: the user meant it to change something. `options` are long names
+// ("--sweep-repeats"), each refused as the field of its name ("sweep_repeats"); `where` says when
+// it is ignored ("without --sweep").
+inline void refuse_ignored_options(const CLI::App& command, const std::vector<std::string>& options, const std::string& where) {
+  for (const std::string& option : options) {
+    if (command.count(option) == 0) continue;
+    std::string field = option.substr(option.find_first_not_of('-'));
+    for (char& c : field) c = c == '-' ? '_' : c;
+    throw InputError(field, option + " is ignored " + where + ": leave it out");
+  }
 }
 
 struct GlobalOptions {

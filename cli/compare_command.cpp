@@ -17,11 +17,13 @@
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/eval/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/io/image_io.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
@@ -37,7 +39,7 @@ namespace fs = std::filesystem;
 struct CompareArgs : MeasureArgs {
   std::optional<int> frame, frames;
   std::string constant_color;  // "r,g,b" linear: paint every face this colour
-  std::string images_dir;
+  std::optional<std::string> images;  // a directory; empty is refused, not taken for none
   int repeat = 3;
   std::vector<std::string> references;  // --reference, repeatable, each a name or a comma list
   bool no_progress = false;
@@ -81,12 +83,15 @@ std::vector<ReferenceKind> reference_kinds(const std::vector<std::string>& given
 
 int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   // Validate everything before any work.
+  const std::string images_dir = given_output_path(args.images, "images", "leave out --images to write no images");
   const json base = base_request(args);
   const RenderOptions frame = parse_render_options(base);
   const std::vector<std::string> methods = split_list(args.methods, "methods");
   const std::vector<int> rates = parse_int_list(args.msaa, "msaa");
   const std::vector<MethodEntry> entries = method_entries(base, methods, rates);
   if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
+  // Ignored otherwise: without --frame the scene's own camera renders.
+  if (args.frames && !args.frame) throw InputError("frames", "--frames is ignored without --frame: leave it out");
   const std::vector<ReferenceKind> kinds = reference_kinds(args.references);
   ReferenceSettings ref_settings = reference_settings(args);
   (void)reference_render_options(frame, ref_settings);  // size and reference settings checked now
@@ -100,8 +105,14 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   ClRuntime runtime(global.device);  // a --device that matches none: refused before any work
   const Scene scene = load_scene_source(frame.scene, frame.texture, source);
   const Camera camera = frame.frame ? orbit_camera(scene, *frame.frame, frame.frames) : scene.camera;
+  // A compare this machine cannot hold is refused before it allocates, as render refuses one.
+  const bool seamless = std::find(kinds.begin(), kinds.end(), ReferenceKind::Seamless) != kinds.end();
+  const CompareMemory memory = compare_memory(scene_sizes(scene), frame, entries, ref_settings, kinds,
+                                              seamless ? std::optional(seamless_scene_sizes(scene)) : std::nullopt);
+  refuse_beyond_machine(memory.device_bytes, memory.host_bytes, runtime.info(), compare_memory_field(memory),
+                        "this compare");
   if (ref_settings.use_cache) ref_settings.scene_hash = scene_content_hash(scene);  // once for every reference kind
-  if (!args.images_dir.empty()) make_output_directory(args.images_dir, "images");
+  if (!images_dir.empty()) make_output_directory(images_dir, "images");
   auto progress = [&](const std::string& line) {
     if (!args.no_progress) std::fprintf(stderr, "compare: %s\n", line.c_str());
   };
@@ -110,14 +121,14 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   renderer.load_scene(scene, frame.texels);
   const ComparisonTargets targets =
       prepare_targets(runtime, renderer, camera, frame, entries, ref_settings, kinds, progress);
-  if (!args.images_dir.empty()) {
+  if (!images_dir.empty()) {
     for (const ReferenceImage& reference : targets.high_res) {
       const std::string name = reference.kind == ReferenceKind::Paper ? "reference" : "reference_" + to_string(reference.kind);
-      write_image((fs::path(args.images_dir) / (name + ".png")).string(), reference.width, reference.height,
+      write_image((fs::path(images_dir) / (name + ".png")).string(), reference.width, reference.height,
                   reference.pixels);
     }
     for (const auto& [msaa, reference] : targets.seamless_by_rate) {
-      write_image((fs::path(args.images_dir) / ("reference_seamless_msaa" + std::to_string(msaa) + ".png")).string(),
+      write_image((fs::path(images_dir) / ("reference_seamless_msaa" + std::to_string(msaa) + ".png")).string(),
                   reference.width, reference.height, reference.pixels);
     }
     for (const auto& [msaa, mask] : targets.masks) {
@@ -127,7 +138,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
         mask_image[i] = mask[i] == SEAMCL_MASK_SEAM       ? glm::vec4(1)
                         : mask[i] == SEAMCL_MASK_BOUNDARY ? glm::vec4(0.2f, 0.2f, 0.2f, 1.0f)
                                                           : glm::vec4(0, 0, 0, 1);
-      write_image((fs::path(args.images_dir) / ("seam_mask_msaa" + std::to_string(msaa) + ".png")).string(), frame.width,
+      write_image((fs::path(images_dir) / ("seam_mask_msaa" + std::to_string(msaa) + ".png")).string(), frame.width,
                   frame.height, mask_image);
     }
   }
@@ -137,11 +148,11 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   for (const EntryResult& measured :
        compare_methods(renderer, scene, camera, entries, targets_for, args.repeat, {}, progress)) {
     json item = compare_result_json(measured);
-    if (!args.images_dir.empty()) {
+    if (!images_dir.empty()) {
       const RenderResult& result = measured.last;
       const std::string stem = measured.entry.method_name + "_msaa" + std::to_string(measured.entry.options.msaa);
-      const fs::path image = fs::path(args.images_dir) / (stem + ".png");
-      const fs::path heat = fs::path(args.images_dir) / (stem + "_error.png");
+      const fs::path image = fs::path(images_dir) / (stem + ".png");
+      const fs::path heat = fs::path(images_dir) / (stem + "_error.png");
       write_image(image.string(), result.width, result.height, result.pixels);
       write_image(heat.string(), result.width, result.height, error_heatmap(measured.errors->distance));
       item["images"] = {{"image", image.string()}, {"error", heat.string()}};
@@ -167,7 +178,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
       out["frame"] = *frame.frame;
       out["frames"] = frame.frames;
     }
-    if (!args.images_dir.empty()) out["images"] = args.images_dir;
+    if (!images_dir.empty()) out["images"] = images_dir;
     if (!displacement.is_null()) out["displacement"] = displacement;
     std::cout << out.dump(2) << "\n";
   } else {
@@ -210,7 +221,7 @@ Command add_compare_command(CLI::App& app) {
   cmd->add_option("--frames", args->frames, "Frames in the orbit [60]");
   cmd->add_option("--constant-color", args->constant_color,
                   "Paint every face one linear colour r,g,b (each 0..1): seams then carry no texture error");
-  cmd->add_option("--images", args->images_dir,
+  cmd->add_option("--images", args->images,
                   "Write each image, an error heat map (log scale 1e-4..1), the reference and the seam mask (PNG) here");
   cmd->add_option("--repeat", args->repeat, "Timed renders per method and rate; ms reports median, min, max [3]");
   cmd->add_option("--reference", args->references,

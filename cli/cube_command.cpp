@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,7 +40,7 @@ struct CubeArgs {
   int frame = 0, frames = 1;
   int repeat = 5;
   int reference_scale = 8;
-  std::string images_dir;
+  std::optional<std::string> images;  // a directory; empty is refused, not taken for none
   bool json_out = false;
 };
 
@@ -76,6 +77,7 @@ std::string scientific(double v) {
 }
 
 int run(const CubeArgs& args, const GlobalOptions& global) {
+  const std::string images_dir = given_output_path(args.images, "images", "leave out --images to write no images");
   std::vector<CubeMethod> methods;
   for (const std::string& name : split_list(args.cube_methods, "cube_methods")) {
     const auto method = parse_cube_method(name);
@@ -96,17 +98,17 @@ int run(const CubeArgs& args, const GlobalOptions& global) {
   Scene scene = load_scene_source(base.scene);
   if (!scene.environment) throw InputError("scene", "'" + base.scene + "' has no environment (try envmap)");
   const Camera camera = scene.orbit ? orbit_camera(scene, args.frame, args.frames) : scene.camera;
-  if (!args.images_dir.empty()) make_output_directory(args.images_dir, "images");
+  if (!images_dir.empty()) make_output_directory(images_dir, "images");
 
   Renderer renderer(runtime);
   renderer.load_scene(scene);
   // The reference does not depend on the cube: it is the environment itself.
   const CubeReference reference = cube_reference(renderer, camera, base, args.reference_scale);
-  if (!args.images_dir.empty()) {
-    write_image(args.images_dir + "/reference.png", reference.width, reference.height, reference.pixels);
+  if (!images_dir.empty()) {
+    write_image(images_dir + "/reference.png", reference.width, reference.height, reference.pixels);
     std::vector<glm::vec4> mask(reference.cube_edge.size());
     for (size_t i = 0; i < mask.size(); ++i) mask[i] = glm::vec4(glm::vec3(reference.cube_edge[i] ? 1.0f : 0.0f), 1.0f);
-    write_image(args.images_dir + "/cube_edge_mask.png", reference.width, reference.height, mask);
+    write_image(images_dir + "/cube_edge_mask.png", reference.width, reference.height, mask);
   }
 
   json results = json::array();
@@ -127,8 +129,8 @@ int run(const CubeArgs& args, const GlobalOptions& global) {
       const ImageErrors errors = compare_images(image.pixels, reference.pixels, &reference.cube_edge);
       const EdgeMeasures edges = measure_cube_edges(runtime, *scene.environment, method, n);
       const size_t cube_bytes = static_cast<size_t>(kCubeFaces) * (4 * static_cast<size_t>(n) * n - 1) / 3 * 16;
-      if (!args.images_dir.empty()) {
-        write_image(args.images_dir + "/" + to_string(method) + "-" + std::to_string(n) + ".png", image.width,
+      if (!images_dir.empty()) {
+        write_image(images_dir + "/" + to_string(method) + "-" + std::to_string(n) + ".png", image.width,
                     image.height, image.pixels);
       }
       results.push_back({{"cube_size", n},
@@ -201,7 +203,7 @@ Command add_cube_command(CLI::App& app) {
   command->add_option("--repeat", args->repeat, "Timed renders per entry; the median is reported [5]");
   command->add_option("--reference-scale", args->reference_scale,
                       "Supersampling of the analytic reference per axis [8]");
-  command->add_option("--images", args->images_dir, "Write each image, the reference and the cube-edge mask as PNG");
+  command->add_option("--images", args->images, "Write each image, the reference and the cube-edge mask as PNG");
   command->add_flag("--json", args->json_out, "Print one JSON object");
   return {command, [args](const GlobalOptions& global) { return run(*args, global); }};
 }

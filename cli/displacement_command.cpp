@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,7 @@ struct DisplacementArgs {
   int msaa = 4;
   int frames = 60;
   int repeat = 5;
-  std::string images_dir;
+  std::optional<std::string> images;  // a directory; empty is refused, not taken for none
   bool json_out = false;
   bool no_progress = false;
 };
@@ -60,6 +61,7 @@ std::vector<DisplacementMethod> parse_methods(const std::string& text) {
 
 int run(const DisplacementArgs& args, const GlobalOptions& global) {
   // Validate everything before any work.
+  const std::string images_dir = given_output_path(args.images, "images", "leave out --images to write no images");
   const std::vector<DisplacementMethod> methods = parse_methods(args.methods);
   const std::vector<int> levels = parse_int_list(args.tessellation, "tessellation");
   for (int t : levels) {
@@ -87,7 +89,7 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
   }
   check_tessellation_levels(scene, levels);  // the triangle bound of every level, before any render
   const bool closed = is_closed_mesh(scene);
-  if (!args.images_dir.empty()) make_output_directory(args.images_dir, "images");
+  if (!images_dir.empty()) make_output_directory(images_dir, "images");
   auto progress = [&](const std::string& line) {
     if (!args.no_progress) std::fprintf(stderr, "displacement-metrics: %s\n", line.c_str());
   };
@@ -104,14 +106,14 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
                std::to_string(t));
       const DisplacementReport report = measure_displacement(runtime, scene, scene.camera, options, args.frames, args.repeat);
       json item = report.to_json();
-      if (!args.images_dir.empty()) {
+      if (!images_dir.empty()) {
         // Frame 0 of the orbit with the flag shell inside (closed meshes): cracks show as magenta.
         const Camera camera = scene.orbit ? orbit_camera(scene, 0, std::max(args.frames, 1)) : scene.camera;
         Renderer renderer(runtime);
         const Scene shown = closed ? with_flag_shell(scene) : scene;
         renderer.load_scene(shown, options.texels);
         const RenderResult image = renderer.render(camera, options);
-        const fs::path path = fs::path(args.images_dir) / (to_string(method) + "_T" + std::to_string(t) + ".png");
+        const fs::path path = fs::path(images_dir) / (to_string(method) + "_T" + std::to_string(t) + ".png");
         write_image(path.string(), image.width, image.height, image.pixels);
         item["image"] = path.string();
       }
@@ -164,7 +166,7 @@ Command add_displacement_command(CLI::App& app) {
   command->add_option("--msaa", args->msaa, "Samples per pixel (crack pixels count a pixel when any sample sees the flag) [4]");
   command->add_option("--frames", args->frames, "Orbit frames to count crack pixels over; 0: the scene's camera only [60]");
   command->add_option("--repeat", args->repeat, "Timed renders per entry; the median is reported [5]");
-  command->add_option("--images", args->images_dir, "Write frame 0 of each entry as PNG (flag shell inside: cracks magenta)");
+  command->add_option("--images", args->images, "Write frame 0 of each entry as PNG (flag shell inside: cracks magenta)");
   command->add_flag("--json", args->json_out, "Print one JSON object");
   command->add_flag("--no-progress", args->no_progress, "Do not print progress lines on stderr");
   return {command, [args](const GlobalOptions& global) { return run(*args, global); }};

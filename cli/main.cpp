@@ -38,7 +38,7 @@ struct RenderArgs {
   int crack_orbit = 0;           // count crack pixels over this many orbit frames (0: this frame)
   bool centroid = false;
   bool tint = false;
-  std::string output;
+  std::optional<std::string> output;
   bool json_out = false;
   int repeat = 1;
 };
@@ -76,10 +76,11 @@ json render_request(const RenderArgs& a) {
 
 int run_render(const RenderArgs& args, const std::string& device) {
   // Validate everything before any work, so bad input changes nothing.
+  const std::string output = cli::given_output_path(args.output, "output", "leave out -o to render and time only");
   const RenderOptions options = parse_render_options(render_request(args));
-  if (!args.output.empty()) {
-    image_format_for_path(args.output, "output");
-    cli::check_output_parent(args.output, "output");
+  if (!output.empty()) {
+    image_format_for_path(output, "output");
+    cli::check_output_parent(output, "output");
   }
   if (args.repeat < 1 || args.repeat > 1000) throw InputError("repeat", "must be in 1..1000");
   if (args.crack_orbit < 0 || args.crack_orbit > 3600) throw InputError("crack_orbit", "must be in 0..3600");
@@ -87,6 +88,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
   if (args.crack_orbit > 0 && (!options.displacement || !args.json_out))
     throw InputError("crack_orbit", "counts the cracks of a displaced render in --json's displacement block: give "
                                     "--displacement-method and --json too");
+  if (args.frames && !args.frame) throw InputError("frames", "--frames is ignored without --frame: leave it out");
   if (!args.displacement_map.empty() && !options.displacement)
     throw InputError("displacement_map", "displaces only a render with --displacement-method");
 
@@ -117,7 +119,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
     result = renderer.render(camera, options);
     times.push_back(result.ms);
   }
-  if (!args.output.empty()) write_image(args.output, result.width, result.height, result.pixels);
+  if (!output.empty()) write_image(output, result.width, result.height, result.pixels);
 
   auto stage_median = [&](double StageTimes::*stage) {
     std::vector<double> values;
@@ -149,15 +151,15 @@ int run_render(const RenderArgs& args, const std::string& device) {
       out["displacement"] = report.to_json();
       out["triangles"] = report.triangles;
     }
-    if (!args.output.empty()) out["output"] = args.output;
+    if (!output.empty()) out["output"] = output;
     out["memory"] = to_json(measure_memory(renderer));  // peak over everything above
     std::cout << out.dump(2) << "\n";
   } else {
     std::printf("%s: %dx%d msaa %d, %.2f ms (setup %.2f, binning %.2f, raster %.2f, shade %.2f), %u fragments%s%s\n",
                 loaded.name.c_str(), result.width, result.height, options.msaa, ms["total"].get<double>(),
                 ms["setup"].get<double>(), ms["binning"].get<double>(), ms["raster"].get<double>(),
-                ms["shade"].get<double>(), result.stats.fragments, args.output.empty() ? "" : " -> ",
-                args.output.c_str());
+                ms["shade"].get<double>(), result.stats.fragments, output.empty() ? "" : " -> ",
+                output.c_str());
   }
   return 0;
 }

@@ -3,11 +3,13 @@
 // merge exactly, which are recomputed from the merged samples and which are not exact).
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -16,6 +18,7 @@
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/json_document.h>
+#include <seamcl/core/regular_file.h>
 #include <seamcl/eval/bench_merge.h>
 #include "commands.h"
 
@@ -29,23 +32,20 @@ constexpr std::uintmax_t kMaxPartBytes = 256ull << 20;
 
 struct MergeArgs {
   std::vector<std::string> parts;
-  std::string output;
+  std::optional<std::string> output;
 };
 
 BenchPart read_part(const std::string& path) {
-  std::error_code ec;
-  const std::uintmax_t bytes = fs::file_size(path, ec);
-  if (ec || !fs::is_regular_file(path)) throw InputError("parts", path + ": not a readable file");
-  if (bytes > kMaxPartBytes) {
-    throw InputError("parts", path + ": " + std::to_string(bytes >> 20) + " MiB, over the " +
-                                  std::to_string(kMaxPartBytes >> 20) + " MiB a part may have");
+  RegularFile file(path);  // opened and checked as one file: a FIFO swapped in cannot block the read
+  if (file.refusal() != RegularFile::Refusal::None) throw InputError("parts", path + ": not a readable file");
+  std::string text;
+  if (!file.read_all(text, kMaxPartBytes)) throw InputError("parts", path + ": not a readable file");
+  if (text.size() > kMaxPartBytes) {
+    throw InputError("parts", path + ": " + std::to_string(std::max<std::uintmax_t>(file.size(), text.size()) >> 20) +
+                                  " MiB, over the " + std::to_string(kMaxPartBytes >> 20) + " MiB a part may have");
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("parts", path + ": cannot be opened");
-  std::ostringstream text;
-  text << in.rdbuf();
   try {
-    return BenchPart{path, parse_json_document(text.str())};
+    return BenchPart{path, parse_json_document(text)};
   } catch (const nlohmann::json::exception& error) {
     throw InputError("parts", path + ": not valid JSON: " + error.what());
   } catch (const std::invalid_argument& error) {  // parse_json_document's refusals
@@ -66,15 +66,16 @@ void write_atomically(const std::string& path, const std::string& text) {
 }
 
 int run_merge(const MergeArgs& args) {
-  if (!args.output.empty() && args.output != "-") check_output_parent(args.output, "output");
+  const std::string output = given_output_path(args.output, "output", "give - or leave out -o for stdout");
+  if (!output.empty() && output != "-") check_output_parent(output, "output");
   std::vector<BenchPart> parts;
   for (const std::string& path : args.parts) parts.push_back(read_part(path));
   const nlohmann::json merged = merge_bench_parts(parts);
   const std::string text = merged.dump(2) + "\n";
-  if (args.output.empty() || args.output == "-") {
+  if (output.empty() || output == "-") {
     std::cout << text;
   } else {
-    write_atomically(args.output, text);
+    write_atomically(output, text);
   }
   return 0;
 }

@@ -275,6 +275,36 @@ TEST(Assets, FaceCountsMustMatchAndADisagreeingAdjacencyNamesBothFaces) {
   EXPECT_NE(message.find("but face " + std::to_string(old_neighbor) + " edge"), std::string::npos) << message;
 }
 
+// Faces that share an edge, but only an edge of three faces: nothing links them, and the refusal
+// says so instead of claiming that no two faces share an edge.
+TEST(Assets, TraverseRefusesAMeshWhoseOnlySharedEdgeIsNonManifoldSayingSo) {
+  TempDir dir;
+  // Three quads around the edge from vertex 1 to vertex 2 (0-based 0 and 1), like pages of a book.
+  const std::string book = dir.write("book.obj", "v 0 0 0\nv 0 1 0\nv 1 1 0\nv 1 0 0\nv -1 1 0\nv -1 0 0\n"
+                                                 "v 0 1 1\nv 0 0 1\nf 1 2 3 4\nf 2 1 6 5\nf 1 2 7 8\n");
+  const Scene scene = load_scene_source(book);
+  const NonManifoldEdges non_manifold = non_manifold_edges(scene);
+  EXPECT_EQ(non_manifold.count, 1u);
+  EXPECT_EQ(non_manifold.first_vertex, 0u);
+  EXPECT_EQ(non_manifold.second_vertex, 1u);
+  EXPECT_EQ(non_manifold.example_faces, 3u);
+  Renderer renderer(shared_runtime());
+  renderer.load_scene(scene);
+  RenderOptions options;
+  options.width = 32;
+  options.height = 32;
+  for (Method method : {Method::Traverse, Method::Guardband}) {
+    options.method = method;
+    const std::string message = input_error([&] { renderer.render(scene.camera, options); }, "method");
+    EXPECT_EQ(message.find("no two of"), std::string::npos) << message;
+    EXPECT_NE(message.find("its only shared edge, between vertices 0 and 1 (0-based), is shared by 3 faces"),
+              std::string::npos)
+        << message;
+  }
+  // A manifold mesh has none.
+  EXPECT_EQ(non_manifold_edges(load_scene_source(sample("plane.obj"))).count, 0u);
+}
+
 TEST(Assets, TraverseAndGuardbandRefuseAMeshWithoutSharedEdgesSingleQuadsStillRender) {
   TempDir dir;
   // Two quads side by side, each with vertices of its own: no edge is shared by index.

@@ -733,3 +733,49 @@ TEST(Budget, CommandLineRendersMustFitTheMachine) {
   EXPECT_EQ(device_memory_bound(cpu), machine);
   EXPECT_EQ(device_memory_bound(gpu), gpu.global_memory_bytes);
 }
+
+// compare and bench refuse a run the machine cannot hold as render does, from the run's totals,
+// naming what drives them: size, msaa or scene for a compare (compare_memory_field), frames for a
+// bench whose pooled errors grow with its frames (the CLI tests hold bench to that).
+TEST(Budget, CommandLineComparesAndBenchesMustFitTheMachine) {
+  const size_t machine = physical_memory_bytes();
+  DeviceInfo cpu;
+  cpu.host_unified_memory = true;
+  EXPECT_NO_THROW(refuse_beyond_machine(1 << 20, 1 << 20, cpu, "size", "this compare"));
+  try {
+    refuse_beyond_machine(machine / 2 + 1, machine / 2 + 1, cpu, "frames", "this bench");
+    ADD_FAILURE() << "a bench larger than the machine was let through";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "frames");
+    EXPECT_NE(std::string(e.what()).find("this bench needs"), std::string::npos) << e.what();
+  }
+  DeviceInfo gpu;
+  gpu.global_memory_bytes = size_t{1} << 24;
+  try {
+    refuse_beyond_machine(size_t{1} << 25, 1 << 20, gpu, "scene", "this compare");
+    ADD_FAILURE() << "device bytes past the device's memory were let through";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "scene");
+    EXPECT_EQ(e.limit_bytes(), gpu.global_memory_bytes);
+  }
+
+  // The field: the 8x reference's frame buffers are the size's doing.
+  const SceneSizes quad2 = scene_sizes(generate_scene("quad2", GeneratorOptions{}));
+  RenderOptions frame;
+  frame.width = 64;
+  frame.height = 64;
+  const std::vector<MethodEntry> entries = method_entries(nlohmann::json{{"size", "64x64"}}, {"discard"}, {1, 16});
+  EXPECT_EQ(compare_memory_field(compare_memory(quad2, frame, entries, ReferenceSettings{})), "size");
+  // A scene whose packing outweighs the frames.
+  SceneSizes textured = quad2;
+  for (auto& face : textured.faces) face = {4096, 4096};
+  EXPECT_EQ(compare_memory_field(compare_memory(textured, frame, entries, ReferenceSettings{})), "scene");
+  // A measured rate's samples past the reference's buffers.
+  CompareMemory multisampled;
+  multisampled.reference.samples = 1000;
+  multisampled.reference.image = 4000;
+  multisampled.entries.resize(1);
+  multisampled.entries[0].samples = 16 * 1000;  // 16 samples a pixel
+  multisampled.entries[0].image = 4000;
+  EXPECT_EQ(compare_memory_field(multisampled), "msaa");
+}

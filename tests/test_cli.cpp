@@ -283,3 +283,59 @@ TEST_F(Cli, UnknownFlagIsUsageError) {
   EXPECT_FALSE(r.err.empty());
   EXPECT_TRUE(listing().empty());
 }
+
+// An empty output path is a mistake (a shell variable that expanded to nothing, say), not the
+// option left out: taken for none, it quietly wrote nothing, or wrote merge's JSON to stdout.
+TEST_F(Cli, EmptyOutputPathsAreInputErrors) {
+  expect_input_error("render --scene quad2 --size 16x16 -o ''", "output: must not be empty");
+  write("part.json", "{}");
+  expect_input_error("merge part.json -o ''", "output: must not be empty");
+  expect_input_error("compare --scene quad2 --methods discard --msaa 1 --size 16x16 --repeat 1 --no-progress "
+                     "--no-cache --images ''",
+                     "images: must not be empty");
+  expect_input_error("cube-metrics --cube-sizes 16 --size 16x16 --repeat 1 --images ''", "images: must not be empty");
+  expect_input_error("displacement-metrics --tessellation 1 --size 16x16 --frames 0 --repeat 1 --no-progress "
+                     "--images ''",
+                     "images: must not be empty");
+}
+
+// An option that acts only with another (or only without one) is refused where it would be parsed
+// and then ignored, naming itself: whoever gave it meant it to change something.
+TEST_F(Cli, OptionsThatWouldBeIgnoredAreInputErrors) {
+  expect_input_error("bench --scene quad2 --size 16x16 --sweep '' --check", "sweep: must not be empty");
+  expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --sweep-repeats 3 --check",
+                     "sweep_repeats: --sweep-repeats is ignored without --sweep");
+  // The orbit's options with --sweep, which renders no orbit.
+  expect_input_error("bench --scene quad2 --sweep msaa --msaa 4 --check", "msaa: --msaa is ignored with --sweep");
+  expect_input_error("bench --scene quad2 --sweep msaa --frames 2 --check", "frames: --frames is ignored with --sweep");
+  expect_input_error("bench --scene quad2 --sweep msaa --shard 1/2 --check", "shard: --shard is ignored with --sweep");
+  expect_input_error("bench --scene quad2 --sweep msaa --no-errors --check", "no_errors: --no-errors is ignored");
+  // The reference's options without references.
+  expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --no-errors --reference-frames 2 --check",
+                     "reference_frames: --reference-frames is ignored with --no-errors");
+  expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --no-errors --reference-msaa 4 --check",
+                     "reference_msaa: --reference-msaa is ignored with --no-errors");
+  // --frames without --frame: the scene's own camera renders.
+  expect_input_error("render --scene quad2 --size 16x16 --frames 30 -o x.png", "frames: --frames is ignored without --frame");
+  expect_input_error("compare --scene quad2 --methods discard --msaa 1 --size 16x16 --repeat 1 --no-progress --no-cache "
+                     "--frames 30",
+                     "frames: --frames is ignored without --frame");
+  // Each with what it needs, they are taken.
+  for (const std::string args : {"bench --scene quad2 --sweep msaa --sweep-repeats 1 --check",
+                                 "bench --scene quad2 --size 16x16 --frames 2 --reference-frames 2 --check"}) {
+    const Process r = run(args);
+    EXPECT_EQ(r.exit_code, 0) << args << ": " << r.err;
+  }
+}
+
+// compare and bench refuse a run this machine cannot hold before they allocate, as render does
+// (tests/test_budget.cpp holds the refusal to the machine's memory). A bench pools every error
+// frame's distances: a million frames at 1024x1024 need terabytes, so it names frames.
+TEST_F(Cli, BenchTheMachineCannotHoldIsRefusedNamingFrames) {
+  expect_input_error("bench --scene quad2 --methods discard,traverse --msaa 1,4 --size 1024x1024 --frames 1000000 "
+                     "--no-cache",
+                     "frames: this bench needs");
+  // A small bench is let through.
+  const Process r = run("bench --scene quad2 --methods discard --msaa 1 --size 16x16 --frames 3 --no-errors --no-cache");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}

@@ -18,6 +18,7 @@
 #include <seamcl/assets/obj_mesh.h>
 #include <seamcl/assets/ptex_file.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/regular_file.h>
 #include <seamcl/scene/scene.h>
 
 #include "ptex_test_writer.h"
@@ -494,6 +495,35 @@ TEST(Ptex, ReadFileNamesThePath) {
             std::string::npos);
 }
 
+// The readers of users' files (.ptx, .obj, scene JSON, merge's parts) open a path once and check
+// the open descriptor: what was checked is what is read, even when the path is swapped for a FIFO
+// after the open, and a FIFO named from the start opens without blocking and is refused.
+TEST(Ptex, RegularFileChecksAndReadsOneFile) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("seamcl_regular_file_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "folder");
+  const std::string fifo = (dir / "fifo").string(), plain = (dir / "plain").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::ofstream(plain, std::ios::binary) << "hello";
+
+  EXPECT_EQ(RegularFile(fifo).refusal(), RegularFile::Refusal::NotRegular);  // with no writer: at once
+  EXPECT_EQ(RegularFile((dir / "folder").string()).refusal(), RegularFile::Refusal::NotRegular);
+  EXPECT_EQ(RegularFile((dir / "none").string()).refusal(), RegularFile::Refusal::Missing);
+  EXPECT_EQ(RegularFile((dir / "none").string()).refusal_text(), "no such file");
+  std::string text;
+  EXPECT_FALSE(RegularFile(fifo).read_all(text, 100));
+
+  RegularFile file(plain);
+  ASSERT_EQ(file.refusal(), RegularFile::Refusal::None);
+  EXPECT_EQ(file.size(), 5u);
+  // The path now names a FIFO; the file opened is still the one read.
+  std::filesystem::rename(fifo, plain);
+  ASSERT_TRUE(file.read_all(text, 100));
+  EXPECT_EQ(text, "hello");
+  // Bounded: one byte past the bound says "too large" without reading on.
+  ASSERT_TRUE(file.read_all(text, 3));
+  EXPECT_EQ(text, "hell");
+  std::filesystem::remove_all(dir);
+}
 
 // Deferred (issue 14): the faces hold their sizes only and the source decodes each one to exactly
 // the chain an eager read stores; the whole file is still checked while parsing, so a file an

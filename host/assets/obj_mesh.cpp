@@ -10,6 +10,7 @@
 #include <tiny_obj_loader.h>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/regular_file.h>
 
 namespace seamcl {
 namespace {
@@ -288,19 +289,16 @@ ObjMesh parse_obj(const std::string& text, const std::string& source, const std:
 }
 
 ObjMesh read_obj_file(const std::string& path, const std::string& field) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error))
-    throw InputError(field, "cannot read mesh file '" + path + "': no such file");
-  if (!std::filesystem::is_regular_file(path, error))
-    throw InputError(field, "cannot read mesh file '" + path + "': not a regular file");
-  const std::uintmax_t size = std::filesystem::file_size(path, error);
-  if (error || size > kMaxObjBytes)
+  // Opened and checked as one file (core/regular_file.h); tinyobjloader parses the text read here.
+  RegularFile file(path);
+  if (file.refusal() != RegularFile::Refusal::None)
+    throw InputError(field, "cannot read mesh file '" + path + "': " + file.refusal_text());
+  std::string text;
+  if (!file.read_all(text, kMaxObjBytes))
+    throw InputError(field, "cannot read mesh file '" + path + "': " + file.refusal_text());
+  if (text.size() > kMaxObjBytes)
     throw InputError(field, "mesh file '" + path + "' is larger than " + std::to_string(kMaxObjBytes >> 20) + " MiB");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) throw InputError(field, "cannot read mesh file '" + path + "'");
-  return parse_obj(text.str(), path, field);
+  return parse_obj(text, path, field);
 }
 
 }  // namespace seamcl

@@ -15,6 +15,7 @@
 #include <zlib.h>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/regular_file.h>
 
 namespace seamcl {
 namespace {
@@ -818,22 +819,18 @@ PtexFile parse_ptex(std::span<const uint8_t> bytes, const PtexLimits& limits, bo
 }
 
 PtexFile read_ptex_file(const std::string& path, const PtexLimits& limits, bool defer_textures) {
-  // A FIFO or a device would block the open or the read until something wrote to it; a directory
-  // opens and reads as an enormous size.
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw InputError("texture", path + ": no such file");
-  if (!std::filesystem::is_regular_file(path, error)) throw InputError("texture", path + ": not a regular file");
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw InputError("texture", path + ": cannot be read (" + std::strerror(errno) + ")");
-  const std::streamoff size = in.tellg();
-  if (size < 0) throw InputError("texture", path + ": cannot be read");
-  if (static_cast<uint64_t>(size) > limits.max_file_bytes)
-    throw InputError("texture", path + ": " + str(uint64_t(size)) + " bytes, more than the limit of " +
+  // Opened and checked as one file: a FIFO or a device would block the read until something
+  // wrote to it; a directory reads as an enormous size.
+  RegularFile file(path);
+  if (file.refusal() != RegularFile::Refusal::None) throw InputError("texture", path + ": " + file.refusal_text());
+  if (file.size() > limits.max_file_bytes)
+    throw InputError("texture", path + ": " + str(uint64_t(file.size())) + " bytes, more than the limit of " +
                                     str(limits.max_file_bytes));
-  auto bytes = std::make_shared<std::vector<uint8_t>>(static_cast<size_t>(size));
-  in.seekg(0);
-  if (!in.read(reinterpret_cast<char*>(bytes->data()), size))
-    throw InputError("texture", path + ": cannot be read to its end");
+  auto bytes = std::make_shared<std::vector<uint8_t>>();
+  if (!file.read_all(*bytes, limits.max_file_bytes))
+    throw InputError("texture", path + ": cannot be read to its end: " + file.refusal_text());
+  if (bytes->size() > limits.max_file_bytes)
+    throw InputError("texture", path + ": more than the limit of " + str(limits.max_file_bytes) + " bytes");
   try {
     if (!defer_textures) return parse_ptex(*bytes, limits);
     const std::span<const uint8_t> view(*bytes);

@@ -14,6 +14,7 @@
 #include <seamcl/assets/face_image.h>
 #include <seamcl/assets/obj_mesh.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/regular_file.h>
 #include <seamcl/core/json_document.h>
 #include <seamcl/scene/scene_json.h>
 
@@ -109,17 +110,14 @@ struct Loader {
 
   Scene scene_file(const std::string& path) const {
     json doc;  // stays discarded (not an object) when the file is missing or not JSON: load_scene says why
-    std::error_code ignored;
     // Only a file the scene reader would read whole is looked into here (a larger one, or one
     // that fails mid-read, is refused by that reader, naming why).
-    if (fs::is_regular_file(path, ignored) && fs::file_size(path, ignored) <= kMaxSceneFileBytes) {
+    std::string text;
+    if (RegularFile(path).read_all(text, kMaxSceneFileBytes) && text.size() <= kMaxSceneFileBytes) {
       // Parsed as strictly as the scene reader parses (no repeated key, no NUL byte), since a mesh
       // form is read from this document alone.
       try {
-        std::ifstream in(path, std::ios::binary);
-        std::ostringstream text;
-        text << in.rdbuf();
-        doc = parse_json_document(text.str());
+        doc = parse_json_document(text);
       } catch (const std::exception&) {
         doc = json(json::value_t::discarded);
       }

@@ -141,4 +141,24 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   return out;
 }
 
+std::string compare_memory_field(const CompareMemory& memory) {
+  const auto frame_buffers = [](const RenderMemory& m) { return add(add(m.samples, m.image), m.seam_mask); };
+  const auto scene_part = [](const RenderMemory& m) { return add(m.scene_device_bytes(), add(m.setups, m.tile_lists)); };
+  size_t scene_driven = 0, reference_frame = 0, entry_frame = 0;
+  bool entry_multisampled = false;
+  for (const RenderMemory* part : {&memory.face_map, &memory.reference, &memory.analytic, &memory.seamless}) {
+    scene_driven = std::max(scene_driven, scene_part(*part));
+    reference_frame = std::max(reference_frame, frame_buffers(*part));
+  }
+  for (const RenderMemory& entry : memory.entries) {
+    scene_driven = std::max(scene_driven, scene_part(entry));
+    if (frame_buffers(entry) > entry_frame) {
+      entry_frame = frame_buffers(entry);
+      entry_multisampled = entry.samples > entry.image / 4;  // a uint per sample against a float4 per pixel
+    }
+  }
+  if (scene_driven > std::max(reference_frame, entry_frame)) return "scene";
+  return entry_frame > reference_frame && entry_multisampled ? "msaa" : "size";
+}
+
 }  // namespace seamcl

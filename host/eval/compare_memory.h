@@ -13,6 +13,7 @@
 #pragma once
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <seamcl/eval/comparison.h>
@@ -52,5 +53,10 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
                              const ReferenceSettings& settings,
                              const std::vector<ReferenceKind>& kinds = {ReferenceKind::Paper},
                              const std::optional<SceneSizes>& seamless_scene = std::nullopt);
+
+// The request field that drives a compare's memory, for refuse_beyond_machine: "scene" when the
+// largest part's packed scene, setups and tile lists outweigh its frame buffers; else "msaa" when
+// the largest frame buffers are a measured rate's above 1 (the 8x reference's are not), else "size".
+std::string compare_memory_field(const CompareMemory& memory);
 
 }  // namespace seamcl

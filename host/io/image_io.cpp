@@ -107,7 +107,9 @@ namespace {
 
 // The file opened for reading: its header is read, none of its pixels yet.
 std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path) {
-  // A FIFO or a device would block the open or the read until something wrote to it.
+  // A FIFO or a device would block the open or the read until something wrote to it. OpenImageIO
+  // opens by path itself, so a path swapped for a FIFO between this check and its open still
+  // blocks there (the readers that open files themselves close that gap: core/regular_file.h).
   std::error_code error;
   if (!std::filesystem::exists(path, error)) throw std::runtime_error("cannot read " + path + ": no such file");
   if (!std::filesystem::is_regular_file(path, error)) throw std::runtime_error("cannot read " + path + ": not a regular file");

@@ -245,6 +245,32 @@ std::vector<FaceNeighbors> build_adjacency(const Scene& scene) {
   return out;
 }
 
+NonManifoldEdges non_manifold_edges(const Scene& scene) {
+  std::vector<uint64_t> edges;
+  edges.reserve(scene.faces.size() * 4);
+  for (const Face& face : scene.faces) {
+    for (int k = 0; k < 4; ++k) {
+      const uint32_t a = face.vertices[k], b = face.vertices[(k + 1) % 4];
+      edges.push_back((uint64_t{std::min(a, b)} << 32) | std::max(a, b));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  NonManifoldEdges out;
+  for (size_t first = 0; first < edges.size();) {
+    size_t end = first + 1;
+    while (end < edges.size() && edges[end] == edges[first]) ++end;
+    if (end - first > 2) {
+      if (out.count++ == 0) {
+        out.first_vertex = static_cast<uint32_t>(edges[first] >> 32);
+        out.second_vertex = static_cast<uint32_t>(edges[first]);
+        out.example_faces = end - first;
+      }
+    }
+    first = end;
+  }
+  return out;
+}
+
 bool has_adjacency(const std::vector<FaceNeighbors>& adjacency) {
   if (adjacency.size() < 2) return true;
   for (const FaceNeighbors& n : adjacency)

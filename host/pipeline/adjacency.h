@@ -45,6 +45,16 @@ std::vector<FaceNeighbors> build_adjacency(const Scene& scene);
 // discard or clamp.
 bool has_adjacency(const std::vector<FaceNeighbors>& adjacency);
 
+// The edges held by three or more faces (non-manifold): build_adjacency links no face across them,
+// so a mesh whose only shared edges are these has no adjacency although its faces do share edges.
+// For the refusal's message: how many there are, and the first by vertex indices with its faces.
+struct NonManifoldEdges {
+  size_t count = 0;
+  uint32_t first_vertex = 0, second_vertex = 0;  // the example edge, lower index first
+  size_t example_faces = 0;                      // faces holding it (a face holding it twice counts twice)
+};
+NonManifoldEdges non_manifold_edges(const Scene& scene);
+
 // Applies edge map k of `n` to a uv point (or, with translate = false, to a derivative).
 glm::vec2 transform_uv(const FaceNeighbors& n, int edge, glm::vec2 uv, bool translate = true);
 

@@ -221,15 +221,20 @@ void refuse_beyond_machine(const RenderMemory& memory, const DeviceInfo& device,
   const size_t pixel_driven = saturating_add(saturating_add(memory.samples, memory.image), memory.seam_mask);
   const size_t scene_driven = saturating_add(memory.scene_device_bytes(), saturating_add(memory.setups, memory.tile_lists));
   const std::string field = pixel_driven >= scene_driven ? "size" : "scene";
+  refuse_beyond_machine(memory.device_bytes(), memory.host_bytes(), device, field, what);
+}
+
+void refuse_beyond_machine(size_t device_bytes, size_t host_bytes, const DeviceInfo& device, const std::string& field,
+                           const std::string& what) {
   const size_t host = physical_memory_bytes(), device_bound = device_memory_bound(device);
   if (device.host_unified_memory) {
-    const size_t needed = saturating_add(memory.device_bytes(), memory.host_bytes());
+    const size_t needed = saturating_add(device_bytes, host_bytes);
     if (host != 0 && needed > host) throw OverBudget(field, what, needed, host);
     return;
   }
-  if (host != 0 && memory.host_bytes() > host) throw OverBudget(field, what + " (host memory)", memory.host_bytes(), host);
-  if (device_bound != 0 && memory.device_bytes() > device_bound)
-    throw OverBudget(field, what + " (device memory)", memory.device_bytes(), device_bound);
+  if (host != 0 && host_bytes > host) throw OverBudget(field, what + " (host memory)", host_bytes, host);
+  if (device_bound != 0 && device_bytes > device_bound)
+    throw OverBudget(field, what + " (device memory)", device_bytes, device_bound);
 }
 
 ProcessMemory process_memory() {

@@ -152,6 +152,10 @@ size_t device_memory_bound(const DeviceInfo& device);
 // it and the device bytes against the device's. Field "size" when the pixels' buffers (samples,
 // image) drive it, else "scene" (its textures, or its triangles' setups and tile lists). For the command line, before any allocation (the service has a budget of its own).
 void refuse_beyond_machine(const RenderMemory& memory, const DeviceInfo& device, const std::string& what);
+// The same for a run of several renders from its totals (a compare's, a bench's), `field` naming
+// what drives them.
+void refuse_beyond_machine(size_t device_bytes, size_t host_bytes, const DeviceInfo& device, const std::string& field,
+                           const std::string& what);
 
 // Makes the allocator give blocks of 1 MiB and more back to the system as soon as they are freed
 // (glibc: a fixed mmap threshold; nothing elsewhere). glibc raises its threshold to the largest

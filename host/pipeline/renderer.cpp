@@ -416,9 +416,24 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   }
   // Neither built nor kept: a banded packing, whose adjacency was checked when it was made.
   if (needs_adjacency(options.method) && !has_adjacency(adjacency.empty() ? impl_->packed.neighbors : adjacency)) {
-    throw InputError("method", to_string(options.method) + " reads each face's edge neighbours, and no two of the " +
-                                   std::to_string(impl_->scene->faces.size()) + " faces of scene '" + impl_->scene->name +
-                                   "' share an edge (faces are neighbours through shared vertex indices)");
+    const Scene& scene = *impl_->scene;
+    const std::string reads = to_string(options.method) + " reads each face's edge neighbours, and ";
+    // Faces that do share edges, but only edges of three or more faces, have no single neighbour
+    // across any: saying that no two share an edge would send the user looking for split vertices.
+    if (const NonManifoldEdges non_manifold = non_manifold_edges(scene); non_manifold.count > 0) {
+      const std::string example = "between vertices " + std::to_string(non_manifold.first_vertex) + " and " +
+                                  std::to_string(non_manifold.second_vertex) + " (0-based)";
+      const std::string faces = std::to_string(non_manifold.example_faces) + " faces";
+      throw InputError("method", reads + "no edge of scene '" + scene.name + "' links two faces: " +
+                                     (non_manifold.count == 1
+                                          ? "its only shared edge, " + example + ", is shared by " + faces
+                                          : "its " + std::to_string(non_manifold.count) +
+                                                " shared edges are each shared by more than two faces (the first, " +
+                                                example + ", by " + faces + ")") +
+                                     "; an edge links faces only when exactly two share it");
+    }
+    throw InputError("method", reads + "no two of the " + std::to_string(scene.faces.size()) + " faces of scene '" +
+                                   scene.name + "' share an edge (faces are neighbours through shared vertex indices)");
   }
   if (repack) {
     impl_->pack_and_upload(options.texels, sampler.guard_band, std::move(adjacency), keep_adjacency);

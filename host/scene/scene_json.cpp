@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/regular_file.h>
 #include <seamcl/scene/cube_map.h>
 
 namespace seamcl {
@@ -502,23 +503,16 @@ Scene realize(SceneSource source, const GeneratorOptions& extra) {
 }
 
 SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load_image, bool defer) {
-  std::error_code error_code;
-  if (!std::filesystem::exists(path, error_code))
-    throw InputError("scene", "cannot read scene file '" + path + "': no such file");
-  if (!std::filesystem::is_regular_file(path, error_code))
-    throw InputError("scene", "cannot read scene file '" + path + "': not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("scene", "cannot read scene file '" + path + "'");
-  // Read whole, in chunks and no further than the bound (the parsed document takes some 40 times
-  // the text), so that neither a huge file nor one that fails mid-read reaches the parser.
+  RegularFile file(path);
+  if (file.refusal() != RegularFile::Refusal::None)
+    throw InputError("scene", "cannot read scene file '" + path + "': " + file.refusal_text());
+  // Read whole and no further than the bound (the parsed document takes some 40 times the text),
+  // so that neither a huge file nor one that fails mid-read reaches the parser.
   std::string text;
-  std::array<char, 1 << 16> chunk;
-  while (in.read(chunk.data(), chunk.size()) || in.gcount() > 0) {
-    text.append(chunk.data(), static_cast<size_t>(in.gcount()));
-    if (text.size() > kMaxSceneFileBytes)
-      throw InputError("scene", "scene file '" + path + "' is larger than " + std::to_string(kMaxSceneFileBytes >> 20) + " MiB");
-  }
-  if (in.bad()) throw InputError("scene", "cannot read scene file '" + path + "': a read failed");
+  if (!file.read_all(text, kMaxSceneFileBytes))
+    throw InputError("scene", "cannot read scene file '" + path + "': a read failed: " + file.refusal_text());
+  if (text.size() > kMaxSceneFileBytes)
+    throw InputError("scene", "scene file '" + path + "' is larger than " + std::to_string(kMaxSceneFileBytes >> 20) + " MiB");
   json doc;
   try {
     doc = parse_json_document(text);
