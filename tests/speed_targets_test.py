@@ -40,7 +40,7 @@ def main():
 
     with tempfile.TemporaryDirectory() as d:
         out = os.path.join(d, "targets")
-        rc, text = speed_targets("--build", args.build, "--out", out, "--quick", "--compare-runs", "1")
+        rc, text = speed_targets("--build", args.build, "--out", out, "--quick", "--rounds", "1")
         check(rc == 0, f"a quick run exits 0 (got {rc}): {text[-2000:]}")
         if rc == 0:
             with open(os.path.join(out, "targets.json")) as f:
@@ -58,17 +58,18 @@ def main():
                     check(len(r["values"]) >= 1 and all(isinstance(v, (int, float)) and v > 0 for v in r["values"]),
                           f"{name}: positive measured values, got {r['values']}")
                     check(isinstance(r["met"], bool), f"{name}: a verdict, got {r['met']}")
+                    check(isinstance(r["settled"], bool), f"{name}: whether the verdict is settled, got {r.get('settled')}")
             paper = rows.get("peak RSS of render --scene paper")
             if paper:
                 # The verdict follows the value, not the other way round.
                 check(paper["met"] == (paper["values"][0] <= 350), f"paper RSS verdict: {paper}")
-            for name in ("compare_1.json", "sweep.json", "render_quad2.json", "render_paper.json"):
+            for name in ("sweep.json", "render_quad2.json", "render_paper.json"):
                 check(os.path.getsize(os.path.join(out, name)) > 0, f"{name} kept under --out")
             check("MISSED" in text or "met" in text, "the table names verdicts")
         rc, text = speed_targets("--build", os.path.join(d, "nowhere"), "--out", out)
         check(rc == 2 and "--build: no seamcl binary" in text, f"a build folder without seamcl: {rc} {text}")
-        rc, text = speed_targets("--build", args.build, "--compare-runs", "0", "--out", out)
-        check(rc == 2 and "--compare-runs must be at least 1" in text, f"--compare-runs 0: {rc} {text}")
+        rc, text = speed_targets("--build", args.build, "--rounds", "0", "--out", out)
+        check(rc == 2 and "--rounds must be at least 1" in text, f"--rounds 0: {rc} {text}")
 
     print("speed_targets_test:", "FAILED" if failures else "ok")
     return 1 if failures else 0
