@@ -231,6 +231,7 @@ int run_bench(const BenchArgs& args, const CLI::App& command, const GlobalOption
   if (args.sweep) {
     if (args.sweep->empty()) throw InputError("sweep", "must not be empty (leave out --sweep to run the orbit)");
     refuse_ignored_options(command, kOrbitOnlyOptions, "with --sweep (a sweep renders no orbit)");
+    (void)reference_settings(args);  // the cache options, unused here, are still checked (an empty --cache is a mistake)
     return run_sweep(args, global);
   }
   refuse_ignored_options(command, {"--sweep-repeats"}, "without --sweep");

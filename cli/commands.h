@@ -40,12 +40,12 @@ inline void make_output_directory(const std::string& dir, const std::string& fie
     throw InputError(field, "cannot make the directory '" + dir + "'" + (error ? ": " + error.message() : ""));
 }
 
-// An output option given an empty value (a shell variable that expanded to nothing, say) is refused
-// rather than read as the option left out, which would quietly write nothing where a file was
-// meant. Returns the path given, "" when the option was left out; `without_it` says what leaving
-// it out does.
-inline std::string given_output_path(const std::optional<std::string>& given, const std::string& field,
-                                     const std::string& without_it) {
+// An option given an empty value (a shell variable that expanded to nothing, say) is refused rather
+// than read as the option left out, which would quietly fall back to the default: write nothing
+// where a file was meant, or use a cache, device or file other than the one meant. Returns the
+// value given, "" when the option was left out; `without_it` says what leaving it out does.
+inline std::string given_value(const std::optional<std::string>& given, const std::string& field,
+                               const std::string& without_it) {
   if (given && given->empty()) throw InputError(field, "must not be empty (" + without_it + ")");
   return given.value_or("");
 }

@@ -38,7 +38,7 @@ namespace fs = std::filesystem;
 
 struct CompareArgs : MeasureArgs {
   std::optional<int> frame, frames;
-  std::string constant_color;  // "r,g,b" linear: paint every face this colour
+  std::optional<std::string> constant_color;  // "r,g,b" linear: paint every face this colour; empty is refused
   std::optional<std::string> images;  // a directory; empty is refused, not taken for none
   int repeat = 3;
   std::vector<std::string> references;  // --reference, repeatable, each a name or a comma list
@@ -83,7 +83,7 @@ std::vector<ReferenceKind> reference_kinds(const std::vector<std::string>& given
 
 int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   // Validate everything before any work.
-  const std::string images_dir = given_output_path(args.images, "images", "leave out --images to write no images");
+  const std::string images_dir = given_value(args.images, "images", "leave out --images to write no images");
   const json base = base_request(args);
   const RenderOptions frame = parse_render_options(base);
   const std::vector<std::string> methods = split_list(args.methods, "methods");
@@ -97,7 +97,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   (void)reference_render_options(frame, ref_settings);  // size and reference settings checked now
   GeneratorOptions generator_options;
   generator_options.tint = frame.tint;
-  if (!args.constant_color.empty()) generator_options.constant_color = parse_color(args.constant_color);
+  if (args.constant_color) generator_options.constant_color = parse_color(*args.constant_color);
 
   SceneSourceOptions source;
   source.generator = generator_options;

@@ -77,7 +77,7 @@ std::string scientific(double v) {
 }
 
 int run(const CubeArgs& args, const GlobalOptions& global) {
-  const std::string images_dir = given_output_path(args.images, "images", "leave out --images to write no images");
+  const std::string images_dir = given_value(args.images, "images", "leave out --images to write no images");
   std::vector<CubeMethod> methods;
   for (const std::string& name : split_list(args.cube_methods, "cube_methods")) {
     const auto method = parse_cube_method(name);

@@ -33,7 +33,7 @@ namespace fs = std::filesystem;
 
 struct DisplacementArgs {
   std::string scene = "displaced";
-  std::string displacement_map;
+  std::optional<std::string> displacement_map;  // a .ptx for an .obj scene; empty is refused, not taken for none
   std::string methods;
   std::string tessellation = "4,16,64";
   int level = 0;
@@ -61,7 +61,9 @@ std::vector<DisplacementMethod> parse_methods(const std::string& text) {
 
 int run(const DisplacementArgs& args, const GlobalOptions& global) {
   // Validate everything before any work.
-  const std::string images_dir = given_output_path(args.images, "images", "leave out --images to write no images");
+  const std::string images_dir = given_value(args.images, "images", "leave out --images to write no images");
+  const std::string displacement_map =
+      given_value(args.displacement_map, "displacement_map", "leave out --displacement-map to use the scene's own maps");
   const std::vector<DisplacementMethod> methods = parse_methods(args.methods);
   const std::vector<int> levels = parse_int_list(args.tessellation, "tessellation");
   for (int t : levels) {
@@ -79,7 +81,7 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
                                                    {"displacement_level", args.level}});
   ClRuntime runtime(global.device);  // a --device that matches none: refused before any work
   Scene scene = load_scene_source(base.scene);
-  if (!args.displacement_map.empty()) attach_ptex_displacement(scene, args.displacement_map);
+  if (!displacement_map.empty()) attach_ptex_displacement(scene, displacement_map);
   if (args.frames > 0 && !scene.orbit) {
     throw InputError("frames", "scene '" + scene.name + "' has no orbit; pass --frames 0 to measure its camera only");
   }
@@ -131,7 +133,7 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
                 {"repeat", args.repeat},
                 {"device", runtime.device_description()},
                 {"results", results}};
-    if (!args.displacement_map.empty()) out["displacement_map"] = args.displacement_map;
+    if (!displacement_map.empty()) out["displacement_map"] = displacement_map;
     std::cout << out.dump(2) << "\n";
     return 0;
   }

@@ -34,7 +34,7 @@ struct RenderArgs {
   std::optional<int> msaa, aniso, guard_band, frame, frames;
   std::optional<std::string> displacement_method;
   std::optional<int> tessellation, displacement_level;
-  std::string displacement_map;  // a .ptx of displacement for an .obj scene (CLI only)
+  std::optional<std::string> displacement_map;  // a .ptx of displacement for an .obj scene (CLI only)
   int crack_orbit = 0;           // count crack pixels over this many orbit frames (0: this frame)
   bool centroid = false;
   bool tint = false;
@@ -76,7 +76,9 @@ json render_request(const RenderArgs& a) {
 
 int run_render(const RenderArgs& args, const std::string& device) {
   // Validate everything before any work, so bad input changes nothing.
-  const std::string output = cli::given_output_path(args.output, "output", "leave out -o to render and time only");
+  const std::string output = cli::given_value(args.output, "output", "leave out -o to render and time only");
+  const std::string displacement_map = cli::given_value(args.displacement_map, "displacement_map",
+                                                        "leave out --displacement-map to use the scene's own maps");
   const RenderOptions options = parse_render_options(render_request(args));
   if (!output.empty()) {
     image_format_for_path(output, "output");
@@ -89,7 +91,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
     throw InputError("crack_orbit", "counts the cracks of a displaced render in --json's displacement block: give "
                                     "--displacement-method and --json too");
   if (args.frames && !args.frame) throw InputError("frames", "--frames is ignored without --frame: leave it out");
-  if (!args.displacement_map.empty() && !options.displacement)
+  if (!displacement_map.empty() && !options.displacement)
     throw InputError("displacement_map", "displaces only a render with --displacement-method");
 
   ClRuntime runtime(device);  // a --device that matches none is bad input too: refused before any work
@@ -98,7 +100,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
   source.generator.tint = options.tint;
   source.generator.defer_textures = true;  // baked face by face while packing: no float copy of them all
   Scene scene = load_scene_source(options.scene, options.texture, source);
-  if (!args.displacement_map.empty()) attach_ptex_displacement(scene, args.displacement_map);
+  if (!displacement_map.empty()) attach_ptex_displacement(scene, displacement_map);
   const Camera camera = options.frame ? orbit_camera(scene, *options.frame, options.frames) : scene.camera;
   const double scene_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - scene_start).count();
 
@@ -200,8 +202,8 @@ int main(int argc, char** argv) {
   seamcl::return_large_blocks_at_once();  // freed textures leave the process (render_memory.h)
   CLI::App app{"seamcl: render per-face textured scenes with OpenCL and compare texture seam methods"};
   app.require_subcommand(0, 1);
-  std::string device;
-  app.add_option("--device", device, "OpenCL device: a substring of 'platform device' (default $SEAMCL_DEVICE, else the first GPU, else the first CPU)");
+  std::optional<std::string> given_device;
+  app.add_option("--device", given_device, "OpenCL device: a substring of 'platform device' (default $SEAMCL_DEVICE, else the first GPU, else the first CPU)");
   bool show_version = false;
   app.add_flag("--version", show_version, "Print the version and the OpenCL device, then exit");
 
@@ -266,6 +268,8 @@ int main(int argc, char** argv) {
   }
 
   try {
+    const std::string device = cli::given_value(given_device, "device",
+                                                "leave out --device for $SEAMCL_DEVICE, else the first GPU, else the first CPU");
     if (show_version) {
       std::printf("seamcl %s\n", SEAMCL_VERSION);
       std::printf("device: %s\n", ClRuntime(device).device_description().c_str());

@@ -65,9 +65,10 @@ nlohmann::json measure_request(const MeasureArgs& a) {
 
 ReferenceSettings reference_settings(const MeasureArgs& a) {
   ReferenceSettings settings;
-  settings.method = a.reference_method;
+  settings.method = given_value(a.reference_method, "reference_method",
+                                "leave out --reference-method for traverse, or discard where traverse is not built in");
   settings.msaa = a.reference_msaa;
-  settings.cache_dir = a.cache_dir;
+  settings.cache_dir = given_value(a.cache_dir, "cache", "leave out --cache for $SEAMCL_CACHE_DIR or ~/.cache/seamcl");
   settings.use_cache = !a.no_cache;
   if (a.cache_max_mib < 0 || a.cache_max_mib > (1LL << 40)) {
     throw InputError("cache_max_mib", "must be in 0..2^40 (0: unbounded), got " + std::to_string(a.cache_max_mib));

@@ -20,9 +20,9 @@ struct MeasureArgs {
   std::string msaa = "1,2,4,8";
   bool tint = false;
   bool centroid = false;
-  std::string reference_method;
+  std::optional<std::string> reference_method;  // empty is refused, not taken for the default
   int reference_msaa = 0;
-  std::string cache_dir;
+  std::optional<std::string> cache_dir;  // empty is refused, not taken for the default
   long long cache_max_mib = static_cast<long long>(kDefaultReferenceCacheBytes >> 20);
   long long cache_max_entries = 0;
   bool no_cache = false;
@@ -35,7 +35,8 @@ void add_measure_options(CLI::App* command, MeasureArgs& args, const std::string
 // The frame's render options given on the command line, as parse_render_options reads them.
 nlohmann::json measure_request(const MeasureArgs& args);
 
-// InputError("cache_max_mib" / "cache_max_entries") for a negative bound.
+// InputError("reference_method" / "cache") for an empty value, ("cache_max_mib" /
+// "cache_max_entries") for a bound out of range.
 ReferenceSettings reference_settings(const MeasureArgs& args);
 
 }  // namespace seamcl::cli

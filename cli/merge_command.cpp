@@ -66,7 +66,7 @@ void write_atomically(const std::string& path, const std::string& text) {
 }
 
 int run_merge(const MergeArgs& args) {
-  const std::string output = given_output_path(args.output, "output", "give - or leave out -o for stdout");
+  const std::string output = given_value(args.output, "output", "give - or leave out -o for stdout");
   if (!output.empty() && output != "-") check_output_parent(output, "output");
   std::vector<BenchPart> parts;
   for (const std::string& path : args.parts) parts.push_back(read_part(path));

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cstdint>
 #include <ctime>
+#include <optional>
+#include <string>
 #include <thread>
 
 #include <pthread.h>
@@ -29,14 +31,19 @@ struct ServeArgs {
   int max_connections = 256;
   double read_timeout_s = 10;
   double deadline_s = 60;
-  std::string cache_dir;
+  std::optional<std::string> cache_dir;  // empty is refused, not taken for the default
   long long cache_max_mib = 256;
-  std::string assets_dir;
+  std::optional<std::string> assets_dir;  // empty is refused, not taken for none
   long long assets_cache_mib = 512;
   long long request_memory_mib = 1024;
 };
 
 int run_serve(const ServeArgs& args, const GlobalOptions& global) {
+  // An empty address would listen wherever the resolver puts "" (loopback here), not where meant.
+  if (args.host.empty()) throw InputError("host", "must not be empty (leave out --host for 127.0.0.1)");
+  const std::string cache_dir =
+      given_value(args.cache_dir, "cache-dir", "leave out --cache-dir for $SEAMCL_CACHE_DIR, else <temp>/seamcl-serve-cache");
+  const std::string assets_dir = given_value(args.assets_dir, "assets", "leave out --assets to serve no files");
   if (args.port < 0 || args.port > 65535) throw InputError("port", "must be in 0..65535");
   if (args.threads < 1 || args.threads > 64) throw InputError("threads", "must be in 1..64");
   if (args.queue < 0 || args.queue > 1024) throw InputError("queue", "must be in 0..1024");
@@ -69,9 +76,9 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   options.max_connections = args.max_connections;
   options.request_read_timeout_ms = static_cast<int>(args.read_timeout_s * 1000);
   options.deadline_ms = static_cast<int>(args.deadline_s * 1000);
-  options.cache_dir = args.cache_dir;
+  options.cache_dir = cache_dir;
   options.cache_max_bytes = static_cast<std::uintmax_t>(args.cache_max_mib) << 20;
-  options.assets_dir = args.assets_dir;
+  options.assets_dir = assets_dir;
   options.asset_cache.max_bytes = static_cast<size_t>(args.assets_cache_mib) << 20;
   options.max_request_device_bytes = static_cast<size_t>(args.request_memory_mib) << 20;
   options.max_request_host_bytes = static_cast<size_t>(args.request_memory_mib) << 20;

@@ -61,7 +61,7 @@ class Cli : public ::testing::Test {
 
   Process run(const std::string& args) {
     const fs::path out = root_ / "stdout.txt", err = root_ / "stderr.txt";
-    const std::string command = "cd " + quoted(dir_.string()) + " && " + quoted(SEAMCL_BINARY) + " " + args + " >" +
+    const std::string command = "cd " + quoted(dir_.string()) + " && " + launcher_ + quoted(SEAMCL_BINARY) + " " + args + " >" +
                                 quoted(out.string()) + " 2>" + quoted(err.string()) + " </dev/null";
     const int status = std::system(command.c_str());
     Process r;
@@ -99,6 +99,7 @@ class Cli : public ::testing::Test {
   }
 
   fs::path root_, dir_;
+  std::string launcher_;  // put before the binary: "timeout 30 " for a command that would otherwise run on
 };
 
 const std::string kQuad2Json = R"({
@@ -338,4 +339,30 @@ TEST_F(Cli, BenchTheMachineCannotHoldIsRefusedNamingFrames) {
   // A small bench is let through.
   const Process r = run("bench --scene quad2 --methods discard --msaa 1 --size 16x16 --frames 3 --no-errors --no-cache");
   EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+// An empty option value is a mistake (a shell variable that expanded to nothing, say), not the
+// option left out: taken for none, each fell back to its default without a word.
+TEST_F(Cli, EmptyOptionValuesAreInputErrors) {
+  const std::string compare = "compare --scene quad2 --methods discard --msaa 1 --size 16x16 --repeat 1 --no-progress --no-cache ";
+  expect_input_error("render --scene quad2 --size 16x16 --displacement-map ''", "displacement_map: must not be empty");
+  expect_input_error("render --scene quad2 --size 16x16 --displacement-method naive --displacement-map ''",
+                     "displacement_map: must not be empty");
+  expect_input_error("displacement-metrics --tessellation 1 --size 16x16 --frames 0 --repeat 1 --no-progress "
+                     "--displacement-map ''",
+                     "displacement_map: must not be empty");
+  expect_input_error(compare + "--constant-color ''", "constant_color:");
+  expect_input_error(compare + "--reference-method ''", "reference_method: must not be empty");
+  expect_input_error(compare + "--cache ''", "cache: must not be empty");
+  expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --reference-method '' --check",
+                     "reference_method: must not be empty");
+  expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --cache '' --check", "cache: must not be empty");
+  expect_input_error("bench --scene quad2 --sweep msaa --cache '' --check", "cache: must not be empty");
+  expect_input_error("--device '' render --scene quad2 --size 16x16", "device: must not be empty");
+  expect_input_error("--device '' devices", "device: must not be empty");
+  // serve would listen until stopped: the timeout ends it where the refusal is missing.
+  launcher_ = "timeout 30 ";
+  expect_input_error("serve --port 0 --quick-start --host ''", "host: must not be empty");
+  expect_input_error("serve --port 0 --quick-start --cache-dir ''", "cache-dir: must not be empty");
+  expect_input_error("serve --port 0 --quick-start --assets ''", "assets: must not be empty");
 }
