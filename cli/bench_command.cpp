@@ -189,8 +189,11 @@ void refuse_beyond_machine(const Scene& scene, const RenderOptions& frame, const
 }
 
 // --sweep: the scaling sweeps (one JSON, the chart's input: examples/scaling_chart.py).
-int run_sweep(const BenchArgs& args, const GlobalOptions& global) {
+int run_sweep(const BenchArgs& args, const CLI::App& command, const GlobalOptions& global) {
   const std::vector<SweepAxis> axes = parse_sweep(*args.sweep);
+  if (std::none_of(axes.begin(), axes.end(), sweep_reads_base_size)) {
+    refuse_ignored_options(command, {"--size"}, "with --sweep " + *args.sweep + " (its points have sizes of their own)");
+  }
   SweepSettings settings;
   settings.base = parse_render_options(measure_request(args));
   settings.methods = split_list(args.methods, "methods");
@@ -232,7 +235,7 @@ int run_bench(const BenchArgs& args, const CLI::App& command, const GlobalOption
     if (args.sweep->empty()) throw InputError("sweep", "must not be empty (leave out --sweep to run the orbit)");
     refuse_ignored_options(command, kOrbitOnlyOptions, "with --sweep (a sweep renders no orbit)");
     (void)reference_settings(args);  // the cache options, unused here, are still checked (an empty --cache is a mistake)
-    return run_sweep(args, global);
+    return run_sweep(args, command, global);
   }
   refuse_ignored_options(command, {"--sweep-repeats"}, "without --sweep");
   if (args.no_errors) {

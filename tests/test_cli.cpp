@@ -311,6 +311,10 @@ TEST_F(Cli, OptionsThatWouldBeIgnoredAreInputErrors) {
   expect_input_error("bench --scene quad2 --sweep msaa --frames 2 --check", "frames: --frames is ignored with --sweep");
   expect_input_error("bench --scene quad2 --sweep msaa --shard 1/2 --check", "shard: --shard is ignored with --sweep");
   expect_input_error("bench --scene quad2 --sweep msaa --no-errors --check", "no_errors: --no-errors is ignored");
+  // The pixels sweep's points have sizes of their own; faces, msaa and texels render at --size.
+  expect_input_error("bench --scene quad2 --sweep pixels --size 64x64 --check",
+                     "size: --size is ignored with --sweep pixels");
+  expect_input_error("bench --scene quad2 --sweep msaa --sweep-repeats 0 --check", "sweep_repeats: must be in 1..100");
   // The reference's options without references.
   expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --no-errors --reference-frames 2 --check",
                      "reference_frames: --reference-frames is ignored with --no-errors");
@@ -323,6 +327,7 @@ TEST_F(Cli, OptionsThatWouldBeIgnoredAreInputErrors) {
                      "frames: --frames is ignored without --frame");
   // Each with what it needs, they are taken.
   for (const std::string args : {"bench --scene quad2 --sweep msaa --sweep-repeats 1 --check",
+                                 "bench --scene quad2 --sweep pixels,msaa --size 64x64 --check",
                                  "bench --scene quad2 --size 16x16 --frames 2 --reference-frames 2 --check"}) {
     const Process r = run(args);
     EXPECT_EQ(r.exit_code, 0) << args << ": " << r.err;

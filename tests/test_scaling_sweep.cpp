@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -65,8 +66,16 @@ TEST(Sweep, PixelPointsGrowMonotonicallyFrom480x540To3840x2160) {
   RenderOptions base;
   base.width = 320;
   base.height = 200;
-  for (SweepAxis axis : {SweepAxis::Faces, SweepAxis::Msaa, SweepAxis::Texels})
+  for (SweepAxis axis : {SweepAxis::Faces, SweepAxis::Msaa, SweepAxis::Texels}) {
+    EXPECT_TRUE(sweep_reads_base_size(axis)) << to_string(axis);
     for (const SweepPoint& p : sweep_points(axis, base)) EXPECT_EQ(p.width * p.height, 320 * 200);
+  }
+  // The pixel points are the same whatever the base's size: bench refuses --size with them alone.
+  EXPECT_FALSE(sweep_reads_base_size(SweepAxis::Pixels));
+  const std::vector<SweepPoint> at_base = sweep_points(SweepAxis::Pixels, base);
+  ASSERT_EQ(at_base.size(), points.size());
+  for (size_t i = 0; i < points.size(); ++i)
+    EXPECT_EQ(std::pair(at_base[i].width, at_base[i].height), std::pair(points[i].width, points[i].height));
   const std::vector<SweepPoint> faces = sweep_points(SweepAxis::Faces, base);
   EXPECT_EQ(*faces.front().faces, kPaperFaces);
   EXPECT_GE(*faces.back().faces, 100000);
@@ -86,7 +95,8 @@ TEST(Sweep, ValidationNamesTheFieldAtFault) {
   EXPECT_EQ(input_error_field([&] { validate_sweep({SweepAxis::Msaa}, settings); }), "methods");
   settings.methods = {"discard"};
   settings.repeats = 0;
-  EXPECT_EQ(input_error_field([&] { validate_sweep({SweepAxis::Msaa}, settings); }), "repeats");
+  // Named as bench's option, --sweep-repeats.
+  EXPECT_EQ(input_error_field([&] { validate_sweep({SweepAxis::Msaa}, settings); }), "sweep_repeats");
 }
 
 TEST(Sweep, JsonHasOnePointPerRateWithEveryMethodTimed) {

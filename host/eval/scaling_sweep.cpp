@@ -135,12 +135,14 @@ std::vector<SweepPoint> sweep_points(SweepAxis axis, const RenderOptions& base) 
   return points;
 }
 
+bool sweep_reads_base_size(SweepAxis axis) { return axis != SweepAxis::Pixels; }
+
 void validate_sweep(const std::vector<SweepAxis>& axes, const SweepSettings& settings) {
   if (axes.empty()) throw InputError("sweep", "names no sweep (known: " + known_axes() + ")");
   if (settings.methods.empty()) throw InputError("methods", "names no method");
   for (const std::string& method : settings.methods)
     if (!parse_method(method)) throw InputError("methods", "unknown method '" + method + "'");
-  if (settings.repeats < 1 || settings.repeats > 100) throw InputError("repeats", "must be in 1..100");
+  if (settings.repeats < 1 || settings.repeats > 100) throw InputError("sweep_repeats", "must be in 1..100");
   for (SweepAxis axis : axes) {
     if ((axis == SweepAxis::Faces || axis == SweepAxis::Texels) && settings.base.scene != "paper") {
       throw InputError("scene", "the " + to_string(axis) + " sweep subdivides or rescales the paper scene, not '" +

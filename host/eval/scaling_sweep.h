@@ -43,6 +43,8 @@ struct SweepPoint {
 };
 // The points of an axis over `base` (its size and rate where the axis does not set them).
 std::vector<SweepPoint> sweep_points(SweepAxis axis, const RenderOptions& base);
+// Whether the axis's points render at the base's size: all but pixels, whose points set their own.
+bool sweep_reads_base_size(SweepAxis axis);
 
 struct SweepSettings {
   RenderOptions base;                // scene, texel format, filter, size and rate where fixed
@@ -54,8 +56,9 @@ struct SweepSettings {
   std::function<void(const std::string&)> progress;  // one line per point; may be empty
 };
 
-// Throws InputError: "sweep" for no axis, "methods" for an unknown method, "repeats" out of
-// range, "scene" for the faces or texels axis on a scene other than paper.
+// Throws InputError: "sweep" for no axis, "methods" for an unknown method, "sweep_repeats" for
+// repeats out of range (bench's --sweep-repeats), "scene" for the faces or texels axis on a scene
+// other than paper.
 void validate_sweep(const std::vector<SweepAxis>& axes, const SweepSettings& settings);
 
 // {"kind": "scaling_sweep", "device", "options", "methods", "repeats",
