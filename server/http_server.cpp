@@ -964,7 +964,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   const bool seamless = std::find(reference_kinds.begin(), reference_kinds.end(), ReferenceKind::Seamless) != reference_kinds.end();
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, entries, reference_settings, reference_kinds,
                                               seamless ? std::optional(seamless_scene_sizes(*scene)) : std::nullopt);
-  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this compare");
+  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, compare_memory_field(memory), "this compare");
   // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
   const Clock::time_point deadline =
       options_.deadline_ms > 0 ? start + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
@@ -1096,7 +1096,7 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
   check_reference_limits(frame, settings, explicit_reference_msaa);
   refuse_scene_over_budget(*scene, frame, inline_scene, key);
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, {}, settings);
-  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, "size", "this reference");
+  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, compare_memory_field(memory), "this reference");
 
   const Clock::time_point queued = Clock::now();
   double queue_ms = 0;

@@ -28,6 +28,7 @@
 #include <unistd.h>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/eval/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
@@ -1201,6 +1202,62 @@ TEST(ServerCompare, WithoutSizeUsesTheLargestDefaultAspectSizeWithinTheLimit) {
   ASSERT_TRUE(over);
   EXPECT_EQ(over->status, 413);
   EXPECT_EQ(json::parse(over->body).at("field"), "size");
+  std::error_code ec;
+  fs::remove_all(options.cache_dir, ec);
+}
+
+// A compare (or a reference) over the request-memory budget names what drives its memory, as
+// seamcl compare does (compare_memory_field): the paper scene at 16x16 is the scene's doing, quad2
+// at 256x256 the size's. The budget lies between what the scene alone needs, checked first, and
+// what the paper compare and reference need, computed here as the server computes them.
+TEST(ServerCompare, OverTheMemoryBudgetNamesWhatDrivesIt) {
+  std::signal(SIGPIPE, SIG_IGN);
+  GeneratorOptions deferred;
+  deferred.defer_textures = true;
+  const SceneSizes paper = scene_sizes(generate_scene("paper", deferred));
+  const json paper_request = {{"scene", "paper"}, {"size", "16x16"}, {"methods", "discard"}, {"msaa", 1}, {"repeat", 1}};
+  const json paper_base = {{"scene", "paper"}, {"size", "16x16"}};
+  const RenderOptions paper_frame = parse_render_options(paper_base);
+  const CompareMemory paper_compare =
+      compare_memory(paper, paper_frame, method_entries(paper_base, {"discard"}, {1}), ReferenceSettings{});
+  const CompareMemory paper_reference = compare_memory(paper, paper_frame, {}, ReferenceSettings{});
+  const size_t scene_alone = scene_render_memory(paper, paper_frame).device_bytes();
+  const size_t reference_bound = std::min(paper_compare.device_bytes_bound, paper_reference.device_bytes_bound);
+  ASSERT_LT(scene_alone, reference_bound);
+  ASSERT_EQ(compare_memory_field(paper_compare), "scene");
+  ASSERT_EQ(compare_memory_field(paper_reference), "scene");
+
+  server::ServerOptions options;
+  options.threads = 1;
+  options.max_request_device_bytes = scene_alone + (reference_bound - scene_alone) / 2;
+  options.cache_dir = (fs::temp_directory_path() / ("seamcl-test-server-cache-budget-" + std::to_string(::getpid()))).string();
+  const SceneSizes quad2 = scene_sizes(generate_scene("quad2", deferred));
+  const json quad2_request = {{"scene", "quad2"}, {"size", "256x256"}, {"methods", "discard"}, {"msaa", 1}, {"repeat", 1}};
+  const json quad2_base = {{"scene", "quad2"}, {"size", "256x256"}};
+  const RenderOptions quad2_frame = parse_render_options(quad2_base);
+  const CompareMemory quad2_compare =
+      compare_memory(quad2, quad2_frame, method_entries(quad2_base, {"discard"}, {1}), ReferenceSettings{});
+  ASSERT_GT(quad2_compare.device_bytes_bound, options.max_request_device_bytes);
+  ASSERT_EQ(compare_memory_field(quad2_compare), "size");
+
+  RunningServer s(options);
+  httplib::Client c = s.client();
+  struct Case {
+    std::string path;
+    json body;
+    std::string field, what;
+  };
+  for (const Case& refused : {Case{"/v1/compare", paper_request, "scene", "this compare"},
+                              Case{"/v1/reference", {{"scene", "paper"}, {"size", "16x16"}}, "scene", "this reference"},
+                              Case{"/v1/compare", quad2_request, "size", "this compare"}}) {
+    SCOPED_TRACE(refused.path + " " + refused.body.dump());
+    const auto res = c.Post(refused.path, refused.body.dump(), "application/json");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 413) << res->body;
+    const json answer = json::parse(res->body);
+    EXPECT_EQ(answer.at("field"), refused.field);
+    EXPECT_NE(answer.at("error").get<std::string>().find(refused.what + " needs about"), std::string::npos) << res->body;
+  }
   std::error_code ec;
   fs::remove_all(options.cache_dir, ec);
 }
