@@ -80,6 +80,34 @@ TEST(Adjacency, Quad2HasOneLinkEachWay) {
   expect_transforms_follow_the_surface(scene, 1e-5f);
 }
 
+TEST(Adjacency, CollapsedEdgesLinkNothing) {
+  // Two triangles written as quads (vertex 0 twice), sharing the real edge 0-2 and, as written,
+  // the collapsed edge 0-0: only the real edge links them. Three more such faces around a pole
+  // (vertex 5) share nothing but it: no links, and no "non-manifold" edge 5-5.
+  Scene scene;
+  scene.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 2, 0}, {5, 5, 1},
+                     {6, 5, 0}, {5, 6, 0}, {4, 5, 0}, {5, 4, 0}};
+  for (std::array<uint32_t, 4> v : std::vector<std::array<uint32_t, 4>>{
+           {0, 0, 1, 2}, {0, 0, 2, 3}, {5, 5, 6, 7}, {5, 5, 7, 8}, {5, 5, 8, 9}}) {
+    Face face;
+    face.vertices = v;
+    scene.faces.push_back(face);
+  }
+  const std::vector<FaceNeighbors> adjacency = build_adjacency(scene);
+  ASSERT_EQ(adjacency.size(), 5u);
+  for (size_t f = 0; f < adjacency.size(); ++f) {
+    EXPECT_EQ(adjacency[f].neighbor[0], -1) << "face " << f << ": its collapsed edge";
+  }
+  EXPECT_EQ(adjacency[0].neighbor[3], 1);  // 2-0 of face 0 is 0-2 of face 1
+  EXPECT_EQ(adjacency[1].neighbor[1], 0);
+  int links = 0;
+  for (const FaceNeighbors& n : adjacency) {
+    for (int k = 0; k < 4; ++k) links += n.neighbor[k] >= 0;
+  }
+  EXPECT_EQ(links, 2 + 4);  // 0-2 both ways; around the pole 5-7 and 5-8, each both ways
+  EXPECT_EQ(non_manifold_edges(scene).count, 0u);
+}
+
 TEST(Adjacency, ClosedMeshesLinkEveryEdge) {
   for (const char* name : {"cube", "paper"}) {
     SCOPED_TRACE(name);

@@ -30,6 +30,28 @@ struct EdgeRef {
   int edge;
 };
 
+// Every face's edges by their undirected vertex pair, sorted: the faces that share an edge lie
+// side by side. A collapsed edge (both ends one vertex: a triangle written as a quad) is left
+// out: it has no length for a footprint to cross, and faces that meet only at that vertex (the
+// quads around a sphere's pole) would otherwise read as sharing it. 16 bytes an edge: a
+// std::map of vectors, held while the packed texels were already there, took traverse's peak at
+// 99,037 faces 4.8 MB higher.
+std::vector<EdgeRef> sorted_edges(const Scene& scene) {
+  std::vector<EdgeRef> edges;
+  edges.reserve(scene.faces.size() * 4);
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    for (int k = 0; k < 4; ++k) {
+      const uint32_t a = scene.faces[f].vertices[k], b = scene.faces[f].vertices[(k + 1) % 4];
+      if (a == b) continue;
+      edges.push_back({(uint64_t{std::min(a, b)} << 32) | std::max(a, b), static_cast<int>(f), k});
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const EdgeRef& x, const EdgeRef& y) {
+    return std::tie(x.vertices, x.face, x.edge) < std::tie(y.vertices, y.face, y.edge);
+  });
+  return edges;
+}
+
 // The map across edge k of face f onto edge j of face g, where g runs the edge backwards when
 // `reversed` (consistently oriented neighbours do).
 UvMap edge_map(int k, int j, bool reversed) {
@@ -185,20 +207,7 @@ std::vector<FaceNeighbors> build_adjacency(const Scene& scene) {
       n.reach_min_side[k] = n.reach_max_side[k] = SEAMCL_SIDE_NONE;  // fill_edge_reach fills them
     }
   }
-  // Every face's edges by their undirected vertex pair, sorted: the faces that share an edge lie
-  // side by side. 16 bytes an edge: a std::map of vectors, held while the packed texels were
-  // already there, took traverse's peak at 99,037 faces 4.8 MB higher.
-  std::vector<EdgeRef> edges;
-  edges.reserve(scene.faces.size() * 4);
-  for (size_t f = 0; f < scene.faces.size(); ++f) {
-    for (int k = 0; k < 4; ++k) {
-      const uint32_t a = scene.faces[f].vertices[k], b = scene.faces[f].vertices[(k + 1) % 4];
-      edges.push_back({(uint64_t{std::min(a, b)} << 32) | std::max(a, b), static_cast<int>(f), k});
-    }
-  }
-  std::sort(edges.begin(), edges.end(), [](const EdgeRef& x, const EdgeRef& y) {
-    return std::tie(x.vertices, x.face, x.edge) < std::tie(y.vertices, y.face, y.edge);
-  });
+  std::vector<EdgeRef> edges = sorted_edges(scene);
   for (size_t first = 0; first < edges.size();) {
     size_t end = first + 1;
     while (end < edges.size() && edges[end].vertices == edges[first].vertices) ++end;
@@ -246,23 +255,15 @@ std::vector<FaceNeighbors> build_adjacency(const Scene& scene) {
 }
 
 NonManifoldEdges non_manifold_edges(const Scene& scene) {
-  std::vector<uint64_t> edges;
-  edges.reserve(scene.faces.size() * 4);
-  for (const Face& face : scene.faces) {
-    for (int k = 0; k < 4; ++k) {
-      const uint32_t a = face.vertices[k], b = face.vertices[(k + 1) % 4];
-      edges.push_back((uint64_t{std::min(a, b)} << 32) | std::max(a, b));
-    }
-  }
-  std::sort(edges.begin(), edges.end());
+  const std::vector<EdgeRef> edges = sorted_edges(scene);
   NonManifoldEdges out;
   for (size_t first = 0; first < edges.size();) {
     size_t end = first + 1;
-    while (end < edges.size() && edges[end] == edges[first]) ++end;
+    while (end < edges.size() && edges[end].vertices == edges[first].vertices) ++end;
     if (end - first > 2) {
       if (out.count++ == 0) {
-        out.first_vertex = static_cast<uint32_t>(edges[first] >> 32);
-        out.second_vertex = static_cast<uint32_t>(edges[first]);
+        out.first_vertex = static_cast<uint32_t>(edges[first].vertices >> 32);
+        out.second_vertex = static_cast<uint32_t>(edges[first].vertices);
         out.example_faces = end - first;
       }
     }

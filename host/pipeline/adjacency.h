@@ -35,8 +35,9 @@ uint8_t encode_reach_side(float side);
 float reach_side(uint8_t stored);
 
 // Per face, as the kernels read it (FaceNeighbors in kernels/seamcl_types.h). An edge shared by
-// exactly two faces links them; an edge of one face, or of three or more, has no neighbour. A
-// corner whose vertex has valence 4 links the diagonal face, through the edge maps composed.
+// exactly two faces links them; an edge of one face, or of three or more, has no neighbour, nor
+// has a collapsed edge (one vertex at both ends: a triangle written as a quad). A corner whose
+// vertex has valence 4 links the diagonal face, through the edge maps composed.
 std::vector<FaceNeighbors> build_adjacency(const Scene& scene);
 
 // What the methods that read neighbours (traverse, guardband) need: true unless there are two or
