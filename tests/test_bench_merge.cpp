@@ -345,7 +345,14 @@ TEST_F(BenchMerge, MergeCommandRefusesFilesThatAreNotParts) {
   EXPECT_NE(r.err.find("parts: garbage.json: not valid JSON"), std::string::npos) << r.err;
   r = seamcl(*dir_, "merge part1.json missing.json");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("missing.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("parts: missing.json: no such file"), std::string::npos) << r.err;
+  fs::create_directory(*dir_ / "a_directory");
+  r = seamcl(*dir_, "merge part1.json a_directory");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("parts: a_directory: not a regular file"), std::string::npos) << r.err;
+  r = seamcl(*dir_, "merge part1.json ''");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("parts: a part's path is empty"), std::string::npos) << r.err;
   r = seamcl(*dir_, "merge part1.json part2.json");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("parts missing: 3/3"), std::string::npos) << r.err;
