@@ -66,6 +66,22 @@ std::string input_error(Run run, const std::string& field) {
   return {};
 }
 
+// The refusals of the two methods that read neighbours (traverse, guardband), each checked to name
+// `method`, for a 32x32 render of `scene`.
+std::vector<std::string> neighbour_method_refusals(const Scene& scene) {
+  Renderer renderer(shared_runtime());
+  renderer.load_scene(scene);
+  RenderOptions options;
+  options.width = 32;
+  options.height = 32;
+  std::vector<std::string> messages;
+  for (Method method : {Method::Traverse, Method::Guardband}) {
+    options.method = method;
+    messages.push_back(input_error([&] { renderer.render(scene.camera, options); }, "method"));
+  }
+  return messages;
+}
+
 // A fresh directory per test, removed after it.
 class TempDir {
  public:
@@ -288,14 +304,7 @@ TEST(Assets, TraverseRefusesAMeshWhoseOnlySharedEdgeIsNonManifoldSayingSo) {
   EXPECT_EQ(non_manifold.first_vertex, 0u);
   EXPECT_EQ(non_manifold.second_vertex, 1u);
   EXPECT_EQ(non_manifold.example_faces, 3u);
-  Renderer renderer(shared_runtime());
-  renderer.load_scene(scene);
-  RenderOptions options;
-  options.width = 32;
-  options.height = 32;
-  for (Method method : {Method::Traverse, Method::Guardband}) {
-    options.method = method;
-    const std::string message = input_error([&] { renderer.render(scene.camera, options); }, "method");
+  for (const std::string& message : neighbour_method_refusals(scene)) {
     EXPECT_EQ(message.find("no two of"), std::string::npos) << message;
     EXPECT_NE(message.find("its only shared edge, between vertices 0 and 1 (0-based), is shared by 3 faces"),
               std::string::npos)
@@ -311,16 +320,16 @@ TEST(Assets, TraverseAndGuardbandRefuseAMeshWithoutSharedEdgesSingleQuadsStillRe
   const std::string split = dir.write("split.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 1 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\n"
                                                    "f 1 2 3 4\nf 5 6 7 8\n");
   const Scene scene = load_scene_source(split);
+  const std::vector<std::string> refusals = neighbour_method_refusals(scene);
+  ASSERT_EQ(refusals.size(), 2u);
+  for (const std::string& message : refusals) {
+    EXPECT_NE(message.find("no two of the 2 faces of scene 'split' share an edge"), std::string::npos) << message;
+  }
   Renderer renderer(shared_runtime());
   renderer.load_scene(scene);
   RenderOptions options;
   options.width = 32;
   options.height = 32;
-  for (Method method : {Method::Traverse, Method::Guardband}) {
-    options.method = method;
-    const std::string message = input_error([&] { renderer.render(scene.camera, options); }, "method");
-    EXPECT_NE(message.find("no two of the 2 faces of scene 'split' share an edge"), std::string::npos) << message;
-  }
   options.method = Method::Discard;
   EXPECT_TRUE(all_finite(renderer.render(scene.camera, options).pixels));
   // Whatever came before: a discard render (no adjacency packed), a seam-mask render (the empty
