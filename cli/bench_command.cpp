@@ -113,6 +113,21 @@ struct DifferenceAccum {
   Pool pool;
 };
 
+// Figure 5 (left): discard against traverse at each rate both have.
+std::vector<DifferenceAccum> discard_traverse_pairs(const std::vector<MethodEntry>& entries) {
+  std::vector<DifferenceAccum> pairs;
+  for (size_t i = 0; i < entries.size(); ++i) {
+    if (entries[i].options.method != Method::Discard) continue;
+    for (size_t j = 0; j < entries.size(); ++j) {
+      if (entries[j].options.method == Method::Traverse && entries[j].options.msaa == entries[i].options.msaa) {
+        pairs.push_back({i, j, entries[i].options.msaa, {}});
+        break;
+      }
+    }
+  }
+  return pairs;
+}
+
 class Progress {
  public:
   Progress(size_t total, bool quiet) : total_(total), tty_(!quiet && isatty(STDERR_FILENO) == 1), quiet_(quiet) {}
@@ -144,11 +159,14 @@ class Progress {
 
 // A bench this machine cannot hold is refused before it allocates, as render and compare refuse
 // theirs. It holds at once: the face-map and reference Renderer, one Renderer per method (with its
-// largest entry's buffers), every entry's last two images, and the error distances and seam masks
-// pooled over every error frame, which grow with the frames: field "frames" when they are most of
-// it, else "scene" or "size", whichever drives the Renderers' buffers.
-void refuse_beyond_machine(const Scene& scene, const RenderOptions& frame, const std::vector<MethodEntry>& entries,
-                           const ReferenceSettings& settings, bool with_errors, int error_frames, const DeviceInfo& device) {
+// largest entry's buffers), every entry's last two images, and the distances and seam masks pooled
+// over the frames (each entry's errors on every error frame; each discard / traverse pair's
+// difference on every frame of the range, with --no-errors too), plus the largest pool's summary
+// copies: field "frames" when the pools are most of it, else "scene" or "size", whichever drives
+// the Renderers' buffers.
+void refuse_bench_beyond_machine(const Scene& scene, const RenderOptions& frame, const std::vector<MethodEntry>& entries,
+                                 const ReferenceSettings& settings, bool with_errors, int error_frames,
+                                 size_t difference_pairs, int range_frames, const DeviceInfo& device) {
   const SceneSizes sizes = scene_sizes(scene);
   RenderOptions face_map = frame;  // as render_face_map renders it
   face_map.msaa = 1;
@@ -179,8 +197,15 @@ void refuse_beyond_machine(const Scene& scene, const RenderOptions& frame, const
   for (const auto& [method, m] : largest_per_method) add_renderer(m);
   const size_t pixels = static_cast<size_t>(frame.width) * static_cast<size_t>(frame.height);
   const size_t images = saturating_mul(saturating_mul(pixels, 2 * sizeof(glm::vec4)), entries.size());
-  const size_t pools = saturating_mul(saturating_mul(pixels, sizeof(float) + 1),
-                                      saturating_mul(entries.size(), static_cast<size_t>(error_frames)));
+  const size_t pooled_bytes = sizeof(float) + 1;  // a distance and a mask byte per pixel and frame
+  const size_t error_pools = saturating_mul(saturating_mul(pixels, pooled_bytes),
+                                            saturating_mul(entries.size(), static_cast<size_t>(error_frames)));
+  const size_t difference_pools = saturating_mul(saturating_mul(pixels, pooled_bytes),
+                                                 saturating_mul(difference_pairs, static_cast<size_t>(range_frames)));
+  // Pool::stats copies the largest pool's seam and off-seam masks.
+  const size_t summary = saturating_mul(saturating_mul(pixels, 2),
+                                        static_cast<size_t>(std::max(error_frames, difference_pairs > 0 ? range_frames : 0)));
+  const size_t pools = saturating_add(error_pools, saturating_add(difference_pools, summary));
   host_bytes = saturating_add(host_bytes, saturating_add(images, pools));
   const std::string field = pools >= std::max(scene_driven, frame_driven) ? "frames"
                             : scene_driven > frame_driven                  ? "scene"
@@ -274,7 +299,9 @@ int run_bench(const BenchArgs& args, const CLI::App& command, const GlobalOption
   for (int k = range.first; k < range.end; ++k) error_frames += with_errors && k % args.reference_frames == 0 ? 1 : 0;
   const auto wall_start = std::chrono::steady_clock::now();
   ClRuntime runtime(global.device);
-  refuse_beyond_machine(scene, frame, entries, ref_settings, with_errors, error_frames, runtime.info());
+  std::vector<DifferenceAccum> diffs = discard_traverse_pairs(entries);
+  refuse_bench_beyond_machine(scene, frame, entries, ref_settings, with_errors, error_frames, diffs.size(), range.size(),
+                              runtime.info());
   // Once, not per reference frame: hashing bakes every face.
   if (with_errors && ref_settings.use_cache) ref_settings.scene_hash = scene_content_hash(scene);
 
@@ -293,17 +320,6 @@ int run_bench(const BenchArgs& args, const CLI::App& command, const GlobalOption
     acc[i].entry = entries[i];
     acc[i].renderer = r.get();
     r->warm_up(entries[i].options);
-  }
-  // Figure 5 (left): discard against traverse at each rate both have.
-  std::vector<DifferenceAccum> diffs;
-  for (size_t i = 0; i < entries.size(); ++i) {
-    if (entries[i].options.method != Method::Discard) continue;
-    for (size_t j = 0; j < entries.size(); ++j) {
-      if (entries[j].options.method == Method::Traverse && entries[j].options.msaa == entries[i].options.msaa) {
-        diffs.push_back({i, j, entries[i].options.msaa, {}});
-        break;
-      }
-    }
   }
 
   const int frames = frame.frames;

@@ -341,6 +341,10 @@ TEST_F(Cli, BenchTheMachineCannotHoldIsRefusedNamingFrames) {
   expect_input_error("bench --scene quad2 --methods discard,traverse --msaa 1,4 --size 1024x1024 --frames 1000000 "
                      "--no-cache",
                      "frames: this bench needs");
+  // Without errors the discard / traverse differences are still pooled on every frame.
+  expect_input_error("bench --scene quad2 --methods discard,traverse --msaa 1 --size 1024x1024 --frames 1000000 "
+                     "--no-errors",
+                     "frames: this bench needs");
   // A small bench is let through.
   const Process r = run("bench --scene quad2 --methods discard --msaa 1 --size 16x16 --frames 3 --no-errors --no-cache");
   EXPECT_EQ(r.exit_code, 0) << r.err;
