@@ -38,12 +38,13 @@ BenchPart read_part(const std::string& path) {
   if (path.empty()) throw InputError("parts", "a part's path is empty");
   RegularFile file(path);  // opened and checked as one file: a FIFO swapped in cannot block the read
   if (file.refusal() != RegularFile::Refusal::None) throw InputError("parts", path + ": " + file.refusal_text());
+  const auto too_large = [&] {
+    return InputError("parts", path + ": more than the " + std::to_string(kMaxPartBytes >> 20) + " MiB a part may have");
+  };
+  if (file.size() > kMaxPartBytes) throw too_large();  // before any of it is read
   std::string text;
   if (!file.read_all(text, kMaxPartBytes)) throw InputError("parts", path + ": " + file.refusal_text());
-  if (text.size() > kMaxPartBytes) {
-    throw InputError("parts", path + ": " + std::to_string(std::max<std::uintmax_t>(file.size(), text.size()) >> 20) +
-                                  " MiB, over the " + std::to_string(kMaxPartBytes >> 20) + " MiB a part may have");
-  }
+  if (text.size() > kMaxPartBytes) throw too_large();  // grown since it was opened
   try {
     return BenchPart{path, parse_json_document(text)};
   } catch (const nlohmann::json::exception& error) {

@@ -290,11 +290,14 @@ ObjMesh read_obj_file(const std::string& path, const std::string& field) {
   RegularFile file(path);
   if (file.refusal() != RegularFile::Refusal::None)
     throw InputError(field, "cannot read mesh file '" + path + "': " + file.refusal_text());
+  const auto too_large = [&] {
+    return InputError(field, "mesh file '" + path + "' is larger than " + std::to_string(kMaxObjBytes >> 20) + " MiB");
+  };
+  if (file.size() > kMaxObjBytes) throw too_large();  // before any of it is read
   std::string text;
   if (!file.read_all(text, kMaxObjBytes))
     throw InputError(field, "cannot read mesh file '" + path + "': " + file.refusal_text());
-  if (text.size() > kMaxObjBytes)
-    throw InputError(field, "mesh file '" + path + "' is larger than " + std::to_string(kMaxObjBytes >> 20) + " MiB");
+  if (text.size() > kMaxObjBytes) throw too_large();  // grown since it was opened
   return parse_obj(text, path, field);
 }
 

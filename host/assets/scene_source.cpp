@@ -111,7 +111,9 @@ struct Loader {
     // Only a file the scene reader would read whole is looked into here (a larger one, or one
     // that fails mid-read, is refused by that reader, naming why).
     std::string text;
-    if (RegularFile(path).read_all(text, kMaxSceneFileBytes) && text.size() <= kMaxSceneFileBytes) {
+    RegularFile document_file(path);
+    if (document_file.size() <= kMaxSceneFileBytes && document_file.read_all(text, kMaxSceneFileBytes) &&
+        text.size() <= kMaxSceneFileBytes) {
       // Parsed as strictly as the scene reader parses (no repeated key, no NUL byte), since a mesh
       // form is read from this document alone.
       try {

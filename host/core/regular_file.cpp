@@ -11,14 +11,20 @@
 namespace seamcl {
 
 RegularFile::RegularFile(const std::string& path) {
-  // O_NOCTTY: a terminal device named by mistake must not become the process's terminal.
+  // The path first, so that a device named by mistake is not opened at all (opening some has
+  // effects: a tape rewinds, a watchdog arms); the descriptor's fstat below stays the authority.
+  struct stat status {};
+  if (::stat(path.c_str(), &status) == 0 && !S_ISREG(status.st_mode)) {
+    refusal_ = Refusal::NotRegular;
+    return;
+  }
+  // O_NOCTTY: a terminal device swapped in must not become the process's terminal.
   descriptor_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
   if (descriptor_ < 0) {
     error_number_ = errno;
     refusal_ = error_number_ == ENOENT ? Refusal::Missing : Refusal::Unreadable;
     return;
   }
-  struct stat status {};
   if (::fstat(descriptor_, &status) != 0) {
     error_number_ = errno;
     refusal_ = Refusal::Unreadable;
@@ -26,6 +32,13 @@ RegularFile::RegularFile(const std::string& path) {
     refusal_ = Refusal::NotRegular;
   } else {
     size_ = static_cast<std::uintmax_t>(status.st_size);
+    // Blocking again for the reads: FUSE and network file systems pass O_NONBLOCK on, and a read
+    // there could fail with EAGAIN where it should wait.
+    const int flags = ::fcntl(descriptor_, F_GETFL);
+    if (flags == -1 || ::fcntl(descriptor_, F_SETFL, flags & ~O_NONBLOCK) == -1) {
+      error_number_ = errno;
+      refusal_ = Refusal::Unreadable;
+    }
   }
 }
 

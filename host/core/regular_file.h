@@ -1,8 +1,9 @@
 // Reading a file a user named, so that the check that it is a regular file and the read are on
 // one file. Checking the path first (stat) and opening it after leaves a gap: a path swapped for
 // a FIFO in between would block the open until something wrote to it. Here the path is opened
-// without blocking (a FIFO opens at once; regular files ignore O_NONBLOCK) and the open
-// descriptor is checked, then read.
+// without blocking (a FIFO opens at once) and the open descriptor is checked, then set blocking
+// again and read. (The path is also checked before the open, only so that a device named by
+// mistake is never opened; the descriptor's check decides.)
 #pragma once
 #include <cstdint>
 #include <string>

@@ -507,11 +507,14 @@ SceneSource read_scene_file(const std::string& path, const FaceImageLoader& load
     throw InputError("scene", "cannot read scene file '" + path + "': " + file.refusal_text());
   // Read whole and no further than the bound (the parsed document takes some 40 times the text),
   // so that neither a huge file nor one that fails mid-read reaches the parser.
+  const auto too_large = [&] {
+    return InputError("scene", "scene file '" + path + "' is larger than " + std::to_string(kMaxSceneFileBytes >> 20) + " MiB");
+  };
+  if (file.size() > kMaxSceneFileBytes) throw too_large();  // before any of it is read
   std::string text;
   if (!file.read_all(text, kMaxSceneFileBytes))
     throw InputError("scene", "cannot read scene file '" + path + "': a read failed: " + file.refusal_text());
-  if (text.size() > kMaxSceneFileBytes)
-    throw InputError("scene", "scene file '" + path + "' is larger than " + std::to_string(kMaxSceneFileBytes >> 20) + " MiB");
+  if (text.size() > kMaxSceneFileBytes) throw too_large();  // grown since it was opened
   json doc;
   try {
     doc = parse_json_document(text);
