@@ -63,9 +63,18 @@ def main():
             if paper:
                 # The verdict follows the value, not the other way round.
                 check(paper["met"] == (paper["values"][0] <= 350), f"paper RSS verdict: {paper}")
-            for name in ("sweep.json", "render_quad2.json", "render_paper.json"):
+            for name in ("sweep.json", "render_quad2_discard.json", "render_paper_traverse.json"):
                 check(os.path.getsize(os.path.join(out, name)) > 0, f"{name} kept under --out")
-            check("MISSED" in text or "met" in text, "the table names verdicts")
+            # Every verdict follows from its value and goal ("<= x" or ">= x").
+            for r in report["targets"]:
+                op, bound = r["goal"].split()[0], float(r["goal"].split()[1])
+                for value in r["values"][:1]:
+                    check(r["met"] == (value <= bound if op == "<=" else value >= bound),
+                          f"{r['target']}: verdict {r['met']} for {value} against {r['goal']}")
+            # One table line per row, each with its verdict.
+            lines = [line for line in text.splitlines() if any(line.startswith(r["target"]) for r in report["targets"])]
+            check(len(lines) == len(report["targets"]) and all(("met" in l) or ("MISSED" in l) for l in lines),
+                  f"a table line with a verdict per target: {lines}")
         rc, text = speed_targets("--build", os.path.join(d, "nowhere"), "--out", out)
         check(rc == 2 and "--build: no seamcl binary" in text, f"a build folder without seamcl: {rc} {text}")
         rc, text = speed_targets("--build", args.build, "--rounds", "0", "--out", out)
