@@ -330,6 +330,12 @@ std::string mebibytes(size_t bytes) {
   return text;
 }
 
+// The request field to change when the library names what drives a figure: a built-in or asset
+// scene cannot be changed by the client, but its texel format can (`texels`), as /v1/render names it.
+std::string budget_field(const std::string& library_field, const json& inline_scene) {
+  return library_field == "scene" && inline_scene.is_null() ? "texels" : library_field;
+}
+
 }  // namespace
 
 // A refusal: status, the field at fault and a message, answered as {"error", "field"}.
@@ -964,7 +970,8 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   const bool seamless = std::find(reference_kinds.begin(), reference_kinds.end(), ReferenceKind::Seamless) != reference_kinds.end();
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, entries, reference_settings, reference_kinds,
                                               seamless ? std::optional(seamless_scene_sizes(*scene)) : std::nullopt);
-  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, compare_memory_field(memory), "this compare");
+  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, budget_field(compare_memory_field(memory), inline_scene),
+                     "this compare");
   // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
   const Clock::time_point deadline =
       options_.deadline_ms > 0 ? start + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
@@ -1096,7 +1103,8 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
   check_reference_limits(frame, settings, explicit_reference_msaa);
   refuse_scene_over_budget(*scene, frame, inline_scene, key);
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, {}, settings);
-  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, compare_memory_field(memory), "this reference");
+  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, budget_field(compare_memory_field(memory), inline_scene),
+                     "this reference");
 
   const Clock::time_point queued = Clock::now();
   double queue_ms = 0;
