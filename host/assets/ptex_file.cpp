@@ -1,7 +1,6 @@
 #include <seamcl/assets/ptex_file.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <limits>
