@@ -1212,16 +1212,34 @@ TEST(ServerCompare, WithoutSizeUsesTheLargestDefaultAspectSizeWithinTheLimit) {
 // what the paper compare and reference need, computed here as the server computes them.
 TEST(ServerCompare, OverTheMemoryBudgetNamesWhatDrivesIt) {
   std::signal(SIGPIPE, SIG_IGN);
-  GeneratorOptions deferred;
-  deferred.defer_textures = true;
-  const SceneSizes paper = scene_sizes(generate_scene("paper", deferred));
-  const json paper_request = {{"scene", "paper"}, {"size", "16x16"}, {"methods", "discard"}, {"msaa", 1}, {"repeat", 1}};
-  const json paper_base = {{"scene", "paper"}, {"size", "16x16"}};
-  const RenderOptions paper_frame = parse_render_options(paper_base);
-  const CompareMemory paper_compare =
-      compare_memory(paper, paper_frame, method_entries(paper_base, {"discard"}, {1}), ReferenceSettings{});
-  const CompareMemory paper_reference = compare_memory(paper, paper_frame, {}, ReferenceSettings{});
-  const size_t scene_alone = scene_render_memory(paper, paper_frame).device_bytes();
+  // A one-entry discard compare of a built-in scene: its request, and the memory the server
+  // estimates for it (and, without entries, for its reference alone).
+  struct Planned {
+    json request;
+    SceneSizes sizes;
+    RenderOptions frame;
+    CompareMemory compare, reference;
+  };
+  const auto plan = [](const std::string& scene, const std::string& size) {
+    GeneratorOptions deferred;
+    deferred.defer_textures = true;
+    const json base = {{"scene", scene}, {"size", size}};
+    Planned p;
+    p.request = base;
+    p.request["methods"] = "discard";
+    p.request["msaa"] = 1;
+    p.request["repeat"] = 1;
+    p.sizes = scene_sizes(generate_scene(scene, deferred));
+    p.frame = parse_render_options(base);
+    p.compare = compare_memory(p.sizes, p.frame, method_entries(base, {"discard"}, {1}), ReferenceSettings{});
+    p.reference = compare_memory(p.sizes, p.frame, {}, ReferenceSettings{});
+    return p;
+  };
+  const Planned paper = plan("paper", "16x16");
+  const json& paper_request = paper.request;
+  const CompareMemory& paper_compare = paper.compare;
+  const CompareMemory& paper_reference = paper.reference;
+  const size_t scene_alone = scene_render_memory(paper.sizes, paper.frame).device_bytes();
   const size_t reference_bound = std::min(paper_compare.device_bytes_bound, paper_reference.device_bytes_bound);
   ASSERT_LT(scene_alone, reference_bound);
   ASSERT_EQ(compare_memory_field(paper_compare), "scene");
@@ -1231,12 +1249,9 @@ TEST(ServerCompare, OverTheMemoryBudgetNamesWhatDrivesIt) {
   options.threads = 1;
   options.max_request_device_bytes = scene_alone + (reference_bound - scene_alone) / 2;
   options.cache_dir = (fs::temp_directory_path() / ("seamcl-test-server-cache-budget-" + std::to_string(::getpid()))).string();
-  const SceneSizes quad2 = scene_sizes(generate_scene("quad2", deferred));
-  const json quad2_request = {{"scene", "quad2"}, {"size", "256x256"}, {"methods", "discard"}, {"msaa", 1}, {"repeat", 1}};
-  const json quad2_base = {{"scene", "quad2"}, {"size", "256x256"}};
-  const RenderOptions quad2_frame = parse_render_options(quad2_base);
-  const CompareMemory quad2_compare =
-      compare_memory(quad2, quad2_frame, method_entries(quad2_base, {"discard"}, {1}), ReferenceSettings{});
+  const Planned quad2 = plan("quad2", "256x256");
+  const json& quad2_request = quad2.request;
+  const CompareMemory& quad2_compare = quad2.compare;
   ASSERT_GT(quad2_compare.device_bytes_bound, options.max_request_device_bytes);
   ASSERT_EQ(compare_memory_field(quad2_compare), "size");
 
