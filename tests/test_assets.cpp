@@ -312,6 +312,13 @@ TEST(Assets, TraverseRefusesAMeshWhoseOnlySharedEdgeIsNonManifoldSayingSo) {
   }
   // A manifold mesh has none.
   EXPECT_EQ(non_manifold_edges(load_scene_source(sample("plane.obj"))).count, 0u);
+
+  // example_faces counts a face once per time it holds the edge; no loaded face holds one twice,
+  // as such a quad (folded back along the edge) has no area and is refused.
+  const std::string folded = dir.write("folded.obj", "v 0 0 0\nv 0 1 0\nv 1 1 0\nv -1 0 0\nv -1 1 0\n"
+                                                     "f 1 2 1 3\nf 2 1 4 5\n");
+  const std::string refusal = input_error([&] { load_scene_source(folded); }, "faces[0].vertices");
+  EXPECT_NE(refusal.find("the quad is degenerate (zero area)"), std::string::npos) << refusal;
 }
 
 TEST(Assets, TraverseAndGuardbandRefuseAMeshWithoutSharedEdgesSingleQuadsStillRender) {

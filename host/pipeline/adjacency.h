@@ -52,7 +52,8 @@ bool has_adjacency(const std::vector<FaceNeighbors>& adjacency);
 struct NonManifoldEdges {
   size_t count = 0;
   uint32_t first_vertex = 0, second_vertex = 0;  // the example edge, lower index first
-  size_t example_faces = 0;                      // faces holding it (a face holding it twice counts twice)
+  size_t example_faces = 0;                      // faces holding it (validate_scene leaves none holding it twice:
+                                                 // such a quad has no area)
 };
 NonManifoldEdges non_manifold_edges(const Scene& scene);
 
