@@ -7,7 +7,8 @@
 
 Prints the median lookups/s of each benchmark over the files and the ratios
 seamcl aniso16 / OIIO aniso, seamcl trilinear / OIIO trilinear, seamcl bilinear / OIIO bilinear
-and aniso / (trilinear / mean probe count), for each storage format, as a Markdown table.
+and aniso / (trilinear / mean probe count), for each storage format, as a Markdown table, with
+issue 14's goals (those the benchmark itself and scripts/speed-targets print).
 """
 import json
 import statistics
@@ -48,8 +49,8 @@ def main(argv):
     print("| ratio | rgba32f | rgba8 | goal |")
     print("| --- | ---: | ---: | --- |")
     rows = [
-        ("seamcl aniso16 / OIIO aniso", "seamcl/aniso16/{}", "oiio/aniso16/f32", ">= 6"),
-        ("seamcl trilinear / OIIO trilinear", "seamcl/trilinear/{}", "oiio/trilinear/f32", ">= 20"),
+        ("seamcl aniso16 / OIIO aniso", "seamcl/aniso16/{}", "oiio/aniso16/f32", ">= 10"),
+        ("seamcl trilinear / OIIO trilinear", "seamcl/trilinear/{}", "oiio/trilinear/f32", ">= 25"),
         ("seamcl bilinear / OIIO bilinear (NoMIP)", "seamcl/bilinear/{}", "oiio/bilinear/f32", ""),
     ]
     for label, ours, theirs, goal in rows:
@@ -58,7 +59,7 @@ def main(argv):
     for fmt in ("rgba32f", "rgba8"):
         a, t = rates.get(f"seamcl/aniso16/{fmt}"), rates.get(f"seamcl/trilinear/{fmt}")
         cells.append(f"{a / (t / probes):.2f}" if a and t and probes else "n/a")
-    print(f"| seamcl aniso16 / (seamcl trilinear / mean probes) | {cells[0]} | {cells[1]} | >= 0.80 |")
+    print(f"| seamcl aniso16 / (seamcl trilinear / mean probes) | {cells[0]} | {cells[1]} | >= 1.3 |")
     return 0
 
 
