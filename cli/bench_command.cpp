@@ -235,6 +235,7 @@ int run_sweep(const BenchArgs& args, const CLI::App& command, const GlobalOption
     return 0;
   }
   ClRuntime runtime(global.device);
+  settings.device_byte_limit = device_memory_bound(runtime.info());  // as limit_to_machine holds the orbit's Renderers
   const json out = run_scaling_sweeps(runtime, axes, settings);
   if (args.json_out) {
     std::cout << out.dump(2) << "\n";
@@ -308,6 +309,7 @@ int run_bench(const BenchArgs& args, const CLI::App& command, const GlobalOption
   // One renderer for the face maps and references, one per method (a method's packing, e.g. the
   // guard bands, then stays uploaded instead of being rebuilt on every switch).
   Renderer base_renderer(runtime);
+  limit_to_machine(base_renderer, runtime.info());
   base_renderer.load_scene(scene, frame.texels);
   std::map<std::string, std::unique_ptr<Renderer>> renderers;
   std::vector<Accum> acc(entries.size());
@@ -315,6 +317,7 @@ int run_bench(const BenchArgs& args, const CLI::App& command, const GlobalOption
     std::unique_ptr<Renderer>& r = renderers[entries[i].method_name];
     if (!r) {
       r = std::make_unique<Renderer>(runtime);
+      limit_to_machine(*r, runtime.info());
       r->load_scene(scene, frame.texels);
     }
     acc[i].entry = entries[i];

@@ -118,6 +118,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   };
 
   Renderer renderer(runtime);
+  limit_to_machine(renderer, runtime.info());
   renderer.load_scene(scene, frame.texels);
   const ComparisonTargets targets =
       prepare_targets(runtime, renderer, camera, frame, entries, ref_settings, kinds, progress);
@@ -164,7 +165,8 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   json displacement;
   if (frame.displacement) {
     progress("displacement: gap and crack pixels of " + to_string(*frame.displacement));
-    displacement = measure_displacement(runtime, scene, camera, entries.front().options, 0, 0).to_json();
+    displacement = measure_displacement(runtime, scene, camera, entries.front().options, 0, 0, renderer.device_byte_limit())
+                       .to_json();
   }
 
   const json summary = targets.summary_json(entries.front().options.msaa, true);

@@ -23,6 +23,7 @@
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
+#include <seamcl/eval/scaling_sweep.h>
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
@@ -375,6 +376,54 @@ TEST(Budget, TileListGrowthStaysUnderTheBoundAndALimitRefusesIt) {
   limited.set_device_byte_limit(expected.device_bytes_bound());
   const RenderResult again = limited.render(scene.camera, options);
   EXPECT_EQ(std::memcmp(again.pixels.data(), grown.pixels.data(), grown.pixels.size() * sizeof(glm::vec4)), 0);
+}
+
+// Every Renderer the command line makes is held to the machine (limit_to_machine): a crowded
+// frame's tile lists may not grow past it. A device of just the estimate's bytes stands in for a
+// machine that cannot hold the growth, which the limit then refuses as it refuses render's.
+TEST(Budget, CommandLineRenderersAreHeldToTheMachine) {
+  const Scene scene = stacked_quads(24);
+  const RenderOptions options = options_of(Method::Discard, TexelFormat::Rgba8, 1, 1024, 1024);
+  const RenderMemory expected = render_memory(scene, options);
+  DeviceInfo cpu;
+  cpu.host_unified_memory = true;
+  DeviceInfo small_gpu;
+  small_gpu.global_memory_bytes = expected.device_bytes();
+  Renderer renderer(seamcl_tests::shared_runtime());
+  EXPECT_EQ(renderer.device_byte_limit(), 0u);  // a Renderer of its own is unbounded
+  limit_to_machine(renderer, cpu);
+  EXPECT_EQ(renderer.device_byte_limit(), physical_memory_bytes());
+  limit_to_machine(renderer, small_gpu);
+  EXPECT_EQ(renderer.device_byte_limit(), expected.device_bytes());
+  renderer.load_scene(scene);
+  try {
+    renderer.render(scene.camera, options);
+    ADD_FAILURE() << "tile lists grew past the device's memory";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "size");
+    EXPECT_EQ(e.limit_bytes(), small_gpu.global_memory_bytes);
+    EXPECT_NE(std::string(e.what()).find("this frame's tile lists"), std::string::npos) << e.what();
+  }
+}
+
+// The Renderers that library code makes for the command line take the limit from their settings:
+// a sweep's (bench --sweep) refuses the same growth.
+TEST(Budget, SweepRenderersAreHeldToTheGivenLimit) {
+  const RenderOptions crowded = options_of(Method::Discard, TexelFormat::Rgba8, 1, 1024, 1024);
+  SweepSettings settings;
+  settings.base = crowded;
+  settings.base.scene = "stacked";
+  settings.methods = {"discard"};
+  settings.repeats = 1;
+  settings.make_scene = [](const GeneratorOptions&) { return stacked_quads(24); };
+  settings.device_byte_limit = render_memory(stacked_quads(24), crowded).device_bytes();
+  try {
+    run_scaling_sweeps(seamcl_tests::shared_runtime(), {SweepAxis::Msaa}, settings);
+    ADD_FAILURE() << "the sweep's tile lists grew past its limit";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "size");
+    EXPECT_EQ(e.limit_bytes(), settings.device_byte_limit);
+  }
 }
 
 // A 24x16 discard frame of the built-in scene `name`, as a compare's frame.

@@ -215,6 +215,10 @@ size_t device_memory_bound(const DeviceInfo& device) {
   return device.host_unified_memory ? physical_memory_bytes() : device.global_memory_bytes;
 }
 
+void limit_to_machine(Renderer& renderer, const DeviceInfo& device) {
+  renderer.set_device_byte_limit(device_memory_bound(device));
+}
+
 void refuse_beyond_machine(const RenderMemory& memory, const DeviceInfo& device, const std::string& what) {
   // The pixels' buffers against what the scene's triangles and textures drive (setups and tile
   // lists grow with the triangles): the field to change is the larger one's.

@@ -147,6 +147,14 @@ size_t physical_memory_bytes();
 // the host's (a CPU), else the device's global memory (0: unknown, no bound).
 size_t device_memory_bound(const DeviceInfo& device);
 
+class Renderer;
+
+// Sets the renderer's device byte limit to device_memory_bound(device). refuse_beyond_machine
+// checks a render's estimate beforehand, but a crowded frame's tile lists grow past any estimate:
+// the limit refuses that growth (OverBudget "size") instead of exhausting the machine. For every
+// Renderer the command line makes (the service holds its own to its per-request budget).
+void limit_to_machine(Renderer& renderer, const DeviceInfo& device);
+
 // OverBudget when `memory` would not fit this machine: on a device that shares the host's memory,
 // device and host bytes together against physical_memory_bytes(); elsewhere the host bytes against
 // it and the device bytes against the device's. Field "size" when the pixels' buffers (samples,
@@ -163,8 +171,6 @@ void refuse_beyond_machine(size_t device_bytes, size_t host_bytes, const DeviceI
 // freed one by one while packing, were kept in its arenas and held through the render: 54 MB of
 // peak RSS for six 1024x1024 image faces. For a process's start, before any thread allocates.
 void return_large_blocks_at_once();
-
-class Renderer;
 
 // What one loaded scene costs, measured after a render: for `render --json` and the benches.
 struct MeasuredMemory {
