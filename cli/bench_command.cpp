@@ -291,18 +291,20 @@ int run_bench(const BenchArgs& args, const CLI::App& command, const GlobalOption
   source.generator = generator_options;
   source.generator.defer_textures = true;  // each Renderer packs face by face: no float copy of the textures
   const Scene scene = load_scene_source(frame.scene, frame.texture, source);
-  if (args.check_only) {
-    std::printf("bench options valid: %s, part %s: frames %d..%d of %d\n", scene.name.c_str(), to_string(shard).c_str(),
-                range.first, range.end - 1, frame.frames);
-    return 0;
-  }
   int error_frames = 0;
   for (int k = range.first; k < range.end; ++k) error_frames += with_errors && k % args.reference_frames == 0 ? 1 : 0;
   const auto wall_start = std::chrono::steady_clock::now();
   ClRuntime runtime(global.device);
   std::vector<DifferenceAccum> diffs = discard_traverse_pairs(entries);
+  // An estimate, so --check makes it too: a batch's pre-check (scripts/farm) must not pass a part
+  // that would then be refused.
   refuse_bench_beyond_machine(scene, frame, entries, ref_settings, with_errors, error_frames, diffs.size(), range.size(),
                               runtime.info());
+  if (args.check_only) {
+    std::printf("bench options valid: %s, part %s: frames %d..%d of %d\n", scene.name.c_str(), to_string(shard).c_str(),
+                range.first, range.end - 1, frame.frames);
+    return 0;
+  }
   // Once, not per reference frame: hashing bakes every face.
   if (with_errors && ref_settings.use_cache) ref_settings.scene_hash = scene_content_hash(scene);
 
@@ -570,7 +572,8 @@ Command add_bench_command(CLI::App& app) {
                   "The seam pixels errors are pooled over: " + join_names(seam_mask_kind_names()) +
                       " (footprint: each rate's pixels whose filter footprint crosses a shared edge, as compare "
                       "measures; band: within 2 px of a face boundary, one mask for every rate) [band]");
-  cmd->add_flag("--check", args->check_only, "Validate the options (and the scene) and exit without rendering");
+  cmd->add_flag("--check", args->check_only,
+                "Validate the options (and the scene), refuse a bench this machine cannot hold, and exit without rendering");
   cmd->add_option("--sweep", args->sweep,
                   "Scaling sweeps instead of the orbit: a comma list of " + join_names(sweep_axis_names()) +
                       ", or all (time against image pixels, paper's face count at equal pixels, MSAA rate, texels)");
