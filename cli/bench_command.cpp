@@ -210,7 +210,7 @@ void refuse_bench_beyond_machine(const Scene& scene, const RenderOptions& frame,
   const std::string field = pools >= std::max(scene_driven, frame_driven) ? "frames"
                             : scene_driven > frame_driven                  ? "scene"
                                                                            : "size";
-  refuse_beyond_machine(device_bytes, host_bytes, device, field, "this bench");
+  refuse_beyond_machine(MemoryShares(field, device_bytes), MemoryShares(field, host_bytes), device, "this bench");
 }
 
 // --sweep: the scaling sweeps (one JSON, the chart's input: examples/scaling_chart.py).
