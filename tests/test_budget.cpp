@@ -19,6 +19,7 @@
 #include <seamcl/core/cancelled.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/over_budget.h>
+#include <seamcl/eval/bench_memory.h>
 #include <seamcl/eval/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
@@ -826,6 +827,60 @@ TEST(Budget, CommandLineComparesAndBenchesMustFitTheMachine) {
     EXPECT_NE(std::string(e.what()).find("(host memory)"), std::string::npos) << e.what();
   }
 
+}
+
+// A bench is refused naming what drives the figure over its limit: the Renderers' samples at a
+// measured rate of 16 on a device too small for them (msaa), the distances pooled over a million
+// frames on the host (frames), the 8x reference's buffers (size), a scene's textures (scene).
+TEST(Budget, BenchMemoryNamesWhatDrivesTheLimitItExceeds) {
+  const SceneSizes quad2 = scene_sizes(generate_scene("quad2", GeneratorOptions{}));
+  RenderOptions frame;
+  frame.width = frame.height = 256;
+  const std::vector<MethodEntry> entries = method_entries(to_json(frame), {"discard", "traverse"}, {16});
+  const BenchRun one_frame{false, 0, 1, 1};
+  const BenchMemory multisampled = bench_memory(quad2, frame, entries, ReferenceSettings{}, one_frame);
+  EXPECT_EQ(multisampled.device.field(), "msaa");
+  EXPECT_GE(multisampled.device.share("msaa"), 2 * size_t{256} * 256 * 16 * sizeof(uint32_t));  // two methods' samples
+  DeviceInfo small_gpu;
+  small_gpu.global_memory_bytes = multisampled.device.total() - 1;
+  try {
+    refuse_beyond_machine(multisampled.device, multisampled.host, small_gpu, "this bench");
+    ADD_FAILURE() << "a bench past the device's memory was let through";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "msaa");
+    EXPECT_EQ(e.needed_bytes(), multisampled.device.total());
+    EXPECT_NE(std::string(e.what()).find("this bench (device memory) needs"), std::string::npos) << e.what();
+  }
+
+  // A million frames: the difference pool holds a distance and a mask byte per pixel and frame.
+  const BenchRun million{false, 0, 1, 1000000};
+  const BenchMemory pooled = bench_memory(quad2, frame, entries, ReferenceSettings{}, million);
+  EXPECT_EQ(pooled.device.total(), multisampled.device.total());  // the Renderers are the same
+  EXPECT_EQ(pooled.host.field(), "frames");
+  EXPECT_GE(pooled.host.share("frames"), size_t{256} * 256 * 5 * 1000000);
+  DeviceInfo cpu;
+  cpu.host_unified_memory = true;
+  DeviceInfo large_gpu;
+  large_gpu.global_memory_bytes = size_t{1} << 40;
+  for (const DeviceInfo& device : {cpu, large_gpu}) {
+    try {
+      refuse_beyond_machine(pooled.device, pooled.host, device, "this bench");
+      ADD_FAILURE() << "a bench past the machine's memory was let through";
+    } catch (const OverBudget& e) {
+      EXPECT_EQ(e.field(), "frames");
+      EXPECT_EQ(e.limit_bytes(), physical_memory_bytes());
+    }
+  }
+
+  // With errors the reference's Renderer renders the 8x frame: its buffers outweigh the methods'.
+  const BenchMemory referenced = bench_memory(quad2, frame, entries, ReferenceSettings{}, {true, 1, 1, 1});
+  EXPECT_EQ(referenced.device.field(), "size");
+  // Large textures: every Renderer's packing and Scene copy.
+  SceneSizes textured = quad2;
+  for (auto& face : textured.faces) face = {4096, 4096};
+  const BenchMemory heavy = bench_memory(textured, frame, entries, ReferenceSettings{}, one_frame);
+  EXPECT_EQ(heavy.device.field(), "scene");
+  EXPECT_EQ(heavy.host.field(), "scene");
 }
 
 // A compare's figures split by what drives them: the phase that needs most, its frame buffers the
