@@ -21,8 +21,8 @@
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/eval/bench_memory.h>
 #include <seamcl/eval/bench_merge.h>
-#include <seamcl/eval/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
@@ -157,62 +157,6 @@ class Progress {
   bool tty_, quiet_;
 };
 
-// A bench this machine cannot hold is refused before it allocates, as render and compare refuse
-// theirs. It holds at once: the face-map and reference Renderer, one Renderer per method (with its
-// largest entry's buffers), every entry's last two images, and the distances and seam masks pooled
-// over the frames (each entry's errors on every error frame; each discard / traverse pair's
-// difference on every frame of the range, with --no-errors too), plus the largest pool's summary
-// copies: field "frames" when the pools are most of it, else "scene" or "size", whichever drives
-// the Renderers' buffers.
-void refuse_bench_beyond_machine(const Scene& scene, const RenderOptions& frame, const std::vector<MethodEntry>& entries,
-                                 const ReferenceSettings& settings, bool with_errors, int error_frames,
-                                 size_t difference_pairs, int range_frames, const DeviceInfo& device) {
-  const SceneSizes sizes = scene_sizes(scene);
-  RenderOptions face_map = frame;  // as render_face_map renders it
-  face_map.msaa = 1;
-  face_map.shading = ShadingMode::Pixel;
-  size_t device_bytes = 0, host_bytes = 0, scene_driven = 0, frame_driven = 0;
-  const auto add_renderer = [&](const RenderMemory& m) {
-    device_bytes = saturating_add(device_bytes, m.device_bytes());
-    host_bytes = saturating_add(host_bytes, m.host_bytes());
-    scene_driven = saturating_add(scene_driven, saturating_add(m.scene_device_bytes(), saturating_add(m.setups, m.tile_lists)));
-    frame_driven = saturating_add(frame_driven, saturating_add(m.samples, m.image));
-  };
-  if (with_errors) {
-    const CompareMemory references = compare_memory(sizes, frame, {}, settings);
-    device_bytes = references.device_bytes;
-    host_bytes = references.host_bytes;
-    frame_driven = saturating_add(references.reference.samples, references.reference.image);
-    scene_driven = saturating_add(references.reference.scene_device_bytes(),
-                                  saturating_add(references.reference.setups, references.reference.tile_lists));
-  } else {
-    add_renderer(render_memory(sizes, face_map));
-  }
-  std::map<std::string, RenderMemory> largest_per_method;
-  for (const MethodEntry& entry : entries) {
-    const RenderMemory m = render_memory(sizes, entry.options);
-    const auto [held, inserted] = largest_per_method.try_emplace(entry.method_name, m);
-    if (!inserted && m.device_bytes() > held->second.device_bytes()) held->second = m;
-  }
-  for (const auto& [method, m] : largest_per_method) add_renderer(m);
-  const size_t pixels = static_cast<size_t>(frame.width) * static_cast<size_t>(frame.height);
-  const size_t images = saturating_mul(saturating_mul(pixels, 2 * sizeof(glm::vec4)), entries.size());
-  const size_t pooled_bytes = sizeof(float) + 1;  // a distance and a mask byte per pixel and frame
-  const size_t error_pools = saturating_mul(saturating_mul(pixels, pooled_bytes),
-                                            saturating_mul(entries.size(), static_cast<size_t>(error_frames)));
-  const size_t difference_pools = saturating_mul(saturating_mul(pixels, pooled_bytes),
-                                                 saturating_mul(difference_pairs, static_cast<size_t>(range_frames)));
-  // Pool::stats copies the largest pool's seam and off-seam masks.
-  const size_t summary = saturating_mul(saturating_mul(pixels, 2),
-                                        static_cast<size_t>(std::max(error_frames, difference_pairs > 0 ? range_frames : 0)));
-  const size_t pools = saturating_add(error_pools, saturating_add(difference_pools, summary));
-  host_bytes = saturating_add(host_bytes, saturating_add(images, pools));
-  const std::string field = pools >= std::max(scene_driven, frame_driven) ? "frames"
-                            : scene_driven > frame_driven                  ? "scene"
-                                                                           : "size";
-  refuse_beyond_machine(device_bytes, host_bytes, device, field, "this bench");
-}
-
 // --sweep: the scaling sweeps (one JSON, the chart's input: examples/scaling_chart.py).
 int run_sweep(const BenchArgs& args, const CLI::App& command, const GlobalOptions& global) {
   const std::vector<SweepAxis> axes = parse_sweep(*args.sweep);
@@ -235,6 +179,7 @@ int run_sweep(const BenchArgs& args, const CLI::App& command, const GlobalOption
     return 0;
   }
   ClRuntime runtime(global.device);
+  settings.device_byte_limit = device_memory_bound(runtime.info());  // as limit_to_machine holds the orbit's Renderers
   const json out = run_scaling_sweeps(runtime, axes, settings);
   if (args.json_out) {
     std::cout << out.dump(2) << "\n";
@@ -290,24 +235,29 @@ int run_bench(const BenchArgs& args, const CLI::App& command, const GlobalOption
   source.generator = generator_options;
   source.generator.defer_textures = true;  // each Renderer packs face by face: no float copy of the textures
   const Scene scene = load_scene_source(frame.scene, frame.texture, source);
-  if (args.check_only) {
-    std::printf("bench options valid: %s, part %s: frames %d..%d of %d\n", scene.name.c_str(), to_string(shard).c_str(),
-                range.first, range.end - 1, frame.frames);
-    return 0;
-  }
   int error_frames = 0;
   for (int k = range.first; k < range.end; ++k) error_frames += with_errors && k % args.reference_frames == 0 ? 1 : 0;
   const auto wall_start = std::chrono::steady_clock::now();
   ClRuntime runtime(global.device);
   std::vector<DifferenceAccum> diffs = discard_traverse_pairs(entries);
-  refuse_bench_beyond_machine(scene, frame, entries, ref_settings, with_errors, error_frames, diffs.size(), range.size(),
-                              runtime.info());
+  // A bench this machine cannot hold is refused before it allocates, as render and compare refuse
+  // theirs. An estimate, so --check makes it too: a batch's pre-check (scripts/farm) must not pass
+  // a part that would then be refused.
+  const BenchMemory memory =
+      bench_memory(scene_sizes(scene), frame, entries, ref_settings, {with_errors, error_frames, diffs.size(), range.size()});
+  refuse_beyond_machine(memory.device, memory.host, runtime.info(), "this bench");
+  if (args.check_only) {
+    std::printf("bench options valid: %s, part %s: frames %d..%d of %d\n", scene.name.c_str(), to_string(shard).c_str(),
+                range.first, range.end - 1, frame.frames);
+    return 0;
+  }
   // Once, not per reference frame: hashing bakes every face.
   if (with_errors && ref_settings.use_cache) ref_settings.scene_hash = scene_content_hash(scene);
 
   // One renderer for the face maps and references, one per method (a method's packing, e.g. the
   // guard bands, then stays uploaded instead of being rebuilt on every switch).
   Renderer base_renderer(runtime);
+  limit_to_machine(base_renderer, runtime.info());
   base_renderer.load_scene(scene, frame.texels);
   std::map<std::string, std::unique_ptr<Renderer>> renderers;
   std::vector<Accum> acc(entries.size());
@@ -315,6 +265,7 @@ int run_bench(const BenchArgs& args, const CLI::App& command, const GlobalOption
     std::unique_ptr<Renderer>& r = renderers[entries[i].method_name];
     if (!r) {
       r = std::make_unique<Renderer>(runtime);
+      limit_to_machine(*r, runtime.info());
       r->load_scene(scene, frame.texels);
     }
     acc[i].entry = entries[i];
@@ -567,7 +518,8 @@ Command add_bench_command(CLI::App& app) {
                   "The seam pixels errors are pooled over: " + join_names(seam_mask_kind_names()) +
                       " (footprint: each rate's pixels whose filter footprint crosses a shared edge, as compare "
                       "measures; band: within 2 px of a face boundary, one mask for every rate) [band]");
-  cmd->add_flag("--check", args->check_only, "Validate the options (and the scene) and exit without rendering");
+  cmd->add_flag("--check", args->check_only,
+                "Validate the options (and the scene), refuse a bench this machine cannot hold, and exit without rendering");
   cmd->add_option("--sweep", args->sweep,
                   "Scaling sweeps instead of the orbit: a comma list of " + join_names(sweep_axis_names()) +
                       ", or all (time against image pixels, paper's face count at equal pixels, MSAA rate, texels)");

@@ -109,8 +109,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   const bool seamless = std::find(kinds.begin(), kinds.end(), ReferenceKind::Seamless) != kinds.end();
   const CompareMemory memory = compare_memory(scene_sizes(scene), frame, entries, ref_settings, kinds,
                                               seamless ? std::optional(seamless_scene_sizes(scene)) : std::nullopt);
-  refuse_beyond_machine(memory.device_bytes, memory.host_bytes, runtime.info(), compare_memory_field(memory),
-                        "this compare");
+  refuse_beyond_machine(memory.device_shares, memory.host_shares, runtime.info(), "this compare");
   if (ref_settings.use_cache) ref_settings.scene_hash = scene_content_hash(scene);  // once for every reference kind
   if (!images_dir.empty()) make_output_directory(images_dir, "images");
   auto progress = [&](const std::string& line) {
@@ -118,6 +117,7 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   };
 
   Renderer renderer(runtime);
+  limit_to_machine(renderer, runtime.info());
   renderer.load_scene(scene, frame.texels);
   const ComparisonTargets targets =
       prepare_targets(runtime, renderer, camera, frame, entries, ref_settings, kinds, progress);
@@ -164,7 +164,8 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
   json displacement;
   if (frame.displacement) {
     progress("displacement: gap and crack pixels of " + to_string(*frame.displacement));
-    displacement = measure_displacement(runtime, scene, camera, entries.front().options, 0, 0).to_json();
+    displacement = measure_displacement(runtime, scene, camera, entries.front().options, 0, 0, renderer.device_byte_limit())
+                       .to_json();
   }
 
   const json summary = targets.summary_json(entries.front().options.msaa, true);

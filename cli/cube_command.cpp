@@ -19,6 +19,7 @@
 #include <seamcl/eval/cube_metrics.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/packed_cube.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/cube_map.h>
@@ -101,6 +102,7 @@ int run(const CubeArgs& args, const GlobalOptions& global) {
   if (!images_dir.empty()) make_output_directory(images_dir, "images");
 
   Renderer renderer(runtime);
+  limit_to_machine(renderer, runtime.info());
   renderer.load_scene(scene);
   // The reference does not depend on the cube: it is the environment itself.
   const CubeReference reference = cube_reference(renderer, camera, base, args.reference_scale);

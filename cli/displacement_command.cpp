@@ -21,6 +21,7 @@
 #include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/displacement_method.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include "commands.h"
@@ -106,12 +107,14 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
       options.tessellation = t;
       progress("[" + std::to_string(++done) + "/" + std::to_string(total) + "] " + to_string(method) + " T " +
                std::to_string(t));
-      const DisplacementReport report = measure_displacement(runtime, scene, scene.camera, options, args.frames, args.repeat);
+      const DisplacementReport report = measure_displacement(runtime, scene, scene.camera, options, args.frames, args.repeat,
+                                                                     device_memory_bound(runtime.info()));
       json item = report.to_json();
       if (!images_dir.empty()) {
         // Frame 0 of the orbit with the flag shell inside (closed meshes): cracks show as magenta.
         const Camera camera = scene.orbit ? orbit_camera(scene, 0, std::max(args.frames, 1)) : scene.camera;
         Renderer renderer(runtime);
+        limit_to_machine(renderer, runtime.info());
         const Scene shown = closed ? with_flag_shell(scene) : scene;
         renderer.load_scene(shown, options.texels);
         const RenderResult image = renderer.render(camera, options);

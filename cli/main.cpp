@@ -108,7 +108,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
   // each takes about 700 bytes of setup records).
   refuse_beyond_machine(render_memory(scene, options), runtime.info(), "this render");
   Renderer renderer(runtime);
-  renderer.set_device_byte_limit(device_memory_bound(runtime.info()));  // the tile lists grow with the frame: bounded too
+  limit_to_machine(renderer, runtime.info());
   // Handed over, not copied: image faces' float chains exist once (scene() reads them back).
   renderer.load_scene(std::move(scene), options.texels);
   const Scene& loaded = renderer.scene();
@@ -147,7 +147,8 @@ int run_render(const RenderArgs& args, const std::string& device) {
                 {"bin_entries", result.stats.bin_entries}};
     if (options.displacement) {
       // The gap and crack pixels of this frame (docs/displacement.md), the times of the renders above.
-      DisplacementReport report = measure_displacement(runtime, loaded, camera, options, args.crack_orbit, 0);
+      DisplacementReport report = measure_displacement(runtime, loaded, camera, options, args.crack_orbit, 0,
+                                                       renderer.device_byte_limit());
       report.frame_ms = stage_median(&StageTimes::total);
       report.tessellate_ms = stage_median(&StageTimes::tessellate);
       out["displacement"] = report.to_json();

@@ -766,18 +766,24 @@ std::shared_ptr<const Scene> HttpServer::resolve_scene(const json& inline_scene,
   return scene;
 }
 
-void HttpServer::refuse_over_budget(size_t device_bytes, size_t host_bytes, const std::string& field,
-                                    const std::string& what) const {
+void HttpServer::refuse_over_budget(size_t device_bytes, const std::string& device_field, size_t host_bytes,
+                                    const std::string& host_field, const std::string& what) const {
   if (device_bytes > options_.max_request_device_bytes) {
-    throw HttpError{413, field,
+    throw HttpError{413, device_field,
                     what + " needs about " + mebibytes(device_bytes) + " of device memory, over this server's limit of " +
                         mebibytes(options_.max_request_device_bytes) + " per request"};
   }
   if (host_bytes > options_.max_request_host_bytes) {
-    throw HttpError{413, field,
+    throw HttpError{413, host_field,
                     what + " needs about " + mebibytes(host_bytes) + " of host memory, over this server's limit of " +
                         mebibytes(options_.max_request_host_bytes) + " per request"};
   }
+}
+
+void HttpServer::refuse_over_budget(const MemoryShares& device_bytes, const MemoryShares& host_bytes,
+                                    const json& inline_scene, const std::string& what) const {
+  refuse_over_budget(device_bytes.total(), budget_field(device_bytes.field(), inline_scene), host_bytes.total(),
+                     budget_field(host_bytes.field(), inline_scene), what);
 }
 
 void HttpServer::refuse_scene_over_budget(const Scene& scene, const RenderOptions& options, const json& inline_scene,
@@ -798,7 +804,7 @@ void HttpServer::refuse_scene_over_budget(const Scene& scene, const RenderOption
   // The request holds its own copy of an inline scene or asset on top of the Renderer's, and what
   // its texture_source keeps (a deferred .ptx's bytes, also one named inside a scene file).
   const size_t held = key.empty() ? scene_held_bytes(scene) : 0;
-  refuse_over_budget(memory.device_bytes(), saturating_add(memory.host_bytes(), held), field,
+  refuse_over_budget(memory.device_bytes(), field, saturating_add(memory.host_bytes(), held), field,
                      "the scene (" + std::to_string(sizes.faces.size()) + " faces, " +
                          std::to_string(memory.textures.texels) + " packed texels" + sized_by + ")");
 }
@@ -829,8 +835,8 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   const RenderMemory memory = render_memory(sizes, options);
   const bool frame_drives = memory.frame_device_bytes() >= memory.scene_device_bytes();
   const size_t held = inline_request ? scene_held_bytes(*scene) : 0;
-  refuse_over_budget(memory.device_bytes(), saturating_add(memory.host_bytes(), held),
-                     frame_drives ? "size" : inline_request ? "scene" : "texels", "this render");
+  const std::string field = frame_drives ? "size" : inline_request ? "scene" : "texels";
+  refuse_over_budget(memory.device_bytes(), field, saturating_add(memory.host_bytes(), held), field, "this render");
 
   // Wait for a render slot (or 503), render, and give the slot back before encoding.
   const Clock::time_point queued = Clock::now();
@@ -970,8 +976,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   const bool seamless = std::find(reference_kinds.begin(), reference_kinds.end(), ReferenceKind::Seamless) != reference_kinds.end();
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, entries, reference_settings, reference_kinds,
                                               seamless ? std::optional(seamless_scene_sizes(*scene)) : std::nullopt);
-  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, budget_field(compare_memory_field(memory), inline_scene),
-                     "this compare");
+  refuse_over_budget(memory.device_bound_shares, memory.host_shares, inline_scene, "this compare");
   // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
   const Clock::time_point deadline =
       options_.deadline_ms > 0 ? start + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
@@ -1103,8 +1108,7 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
   check_reference_limits(frame, settings, explicit_reference_msaa);
   refuse_scene_over_budget(*scene, frame, inline_scene, key);
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, {}, settings);
-  refuse_over_budget(memory.device_bytes_bound, memory.host_bytes, budget_field(compare_memory_field(memory), inline_scene),
-                     "this reference");
+  refuse_over_budget(memory.device_bound_shares, memory.host_shares, inline_scene, "this reference");
 
   const Clock::time_point queued = Clock::now();
   double queue_ms = 0;

@@ -34,6 +34,7 @@
 #include <seamcl/assets/asset_directory.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/eval/reference.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 
 namespace httplib {
@@ -141,7 +142,13 @@ class HttpServer {
   // empty for an inline scene.
   std::shared_ptr<const Scene> resolve_scene(const nlohmann::json& inline_scene, RenderOptions& options,
                                              std::string& key) const;
-  void refuse_over_budget(size_t device_bytes, size_t host_bytes, const std::string& field, const std::string& what) const;
+  // 413 for a figure over its per-request limit, naming that figure's field.
+  void refuse_over_budget(size_t device_bytes, const std::string& device_field, size_t host_bytes,
+                          const std::string& host_field, const std::string& what) const;
+  // For figures split by what drives them (a compare's): the limit exceeded names the largest
+  // share of its own figure, as budget_field translates it for the client.
+  void refuse_over_budget(const MemoryShares& device_bytes, const MemoryShares& host_bytes, const nlohmann::json& inline_scene,
+                          const std::string& what) const;
   // 413 when the scene alone (scene_render_memory: at 1x1, whatever the size asked) is over the
   // budgets, naming the field that made it so: an inline scene's options.faces (or
   // options.texture_scale_log2, or the scene), "texels" for a built-in, "scene" for an asset.

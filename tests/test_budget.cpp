@@ -19,10 +19,12 @@
 #include <seamcl/core/cancelled.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/over_budget.h>
+#include <seamcl/eval/bench_memory.h>
 #include <seamcl/eval/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
+#include <seamcl/eval/scaling_sweep.h>
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
@@ -375,6 +377,54 @@ TEST(Budget, TileListGrowthStaysUnderTheBoundAndALimitRefusesIt) {
   limited.set_device_byte_limit(expected.device_bytes_bound());
   const RenderResult again = limited.render(scene.camera, options);
   EXPECT_EQ(std::memcmp(again.pixels.data(), grown.pixels.data(), grown.pixels.size() * sizeof(glm::vec4)), 0);
+}
+
+// Every Renderer the command line makes is held to the machine (limit_to_machine): a crowded
+// frame's tile lists may not grow past it. A device of just the estimate's bytes stands in for a
+// machine that cannot hold the growth, which the limit then refuses as it refuses render's.
+TEST(Budget, CommandLineRenderersAreHeldToTheMachine) {
+  const Scene scene = stacked_quads(24);
+  const RenderOptions options = options_of(Method::Discard, TexelFormat::Rgba8, 1, 1024, 1024);
+  const RenderMemory expected = render_memory(scene, options);
+  DeviceInfo cpu;
+  cpu.host_unified_memory = true;
+  DeviceInfo small_gpu;
+  small_gpu.global_memory_bytes = expected.device_bytes();
+  Renderer renderer(seamcl_tests::shared_runtime());
+  EXPECT_EQ(renderer.device_byte_limit(), 0u);  // a Renderer of its own is unbounded
+  limit_to_machine(renderer, cpu);
+  EXPECT_EQ(renderer.device_byte_limit(), physical_memory_bytes());
+  limit_to_machine(renderer, small_gpu);
+  EXPECT_EQ(renderer.device_byte_limit(), expected.device_bytes());
+  renderer.load_scene(scene);
+  try {
+    renderer.render(scene.camera, options);
+    ADD_FAILURE() << "tile lists grew past the device's memory";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "size");
+    EXPECT_EQ(e.limit_bytes(), small_gpu.global_memory_bytes);
+    EXPECT_NE(std::string(e.what()).find("this frame's tile lists"), std::string::npos) << e.what();
+  }
+}
+
+// The Renderers that library code makes for the command line take the limit from their settings:
+// a sweep's (bench --sweep) refuses the same growth.
+TEST(Budget, SweepRenderersAreHeldToTheGivenLimit) {
+  const RenderOptions crowded = options_of(Method::Discard, TexelFormat::Rgba8, 1, 1024, 1024);
+  SweepSettings settings;
+  settings.base = crowded;
+  settings.base.scene = "stacked";
+  settings.methods = {"discard"};
+  settings.repeats = 1;
+  settings.make_scene = [](const GeneratorOptions&) { return stacked_quads(24); };
+  settings.device_byte_limit = render_memory(stacked_quads(24), crowded).device_bytes();
+  try {
+    run_scaling_sweeps(seamcl_tests::shared_runtime(), {SweepAxis::Msaa}, settings);
+    ADD_FAILURE() << "the sweep's tile lists grew past its limit";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "size");
+    EXPECT_EQ(e.limit_bytes(), settings.device_byte_limit);
+  }
 }
 
 // A 24x16 discard frame of the built-in scene `name`, as a compare's frame.
@@ -734,48 +784,158 @@ TEST(Budget, CommandLineRendersMustFitTheMachine) {
   EXPECT_EQ(device_memory_bound(gpu), gpu.global_memory_bytes);
 }
 
-// compare and bench refuse a run the machine cannot hold as render does, from the run's totals,
-// naming what drives them: size, msaa or scene for a compare (compare_memory_field), frames for a
-// bench whose pooled errors grow with its frames (the CLI tests hold bench to that).
+// compare and bench refuse a run the machine cannot hold as render does, from the run's figures
+// split by what drives them: the limit exceeded names the largest share of what it compares (the
+// device and host figures together where the device shares the host's memory).
 TEST(Budget, CommandLineComparesAndBenchesMustFitTheMachine) {
   const size_t machine = physical_memory_bytes();
   DeviceInfo cpu;
   cpu.host_unified_memory = true;
-  EXPECT_NO_THROW(refuse_beyond_machine(1 << 20, 1 << 20, cpu, "size", "this compare"));
+  EXPECT_NO_THROW(refuse_beyond_machine(MemoryShares("size", 1 << 20), MemoryShares("size", 1 << 20), cpu, "this compare"));
+  // Together: the host's frames outweigh the device's scene, though neither is over alone.
   try {
-    refuse_beyond_machine(machine / 2 + 1, machine / 2 + 1, cpu, "frames", "this bench");
+    refuse_beyond_machine(MemoryShares("scene", machine / 2 - 1), MemoryShares("frames", machine / 2 + 2), cpu, "this bench");
     ADD_FAILURE() << "a bench larger than the machine was let through";
   } catch (const OverBudget& e) {
     EXPECT_EQ(e.field(), "frames");
+    EXPECT_EQ(e.needed_bytes(), machine + 1);
     EXPECT_NE(std::string(e.what()).find("this bench needs"), std::string::npos) << e.what();
   }
+  MemoryShares device_by_msaa("size", size_t{1} << 23);
+  device_by_msaa.add("msaa", size_t{1} << 24);
+  device_by_msaa.add("scene", size_t{1} << 22);
   DeviceInfo gpu;
   gpu.global_memory_bytes = size_t{1} << 24;
   try {
-    refuse_beyond_machine(size_t{1} << 25, 1 << 20, gpu, "scene", "this compare");
+    refuse_beyond_machine(device_by_msaa, MemoryShares("frames", 1 << 20), gpu, "this bench");
     ADD_FAILURE() << "device bytes past the device's memory were let through";
   } catch (const OverBudget& e) {
-    EXPECT_EQ(e.field(), "scene");
+    EXPECT_EQ(e.field(), "msaa");  // the device's own largest share, not the host's
     EXPECT_EQ(e.limit_bytes(), gpu.global_memory_bytes);
+    EXPECT_EQ(e.needed_bytes(), device_by_msaa.total());
+    EXPECT_NE(std::string(e.what()).find("(device memory)"), std::string::npos) << e.what();
+  }
+  // Host memory over on a separate device: the host's largest share, whatever drives the device.
+  MemoryShares host_by_frames("size", 1 << 20);
+  host_by_frames.add("frames", machine);
+  try {
+    refuse_beyond_machine(device_by_msaa, host_by_frames, gpu, "this bench");
+    ADD_FAILURE() << "host bytes past the machine's memory were let through";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "frames");
+    EXPECT_EQ(e.limit_bytes(), machine);
+    EXPECT_NE(std::string(e.what()).find("(host memory)"), std::string::npos) << e.what();
   }
 
-  // The field: the 8x reference's frame buffers are the size's doing.
+}
+
+// A bench is refused naming what drives the figure over its limit: the Renderers' samples at a
+// measured rate of 16 on a device too small for them (msaa), the distances pooled over a million
+// frames on the host (frames), the 8x reference's buffers (size), a scene's textures (scene).
+TEST(Budget, BenchMemoryNamesWhatDrivesTheLimitItExceeds) {
+  const SceneSizes quad2 = scene_sizes(generate_scene("quad2", GeneratorOptions{}));
+  RenderOptions frame;
+  frame.width = frame.height = 256;
+  const std::vector<MethodEntry> entries = method_entries(to_json(frame), {"discard", "traverse"}, {16});
+  const BenchRun one_frame{false, 0, 1, 1};
+  const BenchMemory multisampled = bench_memory(quad2, frame, entries, ReferenceSettings{}, one_frame);
+  EXPECT_EQ(multisampled.device.field(), "msaa");
+  EXPECT_GE(multisampled.device.share("msaa"), 2 * size_t{256} * 256 * 16 * sizeof(uint32_t));  // two methods' samples
+  DeviceInfo small_gpu;
+  small_gpu.global_memory_bytes = multisampled.device.total() - 1;
+  try {
+    refuse_beyond_machine(multisampled.device, multisampled.host, small_gpu, "this bench");
+    ADD_FAILURE() << "a bench past the device's memory was let through";
+  } catch (const OverBudget& e) {
+    EXPECT_EQ(e.field(), "msaa");
+    EXPECT_EQ(e.needed_bytes(), multisampled.device.total());
+    EXPECT_NE(std::string(e.what()).find("this bench (device memory) needs"), std::string::npos) << e.what();
+  }
+
+  // A million frames: the difference pool holds a distance and a mask byte per pixel and frame.
+  const BenchRun million{false, 0, 1, 1000000};
+  const BenchMemory pooled = bench_memory(quad2, frame, entries, ReferenceSettings{}, million);
+  EXPECT_EQ(pooled.device.total(), multisampled.device.total());  // the Renderers are the same
+  EXPECT_EQ(pooled.host.field(), "frames");
+  EXPECT_GE(pooled.host.share("frames"), size_t{256} * 256 * 5 * 1000000);
+  DeviceInfo cpu;
+  cpu.host_unified_memory = true;
+  DeviceInfo large_gpu;
+  large_gpu.global_memory_bytes = size_t{1} << 40;
+  for (const DeviceInfo& device : {cpu, large_gpu}) {
+    try {
+      refuse_beyond_machine(pooled.device, pooled.host, device, "this bench");
+      ADD_FAILURE() << "a bench past the machine's memory was let through";
+    } catch (const OverBudget& e) {
+      EXPECT_EQ(e.field(), "frames");
+      EXPECT_EQ(e.limit_bytes(), physical_memory_bytes());
+    }
+  }
+
+  // With errors the reference's Renderer renders the 8x frame: its buffers outweigh the methods'.
+  const BenchMemory referenced = bench_memory(quad2, frame, entries, ReferenceSettings{}, {true, 1, 1, 1});
+  EXPECT_EQ(referenced.device.field(), "size");
+  // Large textures: every Renderer's packing and Scene copy.
+  SceneSizes textured = quad2;
+  for (auto& face : textured.faces) face = {4096, 4096};
+  const BenchMemory heavy = bench_memory(textured, frame, entries, ReferenceSettings{}, one_frame);
+  EXPECT_EQ(heavy.device.field(), "scene");
+  EXPECT_EQ(heavy.host.field(), "scene");
+}
+
+// A compare's figures split by what drives them: the phase that needs most, its frame buffers the
+// size's (the 8x reference's) or the msaa's (a measured rate's above 1), its scene's buffers,
+// setups and tile lists the scene's. The shares add up to the figure they split.
+TEST(Budget, CompareMemoryNamesWhatDrivesEachFigure) {
   const SceneSizes quad2 = scene_sizes(generate_scene("quad2", GeneratorOptions{}));
   RenderOptions frame;
   frame.width = 64;
   frame.height = 64;
   const std::vector<MethodEntry> entries = method_entries(nlohmann::json{{"size", "64x64"}}, {"discard"}, {1, 16});
-  EXPECT_EQ(compare_memory_field(compare_memory(quad2, frame, entries, ReferenceSettings{})), "size");
-  // A scene whose packing outweighs the frames.
+  const CompareMemory small = compare_memory(quad2, frame, entries, ReferenceSettings{});
+  EXPECT_EQ(small.device_shares.field(), "size");
+  EXPECT_EQ(small.device_bound_shares.field(), "size");
+  EXPECT_EQ(small.host_shares.field(), "size");
+  EXPECT_EQ(small.device_shares.total(), small.device_bytes);
+  EXPECT_EQ(small.device_bound_shares.total(), small.device_bytes_bound);
+  EXPECT_EQ(small.host_shares.total(), small.host_bytes);
+  // The 8x reference's phase: its samples and image are all of the frame's share.
+  EXPECT_EQ(small.device_shares.share("size"), small.reference.tiles + small.reference.samples + small.reference.image);
+  // A scene whose packing outweighs the frames, on the device and in the Renderer's packed copy.
   SceneSizes textured = quad2;
   for (auto& face : textured.faces) face = {4096, 4096};
-  EXPECT_EQ(compare_memory_field(compare_memory(textured, frame, entries, ReferenceSettings{})), "scene");
-  // A measured rate's samples past the reference's buffers.
-  CompareMemory multisampled;
-  multisampled.reference.samples = 1000;
-  multisampled.reference.image = 4000;
-  multisampled.entries.resize(1);
-  multisampled.entries[0].samples = 16 * 1000;  // 16 samples a pixel
-  multisampled.entries[0].image = 4000;
-  EXPECT_EQ(compare_memory_field(multisampled), "msaa");
+  const CompareMemory heavy = compare_memory(textured, frame, entries, ReferenceSettings{});
+  EXPECT_EQ(heavy.device_shares.field(), "scene");
+  EXPECT_EQ(heavy.host_shares.field(), "scene");
+  // Without an 8x reference (seamless only), a measured rate of 16 has the largest frame buffers.
+  const Scene corner = generate_scene("closeup-corner", {});
+  RenderOptions large = frame;
+  large.width = large.height = 1024;
+  const CompareMemory multisampled =
+      compare_memory(scene_sizes(corner), large, method_entries(to_json(large), {"discard"}, {1, 16}), ReferenceSettings{},
+                     {ReferenceKind::Seamless}, seamless_scene_sizes(corner));
+  EXPECT_EQ(multisampled.device_shares.field(), "msaa");
+  EXPECT_GE(multisampled.device_shares.share("msaa"), size_t{1024} * 1024 * 16 * sizeof(uint32_t));
+  EXPECT_EQ(multisampled.host_shares.field(), "size");  // the host holds no samples
+}
+
+// The service refuses a compare on device_bytes_bound, with the tile lists at their bound: the
+// field it names weighs them at that bound too. The paper scene's 4,948 triangles at 128x128:
+// with the lists at their first size its packing drives the figure (scene), at their bound (every
+// slot on every tile of the 8x reference's frame, 13x the figure) the frame's tiles do (size),
+// as the Renderer names a refused growth of its lists.
+TEST(Budget, CompareMemoryNamesWhatDrivesTheTileListBound) {
+  GeneratorOptions deferred;
+  deferred.defer_textures = true;
+  const SceneSizes paper = scene_sizes(generate_scene("paper", deferred));
+  RenderOptions frame;
+  frame.width = frame.height = 128;
+  const CompareMemory m =
+      compare_memory(paper, frame, method_entries(nlohmann::json{{"size", "128x128"}}, {"discard"}, {1}), ReferenceSettings{});
+  ASSERT_GT(m.device_bytes_bound, 10 * m.device_bytes);
+  EXPECT_EQ(m.device_shares.field(), "scene");
+  EXPECT_EQ(m.device_bound_shares.field(), "size");
+  EXPECT_EQ(m.device_bound_shares.share("size") - m.device_shares.share("size"),
+            m.reference.tile_lists_bound - m.reference.tile_lists);  // the reference's phase, its lists grown
+  EXPECT_EQ(m.device_bound_shares.share("scene"), m.device_shares.share("scene"));
 }

@@ -350,6 +350,18 @@ TEST_F(Cli, BenchTheMachineCannotHoldIsRefusedNamingFrames) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
+// --check refuses it too, as a pre-check of a batch must (scripts/farm checks part 1 of N), and
+// judges the part it is given: one part of the same orbit fits.
+TEST_F(Cli, BenchCheckRefusesWhatTheMachineCannotHold) {
+  const std::string orbit = "bench --scene quad2 --methods discard,traverse --msaa 1,4 --size 1024x1024 --frames 1000000 ";
+  expect_input_error(orbit + "--no-errors --check", "frames: this bench needs");
+  expect_input_error(orbit + "--no-cache --check", "frames: this bench needs");
+  const Process part = run(orbit + "--no-errors --shard 1/100000 --check");
+  EXPECT_EQ(part.exit_code, 0) << part.err;
+  EXPECT_NE(part.out.find("bench options valid: quad2, part 1/100000: frames 0..9 of 1000000"), std::string::npos)
+      << part.out;
+}
+
 // An empty option value is a mistake (a shell variable that expanded to nothing, say), not the
 // option left out: taken for none, each fell back to its default without a word.
 TEST_F(Cli, EmptyOptionValuesAreInputErrors) {

@@ -1206,9 +1206,9 @@ TEST(ServerCompare, WithoutSizeUsesTheLargestDefaultAspectSizeWithinTheLimit) {
   fs::remove_all(options.cache_dir, ec);
 }
 
-// A compare (or a reference) over the request-memory budget names what drives its memory, as
-// seamcl compare does (compare_memory_field): the paper scene at 16x16 is the scene's doing, quad2
-// at 256x256 the size's. The budget lies between what the scene alone needs, checked first, and
+// A compare (or a reference) over the request-memory budget names what drives the figure it is
+// refused on (device_bound_shares): the paper scene at 16x16 is the scene's doing, quad2
+// at 256x256 the size's, and so is the paper at 128x128 (its tile lists' bound). The budget lies between what the scene alone needs, checked first, and
 // what the paper compare and reference need, computed here as the server computes them.
 TEST(ServerCompare, OverTheMemoryBudgetNamesWhatDrivesIt) {
   std::signal(SIGPIPE, SIG_IGN);
@@ -1242,8 +1242,8 @@ TEST(ServerCompare, OverTheMemoryBudgetNamesWhatDrivesIt) {
   const size_t scene_alone = scene_render_memory(paper.sizes, paper.frame).device_bytes();
   const size_t reference_bound = std::min(paper_compare.device_bytes_bound, paper_reference.device_bytes_bound);
   ASSERT_LT(scene_alone, reference_bound);
-  ASSERT_EQ(compare_memory_field(paper_compare), "scene");
-  ASSERT_EQ(compare_memory_field(paper_reference), "scene");
+  ASSERT_EQ(paper_compare.device_bound_shares.field(), "scene");
+  ASSERT_EQ(paper_reference.device_bound_shares.field(), "scene");
 
   server::ServerOptions options;
   options.threads = 1;
@@ -1253,7 +1253,14 @@ TEST(ServerCompare, OverTheMemoryBudgetNamesWhatDrivesIt) {
   const json& quad2_request = quad2.request;
   const CompareMemory& quad2_compare = quad2.compare;
   ASSERT_GT(quad2_compare.device_bytes_bound, options.max_request_device_bytes);
-  ASSERT_EQ(compare_memory_field(quad2_compare), "size");
+  ASSERT_EQ(quad2_compare.device_bound_shares.field(), "size");
+  // The paper at 128x128: its packing drives the figure with the tile lists at their first size,
+  // but the service refuses on their bound, which the frame's tiles drive (the texel format would
+  // not shrink it).
+  const Planned paper_tiles = plan("paper", "128x128");
+  ASSERT_GT(paper_tiles.compare.device_bytes_bound, options.max_request_device_bytes);
+  ASSERT_EQ(paper_tiles.compare.device_shares.field(), "scene");
+  ASSERT_EQ(paper_tiles.compare.device_bound_shares.field(), "size");
 
   RunningServer s(options);
   httplib::Client c = s.client();
@@ -1265,7 +1272,8 @@ TEST(ServerCompare, OverTheMemoryBudgetNamesWhatDrivesIt) {
   // The library names the scene; a built-in scene is the client's to shrink only by its texel format.
   for (const Case& refused : {Case{"/v1/compare", paper_request, "texels", "this compare"},
                               Case{"/v1/reference", {{"scene", "paper"}, {"size", "16x16"}}, "texels", "this reference"},
-                              Case{"/v1/compare", quad2_request, "size", "this compare"}}) {
+                              Case{"/v1/compare", quad2_request, "size", "this compare"},
+                              Case{"/v1/compare", paper_tiles.request, "size", "this compare"}}) {
     SCOPED_TRACE(refused.path + " " + refused.body.dump());
     const auto res = c.Post(refused.path, refused.body.dump(), "application/json");
     ASSERT_TRUE(res);

@@ -43,6 +43,16 @@ struct CompareMemory {
   // (phase 1), or the reference, every entry's image and distances and one read-back (phase 2).
   // Heap overhead, OpenImageIO's own working memory and the caller's Scene are not counted.
   size_t host_bytes = 0;
+
+  // The three figures above (their totals), each split by the request field that drives it, for a
+  // refusal to name the largest share of the figure it compares. A device figure is its largest
+  // phase's: its frame buffers "msaa" where the render with the largest of them is at a measured
+  // rate above 1 (an entry, a seam mask, the seamless reference), else "size" (the face map, the
+  // 8x reference); its scene's buffers, setups and tile lists at their initial size "scene"; in
+  // device_bound_shares the lists' growth to their bound "size" (RenderMemory::device_shares). The
+  // host figure: the Scene copies, packing and read-back setups "scene"; images, masks,
+  // references and error distances "size".
+  MemoryShares device_shares, device_bound_shares, host_shares;
 };
 
 // Assumes the references are rendered (a cache hit needs less). `kinds` are the references
@@ -54,9 +64,8 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
                              const std::vector<ReferenceKind>& kinds = {ReferenceKind::Paper},
                              const std::optional<SceneSizes>& seamless_scene = std::nullopt);
 
-// The request field that drives a compare's memory, for refuse_beyond_machine: "scene" when the
-// largest part's packed scene, setups and tile lists outweigh its frame buffers; else "msaa" when
-// the largest frame buffers are a measured rate's above 1 (the 8x reference's are not), else "size".
-std::string compare_memory_field(const CompareMemory& memory);
+// What drives the frame buffers of a render at a measured rate (an entry's): "msaa" above 1 sample,
+// else "size".
+std::string measured_frame_field(int msaa);
 
 }  // namespace seamcl

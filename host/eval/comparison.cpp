@@ -205,6 +205,7 @@ ComparisonTargets prepare_targets(ClRuntime& runtime, Renderer& renderer, const 
   }
   if (seamless) {
     Renderer seamless_renderer(runtime);
+    seamless_renderer.set_device_byte_limit(renderer.device_byte_limit());  // the caller's bound is the compare's
     seamless_renderer.load_scene(*seamless, frame.texels);
     for (const MethodEntry& entry : entries) {
       if (targets.seamless_by_rate.count(entry.options.msaa)) continue;

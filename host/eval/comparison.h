@@ -110,7 +110,7 @@ struct ComparisonTargets {
 
 // Validates and makes the targets. A seamless reference on a scene that has none, or analytic
 // on a scene without an albedo function, is InputError("reference") before any render.
-// `runtime` builds the seamless scene's own Renderer.
+// `runtime` builds the seamless scene's own Renderer, held to `renderer`'s device byte limit.
 ComparisonTargets prepare_targets(ClRuntime& runtime, Renderer& renderer, const Camera& camera,
                                   const RenderOptions& frame, const std::vector<MethodEntry>& entries,
                                   const ReferenceSettings& settings, const std::vector<ReferenceKind>& kinds,

@@ -174,7 +174,8 @@ void check_tessellation_levels(const Scene& scene, const std::vector<int>& level
 }
 
 DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, const Camera& camera,
-                                        const RenderOptions& options, int orbit_frames, int repeat) {
+                                        const RenderOptions& options, int orbit_frames, int repeat,
+                                        size_t device_byte_limit) {
   if (!options.displacement) throw InputError("displacement_method", "is needed to measure displacement");
   if (orbit_frames > 0 && !scene.orbit) {
     throw InputError("crack_orbit", "scene '" + scene.name + "' has no orbit to count crack pixels over");
@@ -213,6 +214,7 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   // 2. Time per frame, on the scene itself (repeat 0: the caller times its own renders).
   if (repeat > 0) {
     Renderer renderer(runtime);
+    renderer.set_device_byte_limit(device_byte_limit);
     renderer.load_scene(scene, options.texels);
     renderer.render(cameras.front(), options);  // builds and warms the kernels
     std::vector<double> frame, tessellate;
@@ -229,6 +231,7 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   if (is_closed_mesh(scene)) {
     const Scene flagged = with_flag_shell(scene);
     Renderer renderer(runtime);
+    renderer.set_device_byte_limit(device_byte_limit);
     renderer.load_scene(flagged, options.texels);
     size_t cracks = 0;
     for (const Camera& c : cameras) {

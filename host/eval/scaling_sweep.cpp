@@ -195,6 +195,7 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
       }
       auto held = std::make_unique<Renderer>(runtime);
       Renderer& renderer = *held;
+      renderer.set_device_byte_limit(settings.device_byte_limit);
       renderer.load_scene(*scene, settings.base.texels);
       for (size_t i = begin; i < end; ++i) {
         for (size_t m = 0; m < method_count; ++m) {

@@ -54,6 +54,7 @@ struct SweepSettings {
   // defer_textures is set): the CLI's load_scene_source, which host/eval cannot call itself.
   std::function<Scene(const GeneratorOptions&)> make_scene;
   std::function<void(const std::string&)> progress;  // one line per point; may be empty
+  size_t device_byte_limit = 0;  // every point's Renderer is held to it (Renderer::set_device_byte_limit; 0: none)
 };
 
 // Throws InputError: "sweep" for no axis, "methods" for an unknown method, "sweep_repeats" for

@@ -54,6 +54,41 @@ size_t saturating_mul(size_t a, size_t b) {
   return (a != 0 && b > kMax / a) ? kMax : a * b;
 }
 
+void MemoryShares::add(const std::string& field, size_t bytes) {
+  for (auto& [name, share] : shares_) {
+    if (name == field) {
+      share = saturating_add(share, bytes);
+      return;
+    }
+  }
+  shares_.emplace_back(field, bytes);
+}
+
+void MemoryShares::add(const MemoryShares& other) {
+  for (const auto& [name, share] : other.shares_) add(name, share);
+}
+
+size_t MemoryShares::total() const {
+  size_t sum = 0;
+  for (const auto& entry : shares_) sum = saturating_add(sum, entry.second);
+  return sum;
+}
+
+size_t MemoryShares::share(const std::string& field) const {
+  for (const auto& [name, share] : shares_)
+    if (name == field) return share;
+  return 0;
+}
+
+std::string MemoryShares::field() const {
+  const std::pair<std::string, size_t>* largest = nullptr;
+  for (const auto& entry : shares_)
+    if (largest == nullptr || entry.second > largest->second) largest = &entry;
+  return largest ? largest->first : std::string();
+}
+
+const MemoryShares& larger(const MemoryShares& a, const MemoryShares& b) { return b.total() > a.total() ? b : a; }
+
 size_t RenderMemory::scene_device_bytes() const {
   return add(add(add(add(positions, faces), add(neighbors, level_offsets)), texels), environment);
 }
@@ -66,6 +101,19 @@ size_t RenderMemory::device_bytes_bound() const {
              add(add(add(setups, tiles), add(tile_lists_bound, samples)), add(image, seam_mask)));
 }
 size_t RenderMemory::host_bytes() const { return add(add(host_scene, host_packed), host_image); }
+
+MemoryShares RenderMemory::device_shares(const std::string& frame_field, bool tile_lists_at_bound) const {
+  MemoryShares shares(frame_field, add(add(tiles, samples), add(image, seam_mask)));
+  shares.add("scene", add(add(scene_device_bytes(), constants), add(setups, tile_lists)));
+  if (tile_lists_at_bound && tile_lists_bound > tile_lists) shares.add("size", tile_lists_bound - tile_lists);
+  return shares;
+}
+
+MemoryShares RenderMemory::host_shares() const {
+  MemoryShares shares("size", host_image);
+  shares.add("scene", add(host_scene, host_packed));
+  return shares;
+}
 
 SceneSizes scene_sizes(const Scene& scene) {
   SceneSizes sizes;
@@ -215,26 +263,32 @@ size_t device_memory_bound(const DeviceInfo& device) {
   return device.host_unified_memory ? physical_memory_bytes() : device.global_memory_bytes;
 }
 
+void limit_to_machine(Renderer& renderer, const DeviceInfo& device) {
+  renderer.set_device_byte_limit(device_memory_bound(device));
+}
+
 void refuse_beyond_machine(const RenderMemory& memory, const DeviceInfo& device, const std::string& what) {
   // The pixels' buffers against what the scene's triangles and textures drive (setups and tile
   // lists grow with the triangles): the field to change is the larger one's.
   const size_t pixel_driven = saturating_add(saturating_add(memory.samples, memory.image), memory.seam_mask);
   const size_t scene_driven = saturating_add(memory.scene_device_bytes(), saturating_add(memory.setups, memory.tile_lists));
   const std::string field = pixel_driven >= scene_driven ? "size" : "scene";
-  refuse_beyond_machine(memory.device_bytes(), memory.host_bytes(), device, field, what);
+  refuse_beyond_machine(MemoryShares(field, memory.device_bytes()), MemoryShares(field, memory.host_bytes()), device, what);
 }
 
-void refuse_beyond_machine(size_t device_bytes, size_t host_bytes, const DeviceInfo& device, const std::string& field,
+void refuse_beyond_machine(const MemoryShares& device_bytes, const MemoryShares& host_bytes, const DeviceInfo& device,
                            const std::string& what) {
   const size_t host = physical_memory_bytes(), device_bound = device_memory_bound(device);
   if (device.host_unified_memory) {
-    const size_t needed = saturating_add(device_bytes, host_bytes);
-    if (host != 0 && needed > host) throw OverBudget(field, what, needed, host);
+    MemoryShares together = device_bytes;
+    together.add(host_bytes);
+    if (host != 0 && together.total() > host) throw OverBudget(together.field(), what, together.total(), host);
     return;
   }
-  if (host != 0 && host_bytes > host) throw OverBudget(field, what + " (host memory)", host_bytes, host);
-  if (device_bound != 0 && device_bytes > device_bound)
-    throw OverBudget(field, what + " (device memory)", device_bytes, device_bound);
+  if (host != 0 && host_bytes.total() > host)
+    throw OverBudget(host_bytes.field(), what + " (host memory)", host_bytes.total(), host);
+  if (device_bound != 0 && device_bytes.total() > device_bound)
+    throw OverBudget(device_bytes.field(), what + " (device memory)", device_bytes.total(), device_bound);
 }
 
 ProcessMemory process_memory() {

@@ -21,6 +21,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -65,6 +66,28 @@ struct PackedTextureMemory {
 // Exact. Throws std::invalid_argument for a band outside 0..kMaxGuardBand, as pack_scene does.
 PackedTextureMemory packed_texture_memory(const SceneSizes& scene, TexelFormat format, int guard_band);
 
+// A figure of memory split by the request field that drives each share ("scene", "size", "msaa",
+// "frames"): the field to change to need fewer of those bytes. A refusal of the figure names its
+// largest share's field, so the field named and the bytes compared are the same bytes and cannot
+// disagree. Sums saturate at SIZE_MAX like every figure here.
+class MemoryShares {
+ public:
+  MemoryShares() = default;
+  MemoryShares(const std::string& field, size_t bytes) { add(field, bytes); }
+  void add(const std::string& field, size_t bytes);
+  void add(const MemoryShares& other);
+  size_t total() const;
+  size_t share(const std::string& field) const;  // 0 for a field with no share
+  // The field of the largest share; on a tie the one added first. Empty without any share.
+  std::string field() const;
+
+ private:
+  std::vector<std::pair<std::string, size_t>> shares_;  // in the order the fields were first added
+};
+
+// The one of the two with the larger total (`a` on a tie): a run's peak is its most demanding phase.
+const MemoryShares& larger(const MemoryShares& a, const MemoryShares& b);
+
 // One render's memory, itemised. Device buffers in the order Renderer holds them.
 struct RenderMemory {
   PackedTextureMemory textures;  // in the request's texel format and guard band (0 unless guardband)
@@ -103,6 +126,16 @@ struct RenderMemory {
   // The same with the tile lists at their bound: no render of this request can need more.
   size_t device_bytes_bound() const;
   size_t host_bytes() const;          // host_scene + host_packed + host_image
+
+  // device_bytes() (with tile_lists_at_bound, device_bytes_bound()) split: the pixels' buffers
+  // (tiles, samples, image, seam mask) driven by `frame_field` ("size"; "msaa" for a render at a
+  // measured rate above 1), added first; the scene's buffers, constants, setups and the tile lists
+  // at their initial size (a few entries per triangle) by "scene", as refuse_beyond_machine weighs
+  // a render; the lists' growth to their bound by "size": it is every slot on every tile of the
+  // frame, and Renderer::render refuses that growth naming "size" too.
+  MemoryShares device_shares(const std::string& frame_field, bool tile_lists_at_bound = false) const;
+  // host_bytes() split: host_image "size", then host_scene and host_packed "scene".
+  MemoryShares host_shares() const;
 };
 
 // The request's own options decide everything: size, msaa, texels, and the guard band when the
@@ -147,14 +180,23 @@ size_t physical_memory_bytes();
 // the host's (a CPU), else the device's global memory (0: unknown, no bound).
 size_t device_memory_bound(const DeviceInfo& device);
 
+class Renderer;
+
+// Sets the renderer's device byte limit to device_memory_bound(device). refuse_beyond_machine
+// checks a render's estimate beforehand, but a crowded frame's tile lists grow past any estimate:
+// the limit refuses that growth (OverBudget "size") instead of exhausting the machine. For every
+// Renderer the command line makes (the service holds its own to its per-request budget).
+void limit_to_machine(Renderer& renderer, const DeviceInfo& device);
+
 // OverBudget when `memory` would not fit this machine: on a device that shares the host's memory,
 // device and host bytes together against physical_memory_bytes(); elsewhere the host bytes against
 // it and the device bytes against the device's. Field "size" when the pixels' buffers (samples,
 // image) drive it, else "scene" (its textures, or its triangles' setups and tile lists). For the command line, before any allocation (the service has a budget of its own).
 void refuse_beyond_machine(const RenderMemory& memory, const DeviceInfo& device, const std::string& what);
-// The same for a run of several renders from its totals (a compare's, a bench's), `field` naming
-// what drives them.
-void refuse_beyond_machine(size_t device_bytes, size_t host_bytes, const DeviceInfo& device, const std::string& field,
+// The same for a run of several renders (a compare's, a bench's) from its figures: the limit that
+// is exceeded names the largest share of what it compares (device and host together on a device
+// that shares the host's memory, else each figure on its own).
+void refuse_beyond_machine(const MemoryShares& device_bytes, const MemoryShares& host_bytes, const DeviceInfo& device,
                            const std::string& what);
 
 // Makes the allocator give blocks of 1 MiB and more back to the system as soon as they are freed
@@ -163,8 +205,6 @@ void refuse_beyond_machine(size_t device_bytes, size_t host_bytes, const DeviceI
 // freed one by one while packing, were kept in its arenas and held through the render: 54 MB of
 // peak RSS for six 1024x1024 image faces. For a process's start, before any thread allocates.
 void return_large_blocks_at_once();
-
-class Renderer;
 
 // What one loaded scene costs, measured after a render: for `render --json` and the benches.
 struct MeasuredMemory {

@@ -358,6 +358,7 @@ void Renderer::load_scene(Scene&& scene, TexelFormat format) {
 }
 
 void Renderer::set_device_byte_limit(size_t bytes) { impl_->device_byte_limit = bytes; }
+size_t Renderer::device_byte_limit() const { return impl_->device_byte_limit; }
 
 bool Renderer::has_scene() const { return impl_->scene != nullptr; }
 

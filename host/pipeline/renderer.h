@@ -91,6 +91,7 @@ class Renderer {
   // to grow past it throws OverBudget (field "size") instead of allocating. The rest is the
   // caller's to check beforehand with render_memory().
   void set_device_byte_limit(size_t bytes);
+  size_t device_byte_limit() const;
 
   // with_seam_mask also reads back RenderResult::seam_mask (a program variant of its own, so the
   // renders without it pay nothing). The mask reads the faces' own texels without guard bands:
