@@ -4,10 +4,12 @@
 Per size and MSAA rate: the median of --repeat N renders (one process, kernels warmed first),
 per stage, from OpenCL profiling events; the cells run in turn --rounds times (the order rotated
 each round) and each figure is the median over the rounds, because on a shared machine the load
-moves between processes more than within one. Then the time to a first image in a fresh process
+moves between processes more than within one. 11 renders by default: in a process's first few
+renders after its warm-up frame, and now and then later, a stage can take up to twice its usual
+time (docs/speed-log.md, session 32), and a median of 5 can land on those. Then the time to a first image in a fresh process
 with a cold PoCL kernel cache against a second start that finds the cache warm.
 
-    examples/measure_render.py [--seamcl build/seamcl] [--repeat 5] [--rounds 3] > table.md
+    examples/measure_render.py [--seamcl build/seamcl] [--repeat 11] [--rounds 3] > table.md
 """
 import argparse
 import json
@@ -28,7 +30,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seamcl", default="build/seamcl")
     parser.add_argument("--scene", default="paper")
-    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--repeat", type=int, default=11)
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--sizes", default="480x540,1920x1080")
     parser.add_argument("--msaa", default="1,2,4,8")
