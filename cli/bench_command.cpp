@@ -174,11 +174,16 @@ int run_sweep(const BenchArgs& args, const CLI::App& command, const GlobalOption
   };
   settings.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };  // stdout stays JSON
   validate_sweep(axes, settings);
+  ClRuntime runtime(global.device);
+  // A sweep this machine cannot hold is refused before its first point renders (the run itself
+  // would refuse only the group that cannot be held, after rendering those before it), and by
+  // --check, as the orbit's is: making the points' scenes with their textures deferred renders
+  // and bakes nothing.
+  refuse_sweeps_beyond_machine(axes, settings, runtime.info());
   if (args.check_only) {
     std::printf("sweep options valid: %s\n", args.sweep->c_str());
     return 0;
   }
-  ClRuntime runtime(global.device);
   settings.device_byte_limit = device_memory_bound(runtime.info());  // as limit_to_machine holds the orbit's Renderers
   const json out = run_scaling_sweeps(runtime, axes, settings);
   if (args.json_out) {

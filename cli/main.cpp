@@ -106,7 +106,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
 
   // A render this machine cannot hold is refused before it allocates (a mesh's triangles drive it:
   // each takes about 700 bytes of setup records).
-  refuse_beyond_machine(render_memory(scene, options), runtime.info(), "this render");
+  refuse_beyond_machine(render_memory(scene, options), options.msaa, runtime.info(), "this render");
   Renderer renderer(runtime);
   limit_to_machine(renderer, runtime.info());
   // Handed over, not copied: image faces' float chains exist once (scene() reads them back).

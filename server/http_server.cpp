@@ -330,10 +330,11 @@ std::string mebibytes(size_t bytes) {
   return text;
 }
 
-// The request field to change when the library names what drives a figure: a built-in or asset
-// scene cannot be changed by the client, but its texel format can (`texels`), as /v1/render names it.
-std::string budget_field(const std::string& library_field, const json& inline_scene) {
-  return library_field == "scene" && inline_scene.is_null() ? "texels" : library_field;
+// The request field to change when the library names what drives a figure: a built-in scene
+// cannot be changed by the client, but its texel format can (`texels`); an inline scene or an
+// asset is the client's own (`scene`), held to the budgets as one.
+std::string budget_field(const std::string& library_field, bool builtin_scene) {
+  return library_field == "scene" && builtin_scene ? "texels" : library_field;
 }
 
 }  // namespace
@@ -780,31 +781,38 @@ void HttpServer::refuse_over_budget(size_t device_bytes, const std::string& devi
   }
 }
 
-void HttpServer::refuse_over_budget(const MemoryShares& device_bytes, const MemoryShares& host_bytes,
-                                    const json& inline_scene, const std::string& what) const {
-  refuse_over_budget(device_bytes.total(), budget_field(device_bytes.field(), inline_scene), host_bytes.total(),
-                     budget_field(host_bytes.field(), inline_scene), what);
+void HttpServer::refuse_over_budget(const MemoryShares& device_bytes, const MemoryShares& host_bytes, bool builtin_scene,
+                                    const std::string& what) const {
+  refuse_over_budget(device_bytes.total(), budget_field(device_bytes.field(), builtin_scene), host_bytes.total(),
+                     budget_field(host_bytes.field(), builtin_scene), what);
 }
 
 void HttpServer::refuse_scene_over_budget(const Scene& scene, const RenderOptions& options, const json& inline_scene,
                                           const std::string& key) const {
-  std::string field = inline_scene.is_null() ? (key.empty() ? "scene" : "texels") : "scene";
+  const bool builtin_scene = !key.empty();
+  const SceneSizes sizes = scene_sizes(scene);
+  const RenderMemory memory = scene_render_memory(sizes, options);
+  const MemoryShares device = memory.device_shares(frame_buffers_field(1));  // scene_render_memory: one sample
+  MemoryShares host = memory.host_shares();
+  // The request holds its own copy of an inline scene or asset on top of the Renderer's, and what
+  // its texture_source keeps (a deferred .ptx's bytes, also one named inside a scene file).
+  host.add("scene", builtin_scene ? 0 : scene_held_bytes(scene));
+  std::string device_field = budget_field(device.field(), builtin_scene), host_field = budget_field(host.field(), builtin_scene);
   // An inline generator's sizing options: the field is the first given, the message names them all.
   std::string sized_by;
   if (const auto given = inline_scene.is_object() ? inline_scene.find("options") : inline_scene.end();
       !inline_scene.is_null() && given != inline_scene.end() && given->is_object()) {
     for (const char* option : {"faces", "texture_scale_log2"})
       if (given->contains(option)) {
-        if (sized_by.empty()) field = std::string("scene.options.") + option;
-        sized_by += (sized_by.empty() ? ", sized by scene.options." : " and scene.options.") + std::string(option);
+        const std::string field = std::string("scene.options.") + option;
+        if (sized_by.empty()) {
+          if (device_field == "scene") device_field = field;
+          if (host_field == "scene") host_field = field;
+        }
+        sized_by += (sized_by.empty() ? ", sized by " : " and ") + field;
       }
   }
-  const SceneSizes sizes = scene_sizes(scene);
-  const RenderMemory memory = scene_render_memory(sizes, options);
-  // The request holds its own copy of an inline scene or asset on top of the Renderer's, and what
-  // its texture_source keeps (a deferred .ptx's bytes, also one named inside a scene file).
-  const size_t held = key.empty() ? scene_held_bytes(scene) : 0;
-  refuse_over_budget(memory.device_bytes(), field, saturating_add(memory.host_bytes(), held), field,
+  refuse_over_budget(device.total(), device_field, host.total(), host_field,
                      "the scene (" + std::to_string(sizes.faces.size()) + " faces, " +
                          std::to_string(memory.textures.texels) + " packed texels" + sized_by + ")");
 }
@@ -831,12 +839,10 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
                         " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
   }
   refuse_scene_over_budget(*scene, options, inline_scene, key);
-  const SceneSizes sizes = scene_sizes(*scene);
-  const RenderMemory memory = render_memory(sizes, options);
-  const bool frame_drives = memory.frame_device_bytes() >= memory.scene_device_bytes();
-  const size_t held = inline_request ? scene_held_bytes(*scene) : 0;
-  const std::string field = frame_drives ? "size" : inline_request ? "scene" : "texels";
-  refuse_over_budget(memory.device_bytes(), field, saturating_add(memory.host_bytes(), held), field, "this render");
+  const RenderMemory memory = render_memory(scene_sizes(*scene), options);
+  MemoryShares host = memory.host_shares();
+  host.add("scene", inline_request ? scene_held_bytes(*scene) : 0);  // the request's own copy, as above
+  refuse_over_budget(memory.device_shares(frame_buffers_field(options.msaa)), host, !inline_request, "this render");
 
   // Wait for a render slot (or 503), render, and give the slot back before encoding.
   const Clock::time_point queued = Clock::now();
@@ -976,7 +982,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   const bool seamless = std::find(reference_kinds.begin(), reference_kinds.end(), ReferenceKind::Seamless) != reference_kinds.end();
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, entries, reference_settings, reference_kinds,
                                               seamless ? std::optional(seamless_scene_sizes(*scene)) : std::nullopt);
-  refuse_over_budget(memory.device_bound_shares, memory.host_shares, inline_scene, "this compare");
+  refuse_over_budget(memory.device_bound_shares, memory.host_shares, !key.empty(), "this compare");
   // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
   const Clock::time_point deadline =
       options_.deadline_ms > 0 ? start + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
@@ -1108,7 +1114,7 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
   check_reference_limits(frame, settings, explicit_reference_msaa);
   refuse_scene_over_budget(*scene, frame, inline_scene, key);
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, {}, settings);
-  refuse_over_budget(memory.device_bound_shares, memory.host_shares, inline_scene, "this reference");
+  refuse_over_budget(memory.device_bound_shares, memory.host_shares, !key.empty(), "this reference");
 
   const Clock::time_point queued = Clock::now();
   double queue_ms = 0;

@@ -145,13 +145,15 @@ class HttpServer {
   // 413 for a figure over its per-request limit, naming that figure's field.
   void refuse_over_budget(size_t device_bytes, const std::string& device_field, size_t host_bytes,
                           const std::string& host_field, const std::string& what) const;
-  // For figures split by what drives them (a compare's): the limit exceeded names the largest
-  // share of its own figure, as budget_field translates it for the client.
-  void refuse_over_budget(const MemoryShares& device_bytes, const MemoryShares& host_bytes, const nlohmann::json& inline_scene,
+  // For figures split by what drives them (a render's, a compare's): the limit exceeded names the
+  // largest share of its own figure, as budget_field translates it for the client ("texels" for a
+  // built-in scene's share).
+  void refuse_over_budget(const MemoryShares& device_bytes, const MemoryShares& host_bytes, bool builtin_scene,
                           const std::string& what) const;
   // 413 when the scene alone (scene_render_memory: at 1x1, whatever the size asked) is over the
-  // budgets, naming the field that made it so: an inline scene's options.faces (or
-  // options.texture_scale_log2, or the scene), "texels" for a built-in, "scene" for an asset.
+  // budgets, naming the largest share of the figure over its limit as the above does; for an
+  // inline generator scene the scene's share names its first sizing option given
+  // (scene.options.faces, else scene.options.texture_scale_log2).
   void refuse_scene_over_budget(const Scene& scene, const RenderOptions& options, const nlohmann::json& inline_scene,
                                 const std::string& key) const;
   nlohmann::json scenes_json() const;

@@ -748,11 +748,11 @@ TEST(Budget, CommandLineRendersMustFitTheMachine) {
   RenderMemory small;
   small.texels = 1 << 20;
   small.image = 1 << 20;
-  EXPECT_NO_THROW(refuse_beyond_machine(small, cpu, "this render"));
+  EXPECT_NO_THROW(refuse_beyond_machine(small, 1, cpu, "this render"));
   RenderMemory big_scene = small;
   big_scene.setups = machine;  // a mesh's setup records
   try {
-    refuse_beyond_machine(big_scene, cpu, "this render");
+    refuse_beyond_machine(big_scene, 1, cpu, "this render");
     ADD_FAILURE() << "a render larger than the machine was let through";
   } catch (const OverBudget& e) {
     EXPECT_EQ(e.field(), "scene");  // the triangles' setups: a smaller image would not help
@@ -762,19 +762,19 @@ TEST(Budget, CommandLineRendersMustFitTheMachine) {
   RenderMemory big_image = small;
   big_image.samples = machine;  // a huge --size at 16x
   try {
-    refuse_beyond_machine(big_image, cpu, "this render");
+    refuse_beyond_machine(big_image, 1, cpu, "this render");
     ADD_FAILURE() << "a frame larger than the machine was let through";
   } catch (const OverBudget& e) {
     EXPECT_EQ(e.field(), "size");
   }
   RenderMemory big_textures = small;
   big_textures.texels = machine;
-  EXPECT_THROW(refuse_beyond_machine(big_textures, cpu, "this render"), OverBudget);
+  EXPECT_THROW(refuse_beyond_machine(big_textures, 1, cpu, "this render"), OverBudget);
   // A separate device: its buffers against its own memory, the host's bytes against the machine's.
   DeviceInfo gpu;
   gpu.global_memory_bytes = size_t{1} << 24;
   try {
-    refuse_beyond_machine(big_textures, gpu, "this render");
+    refuse_beyond_machine(big_textures, 1, gpu, "this render");
     ADD_FAILURE() << "device bytes past the device's memory were let through";
   } catch (const OverBudget& e) {
     EXPECT_EQ(e.field(), "scene");
@@ -782,6 +782,44 @@ TEST(Budget, CommandLineRendersMustFitTheMachine) {
   }
   EXPECT_EQ(device_memory_bound(cpu), machine);
   EXPECT_EQ(device_memory_bound(gpu), gpu.global_memory_bytes);
+}
+
+// A render is refused naming the largest share of the figure over its limit, as a compare and a
+// bench are: the samples of a multisampled frame are msaa's doing (the old refusal said size for
+// any frame), a single-sampled frame's buffers size's, a scene's packing and setups scene's, at
+// any rate. Each on a device one byte too small for the render's device bytes.
+TEST(Budget, ARenderIsRefusedNamingTheLargestShareOfTheLimitItExceeds) {
+  GeneratorOptions deferred;
+  deferred.defer_textures = true;
+  const SceneSizes quad2 = scene_sizes(generate_scene("quad2", deferred));
+  const SceneSizes paper = scene_sizes(generate_scene("paper", deferred));
+  struct Case {
+    const SceneSizes* scene;
+    int size, msaa;
+    std::string field;
+  };
+  for (const Case& c : {Case{&quad2, 512, 16, "msaa"}, Case{&quad2, 512, 1, "size"}, Case{&paper, 16, 1, "scene"},
+                        Case{&paper, 16, 16, "scene"}}) {
+    SCOPED_TRACE(std::to_string(c.scene->faces.size()) + " faces at " + std::to_string(c.size) + " msaa " + std::to_string(c.msaa));
+    RenderOptions options;
+    options.width = options.height = c.size;
+    options.msaa = c.msaa;
+    const RenderMemory memory = render_memory(*c.scene, options);
+    DeviceInfo small_gpu;
+    small_gpu.global_memory_bytes = memory.device_bytes() - 1;
+    try {
+      refuse_beyond_machine(memory, options.msaa, small_gpu, "this render");
+      ADD_FAILURE() << "a render past the device's memory was let through";
+    } catch (const OverBudget& e) {
+      EXPECT_EQ(e.field(), c.field);
+      EXPECT_EQ(e.needed_bytes(), memory.device_bytes());
+      EXPECT_EQ(e.limit_bytes(), small_gpu.global_memory_bytes);
+      EXPECT_NE(std::string(e.what()).find("this render (device memory) needs"), std::string::npos) << e.what();
+    }
+    DeviceInfo fitting_gpu;
+    fitting_gpu.global_memory_bytes = memory.device_bytes();
+    EXPECT_NO_THROW(refuse_beyond_machine(memory, options.msaa, fitting_gpu, "this render"));
+  }
 }
 
 // compare and bench refuse a run the machine cannot hold as render does, from the run's figures

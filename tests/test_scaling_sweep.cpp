@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/over_budget.h>
 #include <seamcl/eval/scaling_sweep.h>
 #include <seamcl/scene/scene_generators.h>
 #include <seamcl/scene/scene_json.h>
@@ -253,6 +254,69 @@ TEST(PaperScaling, BoundsAndOtherScenesAreRefusedNamingTheField) {
   const Scene from_file =
       parse_scene_json(json::parse(R"({"generator": "paper", "options": {"faces": 600, "texture_scale_log2": -2}})"));
   EXPECT_NEAR(static_cast<double>(from_file.faces.size()), 600.0, 12.0);
+}
+
+// A sweep whose points the machine cannot hold is refused before anything renders, naming what
+// drives the group over the limit: the pixels sweep's frames size, the msaa sweep's samples msaa,
+// the faces sweep's setups and the texels sweep's packing scene; on a device (faked, as
+// tests/test_budget.cpp fakes them) that holds their first points. Before, a sweep was refused
+// only when a frame's tile lists grew past the device's limit mid-render.
+TEST(Sweep, AGroupTheMachineCannotHoldIsRefusedNamingWhatDrivesIt) {
+  const auto settings_for = [](const std::string& scene, int width, int height) {
+    SweepSettings settings;
+    settings.base.scene = scene;
+    settings.base.width = width;
+    settings.base.height = height;
+    settings.methods = {"discard", "traverse"};
+    settings.make_scene = [scene](const GeneratorOptions& o) { return generate_scene(scene, o); };
+    return settings;
+  };
+  struct Case {
+    SweepAxis axis;
+    SweepSettings settings;
+    size_t device_bytes;
+    std::string field, point;
+  };
+  // Each limit lies between what the axis's last group needs and the one before it (with the
+  // first group's Renderer beside it for faces and texels).
+  const std::vector<Case> cases = {
+      // 3840x2160: 33 MB of samples and 133 MB of image per Renderer; 1920x2160 half that.
+      {SweepAxis::Pixels, settings_for("quad2", 480, 540), size_t{128} << 20, "size", "the pixels sweep's point at 3840x2160"},
+      // 256x256 at 16x: 4 MiB of samples; at 8x, 2 MiB.
+      {SweepAxis::Msaa, settings_for("quad2", 256, 256), size_t{4} << 20, "msaa", "the msaa sweep's point at 256x256 msaa 16"},
+      // About 197,920 faces: 373 MB, most of it triangle setups; 99,037 faces: 217 MB.
+      {SweepAxis::Faces, settings_for("paper", 64, 64), size_t{384} << 20, "scene", "the faces sweep's point at 64x64 msaa 1, 19"},
+      // Twice the texture sides: 201 MB; the paper's own: 53 MB.
+      {SweepAxis::Texels, settings_for("paper", 64, 64), size_t{128} << 20, "scene", "textures x2^1 "},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(to_string(c.axis));
+    DeviceInfo small_gpu;
+    small_gpu.global_memory_bytes = c.device_bytes;
+    try {
+      refuse_sweeps_beyond_machine({c.axis}, c.settings, small_gpu);
+      ADD_FAILURE() << "a sweep past the device's memory was let through";
+    } catch (const OverBudget& e) {
+      EXPECT_EQ(e.field(), c.field);
+      EXPECT_EQ(e.limit_bytes(), c.device_bytes);
+      EXPECT_GT(e.needed_bytes(), c.device_bytes);
+      EXPECT_NE(std::string(e.what()).find(c.point), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("(device memory) needs"), std::string::npos) << e.what();
+    }
+    // Its first group alone fits: the refusal is the growth's.
+    const SweepPoint first = sweep_points(c.axis, c.settings.base).front();
+    GeneratorOptions deferred;
+    deferred.defer_textures = true;
+    deferred.faces = first.faces;
+    deferred.texture_scale_log2 = first.texture_scale_log2;
+    const SweepMemory held = refuse_sweep_group_beyond_machine(c.axis, scene_sizes(c.settings.make_scene(deferred)), {first},
+                                                               c.settings, nullptr, small_gpu);
+    EXPECT_LE(held.device.total(), c.device_bytes);
+  }
+  // A device that holds the largest point lets every sweep through.
+  DeviceInfo large_gpu;
+  large_gpu.global_memory_bytes = size_t{16} << 30;
+  for (const Case& c : cases) EXPECT_NO_THROW(refuse_sweeps_beyond_machine({c.axis}, c.settings, large_gpu)) << to_string(c.axis);
 }
 
 // The command line: a bad sweep name is an input error (exit 2) that names the option.

@@ -1286,6 +1286,63 @@ TEST(ServerCompare, OverTheMemoryBudgetNamesWhatDrivesIt) {
   fs::remove_all(options.cache_dir, ec);
 }
 
+// A render over the request-memory budget names the largest share of its device figure, as a
+// compare does: a multisampled frame's samples msaa (the old refusal said size for any frame that
+// outweighed the scene), a single-sampled frame's buffers size, the paper scene's packing at 16x16
+// texels for the built-in scene and scene for the same scene inline. The budget lies between what
+// the paper scene alone needs, checked first, and its render at 16x16.
+TEST(ServerRender, OverTheMemoryBudgetNamesWhatDrivesIt) {
+  std::signal(SIGPIPE, SIG_IGN);
+  GeneratorOptions deferred;
+  deferred.defer_textures = true;
+  const auto memory_of = [&](const std::string& scene, const json& request) {
+    return render_memory(scene_sizes(generate_scene(scene, deferred)), parse_render_options(request));
+  };
+  const json paper = {{"scene", "paper"}, {"size", "16x16"}, {"msaa", 1}};
+  const RenderOptions paper_options = parse_render_options(paper);
+  const size_t scene_alone =
+      scene_render_memory(scene_sizes(generate_scene("paper", deferred)), paper_options).device_bytes();
+  const size_t paper_render = memory_of("paper", paper).device_bytes();
+  ASSERT_LT(scene_alone, paper_render);
+  server::ServerOptions options;
+  options.threads = 1;
+  options.max_request_device_bytes = scene_alone + (paper_render - scene_alone) / 2;
+
+  const json multisampled = {{"scene", "quad2"}, {"size", "1024x1024"}, {"msaa", 16}};
+  const json single_sampled = {{"scene", "quad2"}, {"size", "2048x2048"}, {"msaa", 1}};
+  for (const json& request : {multisampled, single_sampled}) {
+    const RenderMemory m = memory_of("quad2", request);
+    ASSERT_GT(m.device_bytes(), options.max_request_device_bytes) << request.dump();
+  }
+  ASSERT_EQ(memory_of("quad2", multisampled).device_shares("msaa").field(), "msaa");
+  ASSERT_EQ(memory_of("paper", paper).device_shares("size").field(), "scene");
+  json inline_paper = paper;
+  inline_paper["scene"] = {{"generator", "paper"}};
+
+  RunningServer s(options);
+  httplib::Client c = s.client();
+  struct Case {
+    json body;
+    std::string field;
+  };
+  for (const Case& refused : {Case{multisampled, "msaa"}, Case{single_sampled, "size"}, Case{paper, "texels"},
+                              Case{inline_paper, "scene"}}) {
+    SCOPED_TRACE(refused.body.dump());
+    const auto res = c.Post("/v1/render", refused.body.dump(), "application/json");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 413) << res->body;
+    const json answer = json::parse(res->body);
+    EXPECT_EQ(answer.at("field"), refused.field);
+    EXPECT_NE(answer.at("error").get<std::string>().find("this render needs about"), std::string::npos) << res->body;
+    EXPECT_NE(answer.at("error").get<std::string>().find("of device memory, over this server's limit of"), std::string::npos)
+        << res->body;
+  }
+  // Within the budget it renders.
+  const auto fits = c.Post("/v1/render", json{{"scene", "quad2"}, {"size", "16x16"}, {"msaa", 4}}.dump(), "application/json");
+  ASSERT_TRUE(fits);
+  EXPECT_EQ(fits->status, 200) << fits->body;
+}
+
 // Own server: one render thread, a queue of one. Many slow renders at once: two are admitted,
 // the rest are refused at once with 503 and Retry-After; afterwards the server serves normally.
 TEST(ServerOverload, FullQueueGetsFast503sAndRecovers) {

@@ -36,7 +36,7 @@ BenchMemory bench_memory(const SceneSizes& scene, const RenderOptions& frame, co
     if (!inserted && m.device_bytes() > held->second.memory.device_bytes()) held->second = {m, entry.options.msaa};
   }
   for (const auto& [method, held] : largest_per_method) {
-    out.device.add(held.memory.device_shares(measured_frame_field(held.msaa)));
+    out.device.add(held.memory.device_shares(frame_buffers_field(held.msaa)));
     out.host.add(held.memory.host_shares());
   }
   const size_t pixels = saturating_mul(static_cast<size_t>(std::max(frame.width, 1)), static_cast<size_t>(std::max(frame.height, 1)));

@@ -88,7 +88,7 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
     mask_options.method = Method::Black;
     const RenderMemory mask = render_memory(scene, mask_options, true);
     largest_packed = std::max(largest_packed, mask.host_packed);
-    phase0.include(mask, measured_frame_field(entry.options.msaa));
+    phase0.include(mask, frame_buffers_field(entry.options.msaa));
     phase1.include_scene(mask);
     phase3.include_scene(mask);
   }
@@ -100,11 +100,11 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   std::vector<int> rates;
   for (const MethodEntry& entry : entries) {
     out.entries.push_back(render_memory(scene, entry.options));
-    phase3.include(out.entries.back(), measured_frame_field(entry.options.msaa));
+    phase3.include(out.entries.back(), frame_buffers_field(entry.options.msaa));
     RenderOptions warm_up = entry.options;  // Renderer::warm_up: one tile
     warm_up.width = SEAMCL_TILE_SIZE;
     warm_up.height = SEAMCL_TILE_SIZE;
-    phase3.include(render_memory(scene, warm_up), measured_frame_field(entry.options.msaa));
+    phase3.include(render_memory(scene, warm_up), frame_buffers_field(entry.options.msaa));
     largest_packed = std::max(largest_packed, out.entries.back().host_packed);
     largest_rate = std::max(largest_rate, entry.options.msaa);
     if (std::find(rates.begin(), rates.end(), entry.options.msaa) == rates.end()) rates.push_back(entry.options.msaa);
@@ -117,7 +117,7 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
     seamless_frame.method = Method::Discard;
     seamless_frame.msaa = largest_rate;
     out.seamless = render_memory(*seamless_scene, seamless_frame);
-    phase2_device = out.seamless.device_shares(measured_frame_field(largest_rate), true);
+    phase2_device = out.seamless.device_shares(frame_buffers_field(largest_rate), true);
     phase2_device.add("scene", add(phase1.scene, phase1.constants));
   }
   const auto largest_phase = [&](bool tile_lists_at_bound) {
@@ -167,7 +167,5 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   out.host_bytes = out.host_shares.total();
   return out;
 }
-
-std::string measured_frame_field(int msaa) { return msaa > 1 ? "msaa" : "size"; }
 
 }  // namespace seamcl

@@ -64,8 +64,4 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
                              const std::vector<ReferenceKind>& kinds = {ReferenceKind::Paper},
                              const std::optional<SceneSizes>& seamless_scene = std::nullopt);
 
-// What drives the frame buffers of a render at a measured rate (an entry's): "msaa" above 1 sample,
-// else "size".
-std::string measured_frame_field(int msaa);
-
 }  // namespace seamcl

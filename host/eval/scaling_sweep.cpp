@@ -64,7 +64,82 @@ json stage_medians(const std::vector<StageTimes>& runs) {
           {"readback", median_stage(&StageTimes::readback)}};
 }
 
+// A point's options for one of the settings' methods.
+RenderOptions point_options(const SweepSettings& settings, const SweepPoint& point, const std::string& method) {
+  RenderOptions options = settings.base;
+  options.method = *parse_method(method);
+  options.width = point.width;
+  options.height = point.height;
+  options.msaa = point.msaa;
+  return options;
+}
+
+// The groups of consecutive points that share a scene (the same generator options): [begin, end).
+std::vector<std::pair<size_t, size_t>> scene_groups(const std::vector<SweepPoint>& points) {
+  const auto key_of = [](const SweepPoint& p) { return std::pair{p.faces, p.texture_scale_log2}; };
+  std::vector<std::pair<size_t, size_t>> groups;
+  for (size_t begin = 0; begin < points.size();) {
+    size_t end = begin;
+    while (end < points.size() && key_of(points[end]) == key_of(points[begin])) ++end;
+    groups.emplace_back(begin, end);
+    begin = end;
+  }
+  return groups;
+}
+
+Scene make_point_scene(const SweepSettings& settings, const SweepPoint& point) {
+  GeneratorOptions generator;
+  generator.tint = settings.base.tint;
+  generator.defer_textures = true;
+  generator.faces = point.faces;
+  generator.texture_scale_log2 = point.texture_scale_log2;
+  return settings.make_scene(generator);
+}
+
+// How the refusal names a group: its last point, the largest of it.
+std::string describe_group(SweepAxis axis, const std::vector<SweepPoint>& points, const SceneSizes& scene) {
+  const SweepPoint& p = points.back();
+  return "the " + to_string(axis) + " sweep's point at " + std::to_string(p.width) + "x" + std::to_string(p.height) +
+         " msaa " + std::to_string(p.msaa) + ", " + std::to_string(scene.faces.size()) + " faces" +
+         (p.texture_scale_log2 ? ", textures x2^" + std::to_string(*p.texture_scale_log2) : "");
+}
+
 }  // namespace
+
+SweepMemory refuse_sweep_group_beyond_machine(SweepAxis axis, const SceneSizes& scene, const std::vector<SweepPoint>& points,
+                                             const SweepSettings& settings, const SweepMemory* first, const DeviceInfo& device) {
+  // A Renderer keeps the largest of each buffer any request needed; the points grow along the
+  // axis, so the peak is about the largest render's (the larger of the figures, not the sum).
+  SweepMemory group;
+  for (const SweepPoint& point : points) {
+    for (const std::string& method : settings.methods) {
+      const RenderMemory m = render_memory(scene, point_options(settings, point, method));
+      group.device = larger(group.device, m.device_shares(frame_buffers_field(point.msaa)));
+      group.host = larger(group.host, m.host_shares());
+    }
+  }
+  SweepMemory held = group;
+  if (first) {
+    held.device.add(first->device);
+    held.host.add(first->host);
+  }
+  refuse_beyond_machine(held.device, held.host, device, describe_group(axis, points, scene));
+  return group;
+}
+
+void refuse_sweeps_beyond_machine(const std::vector<SweepAxis>& axes, const SweepSettings& settings, const DeviceInfo& device) {
+  validate_sweep(axes, settings);
+  for (SweepAxis axis : axes) {
+    const std::vector<SweepPoint> points = sweep_points(axis, settings.base);
+    std::optional<SweepMemory> first;
+    for (const auto& [begin, end] : scene_groups(points)) {
+      const SceneSizes sizes = scene_sizes(make_point_scene(settings, points[begin]));
+      const std::vector<SweepPoint> group(points.begin() + static_cast<long>(begin), points.begin() + static_cast<long>(end));
+      const SweepMemory memory = refuse_sweep_group_beyond_machine(axis, sizes, group, settings, first ? &*first : nullptr, device);
+      if (begin == 0) first = memory;
+    }
+  }
+}
 
 std::optional<SweepAxis> parse_sweep_axis(std::string_view name) {
   for (SweepAxis axis : kAxes)
@@ -163,14 +238,7 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
     std::vector<std::vector<double>> totals(method_count, std::vector<double>(points.size()));  // medians
     std::vector<std::vector<double>> minima(method_count, std::vector<double>(points.size()));
     std::vector<double> xs(points.size());
-    auto options_of = [&](const SweepPoint& point, size_t m) {
-      RenderOptions options = settings.base;
-      options.method = *parse_method(settings.methods[m]);
-      options.width = point.width;
-      options.height = point.height;
-      options.msaa = point.msaa;
-      return options;
-    };
+    auto options_of = [&](const SweepPoint& point, size_t m) { return point_options(settings, point, settings.methods[m]); };
     // Points that share a scene (pixels, msaa: all of them) are measured together, the repeats
     // interleaved (every point and method once per round), so that the machine's load, which
     // drifts, falls on all of them alike. A point with a scene of its own (faces, texels) is
@@ -180,19 +248,14 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
     std::optional<Camera> first_camera;  // the renderer holds its own copy of the scene
     std::unique_ptr<Renderer> first_renderer;
     std::vector<std::vector<std::vector<double>>> paired_first(points.size(), std::vector<std::vector<double>>(method_count));
-    for (size_t begin = 0; begin < points.size();) {
-      const auto key_of = [](const SweepPoint& p) { return std::pair{p.faces, p.texture_scale_log2}; };
-      size_t end = begin;
-      while (end < points.size() && key_of(points[end]) == key_of(points[begin])) ++end;
-      std::unique_ptr<Scene> scene;
-      {
-        GeneratorOptions generator;
-        generator.tint = settings.base.tint;
-        generator.defer_textures = true;
-        generator.faces = points[begin].faces;
-        generator.texture_scale_log2 = points[begin].texture_scale_log2;
-        scene = std::make_unique<Scene>(settings.make_scene(generator));
-      }
+    std::optional<SweepMemory> first_memory;
+    for (const auto& [begin, end] : scene_groups(points)) {
+      auto scene = std::make_unique<Scene>(make_point_scene(settings, points[begin]));
+      // Before its Renderer allocates: a later group may need more than the machine has, and
+      // the Renderer's byte limit would catch only the tile lists' growth mid-render.
+      const SweepMemory memory = refuse_sweep_group_beyond_machine(
+          axis, scene_sizes(*scene), std::vector<SweepPoint>(points.begin() + static_cast<long>(begin), points.begin() + static_cast<long>(end)),
+          settings, first_renderer ? &*first_memory : nullptr, runtime.info());
       auto held = std::make_unique<Renderer>(runtime);
       Renderer& renderer = *held;
       renderer.set_device_byte_limit(settings.device_byte_limit);
@@ -261,8 +324,8 @@ json run_scaling_sweeps(ClRuntime& runtime, const std::vector<SweepAxis>& axes, 
       if (begin == 0 && end < points.size()) {
         first_camera = scene->camera;
         first_renderer = std::move(held);
+        first_memory = memory;
       }
-      begin = end;
     }
     first_renderer.reset();
     const json point_list = point_json;

@@ -9,7 +9,9 @@
 // of each, then `repeats` rounds in which every point and method renders once, so that a shared
 // machine's drifting load falls on them alike; a faces or texels point loads its own scene and is
 // measured alone. Times are OpenCL profiling's (median, min, max). The targets of issue 14 are
-// evaluated in the output: 32x pixels in at most 34x time, 40x faces in at most 1.2x time.
+// evaluated in the output: 32x pixels in at most 34x time, 40x faces in at most 1.2x time. Each
+// group of points is refused before its Renderer allocates when the machine cannot hold it
+// (refuse_sweep_group_beyond_machine); bench --sweep refuses the whole sweep before it starts.
 #pragma once
 #include <functional>
 #include <optional>
@@ -20,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include <seamcl/cl/cl_runtime.h>
+#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
@@ -61,6 +64,25 @@ struct SweepSettings {
 // repeats out of range (bench's --sweep-repeats), "scene" for the faces or texels axis on a scene
 // other than paper.
 void validate_sweep(const std::vector<SweepAxis>& axes, const SweepSettings& settings);
+
+// Refuses, as refuse_beyond_machine refuses a render (OverBudget naming the largest share of the
+// limit exceeded), a group of the axis's points that share a scene (`points`, all made of `scene`)
+// and whose renders `device` (and the machine's memory) cannot hold: one Renderer renders every
+// method at every point of the group and keeps the largest of each buffer (render_memory, the
+// frame buffers split as frame_buffers_field of the point's rate: "size" for the pixels sweep's,
+// "msaa" for the msaa sweep's above 1), beside `first` (the first group's figures, kept loaded
+// for a group with a scene of its own; nullptr for none). Returns the group's figures (for the
+// groups after the first). From the scene's sizes alone: nothing is allocated on the device.
+struct SweepMemory {
+  MemoryShares device, host;
+};
+SweepMemory refuse_sweep_group_beyond_machine(SweepAxis axis, const SceneSizes& scene, const std::vector<SweepPoint>& points,
+                                             const SweepSettings& settings, const SweepMemory* first, const DeviceInfo& device);
+
+// The same for every group of every axis before anything renders: each group's scene is made
+// (settings.make_scene, its textures deferred: no texel is baked), its sizes taken and dropped.
+// For bench --sweep and its --check.
+void refuse_sweeps_beyond_machine(const std::vector<SweepAxis>& axes, const SweepSettings& settings, const DeviceInfo& device);
 
 // {"kind": "scaling_sweep", "device", "options", "methods", "repeats",
 //  "sweeps": [{"axis", "x_label", "points": [{"x", "width", "height", "pixels", "msaa", "faces",

@@ -267,13 +267,10 @@ void limit_to_machine(Renderer& renderer, const DeviceInfo& device) {
   renderer.set_device_byte_limit(device_memory_bound(device));
 }
 
-void refuse_beyond_machine(const RenderMemory& memory, const DeviceInfo& device, const std::string& what) {
-  // The pixels' buffers against what the scene's triangles and textures drive (setups and tile
-  // lists grow with the triangles): the field to change is the larger one's.
-  const size_t pixel_driven = saturating_add(saturating_add(memory.samples, memory.image), memory.seam_mask);
-  const size_t scene_driven = saturating_add(memory.scene_device_bytes(), saturating_add(memory.setups, memory.tile_lists));
-  const std::string field = pixel_driven >= scene_driven ? "size" : "scene";
-  refuse_beyond_machine(MemoryShares(field, memory.device_bytes()), MemoryShares(field, memory.host_bytes()), device, what);
+std::string frame_buffers_field(int msaa) { return msaa > 1 ? "msaa" : "size"; }
+
+void refuse_beyond_machine(const RenderMemory& memory, int msaa, const DeviceInfo& device, const std::string& what) {
+  refuse_beyond_machine(memory.device_shares(frame_buffers_field(msaa)), memory.host_shares(), device, what);
 }
 
 void refuse_beyond_machine(const MemoryShares& device_bytes, const MemoryShares& host_bytes, const DeviceInfo& device,

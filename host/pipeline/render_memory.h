@@ -128,8 +128,8 @@ struct RenderMemory {
   size_t host_bytes() const;          // host_scene + host_packed + host_image
 
   // device_bytes() (with tile_lists_at_bound, device_bytes_bound()) split: the pixels' buffers
-  // (tiles, samples, image, seam mask) driven by `frame_field` ("size"; "msaa" for a render at a
-  // measured rate above 1), added first; the scene's buffers, constants, setups and the tile lists
+  // (tiles, samples, image, seam mask) driven by `frame_field` (frame_buffers_field of the
+  // render's rate), added first; the scene's buffers, constants, setups and the tile lists
   // at their initial size (a few entries per triangle) by "scene", as refuse_beyond_machine weighs
   // a render; the lists' growth to their bound by "size": it is every slot on every tile of the
   // frame, and Renderer::render refuses that growth naming "size" too.
@@ -188,11 +188,18 @@ class Renderer;
 // Renderer the command line makes (the service holds its own to its per-request budget).
 void limit_to_machine(Renderer& renderer, const DeviceInfo& device);
 
-// OverBudget when `memory` would not fit this machine: on a device that shares the host's memory,
-// device and host bytes together against physical_memory_bytes(); elsewhere the host bytes against
-// it and the device bytes against the device's. Field "size" when the pixels' buffers (samples,
-// image) drive it, else "scene" (its textures, or its triangles' setups and tile lists). For the command line, before any allocation (the service has a budget of its own).
-void refuse_beyond_machine(const RenderMemory& memory, const DeviceInfo& device, const std::string& what);
+// What drives a render's frame buffers (its samples, image and tiles) at `msaa` samples per
+// pixel: "msaa" above 1, else "size". RenderMemory::device_shares's frame_field for a render.
+std::string frame_buffers_field(int msaa);
+
+// OverBudget when `memory`, a render at `msaa` samples per pixel, would not fit this machine: on a
+// device that shares the host's memory, device and host bytes together against
+// physical_memory_bytes(); elsewhere the host bytes against it and the device bytes against the
+// device's. The limit exceeded names the largest share of what it compares (device_shares with
+// frame_buffers_field(msaa), host_shares), as a compare's and a bench's refusals do, so that a
+// device over its memory is never blamed on the host's image. For the command line, before any
+// allocation (the service has a budget of its own).
+void refuse_beyond_machine(const RenderMemory& memory, int msaa, const DeviceInfo& device, const std::string& what);
 // The same for a run of several renders (a compare's, a bench's) from its figures: the limit that
 // is exceeded names the largest share of what it compares (device and host together on a device
 // that shares the host's memory, else each figure on its own).
