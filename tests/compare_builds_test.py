@@ -14,6 +14,8 @@ import subprocess
 import sys
 import tempfile
 
+from script_checks import Checks
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPT = os.path.join(ROOT, "scripts", "compare-builds")
 
@@ -23,12 +25,7 @@ def main():
     ap.add_argument("--seamcl", required=True)
     args = ap.parse_args()
     args.seamcl = os.path.abspath(args.seamcl)
-    failures = []
-
-    def check(cond, what):
-        if not cond:
-            failures.append(what)
-            print("FAIL:", what)
+    check = Checks("compare_builds_test")
 
     def compare(*options):
         r = subprocess.run([sys.executable, SCRIPT, *options], capture_output=True, text=True, cwd=ROOT)
@@ -68,8 +65,7 @@ def main():
         rc, out = compare("images", "/nonexistent/seamcl", args.seamcl, os.path.join(d, "gone"), *small)
         check(rc != 0 and "/nonexistent/seamcl" in out, f"a missing binary is named: {out}")
 
-    print("compare_builds_test:", "FAILED" if failures else "passed")
-    return 1 if failures else 0
+    return check.result()
 
 
 if __name__ == "__main__":

@@ -11,6 +11,8 @@ import subprocess
 import sys
 import tempfile
 
+from script_checks import Checks
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPT = os.path.join(ROOT, "examples", "lookup_ratios.py")
 
@@ -25,12 +27,7 @@ def run_file(rates, probes):
 
 
 def main():
-    failures = []
-
-    def check(cond, what):
-        if not cond:
-            failures.append(what)
-            print("FAIL:", what)
+    check = Checks("lookup_ratios_test")
 
     runs = [
         {"seamcl/aniso16/rgba8": 10e6, "seamcl/trilinear/rgba8": 60e6, "oiio/aniso16/f32": 1e6,
@@ -61,11 +58,7 @@ def main():
         check("| seamcl bilinear / OIIO bilinear (NoMIP) | n/a | n/a |" in out, "cases not run read n/a: " + out)
     r = subprocess.run([sys.executable, SCRIPT], capture_output=True, text=True)
     check(r.returncode == 2 and "Medians and ratios" in r.stdout, f"no arguments: usage and exit 2 (got {r.returncode})")
-    if failures:
-        print(f"{len(failures)} check(s) failed")
-        return 1
-    print("lookup_ratios: all checks passed")
-    return 0
+    return check.result()
 
 
 if __name__ == "__main__":

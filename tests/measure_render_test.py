@@ -11,6 +11,8 @@ import os
 import subprocess
 import sys
 
+from script_checks import Checks
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPT = os.path.join(ROOT, "examples", "measure_render.py")
 
@@ -19,12 +21,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--seamcl", required=True)
     args = ap.parse_args()
-    failures = []
-
-    def check(cond, what):
-        if not cond:
-            failures.append(what)
-            print("FAIL:", what)
+    check = Checks("measure_render_test")
 
     r = subprocess.run([sys.executable, SCRIPT, "--seamcl", args.seamcl, "--sizes", "32x32,48x32", "--msaa", "1,4",
                         "--repeat", "1", "--rounds", "2"], capture_output=True, text=True, cwd=ROOT)
@@ -45,11 +42,7 @@ def main():
     check("| second start (warm cache) |" in r.stdout, "the start-up table: " + r.stdout)
     r = subprocess.run([sys.executable, SCRIPT, "--seamcl", args.seamcl, "--rounds", "0"], capture_output=True, text=True)
     check(r.returncode == 2 and "--rounds" in r.stderr, f"--rounds 0 refused (got {r.returncode}): {r.stderr}")
-    if failures:
-        print(f"{len(failures)} check(s) failed")
-        return 1
-    print("measure_render: all checks passed")
-    return 0
+    return check.result()
 
 
 if __name__ == "__main__":

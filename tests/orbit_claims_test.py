@@ -12,6 +12,8 @@ import subprocess
 import sys
 import tempfile
 
+from script_checks import Checks
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPT = os.path.join(ROOT, "examples", "orbit_claims.py")
 BENCH = ["bench", "--scene", "quad2", "--size", "48x48", "--frames", "4", "--methods", "clamp,black,discard,traverse",
@@ -27,12 +29,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--seamcl", required=True)
     args = ap.parse_args()
-    failures = []
-
-    def check(cond, what):
-        if not cond:
-            failures.append(what)
-            print("FAIL:", what)
+    check = Checks("orbit_claims_test")
 
     with tempfile.TemporaryDirectory() as d:
         env = dict(os.environ, SEAMCL_CACHE_DIR=os.path.join(d, "cache"))
@@ -49,7 +46,7 @@ def main():
         check(code == 0, f"whole run: exit {code}: {out}")
         code, out = claims([runs["part2"], runs["part1"]], os.path.join(d, "parts"))
         check(code == 0, f"parts: exit {code}: {out}")
-        if not failures:
+        if not check.failures:
             whole = json.load(open(os.path.join(d, "whole", "claims.json")))
             parts = json.load(open(os.path.join(d, "parts", "claims.json")))
             check(parts["covered"] == "0..3" and whole["covered"] == "0..3", f"covered {parts['covered']}")
@@ -80,8 +77,7 @@ def main():
         json.dump({"results": []}, open(bad, "w"))
         code, out = claims([bad], os.path.join(d, "x"))
         check(code == 2 and "not a seamcl bench run with errors" in out, f"not a bench: {code} {out}")
-    print("orbit_claims_test:", "FAILED" if failures else "passed")
-    return 1 if failures else 0
+    return check.result()
 
 
 if __name__ == "__main__":

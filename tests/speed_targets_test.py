@@ -11,6 +11,8 @@ import subprocess
 import sys
 import tempfile
 
+from script_checks import Checks
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPT = os.path.join(ROOT, "scripts", "speed-targets")
 
@@ -27,12 +29,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", required=True)
     args = ap.parse_args()
-    failures = []
-
-    def check(cond, what):
-        if not cond:
-            failures.append(what)
-            print("FAIL:", what)
+    check = Checks("speed_targets_test")
 
     def speed_targets(*options):
         r = subprocess.run([sys.executable, SCRIPT, *options], capture_output=True, text=True, cwd=ROOT)
@@ -80,8 +77,7 @@ def main():
         rc, text = speed_targets("--build", args.build, "--rounds", "0", "--out", out)
         check(rc == 2 and "--rounds must be at least 1" in text, f"--rounds 0: {rc} {text}")
 
-    print("speed_targets_test:", "FAILED" if failures else "ok")
-    return 1 if failures else 0
+    return check.result()
 
 
 if __name__ == "__main__":
