@@ -291,14 +291,16 @@ TEST_F(Connection, RequestsOverTheMemoryBudgetAre413) {
   const auto fits = client.Post("/v1/render", small.dump(), "application/json");
   ASSERT_TRUE(fits);
   EXPECT_EQ(fits->status, 200) << fits->body.substr(0, 300);
-  // A built-in scene whose frame drives the estimate names `size` at 1 sample per pixel, and `msaa`
-  // above (a multisampled render's frame buffers are its rate's share, as a compare's are).
+  // A built-in scene whose frame drives the estimate names `size` while one sample per pixel, the
+  // image and the tiles outweigh the samples beyond it (at 4x, 16 + 4 MiB against 12 MiB: 1x would
+  // not fit either), and `msaa` once those extra samples do (16x: 60 MiB).
   server::ServerOptions tight = options;
   tight.max_request_device_bytes = size_t{8} << 20;
   LiveServer small_server(tight);
   httplib::Client small_client("127.0.0.1", small_server.port());
   for (const auto& [query, field] : {std::pair<std::string, std::string>{"size=1024x1024&msaa=1", "size"},
-                                     {"size=1024x1024&msaa=4", "msaa"}}) {
+                                     {"size=1024x1024&msaa=4", "size"},
+                                     {"size=1024x1024&msaa=16", "msaa"}}) {
     const auto big_frame = small_client.Get("/v1/render?scene=quad2&" + query);
     ASSERT_TRUE(big_frame);
     EXPECT_EQ(big_frame->status, 413) << big_frame->body;

@@ -14,37 +14,29 @@ size_t mul(size_t a, size_t b) { return saturating_mul(a, b); }
 // What a phase of one Renderer holds at most: the largest packing, each frame buffer at its max.
 // The frame buffers are driven by what drives the render that needs the most of them.
 struct PhaseDevice {
-  size_t scene = 0, constants = 0, setups = 0, tiles = 0, tile_lists = 0, tile_lists_bound = 0, samples = 0, image = 0,
-         seam_mask = 0;
-  size_t largest_frame = 0;
-  std::string frame_field = "size";
+  size_t scene = 0, constants = 0;  // the largest packing's buffers, and the per-Renderer constants
+  RenderMemory frames;              // the largest of each frame buffer (its scene buffers stay 0)
+  std::string multisample_field = "size";  // of the render with the most samples
   void include(const RenderMemory& m, const std::string& field) {
-    const size_t frame = add(add(m.tiles, m.samples), add(m.image, m.seam_mask));
-    if (frame > largest_frame) {
-      largest_frame = frame;
-      frame_field = field;
-    }
-    scene = std::max(scene, m.scene_device_bytes());
-    constants = std::max(constants, m.constants);
-    setups = std::max(setups, m.setups);
-    tiles = std::max(tiles, m.tiles);
-    tile_lists = std::max(tile_lists, m.tile_lists);
-    tile_lists_bound = std::max(tile_lists_bound, m.tile_lists_bound);
-    samples = std::max(samples, m.samples);
-    image = std::max(image, m.image);
-    seam_mask = std::max(seam_mask, m.seam_mask);
+    if (m.samples > frames.samples) multisample_field = field;
+    include_scene(m);
+    frames.setups = std::max(frames.setups, m.setups);
+    frames.tiles = std::max(frames.tiles, m.tiles);
+    frames.tile_lists = std::max(frames.tile_lists, m.tile_lists);
+    frames.tile_lists_bound = std::max(frames.tile_lists_bound, m.tile_lists_bound);
+    frames.samples = std::max(frames.samples, m.samples);
+    frames.image = std::max(frames.image, m.image);
+    frames.seam_mask = std::max(frames.seam_mask, m.seam_mask);
   }
   // The scene's buffers only: a packing held over from an earlier phase.
   void include_scene(const RenderMemory& m) {
     scene = std::max(scene, m.scene_device_bytes());
     constants = std::max(constants, m.constants);
   }
-  // Split as RenderMemory::device_shares splits one render's; frame buffers first, so that they
-  // drive a tie.
+  // Split as RenderMemory::device_shares splits one render's.
   MemoryShares shares(bool tile_lists_at_bound) const {
-    MemoryShares out(frame_field, add(add(tiles, samples), add(image, seam_mask)));
-    out.add("scene", add(add(scene, constants), add(setups, tile_lists)));
-    if (tile_lists_at_bound && tile_lists_bound > tile_lists) out.add("size", tile_lists_bound - tile_lists);
+    MemoryShares out = frames.device_shares(multisample_field, tile_lists_at_bound);
+    out.add("scene", add(scene, constants));
     return out;
   }
 };

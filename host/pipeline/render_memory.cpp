@@ -102,8 +102,12 @@ size_t RenderMemory::device_bytes_bound() const {
 }
 size_t RenderMemory::host_bytes() const { return add(add(host_scene, host_packed), host_image); }
 
-MemoryShares RenderMemory::device_shares(const std::string& frame_field, bool tile_lists_at_bound) const {
-  MemoryShares shares(frame_field, add(add(tiles, samples), add(image, seam_mask)));
+MemoryShares RenderMemory::device_shares(const std::string& multisample_field, bool tile_lists_at_bound) const {
+  // One sample per pixel grows with the size, as the image does; only the samples beyond it are
+  // what a lower sample count gives back.
+  const size_t one_sample_per_pixel = std::min(samples, image / (sizeof(cl_float4) / sizeof(cl_uint)));
+  MemoryShares shares("size", add(add(tiles, one_sample_per_pixel), add(image, seam_mask)));
+  shares.add(multisample_field, samples - one_sample_per_pixel);
   shares.add("scene", add(add(scene_device_bytes(), constants), add(setups, tile_lists)));
   if (tile_lists_at_bound && tile_lists_bound > tile_lists) shares.add("size", tile_lists_bound - tile_lists);
   return shares;

@@ -128,12 +128,13 @@ struct RenderMemory {
   size_t host_bytes() const;          // host_scene + host_packed + host_image
 
   // device_bytes() (with tile_lists_at_bound, device_bytes_bound()) split: the pixels' buffers
-  // (tiles, samples, image, seam mask) driven by `frame_field` (frame_buffers_field of the
-  // render's rate), added first; the scene's buffers, constants, setups and the tile lists
-  // at their initial size (a few entries per triangle) by "scene", as refuse_beyond_machine weighs
-  // a render; the lists' growth to their bound by "size": it is every slot on every tile of the
+  // (tiles, one sample per pixel, image, seam mask) by "size", added first; the samples beyond one
+  // per pixel by `multisample_field` (frame_buffers_field of the render's rate: "msaa" where the
+  // request sets it; "size" for a reference, whose rate it does not); the scene's buffers,
+  // constants, setups and the tile lists at their initial size (a few entries per triangle) by
+  // "scene"; the lists' growth to their bound by "size": it is every slot on every tile of the
   // frame, and Renderer::render refuses that growth naming "size" too.
-  MemoryShares device_shares(const std::string& frame_field, bool tile_lists_at_bound = false) const;
+  MemoryShares device_shares(const std::string& multisample_field, bool tile_lists_at_bound = false) const;
   // host_bytes() split: host_image "size", then host_scene and host_packed "scene".
   MemoryShares host_shares() const;
 };
@@ -188,8 +189,8 @@ class Renderer;
 // Renderer the command line makes (the service holds its own to its per-request budget).
 void limit_to_machine(Renderer& renderer, const DeviceInfo& device);
 
-// What drives a render's frame buffers (its samples, image and tiles) at `msaa` samples per
-// pixel: "msaa" above 1, else "size". RenderMemory::device_shares's frame_field for a render.
+// What drives a render's samples beyond one per pixel at `msaa` samples per pixel: "msaa" above 1,
+// else "size" (there are none). RenderMemory::device_shares's multisample_field for a render.
 std::string frame_buffers_field(int msaa);
 
 // OverBudget when `memory`, a render at `msaa` samples per pixel, would not fit this machine: on a
