@@ -938,6 +938,12 @@ TEST(Budget, CompareMemoryNamesWhatDrivesEachFigure) {
   EXPECT_EQ(small.device_shares.total(), small.device_bytes);
   EXPECT_EQ(small.device_bound_shares.total(), small.device_bytes_bound);
   EXPECT_EQ(small.host_shares.total(), small.host_bytes);
+  // The totals above are set from the shares, so those checks pin nothing; these can fail: a figure
+  // holds at least each render it includes, and its bound at least the figure.
+  for (const RenderMemory& entry : small.entries) EXPECT_GE(small.device_bytes, entry.device_bytes());
+  EXPECT_GE(small.device_bytes, small.reference.device_bytes());
+  EXPECT_GE(small.device_bytes_bound, small.device_bytes);
+  EXPECT_GE(small.host_bytes, small.reference.host_image);
   // The 8x reference's phase: its samples and image are all of the frame's share.
   EXPECT_EQ(small.device_shares.share("size"), small.reference.tiles + small.reference.samples + small.reference.image);
   // A scene whose packing outweighs the frames, on the device and in the Renderer's packed copy.
