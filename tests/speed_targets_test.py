@@ -56,6 +56,33 @@ def main():
                           f"{name}: positive measured values, got {r['values']}")
                     check(isinstance(r["met"], bool), f"{name}: a verdict, got {r['met']}")
                     check(isinstance(r["settled"], bool), f"{name}: whether the verdict is settled, got {r.get('settled')}")
+            # The rows whose ratio grows with a stage say what the ratio is made of: the same stage
+            # medians as their cells, and the ratio recomputed with those stages as in the base frame.
+            cells = report["msaa_cells"]
+            bounded = {"discard 16x / 1x": ("discard 16x", ["raster"]), "discard 8x / 1x": ("discard 8x", ["raster"])}
+            faces_rows = [t for t in rows if t.startswith("faces x40.0")]
+            for t in faces_rows:
+                bounded[t] = (None, ["setup", "binning", "raster"])
+            for name, (cell, cheap) in bounded.items():
+                b = rows.get(name, {}).get("bound")
+                check(b is not None, f"{name}: a bound of what the ratio is made of: {rows.get(name)}")
+                if b is None:
+                    continue
+                grown, base = b["grown_ms"], b["base_ms"]
+                check(sorted(grown) == ["binning", "raster", "readback", "setup", "shade"],
+                      f"{name}: the bound sums every stage: {sorted(grown)}")
+                if cell:
+                    check(grown == cells[cell]["stage_median_ms"] and base == cells["discard 1x"]["stage_median_ms"],
+                          f"{name}: the bound's stages are its cells' ({grown} against {cells[cell]})")
+                    check(abs(b["fragment_ratio"] - cells[cell]["fragments"] / cells["discard 1x"]["fragments"]) < 1e-3,
+                          f"{name}: fragment ratio {b['fragment_ratio']}")
+                with_base = (sum(grown.values()) - sum(grown[s] for s in cheap) + sum(base[s] for s in cheap)) / sum(base.values())
+                check(abs(b["ratio_with_stages_as_in_base"] - with_base) < 1e-3,
+                      f"{name}: {b['ratio_with_stages_as_in_base']} against {with_base} recomputed")
+                check(b["goal_reachable_by_those_stages"] == (with_base <= float(rows[name]["goal"].split()[1])),
+                      f"{name}: reachable {b['goal_reachable_by_those_stages']} for {with_base} against {rows[name]['goal']}")
+                check(any(line.startswith(f"  {name}: stages") for line in text.splitlines()), f"{name}: its bound printed")
+            check(len(faces_rows) == 1, f"one faces row: {faces_rows}")
             paper = rows.get("peak RSS of render --scene paper")
             if paper:
                 # The verdict follows the value, not the other way round.
