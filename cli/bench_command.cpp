@@ -29,7 +29,7 @@
 #include <seamcl/eval/scaling_sweep.h>
 #include <seamcl/eval/shard.h>
 #include <seamcl/pipeline/render_memory.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 #include "commands.h"

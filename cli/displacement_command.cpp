@@ -20,9 +20,9 @@
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/io/image_io.h>
-#include <seamcl/pipeline/displacement_method.h>
+#include <seamcl/options/displacement_method.h>
 #include <seamcl/pipeline/render_memory.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include "commands.h"
 

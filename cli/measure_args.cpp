@@ -3,8 +3,8 @@
 #include "commands.h"
 
 #include <seamcl/core/input_error.h>
-#include <seamcl/pipeline/displacement_method.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/displacement_method.h>
+#include <seamcl/options/render_options.h>
 
 namespace seamcl::cli {
 void add_measure_options(CLI::App* command, MeasureArgs& a, const std::string& default_methods) {

@@ -1,5 +1,7 @@
 #include "http_server.h"
 
+#include "api_documents.h"
+
 #include "connection.h"
 
 #include <algorithm>
@@ -29,6 +31,8 @@
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/io/image_io.h>
+#include <seamcl/jobs/compare_job.h>
+#include <seamcl/jobs/render_job.h>
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
@@ -181,14 +185,6 @@ std::string media_type(std::string_view content_type) {
 
 bool is_json_media_type(std::string_view content_type) { return media_type(content_type) == "application/json"; }
 
-// The sizes parse_size takes, WIDTHxHEIGHT with each side in 1..kMaxImageSide (16384; leading
-// zeros are read too), as a pattern for /v1/methods and the OpenAPI document (tests/test_openapi.cpp
-// holds the document's copy to the parser).
-constexpr const char* kSizePattern =
-    "^0*(?:[1-9][0-9]{0,3}|1[0-5][0-9]{3}|16[0-2][0-9]{2}|163[0-7][0-9]|1638[0-4])"
-    "x0*(?:[1-9][0-9]{0,3}|1[0-5][0-9]{3}|16[0-2][0-9]{2}|163[0-7][0-9]|1638[0-4])$";
-static_assert(kMaxImageSide == 16384, "kSizePattern spells out the largest side");
-
 // POST /v1/compare without a size: the render default (480x540) is over the compare limit, so
 // the largest size of the default's aspect within max_pixels (each side floored, at least 1).
 std::string default_compare_size(long long max_pixels) {
@@ -257,26 +253,6 @@ json query_to_json(const httplib::Params& params) {
     }
   }
   return out;
-}
-
-// A compare list ("methods", "msaa") as the comma text `seamcl compare` takes, from either form:
-// a comma string, or an array of strings (methods) or integers (msaa; a single integer too). The
-// text then goes through the CLI's helpers, so both forms are refused with the same messages.
-std::string compare_list_text(const json& value, const std::string& field, bool integers) {
-  const char* expected = integers ? "a comma list string (\"1,4\"), an integer or an array of integers"
-                                  : "a comma list string (\"discard,traverse\") or an array of strings";
-  if (value.is_string()) return value.get<std::string>();
-  if (integers && value.is_number_integer()) return value.dump();
-  if (!value.is_array() || value.empty()) throw InputError(field, std::string("must be ") + expected + ", got " + echo(json_text(value)));
-  std::string text;
-  for (const json& item : value) {
-    if (integers ? !item.is_number_integer() : !item.is_string()) {
-      throw InputError(field, std::string("must be ") + expected + ", got the item " + echo(json_text(item)));
-    }
-    if (!text.empty()) text += ',';
-    text += integers ? item.dump() : item.get<std::string>();
-  }
-  return text;
 }
 
 // The reference cache of POST /v1/compare: the server's own directory, not a user's ~/.cache.
@@ -596,7 +572,6 @@ json HttpServer::make_methods_json() const {
   const RenderOptions defaults;
   // The /v1/methods answer: texture memory of each method on the default scene, as packed for
   // the device (rgba8; rgba32f stores the same texels at 16 bytes each).
-  const json default_json = to_json(defaults);
   const Scene& default_scene = *builtin_scene(defaults.scene, false);
   json methods = json::array();
   // From the sizes (exactly what pack_scene stores, render_memory.h): nothing is baked or packed.
@@ -612,48 +587,13 @@ json HttpServer::make_methods_json() const {
                        {"padding_bytes", {{"rgba8", packed.padding_bytes}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
                        {"adjacency_bytes", reads_adjacency(method) ? packed.adjacency_bytes : 0}});
   }
-  json scene_names = json::array();
+  std::vector<std::string> scene_names;
   for (const GeneratorInfo& g : scene_generators()) scene_names.push_back(g.name);
-  auto enum_option = [&](const std::vector<std::string>& names, const std::string& key) {
-    return json{{"type", "string"}, {"enum", names}, {"default", default_json.at(key)}};
-  };
   return {
       {"scene", defaults.scene},
       {"methods", methods},
-      {"options",
-       {{"scene", {{"type", "string"}, {"enum", scene_names}, {"default", defaults.scene},
-                   {"description", "a built-in scene name, or (POST only) an inline scene object as in docs/scene-format.md"}}},
-        {"method", enum_option(method_names(), "method")},
-        {"filter", enum_option(filter_names(), "filter")},
-        {"zero_coverage", enum_option(zero_coverage_names(), "zero_coverage")},
-        {"cube_method", enum_option(cube_method_names(), "cube_method")},
-        {"texels", enum_option(texel_format_names(), "texels")},
-        {"shading", enum_option(shading_mode_names(), "shading")},
-        {"msaa", {{"type", "integer"}, {"enum", {1, 2, 4, 8, 16}}, {"default", defaults.msaa}}},
-        {"aniso", {{"type", "integer"}, {"minimum", 1}, {"maximum", 16}, {"default", defaults.aniso}}},
-        {"guard_band", {{"type", "integer"}, {"minimum", 1}, {"maximum", kMaxGuardBand}, {"default", defaults.guard_band},
-                        {"description", "guardband: band texels per side of every level"}}},
-        {"size", {{"type", "string"}, {"pattern", kSizePattern}, {"minimum", 1}, {"maximum", kMaxImageSide},
-                  {"default", default_json.at("size")},
-                  {"description", "WIDTHxHEIGHT, each side in 1.." + std::to_string(kMaxImageSide) +
-                                      ", width*height*msaa at most " + std::to_string(options_.max_samples)}}},
-        {"frame", {{"type", "integer"}, {"minimum", 0}, {"maximum", 999999},
-                   {"description", "orbit frame, less than frames (default: the scene's camera)"}}},
-        {"frames", {{"type", "integer"}, {"minimum", 1}, {"maximum", 1000000}, {"default", defaults.frames}}},
-        {"centroid", {{"type", "boolean"}, {"default", false}, {"description", "same as shading=centroid"}}},
-        {"tint", {{"type", "boolean"}, {"default", defaults.tint}}},
-        {"format", {{"type", "string"}, {"enum", {"png", "exr"}}, {"default", "png"}}},
-        {"texture", {{"type", "string"},
-                     {"description", "a .ptx asset (GET /v1/assets) whose face i textures face i of the .obj asset named by "
-                                     "scene; only on a server started with --assets"}}},
-        {"displacement_method", {{"type", "string"}, {"enum", displacement_method_names()},
-                                 {"description", "tessellate every patch and displace it by the scene's maps with this "
-                                                 "seam method; absent: no displacement"}}},
-        {"tessellation", {{"type", "integer"}, {"minimum", 1}, {"maximum", SEAMCL_MAX_TESSELLATION},
-                          {"default", defaults.tessellation}, {"description", "displacement: T, each patch a (T+1)^2 grid"}}},
-        {"displacement_level", {{"type", "integer"}, {"minimum", 0}, {"maximum", kMaxDisplacementLevel},
-                                {"default", defaults.displacement_level},
-                                {"description", "displacement: the maps' level every patch samples"}}}}},
+      {"options", options_document(scene_names, options_)},
+      {"compare_options", compare_options_document(options_)},
       {"limits",
        {{"max_body_bytes", options_.max_body_bytes},
         {"max_samples", options_.max_samples},
@@ -821,15 +761,18 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   const Clock::time_point start = Clock::now();
   if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
 
-  // The server's own keys (format, an inline scene); the rest goes to the shared parser.
+  // The service's own keys (format, an inline scene); the rest is the render job's request, but
+  // the command line's timing keys: one answer is one image.
   json rest = request;
   const ImageFormat format = take_image_format(rest);
   const json inline_scene = take_inline_scene(rest);
-  RenderOptions options = parse_render_options(rest);
+  for (const char* key : {"repeat", "crack_orbit"})
+    if (rest.contains(key)) throw HttpError{400, key, "is the command line's (seamcl render); a request renders one image"};
+  const RenderJob job(rest);
+  RenderOptions options = job.options();
   std::string key;
   const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, options, key);
   const bool inline_request = key.empty();  // an inline scene or an asset: held for this request only
-  const Camera camera = options.frame ? orbit_camera(*scene, *options.frame, options.frames) : scene->camera;
   // Limits after every syntax check (a malformed request is a 400 whatever its size) and before
   // anything is packed or put on the device (an inline scene's own size is bounded by the face
   // and texel limits checked before it is parsed).
@@ -839,14 +782,13 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
                         " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
   }
   refuse_scene_over_budget(*scene, options, inline_scene, key);
-  const RenderMemory memory = render_memory(scene_sizes(*scene), options);
-  MemoryShares host = memory.host_shares();
-  host.add("scene", inline_request ? scene_held_bytes(*scene) : 0);  // the request's own copy, as above
-  refuse_over_budget(memory.device_shares(frame_buffers_field(options.msaa)), host, !inline_request, "this render");
+  // The request's own copy of an inline scene or asset is held on top of the Renderer's.
+  const JobPlan plan = job.plan(*scene, inline_request ? scene_held_bytes(*scene) : 0);
+  refuse_over_budget(plan.device, plan.host, !inline_request, plan.what);
 
   // Wait for a render slot (or 503), render, and give the slot back before encoding.
   const Clock::time_point queued = Clock::now();
-  RenderResult result;
+  RenderRun run;
   double queue_ms = 0;
   {
     const std::unique_ptr<SlotLease> lease = acquire_slot(start);
@@ -863,11 +805,13 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
       // Tile lists grow with what a frame holds, past any estimate: bounded here.
       renderer->set_device_byte_limit(options_.max_request_device_bytes);
       if (key.empty()) renderer->load_scene(*scene, options.texels);
-      result = renderer->render(camera, options);
+      JobControl control;
+      control.device_byte_limit = options_.max_request_device_bytes;
+      run = job.run(runtime_, *renderer, *scene, control);
       // Hold nothing request-sized between requests: the inline scene goes, large frames too.
       if (key.empty()) {
         renderer->release_scene();
-      } else if (memory.frame_device_bytes() > options_.keep_frame_bytes) {
+      } else if (render_memory(scene_sizes(*scene), options).frame_device_bytes() > options_.keep_frame_bytes) {
         renderer->release_frame_buffers();
       }
     } catch (...) {
@@ -875,14 +819,13 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
       throw;
     }
   }
+  const RenderResult& result = run.last;
   const Clock::time_point encode_start = Clock::now();
   std::string image = encode_image(format, result.width, result.height, result.pixels);
   const double encode_ms = ms_since(encode_start);
 
-  const json stage_ms = {{"setup", result.ms.setup},   {"binning", result.ms.binning},   {"raster", result.ms.raster},
-                         {"shade", result.ms.shade},   {"readback", result.ms.readback}, {"total", result.ms.total}};
   res.set_header("X-Seamcl-Render-Ms", std::to_string(result.ms.total));
-  res.set_header("X-Seamcl-Stage-Ms", json_text(stage_ms));
+  res.set_header("X-Seamcl-Stage-Ms", json_text(RenderJob::stage_ms_json(result.ms)));
   res.set_header("X-Seamcl-Queue-Ms", std::to_string(queue_ms));
   res.set_header("X-Seamcl-Encode-Ms", std::to_string(encode_ms));
   res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
@@ -890,6 +833,7 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   res.set_header("X-Seamcl-Fragments", std::to_string(result.stats.fragments));
   res.set_content(std::move(image), format == ImageFormat::Png ? "image/png" : "image/x-exr");
 }
+
 
 json HttpServer::parse_body(const httplib::Request& req) const {
   const std::string type = req.get_header_value("Content-Type");
@@ -908,69 +852,42 @@ json HttpServer::parse_body(const httplib::Request& req) const {
   }
 }
 
-// POST /v1/compare: seamcl compare's loop (host/eval/comparison.h) on one frame, answered as the JSON
-// of `seamcl compare --json` (without server paths: no cache_path, no images).
+// POST /v1/compare: the compare job (host/jobs/compare_job.h) on one frame, admitted as one
+// request, answered as the JSON of `seamcl compare --json` (without server paths: no cache_path,
+// no images).
 void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   const Clock::time_point start = Clock::now();
   if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
-
-  // compare's own keys; the rest is the frame's render options, for the shared parser.
   json rest = request;
-  if (rest.contains("method")) {
-    throw HttpError{400, "method", "compare takes \"methods\", a list (\"discard,traverse\" or [\"discard\", \"traverse\"])"};
-  }
   if (rest.contains("format")) throw HttpError{400, "format", "compare answers JSON; format is for /v1/render"};
-  std::string methods_text = "discard,clamp";  // seamcl compare's defaults
-  std::string msaa_text = "1,2,4,8";
-  if (rest.contains("methods")) {
-    methods_text = compare_list_text(rest.at("methods"), "methods", false);
-    rest.erase("methods");
-  }
-  if (rest.contains("msaa")) {
-    msaa_text = compare_list_text(rest.at("msaa"), "msaa", true);
-    rest.erase("msaa");
-  }
-  int repeat = 3;
-  if (rest.contains("repeat")) {
-    const json& value = rest.at("repeat");
-    if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > options_.max_compare_repeat) {
-      throw InputError("repeat", "must be an integer in 1.." + std::to_string(options_.max_compare_repeat) + ", got " +
-                                     echo(json_text(value)));
-    }
-    repeat = value.get<int>();
-    rest.erase("repeat");
-  }
-  std::vector<ReferenceKind> reference_kinds = {ReferenceKind::Paper};
-  if (rest.contains("reference")) {
-    reference_kinds = parse_reference_kinds(split_list(compare_list_text(rest.at("reference"), "reference", false), "reference"));
-    rest.erase("reference");
-  }
-  bool explicit_reference_msaa = false;
-  ReferenceSettings reference_settings = take_reference_settings(rest, explicit_reference_msaa);
   const json inline_scene = take_inline_scene(rest);
   // No size: the render default would be over this server's compare limit, so compare's own
   // default fits it. The answer says which size was used and where it came from.
   const bool size_given = rest.contains("size");
   if (!size_given) rest["size"] = default_compare_size(options_.max_compare_pixels);
-
-  // Validate everything before any work, in seamcl compare's order.
-  RenderOptions frame = parse_render_options(rest);
-  const long long pixels = static_cast<long long>(frame.width) * frame.height;
-  const std::vector<std::string> methods = split_list(methods_text, "methods");
-  const std::vector<int> rates = parse_int_list(msaa_text, "msaa");
-  if (methods.size() * rates.size() > static_cast<size_t>(options_.max_compare_entries)) {
+  const bool explicit_reference_msaa = rest.contains("reference_msaa");
+  CompareJob job(rest);  // every syntax check, in seamcl compare's order
+  const std::vector<MethodEntry>& entries = job.entries();
+  const size_t methods = job.methods().size();
+  if (entries.size() > static_cast<size_t>(options_.max_compare_entries)) {
     // Named after the longer list: the one to shorten.
-    throw HttpError{400, rates.size() > methods.size() ? "msaa" : "methods",
-                    std::to_string(methods.size()) + " methods x " + std::to_string(rates.size()) +
-                        " msaa rates = " + std::to_string(methods.size() * rates.size()) +
+    throw HttpError{400, job.rates().size() > methods ? "msaa" : "methods",
+                    std::to_string(methods) + " methods x " + std::to_string(job.rates().size()) +
+                        " msaa rates = " + std::to_string(entries.size()) +
                         " renders exceeds this server's limit of " + std::to_string(options_.max_compare_entries)};
   }
-  const std::vector<MethodEntry> entries = method_entries(rest, methods, rates);
+  if (job.repeat() > options_.max_compare_repeat)
+    throw InputError("repeat", "must be an integer in 1.." + std::to_string(options_.max_compare_repeat) + ", got " +
+                                   std::to_string(job.repeat()));
+  ReferenceSettings& reference_settings = job.reference_settings();
+  reference_settings.cache_dir = options_.cache_dir;
+  reference_settings.cache_max_bytes = options_.cache_max_bytes;
+  RenderOptions frame = job.frame();
   std::string key;
   const std::shared_ptr<const Scene> scene = resolve_scene(inline_scene, frame, key);
-  const Camera camera = frame.frame ? orbit_camera(*scene, *frame.frame, frame.frames) : scene->camera;
   // Limits after every syntax check: a malformed request is a 400 whatever its size.
   check_reference_limits(frame, reference_settings, explicit_reference_msaa);
+  const long long pixels = static_cast<long long>(frame.width) * frame.height;
   for (const MethodEntry& entry : entries) {
     if (pixels * entry.options.msaa > options_.max_samples) {
       throw HttpError{413, "size",
@@ -979,59 +896,37 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
     }
   }
   refuse_scene_over_budget(*scene, frame, inline_scene, key);
-  const bool seamless = std::find(reference_kinds.begin(), reference_kinds.end(), ReferenceKind::Seamless) != reference_kinds.end();
-  const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, entries, reference_settings, reference_kinds,
-                                              seamless ? std::optional(seamless_scene_sizes(*scene)) : std::nullopt);
-  refuse_over_budget(memory.device_bound_shares, memory.host_shares, !key.empty(), "this compare");
+  const JobPlan plan = job.plan(*scene);
+  refuse_over_budget(plan.device, plan.host, !key.empty(), plan.what);
   // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
   const Clock::time_point deadline =
       options_.deadline_ms > 0 ? start + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
-  const ShouldStop should_stop = [deadline] { return GuardedHttpServer::client_gone() || Clock::now() > deadline; };
+  JobControl control;
+  control.should_stop = [deadline] { return GuardedHttpServer::client_gone() || Clock::now() > deadline; };
+  control.device_byte_limit = options_.max_request_device_bytes;
 
-  // One admitted request for the whole compare. A Renderer of its own: the 8x reference's
-  // buffers are freed with it, and the slot's warm Renderers keep their scenes.
+  // One admitted request for the whole compare, with a Renderer of its own (the job's): the 8x
+  // reference's buffers are freed with it, and the slot's warm Renderers keep their scenes.
   const Clock::time_point queued = Clock::now();
   double queue_ms = 0;
-  std::optional<ComparisonTargets> targets;
-  std::vector<EntryResult> measured;
+  CompareRun run;
   {
     const std::unique_ptr<SlotLease> lease = acquire_slot(start);
     queue_ms = ms_since(queued);
     if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
-    Renderer renderer(runtime_);
-    renderer.set_device_byte_limit(options_.max_request_device_bytes);
-    renderer.load_scene(*scene, frame.texels);
-    // Hashed once for the lock's key and every reference kind's cache key (hashing bakes every face).
-    reference_settings.scene_hash = scene_content_hash(*scene);
-    {
-      const std::string cache_key = reference_cache_key(*scene, camera, frame, reference_settings);
-      std::lock_guard lock(reference_locks_[std::hash<std::string>{}(cache_key) % reference_locks_.size()]);
-      targets = prepare_targets(runtime_, renderer, camera, frame, entries, reference_settings, reference_kinds);
-    }
+    // Two compares of the same reference at once render it once: the second reads the first's.
+    const ReferenceLock lock_reference = [this](const std::string& cache_key) {
+      return std::unique_lock<std::mutex>(reference_locks_[std::hash<std::string>{}(cache_key) % reference_locks_.size()]);
+    };
     try {
-      throw_if_stopped(should_stop, "before the entries");
-      const TargetsFor targets_for = [&](const MethodEntry& entry) { return targets->for_entry(entry); };
-      measured = compare_methods(renderer, *scene, camera, entries, targets_for, repeat, should_stop, {});
+      run = job.run(runtime_, *scene, control, lock_reference);
     } catch (const Cancelled&) {
       if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
       throw HttpError{503, "deadline", "the compare ran past this server's deadline of " + std::to_string(options_.deadline_ms) + " ms", 1};
     }
   }
-
-  json results = json::array();
-  for (const EntryResult& m : measured) results.push_back(compare_result_json(m));
-  json out = {{"scene", scene->name},
-              {"size", std::to_string(frame.width) + "x" + std::to_string(frame.height)},
-              {"size_from", size_given ? "request" : "default"},
-              {"device", runtime_.device_description()},
-              {"repeat", repeat},
-              {"options", to_json(frame)},
-              {"results", results}};
-  out.update(targets->summary_json(entries.front().options.msaa, false));
-  if (frame.frame) {
-    out["frame"] = *frame.frame;
-    out["frames"] = frame.frames;
-  }
+  json out = job.result_json(run, *scene, runtime_.device_description(), false);
+  out["size_from"] = size_given ? "request" : "default";
   out["queue_ms"] = queue_ms;
   out["server_ms"] = ms_since(start);
   res.set_content(json_text(out), "application/json");

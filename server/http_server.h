@@ -35,7 +35,7 @@
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/pipeline/render_memory.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 
 namespace httplib {
 class Server;
@@ -95,6 +95,8 @@ struct ServerOptions {
 
 // The built-in assets, embedded at build time (server/embed_assets.cmake).
 std::string_view viewer_html();
+// GET /openapi.json: server/openapi.json with every option's schema filled in from the jobs'
+// option tables (server/api_documents.cpp).
 std::string_view openapi_json();
 
 class HttpServer {

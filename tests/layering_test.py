@@ -18,13 +18,15 @@ HOST = ROOT / "host"
 # Each folder and the folders it may include from (besides itself).
 ALLOWED = {
     "core": set(),
+    "options": {"core"},
     "cl": {"core"},
     "scene": {"core"},
-    "pipeline": {"core", "cl", "scene"},
-    "twins": {"core", "scene", "pipeline"},
-    "io": {"core", "scene", "pipeline"},
-    "eval": {"core", "cl", "scene", "pipeline", "io"},
-    "assets": {"core", "scene", "pipeline", "io"},
+    "pipeline": {"core", "options", "cl", "scene"},
+    "twins": {"core", "options", "scene", "pipeline"},
+    "io": {"core", "options", "scene", "pipeline"},
+    "eval": {"core", "options", "cl", "scene", "pipeline", "io"},
+    "assets": {"core", "options", "scene", "pipeline", "io"},
+    "jobs": {"core", "options", "cl", "scene", "pipeline", "io", "eval", "assets"},
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 

@@ -20,7 +20,7 @@
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 #include <seamcl/scene/scene_json.h>

@@ -18,7 +18,7 @@
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/displacement_metrics.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 #include "http_server.h"

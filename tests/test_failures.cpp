@@ -24,7 +24,7 @@
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/io/image_io.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include <seamcl/pipeline/packed_scene.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/pipeline/texture_lookups.h>
 #include "core/srgb.h"

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include <seamcl/cl/cl_runtime.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 #include "core/srgb.h"

@@ -19,7 +19,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/reference.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
 #include "http_server.h"

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <seamcl/core/input_error.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 
 using nlohmann::json;
 using namespace seamcl;

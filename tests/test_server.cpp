@@ -35,7 +35,7 @@
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/render_memory.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 #include <seamcl/scene/scene_json.h>

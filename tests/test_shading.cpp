@@ -17,7 +17,7 @@
 #include <glm/glm.hpp>
 
 #include <seamcl/cl/cl_runtime.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>

@@ -15,7 +15,7 @@
 #include <utility>
 
 #include <seamcl/pipeline/packed_scene.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/texture_lookups.h>
 #include <seamcl/scene/scene_generators.h>
 #include "pipeline/adjacency.h"

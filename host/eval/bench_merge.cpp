@@ -8,7 +8,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/shard.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 
 namespace seamcl {
 

@@ -7,7 +7,7 @@
 
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/eval/metrics.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/environment.h>
 

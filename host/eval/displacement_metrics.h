@@ -11,7 +11,7 @@
 
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/pipeline/gpu_types.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene.h>
 
 namespace seamcl {

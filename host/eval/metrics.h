@@ -32,7 +32,7 @@
 
 #include <glm/glm.hpp>
 
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene.h>
 
 namespace seamcl {

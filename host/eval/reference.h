@@ -25,7 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include <seamcl/pipeline/render_memory.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene.h>
 

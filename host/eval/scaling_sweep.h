@@ -23,7 +23,7 @@
 
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/pipeline/render_memory.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
 

@@ -8,7 +8,7 @@
 
 #include <seamcl/pipeline/gpu_types.h>
 #include <seamcl/scene/scene.h>
-#include <seamcl/pipeline/displacement_method.h>
+#include <seamcl/options/displacement_method.h>
 #include "scene/displacement_map.h"
 
 static_assert(sizeof(DisplacementTexcoord) == 12, "DisplacementTexcoord layout");

@@ -2,7 +2,7 @@
 // request's cube method, the eye and the view rays of the skybox.
 #pragma once
 #include <seamcl/pipeline/gpu_types.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene.h>
 
 namespace seamcl {

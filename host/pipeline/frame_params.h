@@ -4,7 +4,7 @@
 #include <cstdint>
 
 #include <seamcl/pipeline/gpu_types.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene.h>
 
 namespace seamcl {

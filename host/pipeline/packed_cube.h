@@ -4,7 +4,7 @@
 #include <vector>
 
 #include <seamcl/pipeline/gpu_types.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/scene/cube_map.h>
 
 namespace seamcl {

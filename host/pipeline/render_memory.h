@@ -28,7 +28,7 @@
 #include <nlohmann/json.hpp>
 
 #include <seamcl/cl/cl_runtime.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene.h>
 
 namespace seamcl {

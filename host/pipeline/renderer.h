@@ -12,7 +12,7 @@
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/pipeline/gpu_types.h>
 #include <seamcl/pipeline/packed_scene.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene.h>
 
 namespace seamcl {

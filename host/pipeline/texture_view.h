@@ -6,11 +6,10 @@
 
 #include <glm/glm.hpp>
 
+#include <seamcl/options/texel_format.h>
 #include <seamcl/pipeline/gpu_types.h>
 
 namespace seamcl {
-
-enum class TexelFormat { Rgba8, Rgba32f };
 
 // The textures as the kernels see them (see FaceGpu in kernels/seamcl_types.h): one of the two
 // texel arrays is used, as `format` says.

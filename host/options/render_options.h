@@ -1,6 +1,7 @@
-// The options of one render, with their defaults, parsed from one JSON object by the same code
-// for the CLI (which gathers its flags into such an object) and the HTTP service, so the two use
-// the same names, value forms and error messages.
+// The options of one render, with their defaults, declared once in render_option_table() (key,
+// type, bounds, default, help) and parsed from one JSON object by the same code for the CLI
+// (which gathers its flags into such an object), the HTTP service and the Python module, so they
+// all use the same names, value forms and error messages.
 #pragma once
 #include <optional>
 #include <string>
@@ -9,8 +10,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include <seamcl/pipeline/texture_view.h>
-#include <seamcl/pipeline/displacement_method.h>
+#include <seamcl/kernels/seamcl_types.h>
+#include <seamcl/options/displacement_method.h>
+#include <seamcl/options/option_table.h>
+#include <seamcl/options/texel_format.h>
 
 namespace seamcl {
 
@@ -53,7 +56,7 @@ std::vector<std::string> method_names();
 bool reads_adjacency(Method method);
 // Whether the method needs the adjacency: the methods that read it, and guardband, whose bands are
 // copied from the neighbours while packing (a Renderer keeps it only for those that read it, and
-// for seam-mask renders: 48 bytes a face, 4.75 MB at 99,037 faces). A mesh without shared edges
+// for seam-mask renders: 48 bytes a face). A mesh without shared edges
 // refuses them.
 bool needs_adjacency(Method method);
 std::optional<ShadingMode> parse_shading_mode(std::string_view name);
@@ -78,6 +81,8 @@ inline constexpr int kMaxImageSide = 16384;
 inline constexpr long long kMaxSamplesPerImage = 1LL << 28;  // width * height * msaa
 inline constexpr int kMaxDisplacementLevel = 16;              // displacement_level's bound
 inline constexpr int kMaxFrames = 1000000;                    // frames' bound (an orbit of 1..kMaxFrames)
+inline constexpr int kMaxBandTexels = 16;                     // guard_band's bound (kMaxGuardBand of packing)
+inline constexpr float kMaxLodBias = 4.0f;                    // lod_bias's bound, either sign
 
 struct RenderOptions {
   std::string scene = "paper";  // built-in name or scene file (.json, .obj mesh, .ptx with its mesh)
@@ -101,21 +106,27 @@ struct RenderOptions {
   std::optional<DisplacementMethod> displacement;
   int tessellation = 8;         // T, 1..64
   int displacement_level = 0;   // the maps' level sampled, 0..16
+  float lod_bias = 0.0f;        // added to every lookup's mip level (-kMaxLodBias..kMaxLodBias)
 };
 
+// Every render option: its key, type, bounds, default (RenderOptions' own) and help. The parser
+// below, to_json, the command line's flags, the methods document and the OpenAPI document all read
+// it. `centroid` is an input alias of shading=centroid, never written.
+const OptionTable& render_option_table();
+
 // Reads the keys present in `request` over the defaults. Throws InputError naming the key on a
-// wrong type, an out-of-range value or an unknown key. Keys: scene, texture, method, filter, msaa, aniso,
-// size ("WxH"), shading, centroid (bool, same as shading=centroid), zero_coverage, texels,
-// guard_band, frame, frames, tint, cube_method, displacement_method, tessellation, displacement_level.
+// wrong type, an out-of-range value or an unknown key (render_option_table's keys only), and on
+// combinations that cannot be rendered (frame >= frames, centroid with shading=sample, more than
+// kMaxSamplesPerImage samples).
 RenderOptions parse_render_options(const nlohmann::json& request);
 nlohmann::json to_json(const RenderOptions& options);
 
 // The sampler settings a method stands for (see SamplerParams in kernels/seamcl_types.h).
 // guard_band is used by Method::Guardband only (0 otherwise).
 SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCoverage zero_coverage,
-                             int guard_band = 4);
+                             int guard_band = 4, float lod_bias = 0.0f);
 inline SamplerParams sampler_params(const RenderOptions& o) {
-  return sampler_params(o.method, o.filter, o.aniso, o.zero_coverage, o.guard_band);
+  return sampler_params(o.method, o.filter, o.aniso, o.zero_coverage, o.guard_band, o.lod_bias);
 }
 
 // "480x540" -> {480, 540}; throws InputError(field) unless both are integers in 1..kMaxImageSide.

@@ -1,4 +1,4 @@
-#include <seamcl/pipeline/displacement_method.h>
+#include <seamcl/options/displacement_method.h>
 
 #include <array>
 #include <utility>

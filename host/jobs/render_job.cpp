@@ -1,0 +1,137 @@
+#include <seamcl/jobs/render_job.h>
+
+#include <algorithm>
+
+#include <seamcl/core/input_error.h>
+#include <seamcl/eval/comparison.h>
+#include <seamcl/eval/displacement_metrics.h>
+#include <seamcl/pipeline/render_memory.h>
+
+namespace seamcl {
+namespace {
+
+using nlohmann::json;
+
+const OptionTable& render_own_options() {
+  static const OptionTable table = [] {
+    OptionSpec repeat = make_option("repeat", OptionType::Integer, "Render N times and report the median time per stage");
+    repeat.minimum = 1;
+    repeat.maximum = 1000;
+    repeat.default_value = 1;
+    OptionSpec crack_orbit = make_option("crack_orbit", OptionType::Integer,
+                           "Displacement: count crack pixels over N frames of the scene's orbit instead of this frame");
+    crack_orbit.minimum = 0;
+    crack_orbit.maximum = 3600;
+    crack_orbit.default_value = 0;
+    return OptionTable{repeat, crack_orbit};
+  }();
+  return table;
+}
+
+}  // namespace
+
+const OptionTable& render_job_option_table() {
+  static const OptionTable table = [] {
+    OptionTable out = render_option_table();
+    for (const OptionSpec& spec : render_own_options()) out.push_back(spec);
+    return out;
+  }();
+  return table;
+}
+
+RenderJob::RenderJob(const json& request) {
+  if (!request.is_object()) throw InputError("request", "must be a JSON object");
+  json render_request = json::object();
+  for (const auto& [key, value] : request.items()) {
+    if (const OptionSpec* own = find_option(render_own_options(), key)) {
+      const json checked = checked_option(*own, value);
+      if (key == "repeat") repeat_ = checked.get<int>();
+      if (key == "crack_orbit") crack_orbit_ = checked.get<int>();
+    } else {
+      render_request[key] = value;
+    }
+  }
+  if (render_request.contains("frames") && !render_request.contains("frame"))
+    throw InputError("frames", "is ignored without frame (the scene's own camera renders): leave it out");
+  options_ = parse_render_options(render_request);
+  if (crack_orbit_ > 0 && !options_.displacement)
+    throw InputError("crack_orbit", "counts the cracks of a displaced render: give displacement_method too");
+}
+
+GeneratorOptions RenderJob::generator_options() const {
+  GeneratorOptions options;
+  options.tint = options_.tint;
+  options.defer_textures = true;  // baked face by face while packing: no float copy of them all
+  return options;
+}
+
+Camera RenderJob::camera(const Scene& scene) const {
+  return options_.frame ? orbit_camera(scene, *options_.frame, options_.frames) : scene.camera;
+}
+
+JobPlan RenderJob::plan(const Scene& scene, size_t held_scene_bytes) const {
+  const RenderMemory memory = render_memory(scene_sizes(scene), options_);
+  MemoryShares host = memory.host_shares();
+  host.add("scene", held_scene_bytes);
+  return JobPlan{"this render", memory.device_shares(frame_buffers_field(options_.msaa)), host};
+}
+
+RenderRun RenderJob::run(ClRuntime& runtime, Renderer& renderer, const Scene& scene, const JobControl& control,
+                         bool measure_watertightness) const {
+  const Camera view = camera(scene);
+  renderer.warm_up(options_);
+  RenderRun run;
+  // Each run's times, and only the last run's image: holding every frame kept `repeat` images
+  // alive at once.
+  for (int i = 0; i < repeat_; ++i) {
+    throw_if_stopped(control.should_stop, "before render " + std::to_string(i + 1) + " of " + std::to_string(repeat_));
+    if (repeat_ > 1) control.report("render " + std::to_string(i + 1) + "/" + std::to_string(repeat_));
+    run.last = renderer.render(view, options_);
+    run.times.push_back(run.last.ms);
+  }
+  auto stage_median = [&](double StageTimes::*stage) {
+    std::vector<double> values;
+    for (const StageTimes& t : run.times) values.push_back(t.*stage);
+    return median_of(values);
+  };
+  for (double StageTimes::*stage : {&StageTimes::setup, &StageTimes::binning, &StageTimes::raster, &StageTimes::shade,
+                                    &StageTimes::readback, &StageTimes::total, &StageTimes::tessellate})
+    run.median.*stage = stage_median(stage);
+  if (measure_watertightness && options_.displacement) {
+    // The gap and crack pixels of this frame (docs/displacement.md), the times of the renders above.
+    control.report("displacement: gap and crack pixels of " + to_string(*options_.displacement));
+    DisplacementReport report =
+        measure_displacement(runtime, scene, view, options_, crack_orbit_, 0, renderer.device_byte_limit());
+    report.frame_ms = run.median.total;
+    report.tessellate_ms = run.median.tessellate;
+    run.displacement = report.to_json();
+  }
+  return run;
+}
+
+json RenderJob::stage_ms_json(const StageTimes& t) {
+  return {{"total", t.total}, {"setup", t.setup},   {"binning", t.binning},
+          {"raster", t.raster}, {"shade", t.shade}, {"readback", t.readback}};
+}
+
+json RenderJob::result_json(const RenderRun& run, const Renderer& renderer, const std::string& device) const {
+  const PackedScene& packed = renderer.packed_scene();
+  json out = {{"device", device},
+              {"options", to_json(options_)},
+              {"ms", stage_ms_json(run.median)},
+              {"runs", repeat_},
+              {"triangles", renderer.scene().triangle_count()},
+              {"visible_triangles", run.last.stats.visible_triangles},
+              {"fragments", run.last.stats.fragments},
+              {"texture_bytes", packed.texture_bytes()},
+              {"padding_bytes", packed.padding_bytes()},
+              {"adjacency_bytes", reads_adjacency(options_.method) ? packed.adjacency_bytes() : 0},
+              {"bin_entries", run.last.stats.bin_entries}};
+  if (!run.displacement.is_null()) {
+    out["displacement"] = run.displacement;
+    out["triangles"] = run.displacement.at("triangles");
+  }
+  return out;
+}
+
+}  // namespace seamcl
