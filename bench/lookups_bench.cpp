@@ -49,7 +49,7 @@
 
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/pipeline/packed_scene.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/texture_lookups.h>
 #include <seamcl/scene/scene.h>
 #include "io/texture_file.h"

@@ -10,7 +10,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/io/image_io.h>
-#include <seamcl/pipeline/render_options.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_json.h>
 #include <seamcl/version.h>
