@@ -25,6 +25,7 @@ ALLOWED = {
     "io": {"core", "scene", "pipeline"},
     "eval": {"core", "cl", "scene", "pipeline", "io"},
     "assets": {"core", "scene", "pipeline", "io"},
+    "batch": {"core", "cl", "scene", "pipeline", "eval"},
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 
