@@ -2,7 +2,8 @@
 """The library's folders depend on each other one way only, and the outside reaches it through
 <seamcl/...>. Reads every #include of host/, cli/, server/, bench/, tests/ and examples/:
 
-- a file in host/F/ includes only host/F/ and the folders F may depend on (ALLOWED);
+- a file in host/F/ (or a folder inside it, such as host/pipeline/stages/) includes only host/F/
+  and the folders F may depend on (ALLOWED);
 - OpenCL headers only in host/cl/, OpenImageIO only in .cpp files of host/io/ and host/eval/;
 - a public header (listed in CMakeLists.txt) includes no private one;
 - outside host/, a public header is included as <seamcl/F/NAME.h>, never by a relative path,
@@ -21,7 +22,6 @@ ALLOWED = {
     "cl": {"core"},
     "scene": {"core"},
     "pipeline": {"core", "cl", "scene"},
-    "twins": {"core", "scene", "pipeline"},
     "io": {"core", "scene", "pipeline"},
     "eval": {"core", "cl", "scene", "pipeline", "io"},
     "assets": {"core", "scene", "pipeline", "io"},

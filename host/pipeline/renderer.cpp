@@ -13,7 +13,7 @@
 #include "core/srgb.h"
 #include "pipeline/adjacency.h"
 #include "pipeline/frame_params.h"
-#include "pipeline/tessellation_stage.h"
+#include "pipeline/stages/tessellate_launcher.h"
 #include <seamcl/pipeline/packed_cube.h>
 
 namespace seamcl {
@@ -61,7 +61,7 @@ struct Renderer::Impl {
   FrameParams last_params{};
   size_t device_byte_limit = 0;  // 0: none
   // Displacement renders only: the tessellation stage replaces triangle setup.
-  TessellationStage tessellation{runtime};
+  TessellateLauncher tessellation{runtime};
   std::optional<DisplacementSettings> tessellation_settings;  // what `tessellation` holds
   bool displaced = false;        // this frame runs the tessellation stage
   std::string program_key;       // the current program variant's build options
