@@ -53,7 +53,7 @@
 #include <seamcl/pipeline/texture_lookups.h>
 #include <seamcl/scene/scene.h>
 #include "io/texture_file.h"
-#include "twins/texture_sample.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 using namespace seamcl;
 namespace fs = std::filesystem;

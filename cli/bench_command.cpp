@@ -19,15 +19,15 @@
 #include <nlohmann/json.hpp>
 
 #include <seamcl/assets/scene_source.h>
+#include <seamcl/batch/bench_merge.h>
+#include <seamcl/batch/scaling_sweep.h>
+#include <seamcl/batch/shard.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/bench_memory.h>
-#include <seamcl/eval/bench_merge.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
-#include <seamcl/eval/scaling_sweep.h>
-#include <seamcl/eval/shard.h>
 #include <seamcl/pipeline/render_memory.h>
 #include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
@@ -44,10 +44,10 @@ struct BenchArgs : MeasureArgs {
   int frames = 60;
   int reference_frames = 1;
   bool no_errors = false;
-  std::string shard = "1/1";  // part K of N of the orbit's frames (host/eval/shard.h)
+  std::string shard = "1/1";  // part K of N of the orbit's frames (host/batch/shard.h)
   bool check_only = false;    // validate the options and the scene, render nothing
   std::string seam_mask = "band";  // parse_seam_mask_kind: band (the committed results') or footprint (compare's)
-  std::optional<std::string> sweep;  // scaling sweeps instead of the orbit (host/eval/scaling_sweep.h); empty is refused
+  std::optional<std::string> sweep;  // scaling sweeps instead of the orbit (host/batch/scaling_sweep.h); empty is refused
   int sweep_repeats = 5;
 };
 

@@ -1,5 +1,5 @@
 // seamcl merge: the parts of a sharded bench (`seamcl bench --shard K/N --json`, one file each)
-// combined into the JSON one unsharded run gives (host/eval/bench_merge.h says which statistics
+// combined into the JSON one unsharded run gives (host/batch/bench_merge.h says which statistics
 // merge exactly, which are recomputed from the merged samples and which are not exact).
 #include <unistd.h>
 
@@ -15,10 +15,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <seamcl/batch/bench_merge.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/json_document.h>
 #include <seamcl/core/regular_file.h>
-#include <seamcl/eval/bench_merge.h>
 #include "commands.h"
 
 namespace seamcl::cli {

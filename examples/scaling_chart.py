@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Time against problem size, from `seamcl bench --sweep ... --json` (host/eval/scaling_sweep.h).
+"""Time against problem size, from `seamcl bench --sweep ... --json` (host/batch/scaling_sweep.h).
 
 One panel per sweep (pixels, faces, msaa, texels), log-log: the median frame time of each method
 at each point (min..max as error bars), and dashed ideal lines through each method's first point:

@@ -25,7 +25,7 @@
  * stats.bin_entries > capacity, grows the buffer and renders again.
  * Host guarantees: slot_counts written for this frame; chunk_counts holds chunks * tiles entries;
  * chunks * chunk_triangles >= input_triangles (chunks 0 when there are none: bin_count and
- * bin_fill are not run). Twin: host/twins/binning.cpp. */
+ * bin_fill are not run). Twin: host/pipeline/stages/binning_twin.cpp. */
 
 #if SEAMCL_TILE_SIZE != 16
 #error "tile_entry_rows packs tile-relative rows and columns in 4 bits each"

@@ -12,7 +12,7 @@
  * fixup, in the coordinates: see SEAMCL_CUBE_* in seamcl_types.h.
  * Host guarantees: size a power of two, level_count = log2(size) + 1, texels of the whole cube.
  * Only texels of the cube are read, whatever the direction (NaN and zero included).
- * Twin: host/twins/cube_sample.cpp. */
+ * Twin: host/pipeline/stages/cube_sample_twin.cpp. */
 
 /* The cube path is compiled as calls, not inlined: a fold can run at three taps of four in two
  * levels of up to 16 probes, and inlining every copy into shade_resolve made PoCL's compile take

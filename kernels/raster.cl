@@ -24,7 +24,8 @@
  * Host guarantees: bin lists and tile_entry_rows built for this frame; bin_entries <= bin_capacity
  * (else it re-runs);
  * global size (tiles_x, tiles_y), work-groups of one; image sides <= 16384 (kMaxImageSide), so
- * fixed-point sample positions fit 32 bits and convert to float exactly. Twin: host/twins/raster.cpp. */
+ * fixed-point sample positions fit 32 bits and convert to float exactly.
+ * Twin: host/pipeline/stages/raster_twin.cpp. */
 
 /* The D3D11 sample pattern (sample_offsets, sample_pattern_row) is defined in triangle_setup.cl,
  * whose cull reads it too. */

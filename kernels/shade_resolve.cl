@@ -26,8 +26,9 @@
  * only; else SEAMCL_MASK_NONE, and there every seam method returns the same colour.
  * Without guard bands only (GUARD 0): a band would count as inside.
  * Host guarantees: sample_triangle from raster of this frame; seam_mask holds width * height
- * bytes when SEAMCL_SEAM_MASK is 1 (unused otherwise). Twin: host/twins/shade_resolve.cpp
- * (reflections: host/twins/shade_reflection.cpp). */
+ * bytes when SEAMCL_SEAM_MASK is 1 (unused otherwise).
+ * Twin: host/pipeline/stages/shade_resolve_twin.cpp (reflections:
+ * host/pipeline/stages/shade_resolve_reflection_twin.cpp). */
 
 #ifndef SEAMCL_CUBE
 #define SEAMCL_CUBE 0

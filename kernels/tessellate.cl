@@ -20,8 +20,8 @@
  * planes, whose helpers it calls) of micro-triangle t: patch t / (2 T^2), cell c = (t / 2) % T^2
  * at (c % T, c / T), split as the quads are: (00, 10, 11) for even t and (00, 11, 01) for odd t.
  * Every record's face is the patch, so shading reads the patch's colour texture and seam method.
- * Twin: host/twins/tessellate.cpp (tessellate); tessellated_setup at T = 1 without displacement
- * equals triangle_setup exactly (tests/test_displacement.cpp). */
+ * Twin: host/pipeline/stages/tessellate_twin.cpp (tessellate); tessellated_setup at T = 1
+ * without displacement equals triangle_setup exactly (tests/test_displacement.cpp). */
 
 SEAMCL_INLINE float disp_texel(__global const ushort* s, int columns, int i, int j) {
   return (float)s[j * columns + i];

@@ -11,7 +11,7 @@
  * Host guarantees: full chains down to 1x1, power-of-two sizes, offsets in range. Only texels of
  * the face's own levels are ever read, whatever the coordinates (NaN and infinities included).
  * Written for PoCL's vectoriser: scalar channels, no floor/log2 builtins, no float4 arithmetic.
- * Twin: host/twins/texture_sample.cpp. */
+ * Twin: host/pipeline/stages/texture_sample_twin.cpp. */
 
 #ifndef SEAMCL_TEXELS_F32
 #define SEAMCL_TEXELS_F32 0
@@ -74,7 +74,7 @@
  * than half a texel past the texel's edge; the 1/16 texel more absorbs the rounding of u * width - 0.5
  * (the value the filter floors) and, for probes_reach_face's whole-line test, of the probes'
  * positions summed step by step (the per-probe skip tests the very position it samples). Twin:
- * kTapReachTexels in host/twins/texture_sample.cpp. */
+ * kTapReachTexels in host/pipeline/stages/texture_sample_twin.cpp. */
 #define TAP_REACH_TEXELS 0.5625f
 
 #if SEAMCL_TEXELS_F32
@@ -465,7 +465,8 @@ SEAMCL_INLINE FilterSum filter_texture(const FaceGpu* face, __global const uint*
  * it rules out would add exactly nothing, so skipping it changes no bit of the result; it spares
  * interior lookups the neighbours' filters, with no division (the sides are powers of two, so
  * multiplying by them is exact). The bound, term by term, is argued in the twin
- * (host/twins/texture_sample.cpp, ewa_sides_may_contribute). min_side 0: never rules out. */
+ * (host/pipeline/stages/texture_sample_twin.cpp, ewa_sides_may_contribute). min_side 0: never
+ * rules out. */
 SEAMCL_INLINE int ewa_sides_may_contribute(float min_side, float max_side, float distance_u, float distance_v,
                                            float dudx, float dvdx, float dudy, float dvdy) {
   const float axis_x = fabs(dudx) + fabs(dvdx);
@@ -491,7 +492,7 @@ SEAMCL_INLINE int ewa_sides_may_contribute(float min_side, float max_side, float
  * no shorter and whose cross_side / side is no larger (the bound grows as side shrinks and the
  * ratio grows), which is what the per-edge records of FaceNeighbors store. No division by a side
  * (powers of two: multiplying by them is exact). Argued term by term in the twin
- * (host/twins/texture_sample.cpp, axis_rules_out). side 0: never rules out. */
+ * (host/pipeline/stages/texture_sample_twin.cpp, axis_rules_out). side 0: never rules out. */
 SEAMCL_INLINE int axis_rules_out(float side, float cross_side, int filter, int max_aniso, float distance, float x_a,
                                  float x_b, float y_a, float y_b) {
   const float len_x = x_a * side + x_b * cross_side;

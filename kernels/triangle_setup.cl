@@ -22,7 +22,7 @@
  * early_culled_reference), stats->visible_triangles the visible slots.
  * A new vertex on an edge is always computed from the edge's inside end, so two triangles that
  * share the edge create bit-identical vertices: clipping keeps the mesh watertight.
- * Twin: host/twins/triangle_setup.cpp. */
+ * Twin: host/pipeline/stages/triangle_setup_twin.cpp. */
 
 typedef struct {
   float x, y, w; /* clip space (z is not needed: depth is 1/w) */

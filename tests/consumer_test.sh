@@ -24,7 +24,7 @@ for f in "$prefix/bin/seamcl" "$libdir/cmake/seamcl/seamclConfig.cmake" "$libdir
   [ -e "$f" ] || fail "not installed: $f"
 done
 ls "$libdir"/libseamcl.* >/dev/null 2>&1 || fail "no libseamcl in $libdir"
-for private in twins/raster.h cl/kernel_sources.h pipeline/adjacency.h core/srgb.h io/texture_file.h; do
+for private in pipeline/stages/raster_twin.h cl/kernel_sources.h pipeline/adjacency.h core/srgb.h io/texture_file.h; do
   [ ! -e "$prefix/include/seamcl/$private" ] || fail "private header installed: $private"
 done
 "$prefix/bin/seamcl" --version | grep -q "^seamcl " || fail "installed seamcl --version"

@@ -47,7 +47,7 @@ def load_farm():
 
 
 def exact_keys_equal(merged, whole, label):
-    """What merges exactly (host/eval/bench_merge.h) is equal; p99 is an upper bound."""
+    """What merges exactly (host/batch/bench_merge.h) is equal; p99 is an upper bound."""
     for key in ("error_frames", "seam_pixels_per_frame", "frames", "options", "shard"):
         check(merged[key] == whole[key], f"{label}: {key} equal")
     per_entry = ("error_per_frame", "nan_pixels_per_frame", "temporal_per_frame", "temporal", "curve", "seam_curve",

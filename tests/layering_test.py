@@ -2,7 +2,8 @@
 """The library's folders depend on each other one way only, and the outside reaches it through
 <seamcl/...>. Reads every #include of host/, cli/, server/, bench/, tests/ and examples/:
 
-- a file in host/F/ includes only host/F/ and the folders F may depend on (ALLOWED);
+- a file in host/F/ (or a folder inside it, such as host/pipeline/stages/) includes only host/F/
+  and the folders F may depend on (ALLOWED);
 - OpenCL headers only in host/cl/, OpenImageIO only in .cpp files of host/io/ and host/eval/;
 - a public header (listed in CMakeLists.txt) includes no private one;
 - outside host/, a public header is included as <seamcl/F/NAME.h>, never by a relative path,
@@ -22,11 +23,11 @@ ALLOWED = {
     "cl": {"core"},
     "scene": {"core"},
     "pipeline": {"core", "options", "cl", "scene"},
-    "twins": {"core", "options", "scene", "pipeline"},
     "io": {"core", "options", "scene", "pipeline"},
     "eval": {"core", "options", "cl", "scene", "pipeline", "io"},
     "assets": {"core", "options", "scene", "pipeline", "io"},
-    "jobs": {"core", "options", "cl", "scene", "pipeline", "io", "eval", "assets"},
+    "batch": {"core", "options", "cl", "scene", "pipeline", "eval"},
+    "jobs": {"core", "options", "cl", "scene", "pipeline", "io", "eval", "batch", "assets"},
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 

@@ -1,4 +1,4 @@
-// Sharded batch work (host/eval/shard.h, host/eval/bench_merge.h, `seamcl bench --shard K/N`,
+// Sharded batch work (host/batch/shard.h, host/batch/bench_merge.h, `seamcl bench --shard K/N`,
 // `seamcl merge`): the parts of a bench, merged, give what one unsharded run gives, exactly for
 // everything per frame, counted, summed or maximal, and as documented for the rest; bad shards and
 // parts that do not belong together are refused naming the field.
@@ -20,10 +20,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <seamcl/batch/bench_merge.h>
+#include <seamcl/batch/shard.h>
 #include <seamcl/core/input_error.h>
-#include <seamcl/eval/bench_merge.h>
 #include <seamcl/eval/comparison.h>
-#include <seamcl/eval/shard.h>
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include <seamcl/batch/scaling_sweep.h>
 #include <seamcl/core/cancelled.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/over_budget.h>
@@ -24,7 +25,6 @@
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
-#include <seamcl/eval/scaling_sweep.h>
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/renderer.h>

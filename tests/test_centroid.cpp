@@ -10,8 +10,8 @@
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 #include "test_support.h"
-#include "twins/sample_pattern.h"
-#include "twins/shade_resolve.h"
+#include "pipeline/stages/sample_pattern.h"
+#include "pipeline/stages/shade_resolve_twin.h"
 
 using namespace seamcl;
 

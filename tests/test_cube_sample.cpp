@@ -10,7 +10,7 @@
 #include <seamcl/pipeline/cube_lookups.h>
 #include <seamcl/pipeline/packed_cube.h>
 #include "test_support.h"
-#include "twins/cube_sample.h"
+#include "pipeline/stages/cube_sample_twin.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

@@ -11,7 +11,7 @@
 #include <seamcl/scene/scene_generators.h>
 #include <seamcl/scene/scene_json.h>
 #include "test_support.h"
-#include "twins/shade_resolve.h"
+#include "pipeline/stages/shade_resolve_twin.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

@@ -15,12 +15,12 @@
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 #include "pipeline/displacement_packing.h"
-#include "pipeline/tessellation_stage.h"
+#include "pipeline/stages/tessellate_launcher.h"
 #include "scene/displaced_scene.h"
 #include "scene/displacement_map.h"
 #include "test_support.h"
-#include "twins/tessellate.h"
-#include "twins/triangle_setup.h"
+#include "pipeline/stages/tessellate_twin.h"
+#include "pipeline/stages/triangle_setup_twin.h"
 
 namespace {
 
@@ -41,7 +41,7 @@ const Scene& displaced() {
 std::string default_program() { return program_options(TexelFormat::Rgba8, sampler_params(RenderOptions{}), false); }
 
 std::vector<TessVertex> device_tessellation(const Scene& scene, const DisplacementSettings& settings, PackedDisplacement* packed_out = nullptr) {
-  TessellationStage stage(shared_runtime());
+  TessellateLauncher stage(shared_runtime());
   stage.load(pack_displacement(scene, settings));
   std::vector<TessVertex> out = stage.tessellate(default_program());
   if (packed_out) *packed_out = stage.packed();

@@ -24,7 +24,7 @@
 #include "http_server.h"
 #include "server_support.h"
 #include "pipeline/displacement_packing.h"
-#include "pipeline/tessellation_stage.h"
+#include "pipeline/stages/tessellate_launcher.h"
 #include "scene/displacement_map.h"
 #include "test_support.h"
 

@@ -29,9 +29,9 @@
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
 #include "test_support.h"
-#include "twins/raster.h"
-#include "twins/shade_resolve.h"
-#include "twins/texture_sample.h"
+#include "pipeline/stages/raster_twin.h"
+#include "pipeline/stages/shade_resolve_twin.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 using namespace seamcl;
 using nlohmann::json;

@@ -20,7 +20,7 @@
 #include <seamcl/scene/scene_generators.h>
 #include "pipeline/adjacency.h"
 #include "pipeline/guard_band.h"
-#include "twins/texture_sample.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

@@ -15,12 +15,12 @@
 #include <seamcl/scene/scene_generators.h>
 #include "pipeline/frame_params.h"
 #include "test_support.h"
-#include "twins/binning.h"
-#include "twins/raster.h"
-#include "twins/sample_pattern.h"
-#include "twins/shade_resolve.h"
-#include "twins/texture_sample.h"
-#include "twins/triangle_setup.h"
+#include "pipeline/stages/binning_twin.h"
+#include "pipeline/stages/raster_twin.h"
+#include "pipeline/stages/sample_pattern.h"
+#include "pipeline/stages/shade_resolve_twin.h"
+#include "pipeline/stages/texture_sample_twin.h"
+#include "pipeline/stages/triangle_setup_twin.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;
@@ -199,7 +199,7 @@ TEST(KernelVsTwin, EveryStageOnBuiltInAndRandomScenes) {
 
 TEST(SamplePattern, HostAndKernelTablesAreTheD3D11StandardPatterns) {
   // D3D11_STANDARD_MULTISAMPLE_PATTERN, in 1/16 pixel from the centre (D3D11.3 spec 3.5.6.1),
-  // written out here independently of host/twins/sample_pattern.cpp.
+  // written out here independently of host/pipeline/stages/sample_pattern.cpp.
   const std::vector<std::vector<std::pair<int, int>>> standard = {
       {{0, 0}},
       {{4, 4}, {-4, -4}},

@@ -24,7 +24,7 @@
 #include "lit_constant.h"
 #include "test_meshes.h"
 #include "test_support.h"
-#include "twins/texture_sample.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

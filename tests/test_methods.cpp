@@ -13,9 +13,9 @@
 #include "core/srgb.h"
 #include "lit_constant.h"
 #include "test_support.h"
-#include "twins/raster.h"
-#include "twins/shade_resolve.h"
-#include "twins/texture_sample.h"
+#include "pipeline/stages/raster_twin.h"
+#include "pipeline/stages/shade_resolve_twin.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

@@ -1,5 +1,5 @@
 // The OpenAPI document (server/openapi.json) checked against what the server really accepts: the
-// option tables and bounds of the shared parser (host/pipeline/render_options), the compare limits
+// option tables and bounds of the shared parser (host/options/render_options), the compare limits
 // of ServerOptions, the built-in scenes, and the inline scene format of docs/scene-format.md. A
 // client generated from the document (or a fuzzer such as schemathesis) then sends what the
 // parser takes, and every value the document rules out is one the parser refuses.

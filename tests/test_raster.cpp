@@ -14,9 +14,9 @@
 
 #include <seamcl/cl/cl_runtime.h>
 #include "test_support.h"
-#include "twins/raster.h"
-#include "twins/sample_pattern.h"
-#include "twins/triangle_setup.h"
+#include "pipeline/stages/raster_twin.h"
+#include "pipeline/stages/sample_pattern.h"
+#include "pipeline/stages/triangle_setup_twin.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

@@ -13,7 +13,7 @@
 #include <seamcl/pipeline/texture_lookups.h>
 #include "core/srgb.h"
 #include "test_support.h"
-#include "twins/texture_sample.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

@@ -64,7 +64,7 @@
 #include "core/srgb.h"
 #include "io/texture_file.h"
 #include "test_support.h"
-#include "twins/texture_sample.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

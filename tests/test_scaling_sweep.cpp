@@ -1,4 +1,4 @@
-// Scaling sweeps (seamcl bench --sweep, host/eval/scaling_sweep.h) and the paper scene's face
+// Scaling sweeps (seamcl bench --sweep, host/batch/scaling_sweep.h) and the paper scene's face
 // count and texture scale they vary: the sweep names and their refusal, the points, the JSON's
 // shape, and the generator options' bounds and effect.
 #include <gtest/gtest.h>
@@ -17,9 +17,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <seamcl/batch/scaling_sweep.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/over_budget.h>
-#include <seamcl/eval/scaling_sweep.h>
 #include <seamcl/scene/scene_generators.h>
 #include <seamcl/scene/scene_json.h>
 

@@ -23,7 +23,7 @@
 #include <seamcl/scene/scene_generators.h>
 #include "core/srgb.h"
 #include "test_support.h"
-#include "twins/texture_sample.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 using namespace seamcl;
 

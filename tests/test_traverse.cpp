@@ -19,7 +19,7 @@
 #include <seamcl/pipeline/texture_lookups.h>
 #include <seamcl/scene/scene_generators.h>
 #include "pipeline/adjacency.h"
-#include "twins/texture_sample.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;

@@ -7,7 +7,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/pipeline/renderer.h>
 #include "pipeline/displacement_packing.h"
-#include "pipeline/tessellation_stage.h"
+#include "pipeline/stages/tessellate_launcher.h"
 #include "scene/displacement_map.h"
 
 namespace seamcl {
@@ -192,7 +192,7 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   report.matched_samples = packed.matched_samples;
   report.unmatched_edges = packed.unmatched_edges;
   report.triangles = packed.triangle_count();
-  TessellationStage stage(runtime);
+  TessellateLauncher stage(runtime);
   stage.load(std::move(packed));
   const std::vector<TessVertex> vertices =
       stage.tessellate(program_options(options.texels, sampler_params(options), false));

@@ -1,7 +1,6 @@
 #include <seamcl/pipeline/renderer.h>
 
 #include <algorithm>
-#include <map>
 #include <optional>
 #include <cassert>
 #include <stdexcept>
@@ -13,31 +12,18 @@
 #include "core/srgb.h"
 #include "pipeline/adjacency.h"
 #include "pipeline/frame_params.h"
-#include "pipeline/tessellation_stage.h"
+#include "pipeline/stages/binning_launcher.h"
+#include "pipeline/stages/raster_launcher.h"
+#include "pipeline/stages/shade_resolve_launcher.h"
+#include "pipeline/stages/stage_buffers.h"
+#include "pipeline/stages/tessellate_launcher.h"
+#include "pipeline/stages/triangle_setup_launcher.h"
 #include <seamcl/pipeline/packed_cube.h>
 
 namespace seamcl {
-namespace {
-
-template <typename T>
-std::vector<T> read_buffer(cl::CommandQueue& queue, const cl::Buffer& buffer, size_t count) {
-  std::vector<T> out(count);
-  if (count > 0) queue.enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(T), out.data());
-  return out;
-}
-
-size_t round_up(size_t value, size_t multiple) { return (value + multiple - 1) / multiple * multiple; }
-
-}  // namespace
 
 struct Renderer::Impl {
   ClRuntime& runtime;
-  // The kernels of one program variant (texel format and sampler configuration).
-  struct KernelSet {
-    cl::Kernel setup, bin_count, bin_scan, bin_fill, raster, shade;
-  };
-  std::map<std::string, KernelSet> kernel_sets;
-  cl::Kernel setup_kernel, bin_count_kernel, bin_scan_kernel, bin_fill_kernel, raster_kernel, shade_kernel;
 
   std::unique_ptr<Scene> scene;
   // Declared before the buffers that may be these arrays themselves (upload_shared), so that they
@@ -50,18 +36,18 @@ struct Renderer::Impl {
   cl::Buffer reflective_faces, cube_texels;
   std::optional<CubeBake> cube_bake_uploaded;
 
-  // Frame buffers, grown on demand.
-  cl::Buffer frame_params, stats, setups, slot_counts, tile_counts, tile_offsets, chunk_counts, tile_lists, tile_entry_rows,
-      sample_triangle, image;
-  cl::Buffer seam_mask;  // only once a render asks for the mask
-  size_t setups_capacity = 0, slot_counts_capacity = 0, tiles_capacity = 0, chunk_counts_capacity = 0, samples_capacity = 0,
-         pixels_capacity = 0, mask_capacity = 0;
-  uint32_t bin_capacity = 0;         // tile-list entries the next frame asks for
-  uint32_t tile_lists_capacity = 0;  // entries allocated
+  // The frame's constants and counters, which every stage reads; each stage's launcher holds the
+  // buffers it writes, grown on demand.
+  cl::Buffer frame_params, stats;
+  TriangleSetupLauncher setup{runtime};
+  BinningLauncher binning{runtime};
+  RasterLauncher raster{runtime};
+  ShadeResolveLauncher shade{runtime};
+  uint32_t bin_capacity = 0;  // tile-list entries the next frame asks for
   FrameParams last_params{};
   size_t device_byte_limit = 0;  // 0: none
   // Displacement renders only: the tessellation stage replaces triangle setup.
-  TessellationStage tessellation{runtime};
+  TessellateLauncher tessellation{runtime};
   std::optional<DisplacementSettings> tessellation_settings;  // what `tessellation` holds
   bool displaced = false;        // this frame runs the tessellation stage
   std::string program_key;       // the current program variant's build options
@@ -79,20 +65,10 @@ struct Renderer::Impl {
   void use_kernels(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask) {
     const std::string options = program_options(format, sampler, with_seam_mask, scene->environment.has_value());
     program_key = options;
-    auto it = kernel_sets.find(options);
-    if (it == kernel_sets.end()) {
-      const cl::Program& program = runtime.program(options);
-      KernelSet set{cl::Kernel(program, "triangle_setup"), cl::Kernel(program, "bin_count"),
-                    cl::Kernel(program, "bin_scan"),       cl::Kernel(program, "bin_fill"),
-                    cl::Kernel(program, "raster"),         cl::Kernel(program, "shade_resolve")};
-      it = kernel_sets.emplace(options, std::move(set)).first;
-    }
-    setup_kernel = it->second.setup;
-    bin_count_kernel = it->second.bin_count;
-    bin_scan_kernel = it->second.bin_scan;
-    bin_fill_kernel = it->second.bin_fill;
-    raster_kernel = it->second.raster;
-    shade_kernel = it->second.shade;
+    setup.use_program(options);
+    binning.use_program(options);
+    raster.use_program(options);
+    shade.use_program(options);
   }
 
   // Packs and uploads the loaded scene in `format` with `guard_band` texels of band per level, from
@@ -133,7 +109,7 @@ struct Renderer::Impl {
     pack_and_upload(format, 0, {}, false);  // no adjacency until a render reads it
     // Start the tile lists at a few entries per triangle slot; render() grows them when needed.
     bin_capacity = std::max<uint32_t>(bin_capacity, initial_tile_list_entries(scene->triangle_count()));
-    tile_lists = tile_entry_rows = cl::Buffer();
+    binning.release_tile_lists();
   }
 
   // Waits for queued commands, which may read the shared arrays (upload_shared), before one is
@@ -176,10 +152,10 @@ struct Renderer::Impl {
   }
 
   void release_frame_buffers() {
-    setups = slot_counts = tile_counts = tile_offsets = chunk_counts = tile_lists = tile_entry_rows = sample_triangle = image =
-        seam_mask = cl::Buffer();
-    setups_capacity = slot_counts_capacity = tiles_capacity = chunk_counts_capacity = samples_capacity = pixels_capacity = mask_capacity = 0;
-    tile_lists_capacity = 0;
+    setup.release();
+    binning.release();
+    raster.release();
+    shade.release();
     // The tessellated vertices are sized by the request too (packed again on the next render).
     tessellation.release();
     tessellation_settings.reset();
@@ -211,32 +187,15 @@ struct Renderer::Impl {
                       const_cast<T*>(data.data()));
   }
 
-  static void grow(cl::Buffer& buffer, size_t& capacity, size_t needed, size_t element_bytes, const cl::Context& context) {
-    if (needed <= capacity && capacity > 0) return;
-    capacity = std::max<size_t>(needed, 1);
-    buffer = cl::Buffer(context, CL_MEM_READ_WRITE, capacity * element_bytes);
+  void reserve_frame_buffers(const FrameParams& p) {
+    setup.reserve(static_cast<size_t>(p.input_triangles));
+    binning.reserve(p);
+    raster.reserve(p);
+    shade.reserve(p);
   }
 
-  void ensure_frame_buffers(const FrameParams& p) {
-    const cl::Context& context = runtime.context();
-    grow(setups, setups_capacity, static_cast<size_t>(p.input_triangles) * SEAMCL_CLIP_SLOTS, sizeof(TriangleSetup), context);
-    grow(slot_counts, slot_counts_capacity, static_cast<size_t>(p.input_triangles), sizeof(cl_uint), context);
-    const size_t tiles = static_cast<size_t>(p.tiles_x) * p.tiles_y;
-    if (tiles > tiles_capacity || tiles_capacity == 0) {
-      tiles_capacity = tiles;
-      tile_counts = cl::Buffer(context, CL_MEM_READ_WRITE, tiles * sizeof(cl_uint));
-      tile_offsets = cl::Buffer(context, CL_MEM_READ_WRITE, tiles * sizeof(cl_uint));
-    }
-    grow(chunk_counts, chunk_counts_capacity,
-         std::max<size_t>(bin_chunks(static_cast<size_t>(p.input_triangles), tiles).chunks, 1) * tiles, sizeof(cl_uint),
-         context);
-    grow(sample_triangle, samples_capacity, static_cast<size_t>(p.width) * p.height * p.sample_count, sizeof(cl_uint), context);
-    grow(image, pixels_capacity, static_cast<size_t>(p.width) * p.height, sizeof(cl_float4), context);
-    if (tile_lists() == nullptr || tile_lists_capacity < p.bin_capacity) {
-      tile_lists_capacity = p.bin_capacity;
-      tile_lists = cl::Buffer(context, CL_MEM_READ_WRITE, static_cast<size_t>(p.bin_capacity) * sizeof(cl_uint));
-      tile_entry_rows = cl::Buffer(context, CL_MEM_READ_WRITE, static_cast<size_t>(p.bin_capacity) * sizeof(cl_ushort));
-    }
+  ShadeSceneBuffers shade_scene_buffers() const {
+    return ShadeSceneBuffers{faces, neighbors, level_offsets, texels, srgb_table, reflective_faces, cube_texels};
   }
 
   // Queues one frame; returns the events of each stage in order.
@@ -247,102 +206,32 @@ struct Renderer::Impl {
   StageEvents enqueue_frame(const FrameParams& p, std::vector<glm::vec4>& pixels, std::vector<uint8_t>* mask) {
     cl::CommandQueue& queue = runtime.queue();
     StageEvents ev;
-    auto next = [](std::vector<cl::Event>& list) -> cl::Event* {
-      list.emplace_back();
-      return &list.back();
-    };
     ev.setup.reserve(3);
     ev.binning.reserve(3);
-    queue.enqueueWriteBuffer(frame_params, CL_FALSE, 0, sizeof(FrameParams), &p, nullptr, next(ev.setup));
+    queue.enqueueWriteBuffer(frame_params, CL_FALSE, 0, sizeof(FrameParams), &p, nullptr, &ev.setup.emplace_back());
     const FrameStats zero_stats{};
-    queue.enqueueWriteBuffer(stats, CL_FALSE, 0, sizeof(FrameStats), &zero_stats, nullptr, next(ev.setup));
+    queue.enqueueWriteBuffer(stats, CL_FALSE, 0, sizeof(FrameStats), &zero_stats, nullptr, &ev.setup.emplace_back());
 
-    const size_t input_triangles = static_cast<size_t>(p.input_triangles);
     if (displaced) {
-      tessellation.enqueue(program_key, frame_params, setups, slot_counts, stats, p.input_triangles, ev.tessellate, ev.setup);
-    } else if (p.input_triangles > 0) {
-      setup_kernel.setArg(0, frame_params);
-      setup_kernel.setArg(1, positions);
-      setup_kernel.setArg(2, faces);
-      setup_kernel.setArg(3, setups);
-      setup_kernel.setArg(4, slot_counts);
-      setup_kernel.setArg(5, stats);
-      const size_t setup_items = (input_triangles + SEAMCL_SETUP_LANES - 1) / SEAMCL_SETUP_LANES;
-      queue.enqueueNDRangeKernel(setup_kernel, cl::NullRange, cl::NDRange(round_up(setup_items, SEAMCL_SETUP_GROUP)),
-                                 cl::NDRange(SEAMCL_SETUP_GROUP), nullptr, next(ev.setup));
-    }
-    const size_t tiles = static_cast<size_t>(p.tiles_x) * p.tiles_y;
-    const BinChunks chunks = bin_chunks(input_triangles, tiles);
-    const cl_int chunk_triangles = static_cast<cl_int>(chunks.chunk_triangles);
-    if (chunks.chunks > 0) {
-      bin_count_kernel.setArg(0, frame_params);
-      bin_count_kernel.setArg(1, setups);
-      bin_count_kernel.setArg(2, slot_counts);
-      bin_count_kernel.setArg(3, chunk_counts);
-      bin_count_kernel.setArg(4, chunk_triangles);
-      queue.enqueueNDRangeKernel(bin_count_kernel, cl::NullRange, cl::NDRange(chunks.chunks), cl::NDRange(1), nullptr,
-                                 next(ev.binning));
-    }
-    bin_scan_kernel.setArg(0, frame_params);
-    bin_scan_kernel.setArg(1, chunk_counts);
-    bin_scan_kernel.setArg(2, static_cast<cl_int>(chunks.chunks));
-    bin_scan_kernel.setArg(3, tile_counts);
-    bin_scan_kernel.setArg(4, tile_offsets);
-    bin_scan_kernel.setArg(5, stats);
-    queue.enqueueNDRangeKernel(bin_scan_kernel, cl::NullRange, cl::NDRange(1), cl::NDRange(1), nullptr, next(ev.binning));
-    if (chunks.chunks > 0) {
-      bin_fill_kernel.setArg(0, frame_params);
-      bin_fill_kernel.setArg(1, setups);
-      bin_fill_kernel.setArg(2, slot_counts);
-      bin_fill_kernel.setArg(3, chunk_counts);
-      bin_fill_kernel.setArg(4, chunk_triangles);
-      bin_fill_kernel.setArg(5, tile_lists);
-      bin_fill_kernel.setArg(6, tile_entry_rows);
-      queue.enqueueNDRangeKernel(bin_fill_kernel, cl::NullRange, cl::NDRange(chunks.chunks), cl::NDRange(1), nullptr,
-                                 next(ev.binning));
-    }
-    const cl::NDRange tile_grid(static_cast<size_t>(p.tiles_x) * SEAMCL_TILE_SIZE, static_cast<size_t>(p.tiles_y) * SEAMCL_TILE_SIZE);
-    const cl::NDRange tile_group(SEAMCL_TILE_SIZE, SEAMCL_TILE_SIZE);
-    raster_kernel.setArg(0, frame_params);
-    raster_kernel.setArg(1, setups);
-    raster_kernel.setArg(2, tile_counts);
-    raster_kernel.setArg(3, tile_offsets);
-    raster_kernel.setArg(4, tile_lists);
-    raster_kernel.setArg(5, tile_entry_rows);
-    raster_kernel.setArg(6, sample_triangle);
-    // One work-item per tile (kernels/raster.cl walks a tile's list once, a row in a 16-wide vector).
-    queue.enqueueNDRangeKernel(raster_kernel, cl::NullRange,
-                               cl::NDRange(static_cast<size_t>(p.tiles_x), static_cast<size_t>(p.tiles_y)),
-                               cl::NDRange(1, 1), nullptr, next(ev.raster));
-
-    shade_kernel.setArg(0, frame_params);
-    shade_kernel.setArg(1, setups);
-    shade_kernel.setArg(2, faces);
-    shade_kernel.setArg(3, neighbors);
-    shade_kernel.setArg(4, level_offsets);
-    shade_kernel.setArg(5, texels);
-    shade_kernel.setArg(6, srgb_table);
-    shade_kernel.setArg(7, sample_triangle);
-    shade_kernel.setArg(8, image);
-    shade_kernel.setArg(9, stats);
-    if (mask) {
-      grow(seam_mask, mask_capacity, static_cast<size_t>(p.width) * p.height, sizeof(cl_uchar), runtime.context());
-      shade_kernel.setArg(10, seam_mask);
+      tessellation.enqueue(program_key, frame_params, setup.setups(), setup.slot_counts(), stats, p.input_triangles,
+                           ev.tessellate, ev.setup);
     } else {
-      shade_kernel.setArg(10, sizeof(cl_mem), nullptr);  // a null buffer: the variant never touches it
+      setup.enqueue(frame_params, positions, faces, stats, p.input_triangles, ev.setup);
     }
-    shade_kernel.setArg(11, reflective_faces);
-    shade_kernel.setArg(12, cube_texels);
-    queue.enqueueNDRangeKernel(shade_kernel, cl::NullRange, tile_grid, tile_group, nullptr, next(ev.shade));
-
-    pixels.resize(static_cast<size_t>(p.width) * p.height);
-    queue.enqueueReadBuffer(image, CL_FALSE, 0, pixels.size() * sizeof(cl_float4), pixels.data(), nullptr, next(ev.readback));
-    if (mask) {
-      mask->resize(pixels.size());
-      queue.enqueueReadBuffer(seam_mask, CL_FALSE, 0, mask->size(), mask->data(), nullptr, next(ev.readback));
-    }
+    binning.enqueue(frame_params, setup.setups(), setup.slot_counts(), stats, p, ev.binning);
+    raster.enqueue(frame_params, setup.setups(), binning, p, ev.raster);
+    shade.enqueue(frame_params, setup.setups(), shade_scene_buffers(), raster.sample_triangle(), stats, p, mask != nullptr,
+                  ev.shade);
+    shade.enqueue_readback(p, pixels, mask, ev.readback);
     queue.finish();
     return ev;
+  }
+
+  // The tile-list entries the last frame wrote (bin_entries counts the ones that did not fit too).
+  size_t written_bin_entries() {
+    FrameStats written{};
+    runtime.queue().enqueueReadBuffer(stats, CL_TRUE, 0, sizeof(FrameStats), &written);
+    return std::min(written.bin_entries, bin_capacity);
   }
 };
 
@@ -373,14 +262,12 @@ void Renderer::release_scene() {
 size_t Renderer::device_bytes() const {
   const Impl& i = *impl_;
   size_t bytes = 0;
-  for (const cl::Buffer* buffer :
-       {&i.positions, &i.faces, &i.neighbors, &i.level_offsets, &i.texels, &i.reflective_faces, &i.cube_texels,
-        &i.srgb_table, &i.frame_params, &i.stats,
-        &i.setups, &i.slot_counts, &i.tile_counts, &i.tile_offsets, &i.chunk_counts, &i.tile_lists, &i.tile_entry_rows, &i.sample_triangle, &i.image,
-        &i.seam_mask}) {
-    if ((*buffer)() != nullptr) bytes += buffer->getInfo<CL_MEM_SIZE>();
+  for (const cl::Buffer* buffer : {&i.positions, &i.faces, &i.neighbors, &i.level_offsets, &i.texels, &i.reflective_faces,
+                                   &i.cube_texels, &i.srgb_table, &i.frame_params, &i.stats}) {
+    bytes += buffer_bytes(*buffer);
   }
-  return bytes + i.tessellation.device_bytes();
+  return bytes + i.setup.device_bytes() + i.binning.device_bytes() + i.raster.device_bytes() + i.shade.device_bytes() +
+         i.tessellation.device_bytes();
 }
 
 const Scene& Renderer::scene() const {
@@ -459,7 +346,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     FrameParams params = make_frame_params(*impl_->scene, camera, options, impl_->bin_capacity);
     if (impl_->displaced) params.input_triangles = static_cast<cl_int>(impl_->tessellation.packed().triangle_count());
     if (impl_->direction_output) params.environment.sampler.method = SEAMCL_CUBE_DIRECTION;
-    impl_->ensure_frame_buffers(params);
+    impl_->reserve_frame_buffers(params);
     impl_->bin_capacity = params.bin_capacity;
     impl_->last_params = params;
     const Impl::StageEvents ev = impl_->enqueue_frame(params, result.pixels, with_seam_mask ? &result.seam_mask : nullptr);
@@ -471,7 +358,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
       if (impl_->device_byte_limit != 0) {
         // A list entry is a slot index and its rows (tile_entry_rows).
         constexpr size_t entry_bytes = sizeof(cl_uint) + sizeof(cl_ushort);
-        const size_t needed = device_bytes() - size_t{impl_->tile_lists_capacity} * entry_bytes + size_t{grown} * entry_bytes;
+        const size_t needed = device_bytes() - size_t{impl_->binning.tile_list_capacity()} * entry_bytes + size_t{grown} * entry_bytes;
         if (needed > impl_->device_byte_limit) {
           throw OverBudget("size", "this frame's tile lists (" + std::to_string(result.stats.bin_entries) + " entries)",
                            needed, impl_->device_byte_limit);
@@ -531,79 +418,30 @@ void Renderer::warm_up(const RenderOptions& options) {
 
 FrameParams Renderer::last_frame_params() const { return impl_->last_params; }
 
-namespace {
-
-// The read-backs below return setups and slot numbers in input order (slot t * SEAMCL_CLIP_SLOTS
-// + k, as the twins number them), though the device keeps its records slot-major (k * input
-// triangles + t; kernels/seamcl_types.h). This maps a device slot number to input order.
-uint32_t input_order_slot(uint32_t slot, uint32_t triangles) {
-  if (slot == SEAMCL_NO_TRIANGLE || triangles == 0) return slot;
-  return (slot % triangles) * SEAMCL_CLIP_SLOTS + slot / triangles;
-}
-
-}  // namespace
-
 std::vector<TriangleSetup> Renderer::read_setups() {
-  const size_t triangles = static_cast<size_t>(impl_->last_params.input_triangles);
-  const std::vector<TriangleSetup> slot_major =
-      read_buffer<TriangleSetup>(impl_->runtime.queue(), impl_->setups, triangles * SEAMCL_CLIP_SLOTS);
-  if (slot_major.empty()) return {};
-  // Setup writes only a triangle's first slot_counts[t] slots (the rest hold stale data): fill the
-  // others with the empty record triangle_setup.cl's store_empty_setup writes, so every slot reads as before.
-  // Its face: t's face (two triangles each), or for micro-triangles their patch (2 T^2 each).
-  const std::vector<uint32_t> written = read_buffer<uint32_t>(impl_->runtime.queue(), impl_->slot_counts, triangles);
+  // Input triangle t's face: t's face (two triangles each), or for micro-triangles their patch
+  // (2 T^2 each).
   const size_t triangles_per_face =
       impl_->displaced && impl_->tessellation_settings
           ? 2 * static_cast<size_t>(impl_->tessellation_settings->tessellation) * impl_->tessellation_settings->tessellation
           : 2;
-  std::vector<TriangleSetup> setups(slot_major.size());
-  for (size_t t = 0; t < triangles; ++t) {
-    const size_t filled = std::min<size_t>(written[t], SEAMCL_CLIP_SLOTS);
-    for (size_t k = 0; k < SEAMCL_CLIP_SLOTS; ++k) {
-      TriangleSetup& s = setups[t * SEAMCL_CLIP_SLOTS + k];
-      if (k < filled) {
-        s = slot_major[k * triangles + t];
-        continue;
-      }
-      s = TriangleSetup{};
-      for (int i = 0; i < 3; ++i) s.edge_c[i] = -1;
-      s.bbox_max_x = -1;
-      s.bbox_max_y = -1;
-      s.face = static_cast<uint32_t>(t / triangles_per_face);
-    }
-  }
-  return setups;
+  return impl_->setup.read_setups(static_cast<size_t>(impl_->last_params.input_triangles), triangles_per_face);
 }
 std::vector<uint32_t> Renderer::read_tile_counts() {
-  return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_counts,
-                               static_cast<size_t>(impl_->last_params.tiles_x) * impl_->last_params.tiles_y);
+  return impl_->binning.read_tile_counts(static_cast<size_t>(impl_->last_params.tiles_x) * impl_->last_params.tiles_y);
 }
 std::vector<uint32_t> Renderer::read_tile_offsets() {
-  return read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_offsets,
-                               static_cast<size_t>(impl_->last_params.tiles_x) * impl_->last_params.tiles_y);
+  return impl_->binning.read_tile_offsets(static_cast<size_t>(impl_->last_params.tiles_x) * impl_->last_params.tiles_y);
 }
 std::vector<uint32_t> Renderer::read_tile_lists() {
-  if (impl_->tile_lists() == nullptr || impl_->last_params.width == 0) return {};  // released (or none yet)
-  FrameStats stats{};
-  impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &stats);
-  std::vector<uint32_t> lists =
-      read_buffer<uint32_t>(impl_->runtime.queue(), impl_->tile_lists, std::min(stats.bin_entries, impl_->bin_capacity));
-  const uint32_t triangles = static_cast<uint32_t>(impl_->last_params.input_triangles);
-  for (uint32_t& slot : lists) slot = input_order_slot(slot, triangles);
-  return lists;
+  if (impl_->binning.tile_lists()() == nullptr || impl_->last_params.width == 0) return {};  // released (or none yet)
+  return impl_->binning.read_tile_lists(impl_->written_bin_entries(),
+                                        static_cast<uint32_t>(impl_->last_params.input_triangles));
 }
 std::vector<uint16_t> Renderer::read_tile_entry_rows() {
-  if (impl_->tile_entry_rows() == nullptr || impl_->last_params.width == 0) return {};  // released (or none yet)
-  FrameStats stats{};
-  impl_->runtime.queue().enqueueReadBuffer(impl_->stats, CL_TRUE, 0, sizeof(FrameStats), &stats);
-  return read_buffer<uint16_t>(impl_->runtime.queue(), impl_->tile_entry_rows, std::min(stats.bin_entries, impl_->bin_capacity));
+  if (impl_->binning.tile_entry_rows()() == nullptr || impl_->last_params.width == 0) return {};  // released (or none yet)
+  return impl_->binning.read_tile_entry_rows(impl_->written_bin_entries());
 }
-std::vector<uint32_t> Renderer::read_sample_triangles() {
-  const FrameParams& p = impl_->last_params;
-  std::vector<uint32_t> winners = read_buffer<uint32_t>(impl_->runtime.queue(), impl_->sample_triangle,
-                                                       static_cast<size_t>(p.width) * p.height * p.sample_count);
-  for (uint32_t& slot : winners) slot = input_order_slot(slot, static_cast<uint32_t>(p.input_triangles));
-  return winners;
-}
+std::vector<uint32_t> Renderer::read_sample_triangles() { return impl_->raster.read_sample_triangles(impl_->last_params); }
 
 }  // namespace seamcl

@@ -1,7 +1,7 @@
 // A share of a batch: `--shard K/N` names part K (1-based) of N, and a part of an orbit is one
 // contiguous block of its frames, so each part can carry the frame before its block (for the
 // temporal measure, which compares consecutive frames) and the parts merge back in frame order
-// (host/eval/bench_merge.h).
+// (host/batch/bench_merge.h).
 #pragma once
 #include <string>
 

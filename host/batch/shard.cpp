@@ -1,4 +1,4 @@
-#include <seamcl/eval/shard.h>
+#include <seamcl/batch/shard.h>
 
 #include <cctype>
 

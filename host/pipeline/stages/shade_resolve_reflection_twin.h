@@ -6,7 +6,7 @@
 #include <glm/glm.hpp>
 
 #include <seamcl/pipeline/gpu_types.h>
-#include "twins/shade_resolve.h"
+#include "pipeline/stages/shade_resolve_twin.h"
 
 namespace seamcl {
 

@@ -1,11 +1,11 @@
-#include "twins/shade_resolve.h"
+#include "pipeline/stages/shade_resolve_twin.h"
 
 #include <algorithm>
 
-#include "twins/raster.h"
-#include "twins/sample_pattern.h"
-#include "twins/shade_reflection.h"
-#include "twins/texture_sample.h"
+#include "pipeline/stages/raster_twin.h"
+#include "pipeline/stages/sample_pattern.h"
+#include "pipeline/stages/shade_resolve_reflection_twin.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 #include "pipeline/adjacency.h"
 

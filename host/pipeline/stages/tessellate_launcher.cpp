@@ -1,4 +1,4 @@
-#include "pipeline/tessellation_stage.h"
+#include "pipeline/stages/tessellate_launcher.h"
 
 #include <algorithm>
 
@@ -19,7 +19,7 @@ cl::Buffer upload(ClRuntime& runtime, const std::vector<T>& data) {
 
 }  // namespace
 
-void TessellationStage::load(PackedDisplacement packed) {
+void TessellateLauncher::load(PackedDisplacement packed) {
   release();
   packed_ = std::move(packed);
   params_ = upload(runtime_, std::vector<TessellationParams>{packed_.params});
@@ -31,13 +31,13 @@ void TessellationStage::load(PackedDisplacement packed) {
   loaded_ = true;
 }
 
-void TessellationStage::release() {
+void TessellateLauncher::release() {
   loaded_ = false;
   packed_ = PackedDisplacement{};
   params_ = patches_ = samples_ = positions_ = normals_ = vertices_ = cl::Buffer();
 }
 
-TessellationStage::Kernels& TessellationStage::kernels(const std::string& program_options) {
+TessellateLauncher::Kernels& TessellateLauncher::kernels(const std::string& program_options) {
   auto it = kernels_.find(program_options);
   if (it == kernels_.end()) {
     const cl::Program& program = runtime_.program(program_options);
@@ -46,7 +46,7 @@ TessellationStage::Kernels& TessellationStage::kernels(const std::string& progra
   return it->second;
 }
 
-void TessellationStage::enqueue_tessellate(Kernels& k, std::vector<cl::Event>* events) {
+void TessellateLauncher::enqueue_tessellate(Kernels& k, std::vector<cl::Event>* events) {
   const size_t vertices = packed_.vertex_count();
   if (vertices == 0) return;
   k.tessellate.setArg(0, params_);
@@ -61,7 +61,7 @@ void TessellationStage::enqueue_tessellate(Kernels& k, std::vector<cl::Event>* e
                                         nullptr, event);
 }
 
-void TessellationStage::enqueue(const std::string& program_options, const cl::Buffer& frame_params, const cl::Buffer& setups,
+void TessellateLauncher::enqueue(const std::string& program_options, const cl::Buffer& frame_params, const cl::Buffer& setups,
                                 const cl::Buffer& slot_counts, const cl::Buffer& stats, int input_triangles, std::vector<cl::Event>& tessellate_events,
                                 std::vector<cl::Event>& setup_events) {
   Kernels& k = kernels(program_options);
@@ -78,18 +78,18 @@ void TessellationStage::enqueue(const std::string& program_options, const cl::Bu
                                         cl::NDRange(SEAMCL_SETUP_GROUP), nullptr, &setup_events.emplace_back());
 }
 
-std::vector<TessVertex> TessellationStage::tessellate(const std::string& program_options) {
+std::vector<TessVertex> TessellateLauncher::tessellate(const std::string& program_options) {
   enqueue_tessellate(kernels(program_options), nullptr);
   return read_vertices();
 }
 
-std::vector<TessVertex> TessellationStage::read_vertices() {
+std::vector<TessVertex> TessellateLauncher::read_vertices() {
   std::vector<TessVertex> out(packed_.vertex_count());
   if (!out.empty()) runtime_.queue().enqueueReadBuffer(vertices_, CL_TRUE, 0, out.size() * sizeof(TessVertex), out.data());
   return out;
 }
 
-size_t TessellationStage::device_bytes() const {
+size_t TessellateLauncher::device_bytes() const {
   size_t bytes = 0;
   for (const cl::Buffer* b : {&params_, &patches_, &samples_, &positions_, &normals_, &vertices_}) {
     if ((*b)() != nullptr) bytes += b->getInfo<CL_MEM_SIZE>();

@@ -1,13 +1,13 @@
-#include <seamcl/eval/bench_merge.h>
+#include <seamcl/batch/bench_merge.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <map>
 
+#include <seamcl/batch/shard.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
-#include <seamcl/eval/shard.h>
 #include <seamcl/options/render_options.h>
 
 namespace seamcl {

@@ -1,8 +1,8 @@
-#include "twins/shade_reflection.h"
+#include "pipeline/stages/shade_resolve_reflection_twin.h"
 
 #include <cmath>
 
-#include "twins/cube_sample.h"
+#include "pipeline/stages/cube_sample_twin.h"
 
 namespace seamcl {
 namespace {

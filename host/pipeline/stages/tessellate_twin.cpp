@@ -1,4 +1,4 @@
-#include "twins/tessellate.h"
+#include "pipeline/stages/tessellate_twin.h"
 
 #include <cmath>
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include "twins/sample_pattern.h"
+#include "pipeline/stages/sample_pattern.h"
 
 #include <stdexcept>
 #include <string>

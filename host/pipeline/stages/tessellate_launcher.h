@@ -11,9 +11,9 @@
 
 namespace seamcl {
 
-class TessellationStage {
+class TessellateLauncher {
  public:
-  explicit TessellationStage(ClRuntime& runtime) : runtime_(runtime) {}
+  explicit TessellateLauncher(ClRuntime& runtime) : runtime_(runtime) {}
 
   // Uploads the patches, samples, positions and normals, and sizes the vertex buffer.
   void load(PackedDisplacement packed);

@@ -18,8 +18,8 @@ struct SurfaceUv {
 SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y);
 
 // Colour of one fragment: texture lookup times the face's Lambert lighting; on a reflective face
-// the environment along the reflected ray (twins/shade_reflection.h), from `cube_texels` (the
-// renderer's Renderer::cube_texels(); needed by scenes with an environment only).
+// the environment along the reflected ray (pipeline/stages/shade_resolve_reflection_twin.h), from
+// `cube_texels` (the renderer's Renderer::cube_texels(); needed by scenes with an environment only).
 glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& frame, const TriangleSetup& t, float x,
                                    float y, const std::vector<float>* cube_texels = nullptr);
 

@@ -1,10 +1,10 @@
-#include "twins/triangle_setup.h"
+#include "pipeline/stages/triangle_setup_twin.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 
-#include "twins/sample_pattern.h"
+#include "pipeline/stages/sample_pattern.h"
 
 namespace seamcl {
 namespace {

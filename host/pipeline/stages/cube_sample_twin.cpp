@@ -1,11 +1,11 @@
-#include "twins/cube_sample.h"
+#include "pipeline/stages/cube_sample_twin.h"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 
 #include <seamcl/scene/cube_map.h>
-#include "twins/texture_sample.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 namespace seamcl {
 namespace {

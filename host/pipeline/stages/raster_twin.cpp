@@ -1,9 +1,9 @@
-#include "twins/raster.h"
+#include "pipeline/stages/raster_twin.h"
 
 #include <limits>
 
-#include "twins/sample_pattern.h"
-#include "twins/triangle_setup.h"
+#include "pipeline/stages/sample_pattern.h"
+#include "pipeline/stages/triangle_setup_twin.h"
 
 namespace seamcl {
 

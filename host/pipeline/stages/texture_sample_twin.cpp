@@ -1,4 +1,4 @@
-#include "twins/texture_sample.h"
+#include "pipeline/stages/texture_sample_twin.h"
 
 #include "core/srgb.h"
 #include "pipeline/adjacency.h"

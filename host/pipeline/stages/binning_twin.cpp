@@ -1,6 +1,6 @@
-#include "twins/binning.h"
+#include "pipeline/stages/binning_twin.h"
 
-#include "twins/triangle_setup.h"
+#include "pipeline/stages/triangle_setup_twin.h"
 
 namespace seamcl {
 

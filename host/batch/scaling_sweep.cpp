@@ -1,4 +1,4 @@
-#include <seamcl/eval/scaling_sweep.h>
+#include <seamcl/batch/scaling_sweep.h>
 
 #include <algorithm>
 #include <chrono>
@@ -6,8 +6,8 @@
 #include <memory>
 #include <optional>
 
+#include <seamcl/batch/bench_merge.h>
 #include <seamcl/core/input_error.h>
-#include <seamcl/eval/bench_merge.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/pipeline/render_memory.h>
 #include <seamcl/pipeline/renderer.h>

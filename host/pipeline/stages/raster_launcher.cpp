@@ -1,0 +1,50 @@
+#include "pipeline/stages/raster_launcher.h"
+
+#include "pipeline/stages/stage_buffers.h"
+#include "pipeline/stages/triangle_setup_launcher.h"
+
+namespace seamcl {
+
+void RasterLauncher::use_program(const std::string& program_options) {
+  auto it = kernels_.find(program_options);
+  if (it == kernels_.end()) {
+    it = kernels_.emplace(program_options, cl::Kernel(runtime_.program(program_options), "raster")).first;
+  }
+  kernel_ = it->second;
+}
+
+void RasterLauncher::reserve(const FrameParams& p) {
+  grow_buffer(sample_triangle_, samples_capacity_, static_cast<size_t>(p.width) * p.height * p.sample_count,
+              sizeof(cl_uint), runtime_.context());
+}
+
+void RasterLauncher::enqueue(const cl::Buffer& frame_params, const cl::Buffer& setups, const BinningLauncher& binning,
+                             const FrameParams& p, std::vector<cl::Event>& events) {
+  kernel_.setArg(0, frame_params);
+  kernel_.setArg(1, setups);
+  kernel_.setArg(2, binning.tile_counts());
+  kernel_.setArg(3, binning.tile_offsets());
+  kernel_.setArg(4, binning.tile_lists());
+  kernel_.setArg(5, binning.tile_entry_rows());
+  kernel_.setArg(6, sample_triangle_);
+  // One work-item per tile (kernels/raster.cl walks a tile's list once, a row in a 16-wide vector).
+  runtime_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange,
+                                        cl::NDRange(static_cast<size_t>(p.tiles_x), static_cast<size_t>(p.tiles_y)),
+                                        cl::NDRange(1, 1), nullptr, &events.emplace_back());
+}
+
+std::vector<uint32_t> RasterLauncher::read_sample_triangles(const FrameParams& p) {
+  std::vector<uint32_t> winners =
+      read_buffer<uint32_t>(runtime_.queue(), sample_triangle_, static_cast<size_t>(p.width) * p.height * p.sample_count);
+  for (uint32_t& slot : winners) slot = input_order_slot(slot, static_cast<uint32_t>(p.input_triangles));
+  return winners;
+}
+
+void RasterLauncher::release() {
+  sample_triangle_ = cl::Buffer();
+  samples_capacity_ = 0;
+}
+
+size_t RasterLauncher::device_bytes() const { return buffer_bytes(sample_triangle_); }
+
+}  // namespace seamcl
