@@ -17,7 +17,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/io/image_io.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>

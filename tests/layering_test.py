@@ -24,8 +24,11 @@ ALLOWED = {
     "twins": {"core", "scene", "pipeline"},
     "io": {"core", "scene", "pipeline"},
     "eval": {"core", "cl", "scene", "pipeline", "io"},
-    "assets": {"core", "scene", "pipeline", "io"},
+    "memory": {"core", "cl", "scene", "pipeline", "io", "eval"},
+    "assets": {"core", "scene", "pipeline", "io", "memory"},
 }
+# Batch work still in eval/ that issue 35 moves above memory/ (it sizes its renders with it).
+LEAVING_EVAL = {"eval/scaling_sweep.h", "eval/scaling_sweep.cpp"}
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 
 
@@ -76,7 +79,8 @@ def main():
             if target is None:
                 continue
             target_folder = target.split("/")[0]
-            if target_folder != folder and target_folder not in ALLOWED.get(folder, set()):
+            leaving = rel in LEAVING_EVAL and target_folder == "memory"
+            if target_folder != folder and target_folder not in ALLOWED.get(folder, set()) and not leaving:
                 problems.append(f"{where}: host/{folder}/ may not depend on host/{target_folder}/")
             if target in public and kind == '"':
                 problems.append(f"{where}: a public header is included as <seamcl/{target}>")

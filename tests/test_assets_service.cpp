@@ -15,7 +15,7 @@
 
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/io/image_io.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 #include "server_support.h"
 

@@ -23,7 +23,7 @@
 #include <seamcl/eval/reference.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/packed_scene.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 

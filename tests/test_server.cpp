@@ -28,13 +28,13 @@
 #include <unistd.h>
 
 #include <seamcl/core/input_error.h>
-#include <seamcl/eval/compare_memory.h>
+#include <seamcl/memory/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/packed_scene.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>

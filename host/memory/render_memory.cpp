@@ -1,4 +1,4 @@
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 
 #include <algorithm>
 #include <limits>
@@ -129,11 +129,6 @@ SceneSizes scene_sizes(const Scene& scene) {
   }
   sizes.cube_size = scene.environment ? scene.environment->cube_size : 0;
   return sizes;
-}
-
-uint32_t initial_tile_list_entries(size_t triangles) {
-  // As Renderer::load_scene: a few entries per triangle slot plus a floor, at most 2^30.
-  return static_cast<uint32_t>(std::min<size_t>(add(mul(triangles, 8), 65536), size_t{1} << 30));
 }
 
 PackedTextureMemory packed_texture_memory(const SceneSizes& scene, TexelFormat format, int guard_band) {

@@ -49,9 +49,6 @@ struct SceneSizes {
 
 SceneSizes scene_sizes(const Scene& scene);
 
-// Tile-list entries a Renderer allocates for a scene of `triangles` before it learns better.
-uint32_t initial_tile_list_entries(size_t triangles);
-
 // Packed textures in a format with a guard band (0: none): what pack_scene makes.
 struct PackedTextureMemory {
   size_t levels = 0;           // mip levels of all faces (level_offsets entries)

@@ -1,6 +1,6 @@
 // The memory of a compare (compare_methods with its seam mask and 8x reference, as `seamcl
 // compare` and POST /v1/compare run it on one Renderer), computed from the inputs alone, before
-// any texture or buffer exists. The parts are render_memory()s (host/pipeline/render_memory.h);
+// any texture or buffer exists. The parts are render_memory()s (host/memory/render_memory.h);
 // the totals are over the phases of the run:
 //   1. load_scene, the 1-sample face-map frame (seam mask), the 8x reference render and its
 //      Mitchell downsample (with the analytic reference: the 8x frame at 1 sample, its winners
@@ -18,7 +18,7 @@
 
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/reference.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 
 namespace seamcl {
 
@@ -54,6 +54,10 @@ struct CompareMemory {
   // references and error distances "size".
   MemoryShares device_shares, device_bound_shares, host_shares;
 };
+
+// The sizes seamless_scene(scene) would have (one face of the combined texture), from the grid
+// alone, before any texel is copied. Refuses as seamless_scene does.
+SceneSizes seamless_scene_sizes(const Scene& scene);
 
 // Assumes the references are rendered (a cache hit needs less). `kinds` are the references
 // measured against (as prepare_targets takes them); `seamless_scene`, seamless_scene_sizes of the

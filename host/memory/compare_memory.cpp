@@ -1,4 +1,4 @@
-#include <seamcl/eval/compare_memory.h>
+#include <seamcl/memory/compare_memory.h>
 
 #include <algorithm>
 #include <stdexcept>
@@ -6,6 +6,14 @@
 #include <seamcl/pipeline/gpu_types.h>
 
 namespace seamcl {
+
+SceneSizes seamless_scene_sizes(const Scene& scene) {
+  SceneSizes sizes;
+  sizes.vertices = 4;
+  sizes.faces = {seamless_texture_size(scene)};
+  return sizes;
+}
+
 namespace {
 
 size_t add(size_t a, size_t b) { return saturating_add(a, b); }
