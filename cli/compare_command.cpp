@@ -181,6 +181,9 @@ int run_compare(const CompareArgs& args, const GlobalOptions& global) {
     }
     if (!images_dir.empty()) out["images"] = images_dir;
     if (!displacement.is_null()) out["displacement"] = displacement;
+    const bool unified = runtime.info().host_unified_memory;
+    out["estimate"] = estimate_json(memory.device_shares, memory.host_shares, memory.process_shares(unified), unified);
+    out["memory"] = {{"peak_rss_bytes", process_memory().peak_rss_bytes}};
     std::cout << out.dump(2) << "\n";
   } else {
     std::printf("%s %s; seam mask: pixels whose texture footprint crosses a face edge\n", scene.name.c_str(), size.c_str());

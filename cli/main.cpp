@@ -106,7 +106,8 @@ int run_render(const RenderArgs& args, const std::string& device) {
 
   // A render this machine cannot hold is refused before it allocates (a mesh's triangles drive it:
   // each takes about 700 bytes of setup records).
-  refuse_beyond_machine(render_memory(scene, options), options.msaa, runtime.info(), "this render");
+  const RenderMemory estimate = render_memory(scene, options);
+  refuse_beyond_machine(estimate, options.msaa, runtime.info(), "this render");
   Renderer renderer(runtime);
   limit_to_machine(renderer, runtime.info());
   // Handed over, not copied: image faces' float chains exist once (scene() reads them back).
@@ -156,6 +157,10 @@ int run_render(const RenderArgs& args, const std::string& device) {
     }
     if (!output.empty()) out["output"] = output;
     out["memory"] = to_json(measure_memory(renderer));  // peak over everything above
+    const std::string field = frame_buffers_field(options.msaa);
+    const bool unified = runtime.info().host_unified_memory;
+    out["estimate"] = estimate_json(estimate.device_shares(field), estimate.host_shares(),
+                                    estimate.process_shares(field, unified), unified);
     std::cout << out.dump(2) << "\n";
   } else {
     std::printf("%s: %dx%d msaa %d, %.2f ms (setup %.2f, binning %.2f, raster %.2f, shade %.2f), %u fragments%s%s\n",

@@ -53,6 +53,15 @@ struct CompareMemory {
   // host figure: the Scene copies, packing and read-back setups "scene"; images, masks,
   // references and error distances "size".
   MemoryShares device_shares, device_bound_shares, host_shares;
+  // Device bytes that are host bytes too on a device sharing the host's memory: the largest
+  // packing's scene buffers are its packed arrays (RenderMemory::shared_scene).
+  size_t shared_scene = 0;
+
+  // device_shares and host_shares as one memory, each shared byte once for a `unified` device:
+  // what the process holds at the compare's peak beyond what it held before (the "estimate" of
+  // `compare --json`). Tile lists at their initial size: a Renderer's device byte limit refuses
+  // their growth past it.
+  MemoryShares process_shares(bool unified) const;
 };
 
 // The sizes seamless_scene(scene) would have (one face of the combined texture), from the grid
