@@ -794,9 +794,9 @@ void HttpServer::refuse_scene_over_budget(const Scene& scene, const RenderOption
   const RenderMemory memory = scene_render_memory(sizes, options);
   const MemoryShares device = memory.device_shares(frame_buffers_field(1));  // scene_render_memory: one sample
   MemoryShares host = memory.host_shares();
-  // The request holds its own copy of an inline scene or asset on top of the Renderer's, and what
-  // its texture_source keeps (a deferred .ptx's bytes, also one named inside a scene file).
-  host.add("scene", builtin_scene ? 0 : scene_held_bytes(scene));
+  // The request holds its own copy of an inline scene or asset on top of the Renderer's (what its
+  // texture_source keeps, a deferred .ptx's bytes, is shared by the copies: host_scene counts it).
+  host.add("scene", builtin_scene ? 0 : scene_host_bytes(sizes));
   std::string device_field = budget_field(device.field(), builtin_scene), host_field = budget_field(host.field(), builtin_scene);
   // An inline generator's sizing options: the field is the first given, the message names them all.
   std::string sized_by;
@@ -841,7 +841,7 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   refuse_scene_over_budget(*scene, options, inline_scene, key);
   const RenderMemory memory = render_memory(scene_sizes(*scene), options);
   MemoryShares host = memory.host_shares();
-  host.add("scene", inline_request ? scene_held_bytes(*scene) : 0);  // the request's own copy, as above
+  host.add("scene", inline_request ? scene_host_bytes(scene_sizes(*scene)) : 0);  // the request's own copy, as above
   refuse_over_budget(memory.device_shares(frame_buffers_field(options.msaa)), host, !inline_request, "this render");
 
   // Wait for a render slot (or 503), render, and give the slot back before encoding.
@@ -982,7 +982,7 @@ void HttpServer::handle_compare(const json& request, httplib::Response& res) {
   const bool seamless = std::find(reference_kinds.begin(), reference_kinds.end(), ReferenceKind::Seamless) != reference_kinds.end();
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, entries, reference_settings, reference_kinds,
                                               seamless ? std::optional(seamless_scene_sizes(*scene)) : std::nullopt);
-  refuse_over_budget(memory.device_bound_shares, memory.host_shares, !key.empty(), "this compare");
+  refuse_over_budget(memory.device_shares, memory.host_shares, !key.empty(), "this compare");
   // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
   const Clock::time_point deadline =
       options_.deadline_ms > 0 ? start + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
@@ -1114,7 +1114,7 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
   check_reference_limits(frame, settings, explicit_reference_msaa);
   refuse_scene_over_budget(*scene, frame, inline_scene, key);
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, {}, settings);
-  refuse_over_budget(memory.device_bound_shares, memory.host_shares, !key.empty(), "this reference");
+  refuse_over_budget(memory.device_shares, memory.host_shares, !key.empty(), "this reference");
 
   const Clock::time_point queued = Clock::now();
   double queue_ms = 0;
