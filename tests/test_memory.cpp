@@ -297,6 +297,31 @@ TEST(Memory, AssetScenesDeferTheirTexturesAndPackAsTheEagerOnes) {
   EXPECT_NE(reference_cache_key(rand, rand.camera, frame, {}), reference_cache_key(wave, rand.camera, frame, {}));
 }
 
+// Issue 35: the service refused ptex_test_object.obj with cellnoise.ptx at "about 1136.7 MiB of
+// host memory" while the request peaked at about 420 MB: the deferred .ptx's float texels were
+// counted in the Renderer's copy and again in the request's own, though neither holds any. Its
+// host figure, as the service adds it up, now holds no float copy at all, and the file's bytes once.
+TEST(Memory, ADeferredPtxIsCountedWithoutFloatTexelsAndItsFileOnce) {
+  SceneSourceOptions deferred;
+  deferred.generator.defer_textures = true;
+  const std::string dir = seamcl_tests::ptex_assets_dir() + "/";
+  const Scene scene = load_scene_source(dir + "ptex_test_object.obj", dir + "cellnoise.ptx", deferred);
+  ASSERT_EQ(scene.faces.size(), 306u);
+  ASSERT_GT(scene.texture_source_bytes, 0u);
+  const SceneSizes sizes = scene_sizes(scene);
+  const size_t one_float_copy = scene.texel_count() * sizeof(glm::vec4);
+  const RenderMemory memory = render_memory(sizes, RenderOptions{});
+  EXPECT_EQ(memory.host_scene, scene_host_bytes(sizes) + scene.texture_source_bytes);
+  EXPECT_LT(scene_host_bytes(sizes), scene.faces.size() * 1024);  // records, no texels
+  const size_t service_host = memory.host_shares().total() + scene_host_bytes(sizes);  // + the request's copy
+  EXPECT_LT(service_host, one_float_copy) << "a float copy of the texels is counted";
+  EXPECT_LT(service_host, size_t{1} << 30);
+  // What it does count: the packing, the faces made meanwhile (each at most its float chain), the file.
+  EXPECT_GE(service_host, memory.textures.texture_bytes + memory.host_making + scene.texture_source_bytes);
+  EXPECT_GT(memory.host_making, 0u);
+  EXPECT_LE(memory.host_making, std::max(memory.textures.texture_bytes, sizes.heaviest_making.front()));
+}
+
 // The service's budget check (issue 14): the scene's own cost comes from its sizes, so a deferred
 // scene is refused before a texel is baked. What the scene alone costs does not depend on the
 // frame, and is the request at one pixel.

@@ -6,7 +6,7 @@
 
 namespace seamcl {
 
-// Adds 1 MiB and 1/64 of the figure to its largest share.
+// Adds 1/64 of the figure to its largest share.
 void add_process_overhead(MemoryShares& figure);
 
 }  // namespace seamcl
