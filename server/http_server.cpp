@@ -686,9 +686,10 @@ std::shared_ptr<const Scene> HttpServer::asset_scene(const RenderOptions& option
   SceneSourceOptions source;
   source.generator.tint = options.tint;
   source.generator.defer_textures = true;  // a .ptx's faces decoded while packed, not held as floats
-  // A file's decoded texels (float RGBA) beyond the host budget are refused by the reader, before
-  // they are allocated; a smaller asset is measured against the budgets like any scene.
-  source.ptex_limits.max_texels = std::min<uint64_t>(source.ptex_limits.max_texels, options_.max_request_host_bytes / sizeof(glm::vec4));
+  // A file whose texels could not fit the host budget in any packing (4 bytes each, rgba8) is
+  // refused by the reader before they are decoded; a deferred file never holds them all as floats.
+  // A smaller asset is measured against the budgets like any scene.
+  source.ptex_limits.max_texels = std::min<uint64_t>(source.ptex_limits.max_texels, options_.max_request_host_bytes / sizeof(uint32_t));
   return assets_->load(options.scene, options.texture, source);
 }
 

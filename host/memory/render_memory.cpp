@@ -114,7 +114,7 @@ size_t RenderMemory::device_bytes_bound() const {
   return add(add(scene_device_bytes(), constants),
              add(add(add(setups, tiles), add(tile_lists_bound, samples)), add(image, seam_mask)));
 }
-size_t RenderMemory::host_bytes() const { return add(add(host_scene, host_packed), host_image); }
+size_t RenderMemory::host_bytes() const { return add(add(add(host_scene, host_packed), host_image), host_making); }
 
 MemoryShares RenderMemory::device_shares(const std::string& multisample_field, bool tile_lists_at_bound) const {
   // One sample per pixel grows with the size, as the image does; only the samples beyond it are

@@ -140,7 +140,7 @@ struct RenderMemory {
   size_t device_bytes() const;        // scene + constants + frame
   // The same with the tile lists at their bound: no render of this request can need more.
   size_t device_bytes_bound() const;
-  size_t host_bytes() const;          // host_scene + host_packed + host_image
+  size_t host_bytes() const;          // host_scene + host_packed + host_image + host_making
 
   // device_bytes() (with tile_lists_at_bound, device_bytes_bound()) split: the pixels' buffers
   // (tiles, one sample per pixel, image, seam mask) by "size", added first; the samples beyond one
