@@ -10,7 +10,7 @@
 #include <string>
 
 #include <seamcl/assets/ptex_file.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 
 namespace {
 

@@ -24,12 +24,15 @@
 #include <seamcl/batch/shard.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
-#include <seamcl/eval/bench_memory.h>
+#include <seamcl/memory/bench_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/options/render_options.h>
+#include <seamcl/batch/bench_merge.h>
+#include <seamcl/batch/scaling_sweep.h>
+#include <seamcl/batch/shard.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 #include "commands.h"

@@ -13,7 +13,7 @@
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/jobs/compare_job.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include "commands.h"
 #include "option_flags.h"
 #include "reference_cache_flags.h"
@@ -69,7 +69,7 @@ int run_compare(CompareArgs& args, const GlobalOptions& global) {
   const Scene scene = load_scene_source(job.frame().scene, job.frame().texture, source);
   // A compare this machine cannot hold is refused before it allocates, as render refuses one.
   const JobPlan plan = job.plan(scene);
-  refuse_beyond_machine(plan.device, plan.host, runtime.info(), plan.what);
+  refuse_beyond_machine(plan, runtime.info());
   if (!images_dir.empty()) make_output_directory(images_dir, "images");
 
   JobControl control;
@@ -84,6 +84,8 @@ int run_compare(CompareArgs& args, const GlobalOptions& global) {
     out["images"] = images_dir;
   }
   if (args.json_out) {
+    out["estimate"] = plan.estimate_json(runtime.info().host_unified_memory);
+    out["memory"] = {{"peak_rss_bytes", process_memory().peak_rss_bytes}};
     std::cout << out.dump(2) << "\n";
   } else {
     print_table(out);

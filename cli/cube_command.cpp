@@ -19,7 +19,7 @@
 #include <seamcl/eval/cube_metrics.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/packed_cube.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/cube_map.h>

@@ -21,7 +21,7 @@
 #include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/options/displacement_method.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include "commands.h"

@@ -18,7 +18,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/jobs/render_job.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 #include <seamcl/version.h>
@@ -63,7 +63,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
 
   // A render this machine cannot hold is refused before it allocates.
   const JobPlan plan = job.plan(scene);
-  refuse_beyond_machine(plan.device, plan.host, runtime.info(), plan.what);
+  refuse_beyond_machine(plan, runtime.info());
   Renderer renderer(runtime);
   limit_to_machine(renderer, runtime.info());
   // Handed over, not copied: image faces' float chains exist once (scene() reads them back).
@@ -78,9 +78,13 @@ int run_render(const RenderArgs& args, const std::string& device) {
     json out = job.result_json(run, renderer, runtime.device_description());
     out["kernel_build_ms"] = runtime.program_build_ms();
     out["scene_ms"] = scene_ms;
-    out["plan"] = plan.to_json();
+    out["estimate"] = plan.estimate_json(runtime.info().host_unified_memory);
     if (!output.empty()) out["output"] = output;
     out["memory"] = to_json(measure_memory(renderer));  // peak over everything above
+    const std::string field = frame_buffers_field(options.msaa);
+    const bool unified = runtime.info().host_unified_memory;
+    out["estimate"] = estimate_json(estimate.device_shares(field), estimate.host_shares(),
+                                    estimate.process_shares(field, unified), unified);
     std::cout << out.dump(2) << "\n";
   } else {
     const StageTimes& ms = run.median;

@@ -26,7 +26,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/json_document.h>
 #include <seamcl/core/over_budget.h>
-#include <seamcl/eval/compare_memory.h>
+#include <seamcl/memory/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
@@ -34,7 +34,7 @@
 #include <seamcl/jobs/compare_job.h>
 #include <seamcl/jobs/render_job.h>
 #include <seamcl/pipeline/packed_scene.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
@@ -626,9 +626,10 @@ std::shared_ptr<const Scene> HttpServer::asset_scene(const RenderOptions& option
   SceneSourceOptions source;
   source.generator.tint = options.tint;
   source.generator.defer_textures = true;  // a .ptx's faces decoded while packed, not held as floats
-  // A file's decoded texels (float RGBA) beyond the host budget are refused by the reader, before
-  // they are allocated; a smaller asset is measured against the budgets like any scene.
-  source.ptex_limits.max_texels = std::min<uint64_t>(source.ptex_limits.max_texels, options_.max_request_host_bytes / sizeof(glm::vec4));
+  // A file whose texels could not fit the host budget in any packing (4 bytes each, rgba8) is
+  // refused by the reader before they are decoded; a deferred file never holds them all as floats.
+  // A smaller asset is measured against the budgets like any scene.
+  source.ptex_limits.max_texels = std::min<uint64_t>(source.ptex_limits.max_texels, options_.max_request_host_bytes / sizeof(uint32_t));
   return assets_->load(options.scene, options.texture, source);
 }
 
@@ -734,9 +735,9 @@ void HttpServer::refuse_scene_over_budget(const Scene& scene, const RenderOption
   const RenderMemory memory = scene_render_memory(sizes, options);
   const MemoryShares device = memory.device_shares(frame_buffers_field(1));  // scene_render_memory: one sample
   MemoryShares host = memory.host_shares();
-  // The request holds its own copy of an inline scene or asset on top of the Renderer's, and what
-  // its texture_source keeps (a deferred .ptx's bytes, also one named inside a scene file).
-  host.add("scene", builtin_scene ? 0 : scene_held_bytes(scene));
+  // The request holds its own copy of an inline scene or asset on top of the Renderer's (what its
+  // texture_source keeps, a deferred .ptx's bytes, is shared by the copies: host_scene counts it).
+  host.add("scene", builtin_scene ? 0 : scene_host_bytes(sizes));
   std::string device_field = budget_field(device.field(), builtin_scene), host_field = budget_field(host.field(), builtin_scene);
   // An inline generator's sizing options: the field is the first given, the message names them all.
   std::string sized_by;
@@ -783,7 +784,7 @@ void HttpServer::handle_render(const json& request, httplib::Response& res) {
   }
   refuse_scene_over_budget(*scene, options, inline_scene, key);
   // The request's own copy of an inline scene or asset is held on top of the Renderer's.
-  const JobPlan plan = job.plan(*scene, inline_request ? scene_held_bytes(*scene) : 0);
+  const JobPlan plan = job.plan(*scene, inline_request ? scene_host_bytes(scene_sizes(*scene)) : 0);
   refuse_over_budget(plan.device, plan.host, !inline_request, plan.what);
 
   // Wait for a render slot (or 503), render, and give the slot back before encoding.
@@ -1009,7 +1010,7 @@ void HttpServer::handle_reference(const json& request, httplib::Response& res) {
   check_reference_limits(frame, settings, explicit_reference_msaa);
   refuse_scene_over_budget(*scene, frame, inline_scene, key);
   const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, {}, settings);
-  refuse_over_budget(memory.device_bound_shares, memory.host_shares, !key.empty(), "this reference");
+  refuse_over_budget(memory.device_shares, memory.host_shares, !key.empty(), "this reference");
 
   const Clock::time_point queued = Clock::now();
   double queue_ms = 0;

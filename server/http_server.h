@@ -34,7 +34,7 @@
 #include <seamcl/assets/asset_directory.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/eval/reference.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/options/render_options.h>
 
 namespace httplib {

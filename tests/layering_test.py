@@ -25,9 +25,10 @@ ALLOWED = {
     "pipeline": {"core", "options", "cl", "scene"},
     "io": {"core", "options", "scene", "pipeline"},
     "eval": {"core", "options", "cl", "scene", "pipeline", "io"},
-    "assets": {"core", "options", "scene", "pipeline", "io"},
-    "batch": {"core", "options", "cl", "scene", "pipeline", "eval"},
-    "jobs": {"core", "options", "cl", "scene", "pipeline", "io", "eval", "batch", "assets"},
+    "memory": {"core", "options", "cl", "scene", "pipeline", "io", "eval"},
+    "assets": {"core", "options", "scene", "pipeline", "io", "memory"},
+    "batch": {"core", "options", "cl", "scene", "pipeline", "eval", "memory"},
+    "jobs": {"core", "options", "cl", "scene", "pipeline", "io", "eval", "memory", "batch", "assets"},
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 

@@ -29,7 +29,7 @@
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/io/image_io.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/pipeline/texture_lookups.h>
 #include <seamcl/scene/scene_generators.h>

@@ -15,7 +15,7 @@
 
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/io/image_io.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/options/render_options.h>
 #include "server_support.h"
 
@@ -180,7 +180,7 @@ TEST(AssetsService, WithoutAssetsNoFileIsReachableAndAHugeAssetIsRefusedNotLoade
     EXPECT_EQ(answer->status, 400);
     EXPECT_EQ(json::parse(answer->body).at("field"), "scene");
   }
-  // A host budget below what the texture decodes to: refused by the reader's limit, as a 4xx.
+  // A host budget below what the texture packs to at 4 bytes a texel: refused by the reader's limit, as a 4xx.
   seamcl::server::ServerOptions options;
   options.threads = 1;
   options.assets_dir = w.path("assets").string();
@@ -195,8 +195,9 @@ TEST(AssetsService, WithoutAssetsNoFileIsReachableAndAHugeAssetIsRefusedNotLoade
 }
 
 // A deferred .ptx keeps its file's bytes to make the faces from (Scene::texture_source_bytes), and
-// a request's host budget counts them: an asset whose render memory alone fits the budget, but not
-// with those bytes, is refused with a 413 naming the budget; at exactly both it renders.
+// a request's host budget counts them once (with the Renderer's copy of the scene: issue 35, they
+// and the float texels no copy holds were counted twice): one byte short of the figure is a 413
+// naming the budget, at exactly the figure it renders.
 TEST(AssetsService, ADeferredPtexsKeptBytesCountAgainstTheHostBudget) {
   Workspace w;
   fs::copy_file(sample("ptex_test_object.obj"), w.path("assets/object.obj"));
@@ -210,15 +211,16 @@ TEST(AssetsService, ADeferredPtexsKeptBytesCountAgainstTheHostBudget) {
       seamcl::load_scene_source(w.path("assets/object.obj").string(), w.path("assets/cellnoise.ptx").string(), source);
   const seamcl::RenderOptions options = seamcl::parse_render_options(body);
   const seamcl::SceneSizes sizes = seamcl::scene_sizes(scene);
-  const size_t render_bytes = std::max(seamcl::scene_render_memory(sizes, options).host_bytes(),
-                                       seamcl::render_memory(sizes, options).host_bytes());
+  const seamcl::RenderMemory render = seamcl::render_memory(sizes, options);
+  const size_t render_bytes = std::max(seamcl::scene_render_memory(sizes, options).host_bytes(), render.host_bytes());
   const size_t kept = scene.texture_source_bytes;
   ASSERT_EQ(kept, fs::file_size(sample("cellnoise.ptx")));
-  const size_t held = seamcl::scene_held_bytes(scene);  // the request's copy of the scene, and the kept bytes
-  ASSERT_EQ(held, seamcl::scene_host_bytes(sizes) + kept);
-  ASSERT_LE(scene.texel_count() * sizeof(glm::vec4), render_bytes) << "the reader's own limit must not refuse it first";
+  ASSERT_EQ(render.host_scene, seamcl::scene_host_bytes(sizes) + kept);  // the file, with the Renderer's copy
+  const size_t held = seamcl::scene_host_bytes(sizes);  // the request's own copy: records, no texels
+  ASSERT_LT(render_bytes + held, scene.texel_count() * sizeof(glm::vec4)) << "a float copy of the texels is counted";
+  ASSERT_LE(scene.texel_count() * sizeof(uint32_t), render_bytes) << "the reader's own limit must not refuse it first";
 
-  // One byte short of the sum (it would pass without the kept bytes, which are far more), then the sum.
+  // One byte short of the figure, then the figure.
   for (const size_t budget : {render_bytes + held - 1, render_bytes + held}) {
     SCOPED_TRACE(budget);
     seamcl::server::ServerOptions server_options;

@@ -1,4 +1,4 @@
-// Memory budgets (host/pipeline/render_memory.h, host/eval/compare_memory.h) against what the
+// Memory budgets (host/memory/render_memory.h, host/memory/compare_memory.h) against what the
 // library really allocates; Renderer's release of request-sized buffers; the reference cache's
 // bound (LRU); the cancellation hook of compare_methods.
 #include <gtest/gtest.h>
@@ -20,13 +20,13 @@
 #include <seamcl/core/cancelled.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/over_budget.h>
-#include <seamcl/eval/bench_memory.h>
-#include <seamcl/eval/compare_memory.h>
+#include <seamcl/memory/bench_memory.h>
+#include <seamcl/memory/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/eval/reference.h>
 #include <seamcl/pipeline/packed_scene.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 

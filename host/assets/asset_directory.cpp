@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include <seamcl/core/input_error.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 
 namespace seamcl {
 namespace {

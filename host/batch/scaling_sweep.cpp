@@ -9,7 +9,7 @@
 #include <seamcl/batch/bench_merge.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
 
 namespace seamcl {

@@ -22,7 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include <seamcl/cl/cl_runtime.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>

@@ -622,12 +622,9 @@ SeamlessGrid seamless_grid(const Scene& scene) {
 
 }  // namespace
 
-SceneSizes seamless_scene_sizes(const Scene& scene) {
+std::pair<int, int> seamless_texture_size(const Scene& scene) {
   const SeamlessGrid grid = seamless_grid(scene);
-  SceneSizes sizes;
-  sizes.vertices = 4;
-  sizes.faces = {{grid.width, grid.height}};
-  return sizes;
+  return {grid.width, grid.height};
 }
 
 Scene seamless_scene(const Scene& scene) {

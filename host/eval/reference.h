@@ -24,7 +24,6 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
-#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene.h>
@@ -178,9 +177,10 @@ std::vector<glm::vec4> analytic_image(Renderer& renderer, const Scene& scene);
 // by side (its mip chain rebuilt: each level is the faces' same level side by side). Same
 // camera, orbit, light and background. InputError("reference", why) for any other scene.
 Scene seamless_scene(const Scene& scene);
-// The sizes seamless_scene(scene) would have (one face of the combined texture), found from the
-// grid alone, before any texel is copied: what a budget needs. Refuses as seamless_scene does.
-SceneSizes seamless_scene_sizes(const Scene& scene);
+// The level-0 width and height of seamless_scene(scene)'s one face, found from the grid alone,
+// before any texel is copied: what a budget needs (seamless_scene_sizes, compare_memory.h).
+// Refuses as seamless_scene does.
+std::pair<int, int> seamless_texture_size(const Scene& scene);
 
 // The seamless reference of one measured frame: `seamless` (a Renderer with seamless_scene
 // loaded) renders `frame`'s options (rate, filter, anisotropy, shading, texels) with discard: on

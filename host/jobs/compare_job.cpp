@@ -4,7 +4,7 @@
 #include <filesystem>
 
 #include <seamcl/core/input_error.h>
-#include <seamcl/eval/compare_memory.h>
+#include <seamcl/memory/compare_memory.h>
 #include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/io/image_io.h>
@@ -132,7 +132,7 @@ JobPlan CompareJob::plan(const Scene& scene) const {
   const bool seamless = std::find(kinds_.begin(), kinds_.end(), ReferenceKind::Seamless) != kinds_.end();
   const CompareMemory memory = compare_memory(scene_sizes(scene), frame_, entries_, reference_, kinds_,
                                               seamless ? std::optional(seamless_scene_sizes(scene)) : std::nullopt);
-  return JobPlan{"this compare", memory.device_shares, memory.host_shares};
+  return JobPlan{"this compare", memory.device_shares, memory.host_shares, memory.process_shares(true)};
 }
 
 CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobControl& control,

@@ -3,22 +3,24 @@
 #include <algorithm>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/over_budget.h>
 
 namespace seamcl {
 
-nlohmann::json JobPlan::to_json() const {
-  // The fields a share can be named after (MemoryShares' callers use these).
-  auto shares_json = [](const MemoryShares& shares) {
-    nlohmann::json out = nlohmann::json::object();
-    for (const char* field : {"scene", "size", "msaa", "frames"})
-      if (shares.share(field) > 0) out[field] = shares.share(field);
-    return out;
-  };
-  return {{"what", what},
-          {"device_bytes", device.total()},
-          {"host_bytes", host.total()},
-          {"device_shares", shares_json(device)},
-          {"host_shares", shares_json(host)}};
+nlohmann::json JobPlan::estimate_json(bool unified_device) const {
+  MemoryShares separate = device;
+  separate.add(host);
+  return seamcl::estimate_json(device, host, unified_device ? unified : separate, unified_device);
+}
+
+void refuse_beyond_machine(const JobPlan& plan, const DeviceInfo& device) {
+  const size_t physical = physical_memory_bytes();
+  if (device.host_unified_memory) {
+    if (physical != 0 && plan.unified.total() > physical)
+      throw OverBudget(plan.unified.field(), plan.what, plan.unified.total(), physical);
+    return;
+  }
+  refuse_beyond_machine(plan.device, plan.host, device, plan.what);
 }
 
 void refuse_unknown_keys(const nlohmann::json& request, const std::vector<std::string>& known) {

@@ -6,7 +6,7 @@
 //
 //   CompareJob job(request);                      // InputError naming the field on bad input
 //   const JobPlan plan = job.plan(scene);          // memory by share, nothing allocated
-//   refuse_beyond_machine(plan.device, plan.host, device, plan.what);   // or a server's budget
+//   refuse_beyond_machine(plan, runtime.info());   // or a server's per-request budget
 //   const nlohmann::json result = job.run(runtime, scene, control);
 #pragma once
 #include <cstddef>
@@ -16,7 +16,8 @@
 #include <nlohmann/json.hpp>
 
 #include <seamcl/core/cancelled.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/memory/render_memory.h>
 
 namespace seamcl {
 
@@ -42,10 +43,20 @@ struct JobControl {
 struct JobPlan {
   std::string what;  // "this render", "this compare": the subject of a refusal's sentence
   MemoryShares device, host;
+  // The same bytes on a device that shares the host's memory (a CPU): each counted once, at the
+  // job's peak (the scene buffers are the packed arrays themselves), with the process overhead.
+  MemoryShares unified;
 
-  // {"what", "device_bytes", "host_bytes", "device_shares": {field: bytes}, "host_shares": {...}}
-  nlohmann::json to_json() const;
+  // {"device_bytes", "host_bytes", "total_bytes", "unified", "total_shares"}: the figure the
+  // machine is held to on `unified_device` (unified) or elsewhere (device + host).
+  nlohmann::json estimate_json(bool unified_device) const;
 };
+
+// OverBudget naming the largest share when the plan does not fit this machine: on a device that
+// shares the host's memory the unified figure against the physical memory, elsewhere each figure
+// against its own memory. For the command line, before any allocation (the service holds a job to
+// its per-request budget instead).
+void refuse_beyond_machine(const JobPlan& plan, const DeviceInfo& device);
 
 // The request's keys that are not in `known` are refused (InputError naming the first): a key a
 // job does not read would otherwise be ignored without a word.

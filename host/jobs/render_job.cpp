@@ -5,7 +5,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/displacement_metrics.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 
 namespace seamcl {
 namespace {
@@ -71,9 +71,11 @@ Camera RenderJob::camera(const Scene& scene) const {
 
 JobPlan RenderJob::plan(const Scene& scene, size_t held_scene_bytes) const {
   const RenderMemory memory = render_memory(scene_sizes(scene), options_);
-  MemoryShares host = memory.host_shares();
-  host.add("scene", held_scene_bytes);
-  return JobPlan{"this render", memory.device_shares(frame_buffers_field(options_.msaa)), host};
+  const std::string field = frame_buffers_field(options_.msaa);
+  JobPlan plan{"this render", memory.device_shares(field), memory.host_shares(), memory.process_shares(field, true)};
+  plan.host.add("scene", held_scene_bytes);
+  plan.unified.add("scene", held_scene_bytes);
+  return plan;
 }
 
 RenderRun RenderJob::run(ClRuntime& runtime, Renderer& renderer, const Scene& scene, const JobControl& control,

@@ -1,6 +1,5 @@
 #include <seamcl/pipeline/packed_scene.h>
 
-#include <seamcl/pipeline/render_memory.h>
 
 #include "core/srgb.h"
 #include "pipeline/adjacency.h"
@@ -203,7 +202,11 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band, s
   for (const glm::vec3& p : scene.positions) out.positions.push_back({{p.x, p.y, p.z, 1.0f}});
   out.faces.reserve(scene.faces.size());
   // Exactly what is stored, bands included: growing by push_back would hold up to 3x meanwhile.
-  const size_t stored_texels = packed_texture_memory(scene_sizes(scene), format, guard_band).texels;
+  size_t stored_texels = 0;
+  for (const Face& face : scene.faces)
+    for (const TextureLevel& level : face.texture.levels)
+      stored_texels += (static_cast<size_t>(level.width) + 2 * static_cast<size_t>(guard_band)) *
+                       (static_cast<size_t>(level.height) + 2 * static_cast<size_t>(guard_band));
   if (stored_texels > std::numeric_limits<uint32_t>::max() / 4) throw std::length_error("scene textures exceed 2^30 texels");
   // First the tables, from the sizes alone (a level stores (w + 2 band) x (h + 2 band) texels) ...
   std::vector<size_t> first_level(scene.faces.size());
@@ -243,7 +246,6 @@ PackedScene pack_scene(const Scene& scene, TexelFormat format, int guard_band, s
       out.band_texels += stored - own;
     }
   }
-  if (texels != stored_texels) throw std::logic_error("pack_scene: level sizes disagree with packed_texture_memory");
   fill_edge_reach(out.faces, out.neighbors);
   // ... then the texels, faces in parallel, each into its own range: exactly sized up front.
   if (format == TexelFormat::Rgba8) {

@@ -6,7 +6,6 @@
 #include <stdexcept>
 #include <utility>
 
-#include <seamcl/pipeline/render_memory.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/over_budget.h>
 #include "core/srgb.h"

@@ -3,6 +3,8 @@
 // thread (they may share a ClRuntime: contexts, queues and programs are thread-safe, kernel
 // arguments are not).
 #pragma once
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -16,6 +18,13 @@
 #include <seamcl/scene/scene.h>
 
 namespace seamcl {
+
+// Tile-list entries a Renderer allocates for a scene of `triangles` before it learns better: a few
+// per triangle plus a floor, at most 2^30 (render_memory counts the same).
+inline uint32_t initial_tile_list_entries(size_t triangles) {
+  const size_t capped = size_t{1} << 30;
+  return static_cast<uint32_t>(triangles >= (capped - 65536) / 8 ? capped : triangles * 8 + 65536);
+}
 
 // Milliseconds from OpenCL profiling events.
 struct StageTimes {
@@ -75,7 +84,7 @@ class Renderer {
   // Frees the buffers sized by a request (triangle setups, tiles and tile lists, the sample
   // buffer, the image) so that a kept Renderer does not hold the largest frame it ever rendered;
   // the next render allocates them again at its own size (the tile lists back at their initial
-  // size for the scene, see render_memory.h). The last_frame_params and read_* views are empty
+  // size for the scene, initial_tile_list_entries). The last_frame_params and read_* views are empty
   // until then. The scene stays loaded.
   void release_frame_buffers();
   // Frees the loaded scene too: the Renderer's Scene copy, the packed arrays and their device

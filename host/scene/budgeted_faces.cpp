@@ -3,8 +3,14 @@
 #include <algorithm>
 #include <condition_variable>
 #include <mutex>
+#include <thread>
 
 namespace seamcl {
+
+unsigned face_threads() {
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());  // 0 if unknown
+  return 1 + std::min(7u, cores - 1);
+}
 
 void for_each_face_in_budget(size_t count, const std::function<void(size_t face)>& work,
                              const std::function<size_t(size_t face)>& weight, size_t budget) {

@@ -9,6 +9,9 @@
 
 namespace seamcl {
 
+// The threads for_each_face_in_parallel runs on (this one included) on this machine: up to 8.
+unsigned face_threads();
+
 // As for_each_face_in_parallel, but a face starts only while the `weight`s of the faces running,
 // its own included, sum to at most `budget`, or when none is running (a face heavier than the
 // budget runs alone): what the running faces hold together stays within the budget, or within

@@ -1,4 +1,5 @@
 #include <seamcl/scene/scene.h>
+#include "scene/budgeted_faces.h"
 
 #include <algorithm>
 #include <atomic>
@@ -192,8 +193,7 @@ void for_each_face_in_parallel(size_t count, const std::function<void(size_t fac
       next = count;
     }
   };
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());  // 0 if unknown
-  const unsigned helper_count = std::min(7u, cores - 1);
+  const unsigned helper_count = face_threads() - 1;
   std::vector<std::thread> helpers;
   try {
     for (unsigned h = 0; h < helper_count && h < count; ++h) helpers.emplace_back(run_remaining);

@@ -1,11 +1,20 @@
-#include <seamcl/eval/compare_memory.h>
+#include <seamcl/memory/compare_memory.h>
 
 #include <algorithm>
 #include <stdexcept>
 
 #include <seamcl/pipeline/gpu_types.h>
+#include "memory/process_overhead.h"
 
 namespace seamcl {
+
+SceneSizes seamless_scene_sizes(const Scene& scene) {
+  SceneSizes sizes;
+  sizes.vertices = 4;
+  sizes.faces = {seamless_texture_size(scene)};
+  return sizes;
+}
+
 namespace {
 
 size_t add(size_t a, size_t b) { return saturating_add(a, b); }
@@ -137,7 +146,9 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   // The 8x read-back and the downsample's two frame-sized buffers; with the analytic reference,
   // also its 8x render's read-back, winners (one uint a pixel at 1 sample), setups and albedo image.
   MemoryShares high_res_host("size", add(masks, references));
-  if (high_res) high_res_host.add("size", add(out.reference.host_image, mul(frame_image, 2)));
+  // reference_images keeps the 8x render for every kind and hands each a copy (HighResRender
+  // returns by value): two read-backs at once.
+  if (high_res) high_res_host.add("size", add(mul(out.reference.host_image, 2), mul(frame_image, 2)));
   if (analytic) {
     const size_t fine_pixels = out.analytic.host_image / sizeof(glm::vec4);
     high_res_host.add("size", add(mul(out.analytic.host_image, 2), mul(fine_pixels, sizeof(uint32_t))));
@@ -156,8 +167,21 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   for (size_t i = 0; i < entries.size(); ++i) phase3_host.add("size", add(frame_image, mul(pixels, sizeof(float))));
   out.host_shares = larger(larger(phase1_host, phase2_host), phase3_host);
   out.host_shares.add("scene", add(out.face_map.host_scene, largest_packed));  // the Renderer's Scene copy and packing
+  // Each load_scene of a deferred scene makes its faces again while it packs (RenderMemory::host_making).
+  size_t making = std::max(out.face_map.host_making, out.reference.host_making);
+  for (const RenderMemory& entry : out.entries) making = std::max(making, entry.host_making);
+  out.host_shares.add("scene", making);
   out.host_bytes = out.host_shares.total();
+  out.shared_scene = std::min(std::max({phase0.scene, phase1.scene, phase3.scene}), largest_packed);
   return out;
+}
+
+MemoryShares CompareMemory::process_shares(bool unified) const {
+  MemoryShares together = device_shares;
+  together.add(host_shares);
+  if (unified) together.remove("scene", shared_scene);
+  add_process_overhead(together);
+  return together;
 }
 
 }  // namespace seamcl

@@ -43,14 +43,19 @@ struct SceneSizes {
   std::vector<std::pair<int, int>> faces;  // level-0 texture width x height, per face
   size_t reflective_faces = 0;             // faces with roughness >= 0
   int cube_size = 0;                       // the environment's cube size; 0: no environment
+  // A scene whose textures are made while it is packed (Scene::texture_source) holds no float
+  // texels: neither it nor the Renderer's copy of it. What it holds instead: the bytes its source
+  // keeps (a deferred .ptx's whole file), and, while packing, the faces being made at once
+  // (for_each_face_in_budget): the heaviest faces' texture_making_bytes, largest first, as many as
+  // packing runs at once (face_workers()).
+  bool deferred_textures = false;
+  size_t source_bytes = 0;
+  std::vector<size_t> heaviest_making;
 
   size_t triangle_count() const { return faces.size() * 2; }
 };
 
 SceneSizes scene_sizes(const Scene& scene);
-
-// Tile-list entries a Renderer allocates for a scene of `triangles` before it learns better.
-uint32_t initial_tile_list_entries(size_t triangles);
 
 // Packed textures in a format with a guard band (0: none): what pack_scene makes.
 struct PackedTextureMemory {
@@ -80,6 +85,9 @@ class MemoryShares {
   size_t share(const std::string& field) const;  // 0 for a field with no share
   // The field of the largest share; on a tie the one added first. Empty without any share.
   std::string field() const;
+  // Takes up to `bytes` from the field's share (never below 0): bytes another figure holds too.
+  void remove(const std::string& field, size_t bytes);
+  const std::vector<std::pair<std::string, size_t>>& entries() const { return shares_; }
 
  private:
   std::vector<std::pair<std::string, size_t>> shares_;  // in the order the fields were first added
@@ -112,11 +120,18 @@ struct RenderMemory {
   size_t tile_lists_bound = 0;  // upper bound of tile_lists after growth (see above)
 
   // Host.
-  // The Renderer's Scene copy: positions, faces, float RGBA texels of every level. A scene whose
-  // textures are deferred (Scene::texture_source) holds none of those texels: an upper bound then.
+  // The Renderer's Scene copy: positions, faces, float RGBA texels of every level unless they are
+  // deferred (scene_host_bytes), and the bytes its texture source keeps (SceneSizes::source_bytes,
+  // shared with the caller's copy: counted here once).
   size_t host_scene = 0;
   size_t host_packed = 0;  // PackedScene's arrays (the device scene buffers without their minimum)
   size_t host_image = 0;   // RenderResult::pixels, float4 per pixel (and seam_mask, a byte per pixel)
+  // While load_scene packs a deferred scene, before any frame buffer exists: the faces' float
+  // chains being made at once (at most the packed texels' bytes, or the one heaviest face).
+  size_t host_making = 0;
+  // Device bytes that are host bytes too: on a device sharing the host's memory the scene buffers
+  // are the packed arrays themselves (Renderer's CL_MEM_USE_HOST_PTR), counted once by process_shares.
+  size_t shared_scene = 0;
 
   // The sums saturate at SIZE_MAX like every figure here.
   size_t scene_device_bytes() const;  // positions + faces + neighbors + level_offsets + texels + environment
@@ -125,7 +140,7 @@ struct RenderMemory {
   size_t device_bytes() const;        // scene + constants + frame
   // The same with the tile lists at their bound: no render of this request can need more.
   size_t device_bytes_bound() const;
-  size_t host_bytes() const;          // host_scene + host_packed + host_image
+  size_t host_bytes() const;          // host_scene + host_packed + host_image + host_making
 
   // device_bytes() (with tile_lists_at_bound, device_bytes_bound()) split: the pixels' buffers
   // (tiles, one sample per pixel, image, seam mask) by "size", added first; the samples beyond one
@@ -137,6 +152,12 @@ struct RenderMemory {
   MemoryShares device_shares(const std::string& multisample_field, bool tile_lists_at_bound = false) const;
   // host_bytes() split: host_image "size", then host_scene and host_packed "scene".
   MemoryShares host_shares() const;
+  // What the process holds at the render's peak beyond what it held before, host and device
+  // together as one memory (the figure a CPU device's render is held to, and what `render --json`
+  // reports as its estimate): the scene's arrays and buffers (each shared one once, for a
+  // `unified` device), then the larger of packing's faces in flight and the frame's buffers with
+  // the read-back image, which never coexist (load_scene packs before the first render).
+  MemoryShares process_shares(const std::string& multisample_field, bool unified) const;
 };
 
 // The request's own options decide everything: size, msaa, texels, and the guard band when the
@@ -152,13 +173,25 @@ RenderMemory render_memory(const Scene& scene, const RenderOptions& options, boo
 // SceneSizes from a deferred scene (GeneratorOptions::defer_textures) before anything is baked.
 RenderMemory scene_render_memory(const SceneSizes& scene, const RenderOptions& options);
 
+// What `render --json` and `compare --json` print as "estimate", the figures the run was admitted
+// on: {"device_bytes", "host_bytes", "total_bytes" (device and host as one memory, each byte once),
+// "unified" (the device's buffers are host memory), "total_shares": {field: bytes}}.
+nlohmann::json estimate_json(const MemoryShares& device, const MemoryShares& host, const MemoryShares& total, bool unified);
+
 // a + b and a * b, at most SIZE_MAX: budgets must never wrap to a small number.
 size_t saturating_add(size_t a, size_t b);
 size_t saturating_mul(size_t a, size_t b);
 
-// What one Scene holds in memory (positions, faces, every level's float RGBA texels): the
-// Renderer's copy, or the caller's.
+// What one Scene holds in memory (positions, faces, every level's float RGBA texels unless they
+// are deferred): the Renderer's copy, or the caller's.
 size_t scene_host_bytes(const SceneSizes& scene);
+
+// How many faces packing makes at once (for_each_face_in_parallel's threads on this machine).
+size_t face_workers();
+
+// The peak of the faces being made at once while a deferred scene of `scene` packs into
+// `packed_texture_bytes` (for_each_face_in_budget's budget): 0 for a scene of stored textures.
+size_t making_bytes(const SceneSizes& scene, size_t packed_texture_bytes);
 
 // What a loaded Scene holds while it is kept: scene_host_bytes plus the bytes its texture_source
 // keeps to make deferred faces from (a deferred .ptx's whole file).

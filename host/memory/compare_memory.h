@@ -1,6 +1,6 @@
 // The memory of a compare (compare_methods with its seam mask and 8x reference, as `seamcl
 // compare` and POST /v1/compare run it on one Renderer), computed from the inputs alone, before
-// any texture or buffer exists. The parts are render_memory()s (host/pipeline/render_memory.h);
+// any texture or buffer exists. The parts are render_memory()s (host/memory/render_memory.h);
 // the totals are over the phases of the run:
 //   1. load_scene, the 1-sample face-map frame (seam mask), the 8x reference render and its
 //      Mitchell downsample (with the analytic reference: the 8x frame at 1 sample, its winners
@@ -18,7 +18,7 @@
 
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/reference.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 
 namespace seamcl {
 
@@ -53,7 +53,20 @@ struct CompareMemory {
   // host figure: the Scene copies, packing and read-back setups "scene"; images, masks,
   // references and error distances "size".
   MemoryShares device_shares, device_bound_shares, host_shares;
+  // Device bytes that are host bytes too on a device sharing the host's memory: the largest
+  // packing's scene buffers are its packed arrays (RenderMemory::shared_scene).
+  size_t shared_scene = 0;
+
+  // device_shares and host_shares as one memory, each shared byte once for a `unified` device:
+  // what the process holds at the compare's peak beyond what it held before (the "estimate" of
+  // `compare --json`). Tile lists at their initial size: a Renderer's device byte limit refuses
+  // their growth past it.
+  MemoryShares process_shares(bool unified) const;
 };
+
+// The sizes seamless_scene(scene) would have (one face of the combined texture), from the grid
+// alone, before any texel is copied. Refuses as seamless_scene does.
+SceneSizes seamless_scene_sizes(const Scene& scene);
 
 // Assumes the references are rendered (a cache hit needs less). `kinds` are the references
 // measured against (as prepare_targets takes them); `seamless_scene`, seamless_scene_sizes of the

@@ -1,4 +1,4 @@
-#include <seamcl/eval/bench_memory.h>
+#include <seamcl/memory/bench_memory.h>
 
 #include <algorithm>
 #include <map>
@@ -6,7 +6,7 @@
 
 #include <glm/glm.hpp>
 
-#include <seamcl/eval/compare_memory.h>
+#include <seamcl/memory/compare_memory.h>
 
 namespace seamcl {
 

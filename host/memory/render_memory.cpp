@@ -1,4 +1,4 @@
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 
 #include <algorithm>
 #include <limits>
@@ -8,7 +8,9 @@
 #include <seamcl/pipeline/gpu_types.h>
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/renderer.h>
+#include "memory/process_overhead.h"
 #include "pipeline/frame_params.h"
+#include "scene/budgeted_faces.h"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -87,6 +89,18 @@ std::string MemoryShares::field() const {
   return largest ? largest->first : std::string();
 }
 
+void MemoryShares::remove(const std::string& field, size_t bytes) {
+  for (auto& [name, share] : shares_)
+    if (name == field) share -= std::min(share, bytes);
+}
+
+nlohmann::json estimate_json(const MemoryShares& device, const MemoryShares& host, const MemoryShares& total, bool unified) {
+  nlohmann::json shares = nlohmann::json::object();
+  for (const auto& [field, bytes] : total.entries()) shares[field] = bytes;
+  return {{"device_bytes", device.total()}, {"host_bytes", host.total()}, {"total_bytes", total.total()},
+          {"unified", unified}, {"total_shares", shares}};
+}
+
 const MemoryShares& larger(const MemoryShares& a, const MemoryShares& b) { return b.total() > a.total() ? b : a; }
 
 size_t RenderMemory::scene_device_bytes() const {
@@ -100,7 +114,7 @@ size_t RenderMemory::device_bytes_bound() const {
   return add(add(scene_device_bytes(), constants),
              add(add(add(setups, tiles), add(tile_lists_bound, samples)), add(image, seam_mask)));
 }
-size_t RenderMemory::host_bytes() const { return add(add(host_scene, host_packed), host_image); }
+size_t RenderMemory::host_bytes() const { return add(add(add(host_scene, host_packed), host_image), host_making); }
 
 MemoryShares RenderMemory::device_shares(const std::string& multisample_field, bool tile_lists_at_bound) const {
   // One sample per pixel grows with the size, as the image does; only the samples beyond it are
@@ -115,8 +129,29 @@ MemoryShares RenderMemory::device_shares(const std::string& multisample_field, b
 
 MemoryShares RenderMemory::host_shares() const {
   MemoryShares shares("size", host_image);
-  shares.add("scene", add(host_scene, host_packed));
+  shares.add("scene", add(add(host_scene, host_packed), host_making));
   return shares;
+}
+
+MemoryShares RenderMemory::process_shares(const std::string& multisample_field, bool unified) const {
+  const size_t scene_buffers = add(scene_device_bytes(), constants);
+  const size_t shared = unified ? std::min(shared_scene, scene_buffers) : 0;
+  MemoryShares held("scene", add(add(host_scene, host_packed), scene_buffers - shared));
+  RenderMemory frame_only = *this;  // device_shares of the frame's buffers alone
+  frame_only.positions = frame_only.faces = frame_only.neighbors = frame_only.level_offsets = frame_only.texels =
+      frame_only.environment = frame_only.constants = 0;
+  MemoryShares rendering = frame_only.device_shares(multisample_field);
+  rendering.add("size", host_image);
+  held.add(larger(rendering, MemoryShares("scene", host_making)));
+  add_process_overhead(held);
+  return held;
+}
+
+void add_process_overhead(MemoryShares& figure) {
+  // RSS beyond the arrays and buffers themselves: allocator and driver bookkeeping, page rounding,
+  // the packing threads' arenas. tests/estimate_table.py found renders of 15-225 MiB growing by
+  // up to 0.8 MiB more than their exact buffers on PoCL (2026-12-01, before this share existed).
+  figure.add(figure.field(), figure.total() / 64);
 }
 
 SceneSizes scene_sizes(const Scene& scene) {
@@ -128,12 +163,30 @@ SceneSizes scene_sizes(const Scene& scene) {
     if (face.roughness >= 0.0f) ++sizes.reflective_faces;
   }
   sizes.cube_size = scene.environment ? scene.environment->cube_size : 0;
+  sizes.deferred_textures = has_deferred_textures(scene);
+  sizes.source_bytes = scene.texture_source_bytes;
+  if (sizes.deferred_textures) {
+    std::vector<size_t> making(scene.faces.size());
+    for (size_t f = 0; f < making.size(); ++f) making[f] = texture_making_bytes(scene, f);
+    const size_t kept = std::min<size_t>(making.size(), face_threads());
+    std::partial_sort(making.begin(), making.begin() + static_cast<std::ptrdiff_t>(kept), making.end(), std::greater<>());
+    making.resize(kept);
+    sizes.heaviest_making = std::move(making);
+  }
   return sizes;
 }
 
-uint32_t initial_tile_list_entries(size_t triangles) {
-  // As Renderer::load_scene: a few entries per triangle slot plus a floor, at most 2^30.
-  return static_cast<uint32_t>(std::min<size_t>(add(mul(triangles, 8), 65536), size_t{1} << 30));
+size_t face_workers() { return face_threads(); }
+
+size_t making_bytes(const SceneSizes& scene, size_t packed_texture_bytes) {
+  // for_each_face_in_budget: faces start while those running weigh at most the budget together,
+  // or alone; at most face_workers() run at once.
+  size_t together = 0, heaviest = 0;
+  for (size_t i = 0; i < scene.heaviest_making.size() && i < face_workers(); ++i) {
+    together = add(together, scene.heaviest_making[i]);
+    heaviest = std::max(heaviest, scene.heaviest_making[i]);
+  }
+  return std::max(heaviest, std::min(together, packed_texture_bytes));
 }
 
 PackedTextureMemory packed_texture_memory(const SceneSizes& scene, TexelFormat format, int guard_band) {
@@ -158,9 +211,10 @@ PackedTextureMemory packed_texture_memory(const SceneSizes& scene, TexelFormat f
 
 size_t scene_host_bytes(const SceneSizes& scene) {
   size_t bytes = add(mul(scene.vertices, sizeof(glm::vec3)), mul(scene.faces.size(), sizeof(Face)));
+  const size_t texel_bytes = scene.deferred_textures ? 0 : sizeof(glm::vec4);
   for (const auto& [width, height] : scene.faces) {
     for_each_level(width, height, [&](size_t w, size_t h) {
-      bytes = add(bytes, add(sizeof(TextureLevel), mul(mul(w, h), sizeof(glm::vec4))));
+      bytes = add(bytes, add(sizeof(TextureLevel), mul(mul(w, h), texel_bytes)));
     });
   }
   return bytes;
@@ -213,12 +267,15 @@ RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options
   const size_t grown_entries = std::min<size_t>(add(mul(mul(slots, tile_count) / 4 + 1, 5), 1024), size_t{1} << 31);
   m.tile_lists_bound = mul(std::max(initial_entries, grown_entries), entry_bytes);
 
-  m.host_scene = scene_host_bytes(scene);
+  m.host_scene = add(scene_host_bytes(scene), scene.source_bytes);
   m.host_packed = add(add(mul(scene.vertices, sizeof(cl_float4)),
                           add(mul(faces, sizeof(FaceGpu)), mul(adjacency_faces, sizeof(FaceNeighbors)))),
                       add(add(mul(m.textures.levels, sizeof(uint32_t)), m.textures.texture_bytes),
                           add(mul(scene.reflective_faces, sizeof(ReflectiveFace)), mul(cube_texels, 4 * sizeof(float)))));
   m.host_image = add(mul(pixels, sizeof(glm::vec4)), with_seam_mask ? pixels : 0);
+  m.host_making = making_bytes(scene, m.textures.texture_bytes);
+  // Every scene buffer but the constants is upload_shared from a packed array (positions as float4).
+  m.shared_scene = m.scene_device_bytes();
   return m;
 }
 
@@ -274,7 +331,15 @@ void limit_to_machine(Renderer& renderer, const DeviceInfo& device) {
 std::string frame_buffers_field(int msaa) { return msaa > 1 ? "msaa" : "size"; }
 
 void refuse_beyond_machine(const RenderMemory& memory, int msaa, const DeviceInfo& device, const std::string& what) {
-  refuse_beyond_machine(memory.device_shares(frame_buffers_field(msaa)), memory.host_shares(), device, what);
+  const std::string field = frame_buffers_field(msaa);
+  const size_t host = physical_memory_bytes();
+  if (device.host_unified_memory) {
+    // One memory: each byte once, at the render's peak (process_shares).
+    const MemoryShares together = memory.process_shares(field, true);
+    if (host != 0 && together.total() > host) throw OverBudget(together.field(), what, together.total(), host);
+    return;
+  }
+  refuse_beyond_machine(memory.device_shares(field), memory.host_shares(), device, what);
 }
 
 void refuse_beyond_machine(const MemoryShares& device_bytes, const MemoryShares& host_bytes, const DeviceInfo& device,

@@ -12,7 +12,7 @@
 
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/reference.h>
-#include <seamcl/pipeline/render_memory.h>
+#include <seamcl/memory/render_memory.h>
 
 namespace seamcl {
 
