@@ -98,7 +98,7 @@ typedef struct {
   cl_int traverse;       /* SEAMCL_TRAVERSE_*: also filter the neighbours (FaceNeighbors) */
   cl_int guard_band;     /* band texels stored around every level (guardband); the kernels take it
                             from the build option SEAMCL_SAMPLER_GUARD_BAND, this is the host's copy */
-  cl_int pad0;
+  cl_float lod_bias;     /* added to every lookup's mip level, -4..4 (RenderOptions::lod_bias) */
 } SamplerParams;
 
 /* A uv map from one face's unit square to another's, in one byte: (u', v') = (t0 u + t1 v + t2,

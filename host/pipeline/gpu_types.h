@@ -30,6 +30,7 @@ static_assert(offsetof(FaceNeighbors, corner_map) == 12);
 static_assert(offsetof(FaceNeighbors, neighbor) == 16);
 static_assert(offsetof(FaceNeighbors, corner) == 32);
 static_assert(offsetof(SamplerParams, traverse) == 20);
+static_assert(offsetof(SamplerParams, lod_bias) == 28);
 static_assert(sizeof(CubeSampler) == 24, "CubeSampler layout");
 static_assert(sizeof(EnvironmentParams) == 80, "EnvironmentParams layout");
 static_assert(offsetof(EnvironmentParams, ray_dy) == 60);
