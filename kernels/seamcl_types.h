@@ -67,7 +67,7 @@ typedef float cl_float;
 #define SEAMCL_SHADE_SAMPLE 2   /* every sample (supersampling) */
 
 /* SamplerParams.filter */
-#define SEAMCL_FILTER_BILINEAR 0  /* level 0 only */
+#define SEAMCL_FILTER_BILINEAR 0  /* one level: 0, or the one nearest lod_bias */
 #define SEAMCL_FILTER_TRILINEAR 1 /* two levels around log2 of the longer screen axis */
 #define SEAMCL_FILTER_ANISO 2     /* up to max_aniso trilinear probes along the major axis */
 #define SEAMCL_FILTER_EWA 3       /* elliptical Gaussian over the texels of two levels */

@@ -230,7 +230,8 @@ SEAMCL_INLINE float weight_inside(__constant FrameParams* frame, const FaceGpu* 
                                   TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
                                   float dudx, float dvdx, float dudy, float dvdy) {
   return filter_texture(face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(frame->sampler),
-                        SEAMCL_ADDRESS_BORDER, frame->sampler.max_aniso, u, v, dudx, dvdx, dudy, dvdy)
+                        SEAMCL_ADDRESS_BORDER, frame->sampler.max_aniso, frame->sampler.lod_bias, u, v, dudx, dvdx,
+                        dudy, dvdy)
       .weight;
 }
 

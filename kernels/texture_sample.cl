@@ -8,6 +8,11 @@
  * derivatives are d(uv)/d(pixel).
  * Result: a FilterSum, the filtered colour and the summed weight of the taps that read inside the
  * level (1 unless the address mode is border). One place turns it into a colour: resolve_sum.
+ * Mip levels: SamplerParams.lod_bias, read at run time (one program serves every bias), is added
+ * to the level every filter computes from the footprint (trilinear's, each aniso probe's, EWA's)
+ * before the clamp to the chain; bilinear, which has no footprint level, reads the level nearest
+ * the bias (floor(lod_bias + 0.5)) clamped to the chain: level 0 for biases below 0.5. A
+ * non-finite footprint reads the coarsest level whatever the bias.
  * Host guarantees: full chains down to 1x1, power-of-two sizes, offsets in range. Only texels of
  * the face's own levels are ever read, whatever the coordinates (NaN and infinities included).
  * Written for PoCL's vectoriser: scalar channels, no floor/log2 builtins, no float4 arithmetic.
@@ -213,10 +218,12 @@ typedef struct {
   float ax_u, ax_v, ay_u, ay_v; /* d(uv)/dx and d(uv)/dy in uv units */
   float len2_x, len2_y;         /* squared lengths in level-0 texels */
   int finite;
+  float lod_bias;               /* added to the level the filter makes of the axes */
 } Footprint;
 
-SEAMCL_INLINE Footprint footprint(const FaceGpu* face, float dudx, float dvdx, float dudy, float dvdy) {
+SEAMCL_INLINE Footprint footprint(const FaceGpu* face, float lod_bias, float dudx, float dvdx, float dudy, float dvdy) {
   Footprint f;
+  f.lod_bias = lod_bias;
   const float w = (float)face->width, h = (float)face->height;
   f.ax_u = dudx;
   f.ax_v = dvdx;
@@ -237,6 +244,20 @@ SEAMCL_INLINE Footprint footprint(const FaceGpu* face, float dudx, float dvdx, f
 /* lod of a footprint whose longer axis has squared length len2 texels (level 0). */
 SEAMCL_INLINE float lod_of(float len2) {
   return 0.5f * approx_log2(fmax(len2, 1e-30f));
+}
+
+/* The one level a bilinear lookup reads: the one nearest the bias, within the chain (a NaN bias
+ * reads level 0). */
+SEAMCL_INLINE int bilinear_level(const FaceGpu* face, float lod_bias) {
+  return (int)__builtin_floorf(fmin(fmax(lod_bias + 0.5f, 0.0f), (float)(face->level_count - 1)));
+}
+
+/* How many times longer than at bias 0 the texels a lookup reads can be: 2^ceil(lod_bias) for a
+ * positive bias, 1 otherwise (a negative bias reads finer texels, whose taps reach less far).
+ * A power of two, so the early-outs' bounds multiplied by it round as before and stay monotone. */
+SEAMCL_INLINE float bias_coarsening(float lod_bias) {
+  const int steps = (int)__builtin_ceilf(fmin(fmax(lod_bias, 0.0f), 64.0f));
+  return as_float((127 + steps) << 23);
 }
 
 /* The level whose texels are the coarsest a trilinear lookup at `lod` reads (the chain's clamp
@@ -285,7 +306,7 @@ SEAMCL_INLINE int probe_count(float ratio, int max_aniso) {
 typedef struct {
   int probes;                 /* N */
   float weight;               /* 1 / N, each probe's */
-  float lod;                  /* each probe's, before the chain's clamp */
+  float lod;                  /* each probe's, bias included, before the chain's clamp */
   float step_u, step_v;       /* from one probe to the next (uv) */
   float first_u, first_v;     /* probe 0 */
 } AnisoProbes;
@@ -300,8 +321,8 @@ SEAMCL_INLINE AnisoProbes aniso_probes(const FaceGpu* face, float u, float v, Fo
   const float ratio = minor2 > 0.0f ? sqrt(major2 / minor2) : major2 > 0.0f ? (float)max_aniso : 1.0f;
   p.probes = f.finite ? probe_count(ratio, max_aniso) : 1;
   p.weight = 1.0f / (float)p.probes;
-  /* Each probe is trilinear at log2(major / N). */
-  p.lod = f.finite ? lod_of(major2) - log2_probe_count[p.probes - 1] : (float)(face->level_count - 1);
+  /* Each probe is trilinear at log2(major / N), plus the bias. */
+  p.lod = f.finite ? lod_of(major2) - log2_probe_count[p.probes - 1] + f.lod_bias : (float)(face->level_count - 1);
   p.step_u = (x_major ? f.ax_u : f.ay_u) * p.weight;
   p.step_v = (x_major ? f.ax_v : f.ay_v) * p.weight;
   /* Probe i sits at (i + 0.5) / N - 0.5 of the major axis from the centre. */
@@ -341,9 +362,10 @@ SEAMCL_INLINE void accumulate_aniso(FilterSum* sum, const FaceGpu* face, __globa
   accumulate_probes(sum, face, level_offsets, texels, srgb_to_linear, aniso_probes(face, u, v, f, max_aniso), address);
 }
 
-/* The trilinear filter's lod: the footprint's longer axis; a non-finite one reads the coarsest level. */
+/* The trilinear filter's lod: the footprint's longer axis, plus the bias; a non-finite one reads the
+ * coarsest level. */
 SEAMCL_INLINE float trilinear_lod(const FaceGpu* face, Footprint f) {
-  return f.finite ? lod_of(fmax(f.len2_x, f.len2_y)) : (float)(face->level_count - 1);
+  return f.finite ? lod_of(fmax(f.len2_x, f.len2_y)) + f.lod_bias : (float)(face->level_count - 1);
 }
 
 /* EWA over one level (pbrt-v4's MIPMap::EWA, Gaussian alpha = 2): the weights are divided by
@@ -424,12 +446,14 @@ SEAMCL_INLINE void accumulate_ewa(FilterSum* sum, const FaceGpu* face, __global 
     b_v *= scale;
     minor2 = major2 / limit;
   }
+  /* A minor axis of length 0 (a point or a line) is a level of minus infinity: no finite bias
+   * lifts it off level 0. */
   if (!(minor2 > 0.0f)) {
     accumulate_bilinear(sum, texels, srgb_to_linear, face_level(face, level_offsets, 0), u, v, 1.0f, address);
     return;
   }
-  /* The level where the minor axis spans about one texel. */
-  const float lod = fmin(fmax(lod_of(minor2), 0.0f), (float)(face->level_count - 1));
+  /* The level where the minor axis spans about one texel, plus the bias. */
+  const float lod = fmin(fmax(lod_of(minor2) + f.lod_bias, 0.0f), (float)(face->level_count - 1));
   const int level0 = (int)lod;
   const int level1 = min(level0 + 1, face->level_count - 1);
   const float t = lod - (float)level0;
@@ -442,11 +466,12 @@ SEAMCL_INLINE void accumulate_ewa(FilterSum* sum, const FaceGpu* face, __global 
 /* The filtered sum of one lookup, before any renormalisation. */
 SEAMCL_INLINE FilterSum filter_texture(const FaceGpu* face, __global const uint* level_offsets, TEXEL_BUFFER texels,
                                 __global const float* srgb_to_linear, int filter, int address, int max_aniso,
-                                float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
+                                float lod_bias, float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   FilterSum sum = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
-  const Footprint f = footprint(face, dudx, dvdx, dudy, dvdy);
+  const Footprint f = footprint(face, lod_bias, dudx, dvdx, dudy, dvdy);
   if (filter == SEAMCL_FILTER_BILINEAR) {
-    accumulate_bilinear(&sum, texels, srgb_to_linear, face_level(face, level_offsets, 0), u, v, 1.0f, address);
+    accumulate_bilinear(&sum, texels, srgb_to_linear, face_level(face, level_offsets, bilinear_level(face, lod_bias)),
+                        u, v, 1.0f, address);
   } else if (filter == SEAMCL_FILTER_TRILINEAR) {
     accumulate_trilinear(&sum, face, level_offsets, texels, srgb_to_linear, u, v, trilinear_lod(face, f), 1.0f, address);
   } else if (filter == SEAMCL_FILTER_ANISO) {
@@ -465,16 +490,15 @@ SEAMCL_INLINE FilterSum filter_texture(const FaceGpu* face, __global const uint*
  * it rules out would add exactly nothing, so skipping it changes no bit of the result; it spares
  * interior lookups the neighbours' filters, with no division (the sides are powers of two, so
  * multiplying by them is exact). The bound, term by term, is argued in the twin
- * (host/pipeline/stages/texture_sample_twin.cpp, ewa_sides_may_contribute). min_side 0: never
- * rules out. */
-SEAMCL_INLINE int ewa_sides_may_contribute(float min_side, float max_side, float distance_u, float distance_v,
-                                           float dudx, float dvdx, float dudy, float dvdy) {
+ * (host/pipeline/stages/texture_sample_twin.cpp, ewa_sides_may_contribute). min_side 0: never rules out. */
+SEAMCL_INLINE int ewa_sides_may_contribute(float min_side, float max_side, float lod_bias, float distance_u,
+                                           float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
   const float axis_x = fabs(dudx) + fabs(dvdx);
   const float axis_y = fabs(dudy) + fabs(dvdy);
   const float axes = axis_x + axis_y;
   if (!(axes < INFINITY)) return 1;
   /* texel * min_side */
-  const float texel_sides = fmin(min_side, fmax(2.0f, 2.01f * max_side * fmax(axis_x, axis_y)));
+  const float texel_sides = fmin(min_side, fmax(2.0f, 2.01f * max_side * fmax(axis_x, axis_y) * bias_coarsening(lod_bias)));
   const float spread = (1.0f + max_side / min_side) * axes;
   /* The ellipse is widened by about a texel: it keeps a whole texel. */
   const float texel_reach = texel_sides * (1.0f + (float)GUARD);
@@ -493,14 +517,16 @@ SEAMCL_INLINE int ewa_sides_may_contribute(float min_side, float max_side, float
  * ratio grows), which is what the per-edge records of FaceNeighbors store. No division by a side
  * (powers of two: multiplying by them is exact). Argued term by term in the twin
  * (host/pipeline/stages/texture_sample_twin.cpp, axis_rules_out). side 0: never rules out. */
-SEAMCL_INLINE int axis_rules_out(float side, float cross_side, int filter, int max_aniso, float distance, float x_a,
-                                 float x_b, float y_a, float y_b) {
+SEAMCL_INLINE int axis_rules_out(float side, float cross_side, int filter, int max_aniso, float lod_bias,
+                                 float distance, float x_a, float x_b, float y_a, float y_b) {
   const float len_x = x_a * side + x_b * cross_side;
   const float len_y = y_a * side + y_b * cross_side;
   const float probe_len = filter == SEAMCL_FILTER_ANISO ? fmax(fmin(len_x, len_y), fmax(len_x, len_y) / (float)max_aniso)
                                                         : fmax(len_x, len_y);
   /* the coarsest texel read, in level-0 texels, at most the whole side */
-  const float texel_sides = filter == SEAMCL_FILTER_BILINEAR ? 1.0f : fmin(side, fmax(2.0f, 2.01f * probe_len));
+  const float coarsening = bias_coarsening(lod_bias);
+  const float texel_sides = filter == SEAMCL_FILTER_BILINEAR ? fmin(side, coarsening)
+                                                             : fmin(side, fmax(2.0f, 2.01f * probe_len * coarsening));
   const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f * fmax(x_a, y_a) : 0.0f;
   const float texel_reach = texel_sides * (TAP_REACH_TEXELS + (float)GUARD);
   const float counted = distance > 2.0f ? 2.0f : distance;
@@ -509,18 +535,19 @@ SEAMCL_INLINE int axis_rules_out(float side, float cross_side, int filter, int m
 
 /* Whether face `other` can receive weight from a lookup at distance_u / distance_v (as above) of
  * it; `swapped`: its uv axes run along this face's v and u (the map's linear part swaps them). */
-SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int swapped, int filter, int max_aniso, float distance_u,
-                                          float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
+SEAMCL_INLINE int neighbor_may_contribute(const FaceGpu* other, int swapped, int filter, int max_aniso, float lod_bias,
+                                          float distance_u, float distance_v, float dudx, float dvdx, float dudy,
+                                          float dvdy) {
   if (filter == SEAMCL_FILTER_EWA) {
     return ewa_sides_may_contribute((float)min(other->width, other->height), (float)max(other->width, other->height),
-                                    distance_u, distance_v, dudx, dvdx, dudy, dvdy);
+                                    lod_bias, distance_u, distance_v, dudx, dvdx, dudy, dvdy);
   }
   const float x_u = fabs(dudx), x_v = fabs(dvdx), y_u = fabs(dudy), y_v = fabs(dvdy);
   if (!(x_u + x_v + y_u + y_v < INFINITY)) return 1;
   const float side_u = (float)(swapped ? other->height : other->width);
   const float side_v = (float)(swapped ? other->width : other->height);
-  return !(axis_rules_out(side_u, side_v, filter, max_aniso, distance_u, x_u, x_v, y_u, y_v) ||
-           axis_rules_out(side_v, side_u, filter, max_aniso, distance_v, x_v, x_u, y_v, y_u));
+  return !(axis_rules_out(side_u, side_v, filter, max_aniso, lod_bias, distance_u, x_u, x_v, y_u, y_v) ||
+           axis_rules_out(side_v, side_u, filter, max_aniso, lod_bias, distance_v, x_v, x_u, y_v, y_u));
 }
 
 /* A FaceNeighbors map byte as its coefficients: (u', v') = (t[0] u + t[1] v + t[2], t[3] u + t[4] v
@@ -559,12 +586,13 @@ SEAMCL_INLINE void accumulate_across(FilterSum* sum, __global const FaceGpu* fac
                                      uint map, float distance_u, float distance_v,
                                      __global const uint* level_offsets,
                                      TEXEL_BUFFER texels, __global const float* srgb_to_linear, int filter,
-                                     int max_aniso, float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
+                                     int max_aniso, float lod_bias, float u, float v, float dudx, float dvdx,
+                                     float dudy, float dvdy) {
   if (other < 0) return;
   const FaceGpu g = faces[other];
   const int early_out = SEAMCL_TRAVERSE_EARLY_OUT;
-  if (early_out && !neighbor_may_contribute(&g, (map & SEAMCL_MAP_SWAP) != 0, filter, max_aniso, distance_u, distance_v,
-                                            dudx, dvdx, dudy, dvdy)) {
+  if (early_out && !neighbor_may_contribute(&g, (map & SEAMCL_MAP_SWAP) != 0, filter, max_aniso, lod_bias, distance_u,
+                                            distance_v, dudx, dvdx, dudy, dvdy)) {
     return;
   }
   const UvMap m = decode_uv_map(map);
@@ -575,15 +603,16 @@ SEAMCL_INLINE void accumulate_across(FilterSum* sum, __global const FaceGpu* fac
   const float gdudy = t[0] * dudy + t[1] * dvdy, gdvdy = t[3] * dudy + t[4] * dvdy;
   FilterSum s = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
   if (filter == SEAMCL_FILTER_BILINEAR) {
-    if (early_out && !probes_reach_face(&g, 0, gu, gv, 0.0f, 0.0f)) return;
-    accumulate_bilinear(&s, texels, srgb_to_linear, face_level(&g, level_offsets, 0), gu, gv, 1.0f,
+    const int level = bilinear_level(&g, lod_bias);
+    if (early_out && !probes_reach_face(&g, level, gu, gv, 0.0f, 0.0f)) return;
+    accumulate_bilinear(&s, texels, srgb_to_linear, face_level(&g, level_offsets, level), gu, gv, 1.0f,
                         SEAMCL_ADDRESS_BORDER);
   } else if (filter == SEAMCL_FILTER_TRILINEAR) {
-    const float lod = trilinear_lod(&g, footprint(&g, gdudx, gdvdx, gdudy, gdvdy));
+    const float lod = trilinear_lod(&g, footprint(&g, lod_bias, gdudx, gdvdx, gdudy, gdvdy));
     if (early_out && !probes_reach_face(&g, coarser_level(&g, lod), gu, gv, 0.0f, 0.0f)) return;
     accumulate_trilinear(&s, &g, level_offsets, texels, srgb_to_linear, gu, gv, lod, 1.0f, SEAMCL_ADDRESS_BORDER);
   } else if (filter == SEAMCL_FILTER_ANISO) {
-    const AnisoProbes p = aniso_probes(&g, gu, gv, footprint(&g, gdudx, gdvdx, gdudy, gdvdy), max_aniso);
+    const AnisoProbes p = aniso_probes(&g, gu, gv, footprint(&g, lod_bias, gdudx, gdvdx, gdudy, gdvdy), max_aniso);
     /* The probes lie within (N - 1) / 2 steps of the centre; N / 2 leaves half a step spare. */
     const float spread = 0.5f * (float)p.probes;
     if (early_out && !probes_reach_face(&g, coarser_level(&g, p.lod), gu, gv, spread * fabs(p.step_u),
@@ -592,8 +621,8 @@ SEAMCL_INLINE void accumulate_across(FilterSum* sum, __global const FaceGpu* fac
     }
     accumulate_probes(&s, &g, level_offsets, texels, srgb_to_linear, p, SEAMCL_ADDRESS_BORDER);
   } else {
-    s = filter_texture(&g, level_offsets, texels, srgb_to_linear, filter, SEAMCL_ADDRESS_BORDER, max_aniso, gu, gv,
-                       gdudx, gdvdx, gdudy, gdvdy);
+    s = filter_texture(&g, level_offsets, texels, srgb_to_linear, filter, SEAMCL_ADDRESS_BORDER, max_aniso, lod_bias,
+                       gu, gv, gdudx, gdvdx, gdudy, gdvdy);
   }
   sum->r += s.r;
   sum->g += s.g;
@@ -611,8 +640,9 @@ SEAMCL_INLINE void accumulate_across(FilterSum* sum, __global const FaceGpu* fac
 SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* faces,
                                         __global const FaceNeighbors* neighbors, uint face_index,
                                         __global const uint* level_offsets, TEXEL_BUFFER texels,
-                                        __global const float* srgb_to_linear, int filter, int max_aniso, int corners,
-                                        float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
+                                        __global const float* srgb_to_linear, int filter, int max_aniso,
+                                        float lod_bias, int corners, float u, float v, float dudx, float dvdx,
+                                        float dudy, float dvdy) {
   __global const FaceNeighbors* n = neighbors + face_index;
   /* How far the point lies inside each edge: the least distance to the face across it, along v
    * (edges 0 and 2) or u (1 and 3); the other axis never decides (-1). */
@@ -629,7 +659,7 @@ SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* 
     for (int k = 0; k < 4; ++k) {
       const int along_v = (k & 1) == 0;
       const int ruled_out = axis_rules_out(reach_side(n->reach_min_side[k]), reach_side(n->reach_max_side[k]), filter,
-                                           max_aniso, inside[k],
+                                           max_aniso, lod_bias, inside[k],
                                            along_v ? x_v : x_u, along_v ? x_u : x_v, along_v ? y_v : y_u,
                                            along_v ? y_u : y_v);
       edge_may_reach |= (ruled_out ? 0 : 1) << k;
@@ -640,8 +670,8 @@ SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* 
     if (((edge_may_reach >> k) & 1) == 0) continue;
     const int along_v = (k & 1) == 0;
     accumulate_across(sum, faces, n->neighbor[k], n->edge_map[k], along_v ? -1.0f : inside[k],
-                      along_v ? inside[k] : -1.0f, level_offsets, texels, srgb_to_linear, filter, max_aniso, u, v,
-                      dudx, dvdx, dudy, dvdy);
+                      along_v ? inside[k] : -1.0f, level_offsets, texels, srgb_to_linear, filter, max_aniso, lod_bias,
+                      u, v, dudx, dvdx, dudy, dvdy);
   }
   if (!corners) return;
   /* Corner k lies between edges k-1 and k: past both; either edge's test rules it out. */
@@ -650,7 +680,8 @@ SEAMCL_INLINE void accumulate_neighbors(FilterSum* sum, __global const FaceGpu* 
     const float a = inside[(k + 3) & 3], b = inside[k];
     const int b_along_v = (k & 1) == 0;
     accumulate_across(sum, faces, n->corner[k], n->corner_map[k], b_along_v ? a : b, b_along_v ? b : a,
-                      level_offsets, texels, srgb_to_linear, filter, max_aniso, u, v, dudx, dvdx, dudy, dvdy);
+                      level_offsets, texels, srgb_to_linear, filter, max_aniso, lod_bias, u, v, dudx, dvdx, dudy,
+                      dvdy);
   }
 }
 
@@ -666,8 +697,8 @@ SEAMCL_INLINE float4 resolve_sum(FilterSum sum, const FaceGpu* face, __global co
   const int clamp_when_uncovered = SAMPLER_ZERO_COVERAGE(sampler) == SEAMCL_ZERO_COVERAGE_CLAMP;
   if (clamp_when_uncovered && sum.weight == 0.0f) {
     sum = filter_texture(face, level_offsets, texels, srgb_to_linear, SEAMCL_FILTER_TRILINEAR, SEAMCL_ADDRESS_CLAMP,
-                         sampler.max_aniso, fmin(fmax(u, 0.0f), 1.0f), fmin(fmax(v, 0.0f), 1.0f), dudx, dvdx, dudy,
-                         dvdy);
+                         sampler.max_aniso, sampler.lod_bias, fmin(fmax(u, 0.0f), 1.0f), fmin(fmax(v, 0.0f), 1.0f),
+                         dudx, dvdx, dudy, dvdy);
   }
   const float inv_weight = 1.0f / sum.weight;
   return (float4)(sum.r * inv_weight, sum.g * inv_weight, sum.b * inv_weight, sum.a * inv_weight);
@@ -679,10 +710,11 @@ SEAMCL_INLINE float4 sample_texture(__global const FaceGpu* faces, __global cons
                                     float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   const FaceGpu face = faces[face_index];
   FilterSum sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),
-                                 SAMPLER_ADDRESS(sampler), sampler.max_aniso, u, v, dudx, dvdx, dudy, dvdy);
+                                 SAMPLER_ADDRESS(sampler), sampler.max_aniso, sampler.lod_bias, u, v, dudx, dvdx, dudy,
+                                 dvdy);
   if (SAMPLER_TRAVERSE(sampler) != SEAMCL_TRAVERSE_NONE) {
     accumulate_neighbors(&sum, faces, neighbors, face_index, level_offsets, texels, srgb_to_linear,
-                         SAMPLER_FILTER(sampler), sampler.max_aniso,
+                         SAMPLER_FILTER(sampler), sampler.max_aniso, sampler.lod_bias,
                          SAMPLER_TRAVERSE(sampler) == SEAMCL_TRAVERSE_CORNERS, u, v, dudx, dvdx, dudy, dvdy);
   }
   return resolve_sum(sum, &face, level_offsets, texels, srgb_to_linear, sampler, u, v, dudx, dvdx, dudy, dvdy);
@@ -729,10 +761,11 @@ __kernel void texture_filter_batch(__global const FaceGpu* faces, __global const
   const uint face_index = (uint)q[0];
   const FaceGpu face = faces[face_index];
   FilterSum sum = filter_texture(&face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),
-                                 SAMPLER_ADDRESS(sampler), sampler.max_aniso, q[1], q[2], q[3], q[4], q[5], q[6]);
+                                 SAMPLER_ADDRESS(sampler), sampler.max_aniso, sampler.lod_bias, q[1], q[2], q[3], q[4],
+                                 q[5], q[6]);
   if (SAMPLER_TRAVERSE(sampler) != SEAMCL_TRAVERSE_NONE) {
     accumulate_neighbors(&sum, faces, neighbors, face_index, level_offsets, texels, srgb_to_linear,
-                         SAMPLER_FILTER(sampler), sampler.max_aniso,
+                         SAMPLER_FILTER(sampler), sampler.max_aniso, sampler.lod_bias,
                          SAMPLER_TRAVERSE(sampler) == SEAMCL_TRAVERSE_CORNERS, q[1], q[2], q[3], q[4], q[5], q[6]);
   }
   out[i] = (float4)(sum.r, sum.g, sum.b, sum.a);
@@ -753,7 +786,8 @@ __kernel void aniso_plan_batch(__global const FaceGpu* faces, SamplerParams samp
   if (i >= count) return;
   __global const float* q = lookups + 7 * i;
   const FaceGpu face = faces[(uint)q[0]];
-  const AnisoProbes p = aniso_probes(&face, q[1], q[2], footprint(&face, q[3], q[4], q[5], q[6]), sampler.max_aniso);
+  const AnisoProbes p =
+      aniso_probes(&face, q[1], q[2], footprint(&face, sampler.lod_bias, q[3], q[4], q[5], q[6]), sampler.max_aniso);
   __global float* o = plans + 6 * i;
   o[0] = p.first_u;
   o[1] = p.first_v;

@@ -1,6 +1,7 @@
 // The sampler (kernels/texture_sample.cl) against its twin for every filter, address mode,
-// storage and method, and the properties Discard rests on: a constant texture stays exactly
-// constant, weights sum to one, nothing outside a face is read, NaN only where every tap is out.
+// storage, method and a range of mip-level biases, and the properties Discard rests on: a
+// constant texture stays exactly constant, weights sum to one, nothing outside a face is read,
+// NaN only where every tap is out.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -108,30 +109,35 @@ TEST(KernelVsTwin, SamplerEveryFilterAddressModeStorageAndMethod) {
             sampler.renormalize = renormalize;
             sampler.max_aniso = 1 + static_cast<int>(rng() % 16);
             sampler.zero_coverage = zero_coverage;
-            SCOPED_TRACE(testing::Message() << "format " << to_string(format) << " filter " << filter << " address "
-                                            << address << " renormalize " << renormalize << " zero_coverage "
-                                            << zero_coverage << " max_aniso " << sampler.max_aniso);
-            const std::vector<glm::vec4> gpu = device.sample(sampler);
-            const std::vector<FilterSum> gpu_sums = device.filter(sampler);
-            size_t bad = 0;
-            for (size_t i = 0; i < lookups.size(); ++i) {
-              const Lookup& l = lookups[i];
-              const glm::vec4 twin =
-                  sample_texture_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
-              const FilterSum twin_sum =
-                  method_sum_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
-              // 1e-5: the kernels round as the twin does except in the exp and sqrt builtins (EWA, aniso).
-              bool ok = near(gpu_sums[i].weight, twin_sum.weight, 1e-5f);
-              for (int c = 0; c < 4; ++c) {
-                ok &= near(gpu[i][c], twin[c], 1e-5f) && near(gpu_sums[i].color[c], twin_sum.color[c], 1e-5f);
+            // The bias is read at run time: every bias runs on the variant built for the first.
+            for (float lod_bias : {0.0f, -1.5f, -0.25f, 0.5f, 1.0f, 2.75f}) {
+              sampler.lod_bias = lod_bias;
+              SCOPED_TRACE(testing::Message() << "format " << to_string(format) << " filter " << filter << " address "
+                                              << address << " renormalize " << renormalize << " zero_coverage "
+                                              << zero_coverage << " max_aniso " << sampler.max_aniso << " lod_bias "
+                                              << lod_bias);
+              const std::vector<glm::vec4> gpu = device.sample(sampler);
+              const std::vector<FilterSum> gpu_sums = device.filter(sampler);
+              size_t bad = 0;
+              for (size_t i = 0; i < lookups.size(); ++i) {
+                const Lookup& l = lookups[i];
+                const glm::vec4 twin =
+                    sample_texture_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+                const FilterSum twin_sum =
+                    method_sum_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+                // 1e-5: the kernels round as the twin does except in the exp and sqrt builtins (EWA, aniso).
+                bool ok = near(gpu_sums[i].weight, twin_sum.weight, 1e-5f);
+                for (int c = 0; c < 4; ++c) {
+                  ok &= near(gpu[i][c], twin[c], 1e-5f) && near(gpu_sums[i].color[c], twin_sum.color[c], 1e-5f);
+                }
+                if (!ok && bad++ < 3) {
+                  ADD_FAILURE() << "lookup " << i << " face " << l.face << " uv " << l.u << "," << l.v << " d " << l.dudx
+                                << "," << l.dvdx << "," << l.dudy << "," << l.dvdy << ": gpu " << gpu[i].r << " twin "
+                                << twin.r << " weight " << gpu_sums[i].weight << " / " << twin_sum.weight;
+                }
               }
-              if (!ok && bad++ < 3) {
-                ADD_FAILURE() << "lookup " << i << " face " << l.face << " uv " << l.u << "," << l.v << " d " << l.dudx
-                              << "," << l.dvdx << "," << l.dudy << "," << l.dvdy << ": gpu " << gpu[i].r << " twin "
-                              << twin.r << " weight " << gpu_sums[i].weight << " / " << twin_sum.weight;
-              }
+              EXPECT_EQ(bad, 0u);
             }
-            EXPECT_EQ(bad, 0u);
           }
         }
       }
@@ -272,7 +278,7 @@ TEST(KernelVsTwin, AnisoGroupedByProbeCount) {
   // TextureLookups::set_aniso_grouped: aniso lookups planned, ordered by probe count and run by
   // one kernel per count must give the twin's colours: RGBA8 clamped as the benchmark runs it,
   // RGBA32F border-addressed and renormalised as discard does (the non-finite lookups and those
-  // far outside included). Two variants only: each builds seventeen kernels.
+  // far outside included), at three biases. Two variants only: each builds seventeen kernels.
   std::mt19937 rng(8);
   const Scene scene = random_texture_scene(4);
   const std::vector<Lookup> lookups = random_lookups(rng, static_cast<uint32_t>(scene.faces.size()), 3000);
@@ -289,18 +295,23 @@ TEST(KernelVsTwin, AnisoGroupedByProbeCount) {
     TextureLookups device(shared_runtime(), packed);
     device.set_lookups(lookups);
     device.set_aniso_grouped(true);
-    double ms = -1.0;
-    const std::vector<glm::vec4> gpu = device.sample(sampler, &ms);
-    EXPECT_GE(ms, 0.0);
-    size_t bad = 0;
-    for (size_t i = 0; i < lookups.size(); ++i) {
-      const Lookup& l = lookups[i];
-      const glm::vec4 twin =
-          sample_texture_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
-      bool ok = true;
-      for (int c = 0; c < 4; ++c) ok &= near(gpu[i][c], twin[c], 1e-5f);
-      if (!ok && bad++ < 3) ADD_FAILURE() << "lookup " << i << ": gpu " << gpu[i].r << " twin " << twin.r;
+    // The plans carry each probe's lod with the bias in it.
+    for (float lod_bias : {0.0f, -1.5f, 2.75f}) {
+      SCOPED_TRACE(testing::Message() << "lod_bias " << lod_bias);
+      sampler.lod_bias = lod_bias;
+      double ms = -1.0;
+      const std::vector<glm::vec4> gpu = device.sample(sampler, &ms);
+      EXPECT_GE(ms, 0.0);
+      size_t bad = 0;
+      for (size_t i = 0; i < lookups.size(); ++i) {
+        const Lookup& l = lookups[i];
+        const glm::vec4 twin =
+            sample_texture_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+        bool ok = true;
+        for (int c = 0; c < 4; ++c) ok &= near(gpu[i][c], twin[c], 1e-5f);
+        if (!ok && bad++ < 3) ADD_FAILURE() << "lookup " << i << ": gpu " << gpu[i].r << " twin " << twin.r;
+      }
+      EXPECT_EQ(bad, 0u);
     }
-    EXPECT_EQ(bad, 0u);
   }
 }

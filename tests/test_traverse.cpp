@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <random>
 #include <set>
 #include <string>
@@ -66,6 +67,16 @@ void expect_transforms_follow_the_surface(const Scene& scene, float tolerance) {
   }
   EXPECT_GT(links, 0u);
 }
+
+SamplerParams with_bias(SamplerParams sampler, float lod_bias) {
+  sampler.lod_bias = lod_bias;
+  return sampler;
+}
+
+// Biases for the early-outs' tests, taken in turn: a positive one reads coarser texels, whose taps
+// reach further than the footprint alone says; a negative one finer.
+constexpr float kBiases[] = {0.0f, -1.5f, 0.5f, 1.0f, 2.75f, 4.0f};
+float bias_in_turn(size_t i) { return kBiases[i % std::size(kBiases)]; }
 
 }  // namespace
 
@@ -155,26 +166,29 @@ TEST(KernelVsTwin, TraverseOnConnectedFacesOfMixedSizesAndOrientations) {
                {Method::TraverseEdges, Filter::Trilinear}, {Method::TraverseEdges, Filter::Ewa}}) {
         SCOPED_TRACE(testing::Message() << name << " " << to_string(format) << " " << to_string(method) << " "
                                         << to_string(filter));
-        const SamplerParams sampler = sampler_params(method, filter, 8, ZeroCoverage::Clamp);
-        const std::vector<glm::vec4> gpu = device.sample(sampler);
-        const std::vector<FilterSum> sums = device.filter(sampler);
-        size_t bad = 0, beyond_own_face = 0;
-        for (size_t i = 0; i < lookups.size(); ++i) {
-          const Lookup& l = lookups[i];
-          const glm::vec4 twin =
-              sample_texture_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
-          const FilterSum twin_sum =
-              method_sum_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
-          bool ok = std::fabs(sums[i].weight - twin_sum.weight) <= 1e-5f * std::max(1.0f, twin_sum.weight);
-          for (int c = 0; c < 4; ++c) ok &= std::fabs(gpu[i][c] - twin[c]) <= 1e-5f;
-          if (!ok && bad++ < 3) ADD_FAILURE() << "lookup " << i << ": gpu " << gpu[i].r << " twin " << twin.r;
-          // Traverse reads the neighbours: weight beyond what the face alone holds.
-          const FilterSum own = filter_texture_reference(packed.textures(), l.face, sampler, SEAMCL_ADDRESS_BORDER, l.u,
-                                                         l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
-          beyond_own_face += twin_sum.weight > own.weight + 1e-3f;
+        for (float lod_bias : {0.0f, -1.5f, 2.75f}) {
+          SCOPED_TRACE(testing::Message() << "lod_bias " << lod_bias);
+          const SamplerParams sampler = with_bias(sampler_params(method, filter, 8, ZeroCoverage::Clamp), lod_bias);
+          const std::vector<glm::vec4> gpu = device.sample(sampler);
+          const std::vector<FilterSum> sums = device.filter(sampler);
+          size_t bad = 0, beyond_own_face = 0;
+          for (size_t i = 0; i < lookups.size(); ++i) {
+            const Lookup& l = lookups[i];
+            const glm::vec4 twin =
+                sample_texture_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+            const FilterSum twin_sum =
+                method_sum_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+            bool ok = std::fabs(sums[i].weight - twin_sum.weight) <= 1e-5f * std::max(1.0f, twin_sum.weight);
+            for (int c = 0; c < 4; ++c) ok &= std::fabs(gpu[i][c] - twin[c]) <= 1e-5f;
+            if (!ok && bad++ < 3) ADD_FAILURE() << "lookup " << i << ": gpu " << gpu[i].r << " twin " << twin.r;
+            // Traverse reads the neighbours: weight beyond what the face alone holds.
+            const FilterSum own = filter_texture_reference(packed.textures(), l.face, sampler, SEAMCL_ADDRESS_BORDER, l.u,
+                                                           l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+            beyond_own_face += twin_sum.weight > own.weight + 1e-3f;
+          }
+          EXPECT_EQ(bad, 0u);
+          EXPECT_GT(beyond_own_face, lookups.size() / 10);
         }
-        EXPECT_EQ(bad, 0u);
-        EXPECT_GT(beyond_own_face, lookups.size() / 10);
       }
     }
   }
@@ -430,7 +444,8 @@ TEST(Traverse, SkipsOnlyNeighboursThatWouldAddNothing) {
     const float dudx = scale * uniform(rng, -1, 1), dvdx = scale * uniform(rng, -1, 1);
     const float dudy = scale * uniform(rng, -1, 1), dvdy = scale * uniform(rng, -1, 1);
     const Filter filter = static_cast<Filter>(rng() % 4);
-    const SamplerParams sampler = sampler_params(Method::Traverse, filter, 1 + static_cast<int>(rng() % 16), ZeroCoverage::Clamp);
+    const SamplerParams sampler = with_bias(
+        sampler_params(Method::Traverse, filter, 1 + static_cast<int>(rng() % 16), ZeroCoverage::Clamp), bias_in_turn(i));
     const FaceNeighbors& n = packed.neighbors[face];
     const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
     for (int j = 0; j < 8; ++j) {
@@ -443,7 +458,7 @@ TEST(Traverse, SkipsOnlyNeighboursThatWouldAddNothing) {
       const float distance_u = k_along_v ? a : b, distance_v = k_along_v ? b : a;
       const uint8_t code = j < 4 ? n.edge_map[k] : n.corner_map[k];
       if (neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], map_swaps_axes(map_coefficients(code).data()), sampler.filter,
-                                  sampler.max_aniso, 0, distance_u, distance_v, dudx, dvdx, dudy, dvdy)) {
+                                  sampler.max_aniso, sampler.lod_bias, 0, distance_u, distance_v, dudx, dvdx, dudy, dvdy)) {
         ++kept;
         continue;
       }
@@ -453,7 +468,8 @@ TEST(Traverse, SkipsOnlyNeighboursThatWouldAddNothing) {
       const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER,
                                                    p.x, p.y, dx.x, dx.y, dy.x, dy.y);
       ASSERT_EQ(s.weight, 0.0f) << "face " << face << " neighbour " << other << " (" << (j < 4 ? "edge " : "corner ") << k
-                                << ") at " << u << "," << v << " scale " << scale << " " << to_string(filter);
+                                << ") at " << u << "," << v << " scale " << scale << " " << to_string(filter)
+                                << " lod_bias " << sampler.lod_bias;
     }
   }
   // The bound is not vacuous: interior lookups do skip.
@@ -510,9 +526,11 @@ TEST(Traverse, ReachTestSkipsOnlyNeighboursThatWouldAddNothing) {
   const std::vector<Lookup> lookups = lookups_near_edges(scene.faces.size(), 20000, 9);
   std::mt19937 rng(10);
   size_t skipped = 0, kept = 0, reaching = 0;
-  for (const Lookup& l : lookups) {
+  for (size_t i = 0; i < lookups.size(); ++i) {
+    const Lookup& l = lookups[i];
     const Filter filter = static_cast<Filter>(rng() % 3);  // bilinear, trilinear, aniso
-    const SamplerParams sampler = sampler_params(Method::Traverse, filter, 1 + static_cast<int>(rng() % 16), ZeroCoverage::Clamp);
+    const SamplerParams sampler = with_bias(
+        sampler_params(Method::Traverse, filter, 1 + static_cast<int>(rng() % 16), ZeroCoverage::Clamp), bias_in_turn(i));
     const FaceNeighbors& n = packed.neighbors[l.face];
     for (int j = 0; j < 8; ++j) {
       const int k = j % 4;
@@ -524,13 +542,14 @@ TEST(Traverse, ReachTestSkipsOnlyNeighboursThatWouldAddNothing) {
       const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER,
                                                    p.x, p.y, dx.x, dx.y, dy.x, dy.y);
       reaching += s.weight > 0.0f;
-      if (lookup_may_reach_face(g, 0, sampler.filter, sampler.max_aniso, p.x, p.y, dx.x, dx.y, dy.x, dy.y)) {
+      if (lookup_may_reach_face(g, 0, sampler.filter, sampler.max_aniso, sampler.lod_bias, p.x, p.y, dx.x, dx.y, dy.x, dy.y)) {
         ++kept;
         continue;
       }
       ++skipped;
       ASSERT_EQ(s.weight, 0.0f) << "face " << l.face << " neighbour " << other << " (" << (j < 4 ? "edge " : "corner ")
-                                << k << ") at " << l.u << "," << l.v << " " << to_string(filter);
+                                << k << ") at " << l.u << "," << l.v << " " << to_string(filter) << " lod_bias "
+                                << sampler.lod_bias;
       ASSERT_TRUE(same_bits(s, FilterSum{})) << "a skipped neighbour adds colour";
     }
   }
@@ -555,12 +574,13 @@ TEST(Traverse, EdgeReachTestSkipsOnlyFacesThatWouldAddNothing) {
     const std::vector<Lookup> lookups = lookups_near_edges(scene->faces.size(), 20000, 12);
     std::mt19937 rng(13);
     size_t edges_skipped = 0, edges_kept = 0, interior_decided = 0, interior = 0;
-    for (const Lookup& l : lookups) {
+    for (size_t i = 0; i < lookups.size(); ++i) {
+      const Lookup& l = lookups[i];
       const Filter filter = static_cast<Filter>(rng() % 4);
-      const SamplerParams sampler =
-          sampler_params(Method::Traverse, filter, 1 + static_cast<int>(rng() % 16), ZeroCoverage::Clamp);
+      const SamplerParams sampler = with_bias(
+          sampler_params(Method::Traverse, filter, 1 + static_cast<int>(rng() % 16), ZeroCoverage::Clamp), bias_in_turn(i));
       const FaceNeighbors& n = packed.neighbors[l.face];
-      const int mask = edges_may_reach(n, sampler.filter, sampler.max_aniso, 0, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
+      const int mask = edges_may_reach(n, sampler.filter, sampler.max_aniso, sampler.lod_bias, 0, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
       const bool inside_face = l.u > 0.1f && l.u < 0.9f && l.v > 0.1f && l.v < 0.9f;
       interior += inside_face;
       interior_decided += inside_face && mask == 0;
@@ -580,15 +600,17 @@ TEST(Traverse, EdgeReachTestSkipsOnlyFacesThatWouldAddNothing) {
           const float a = j < 4 ? -1.0f : inside[(c + 3) % 4], b = inside[c];
           const uint8_t code = j < 4 ? n.edge_map[c] : n.corner_map[c];
           ASSERT_FALSE(neighbor_may_contribute(packed.faces[static_cast<size_t>(other)], map_swaps_axes(map_coefficients(code).data()),
-                                               sampler.filter, sampler.max_aniso, 0, c_along_v ? a : b,
+                                               sampler.filter, sampler.max_aniso, sampler.lod_bias, 0, c_along_v ? a : b,
                                                c_along_v ? b : a, l.dudx, l.dvdx, l.dudy, l.dvdy))
-              << "edge " << k << " skips face " << other << " that the per-face test keeps";
+              << "edge " << k << " skips face " << other << " that the per-face test keeps (lod_bias "
+              << sampler.lod_bias << ")";
           const UvMap map = uv_map(code);
           const glm::vec2 p = map.point({l.u, l.v}), dx = map.direction({l.dudx, l.dvdx}),
                           dy = map.direction({l.dudy, l.dvdy});
           const FilterSum s = filter_texture_reference(view, static_cast<uint32_t>(other), sampler,
                                                        SEAMCL_ADDRESS_BORDER, p.x, p.y, dx.x, dx.y, dy.x, dy.y);
-          ASSERT_TRUE(same_bits(s, FilterSum{})) << "a skipped face adds weight " << s.weight;
+          ASSERT_TRUE(same_bits(s, FilterSum{})) << "a skipped face adds weight " << s.weight << " (lod_bias "
+                                                 << sampler.lod_bias << ")";
         }
       }
     }
@@ -640,7 +662,7 @@ TEST(Traverse, EdgeReachRecordsBoundTheFacesAround) {
   FaceNeighbors unfilled{};
   for (int k = 0; k < 4; ++k) unfilled.neighbor[k] = unfilled.corner[k] = -1;
   for (Filter filter : {Filter::Bilinear, Filter::Trilinear, Filter::Aniso, Filter::Ewa}) {
-    EXPECT_EQ(edges_may_reach(unfilled, sampler_params(Method::Traverse, filter, 16, ZeroCoverage::Clamp).filter, 16, 0,
+    EXPECT_EQ(edges_may_reach(unfilled, sampler_params(Method::Traverse, filter, 16, ZeroCoverage::Clamp).filter, 16, 0.0f, 0,
                               0.5f, 0.5f, 1e-4f, 0.0f, 0.0f, 1e-4f),
               15);
   }
@@ -658,8 +680,9 @@ TEST(Traverse, EarlyOutsChangeNoBitOfTheTwin) {
     size_t changed = 0, crossing = 0;
     for (Filter filter : {Filter::Bilinear, Filter::Trilinear, Filter::Aniso, Filter::Ewa}) {
       for (Method method : {Method::Traverse, Method::TraverseEdges}) {
-        const SamplerParams sampler = sampler_params(method, filter, 16, ZeroCoverage::Clamp);
-        for (const Lookup& l : lookups) {
+        for (size_t i = 0; i < lookups.size(); ++i) {
+          const Lookup& l = lookups[i];
+          const SamplerParams sampler = with_bias(sampler_params(method, filter, 16, ZeroCoverage::Clamp), bias_in_turn(i));
           const FilterSum fast = method_sum_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx,
                                                       l.dudy, l.dvdy, true);
           const FilterSum every = method_sum_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx,
@@ -668,8 +691,9 @@ TEST(Traverse, EarlyOutsChangeNoBitOfTheTwin) {
                                                          l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
           crossing += every.weight > own.weight;
           if (!same_bits(fast, every) && changed++ < 3) {
-            ADD_FAILURE() << name << " " << to_string(method) << " " << to_string(filter) << " face " << l.face << " at "
-                          << l.u << "," << l.v << ": weight " << fast.weight << " vs " << every.weight;
+            ADD_FAILURE() << name << " " << to_string(method) << " " << to_string(filter) << " lod_bias "
+                          << sampler.lod_bias << " face " << l.face << " at " << l.u << "," << l.v << ": weight "
+                          << fast.weight << " vs " << every.weight;
           }
         }
       }
@@ -694,20 +718,22 @@ TEST(KernelVsTwin, TraverseEarlyOutsChangeNoBitOfTheKernel) {
     fast.set_lookups(lookups);
     every.set_lookups(lookups);
     for (Filter filter : {Filter::Bilinear, Filter::Trilinear, Filter::Aniso, Filter::Ewa}) {
-      SCOPED_TRACE(testing::Message() << name << " " << to_string(filter));
-      const SamplerParams sampler = sampler_params(Method::Traverse, filter, 16, ZeroCoverage::Clamp);
-      const std::vector<FilterSum> a = fast.filter(sampler), b = every.filter(sampler);
-      const std::vector<glm::vec4> ca = fast.sample(sampler), cb = every.sample(sampler);
-      size_t changed = 0;
-      for (size_t i = 0; i < lookups.size(); ++i) {
-        bool same = same_bits(a[i], b[i]);
-        for (int c = 0; c < 4; ++c) same &= same_bits(ca[i][c], cb[i][c]) || (std::isnan(ca[i][c]) && std::isnan(cb[i][c]));
-        if (!same && changed++ < 3) {
-          ADD_FAILURE() << "lookup " << i << ": weight " << a[i].weight << " vs " << b[i].weight << ", red " << ca[i].r
-                        << " vs " << cb[i].r;
+      for (float lod_bias : {0.0f, -1.5f, 2.75f}) {
+        SCOPED_TRACE(testing::Message() << name << " " << to_string(filter) << " lod_bias " << lod_bias);
+        const SamplerParams sampler = with_bias(sampler_params(Method::Traverse, filter, 16, ZeroCoverage::Clamp), lod_bias);
+        const std::vector<FilterSum> a = fast.filter(sampler), b = every.filter(sampler);
+        const std::vector<glm::vec4> ca = fast.sample(sampler), cb = every.sample(sampler);
+        size_t changed = 0;
+        for (size_t i = 0; i < lookups.size(); ++i) {
+          bool same = same_bits(a[i], b[i]);
+          for (int c = 0; c < 4; ++c) same &= same_bits(ca[i][c], cb[i][c]) || (std::isnan(ca[i][c]) && std::isnan(cb[i][c]));
+          if (!same && changed++ < 3) {
+            ADD_FAILURE() << "lookup " << i << ": weight " << a[i].weight << " vs " << b[i].weight << ", red " << ca[i].r
+                          << " vs " << cb[i].r;
+          }
         }
+        EXPECT_EQ(changed, 0u);
       }
-      EXPECT_EQ(changed, 0u);
     }
   }
 }

@@ -97,16 +97,18 @@ void accumulate_trilinear(FilterSum& sum, const TextureView& tex, const FaceGpu&
   accumulate_bilinear(sum, tex, face_level(tex, face, level1), u, v, weight * t, address);
 }
 
-// The footprint's screen axes: uv per pixel, and squared lengths in level-0 texels.
+// The footprint's screen axes: uv per pixel, and squared lengths in level-0 texels; the bias
+// every filter adds to the level it makes of them.
 struct Footprint {
   float ax_u, ax_v, ay_u, ay_v;
   float len2_x, len2_y;
   bool finite;
+  float lod_bias;
 };
 
-Footprint footprint(const FaceGpu& face, float dudx, float dvdx, float dudy, float dvdy) {
+Footprint footprint(const FaceGpu& face, float lod_bias, float dudx, float dvdx, float dudy, float dvdy) {
   const float w = static_cast<float>(face.width), h = static_cast<float>(face.height);
-  Footprint f{dudx, dvdx, dudy, dvdy, 0, 0, false};
+  Footprint f{dudx, dvdx, dudy, dvdy, 0, 0, false, lod_bias};
   f.len2_x = (dudx * w) * (dudx * w) + (dvdx * h) * (dvdx * h);
   f.len2_y = (dudy * w) * (dudy * w) + (dvdy * h) * (dvdy * h);
   f.finite = f.len2_x < INFINITY && f.len2_y < INFINITY;
@@ -119,7 +121,7 @@ float lod_of(float len2) { return 0.5f * approx_log2(std::fmax(len2, 1e-30f)); }
 struct AnisoProbes {
   int probes;              // N
   float weight;            // 1 / N, each probe's
-  float lod;               // each probe's, before the chain's clamp
+  float lod;               // each probe's, bias included, before the chain's clamp
   float step_u, step_v;    // from one probe to the next (uv)
   float first_u, first_v;  // probe 0
 };
@@ -134,7 +136,7 @@ AnisoProbes aniso_probes(const FaceGpu& face, float u, float v, const Footprint&
   AnisoProbes p{};
   p.probes = f.finite ? probe_count(ratio, max_aniso) : 1;
   p.weight = 1.0f / static_cast<float>(p.probes);
-  p.lod = f.finite ? lod_of(major2) - log2_probe_count(p.probes) : static_cast<float>(face.level_count - 1);
+  p.lod = f.finite ? lod_of(major2) - log2_probe_count(p.probes) + f.lod_bias : static_cast<float>(face.level_count - 1);
   p.step_u = (x_major ? f.ax_u : f.ay_u) * p.weight;
   p.step_v = (x_major ? f.ax_v : f.ay_v) * p.weight;
   // Probe i at (i + 0.5) / N - 0.5 of the major axis from the centre.
@@ -144,7 +146,23 @@ AnisoProbes aniso_probes(const FaceGpu& face, float u, float v, const Footprint&
 }
 
 float trilinear_lod(const FaceGpu& face, const Footprint& f) {
-  return f.finite ? lod_of(std::fmax(f.len2_x, f.len2_y)) : static_cast<float>(face.level_count - 1);
+  return f.finite ? lod_of(std::fmax(f.len2_x, f.len2_y)) + f.lod_bias : static_cast<float>(face.level_count - 1);
+}
+
+// Bilinear has no footprint level: it reads the level nearest the bias, within the chain (level 0
+// for biases below 0.5; a NaN bias reads level 0).
+int bilinear_level(const FaceGpu& face, float lod_bias) {
+  return static_cast<int>(std::floor(std::fmin(std::fmax(lod_bias + 0.5f, 0.0f), static_cast<float>(face.level_count - 1))));
+}
+
+// How many times longer than at bias 0 the texels a lookup reads can be, for the early-outs'
+// bounds: a positive bias b moves every level up by b, and the texels of level l + b are 2^b
+// times those of l, so 2^ceil(b) bounds them (and bilinear's level floor(b + 0.5) <= ceil(b)); a
+// negative bias reads finer texels, whose taps reach less far: 1. A power of two, so a bound
+// multiplied by it rounds as before and keeps its order.
+float bias_coarsening(float lod_bias) {
+  const int steps = static_cast<int>(std::ceil(std::fmin(std::fmax(lod_bias, 0.0f), 64.0f)));
+  return std::ldexp(1.0f, steps);
 }
 
 // The level whose texels are the coarsest a trilinear lookup at `lod` reads.
@@ -262,12 +280,14 @@ void accumulate_ewa(FilterSum& sum, const TextureView& tex, const FaceGpu& face,
     b_v *= scale;
     minor2 = major2 / limit;
   }
+  // A minor axis of length 0 (a point or a line) is a level of minus infinity: no finite bias
+  // lifts it off level 0.
   if (!(minor2 > 0.0f)) {
     accumulate_bilinear(sum, tex, face_level(tex, face, 0), u, v, 1.0f, address);
     return;
   }
-  // The level where the minor axis spans about one texel.
-  const float lod = std::fmin(std::fmax(lod_of(minor2), 0.0f), static_cast<float>(face.level_count - 1));
+  // The level where the minor axis spans about one texel, plus the bias.
+  const float lod = std::fmin(std::fmax(lod_of(minor2) + f.lod_bias, 0.0f), static_cast<float>(face.level_count - 1));
   const int level0 = static_cast<int>(lod);
   const int level1 = std::min(level0 + 1, face.level_count - 1);
   const float t = lod - static_cast<float>(level0);
@@ -301,10 +321,10 @@ FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, 
                                    float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
   const FaceGpu& face = tex.faces->at(face_index);
   FilterSum sum;
-  const Footprint f = footprint(face, dudx, dvdx, dudy, dvdy);
+  const Footprint f = footprint(face, sampler.lod_bias, dudx, dvdx, dudy, dvdy);
   switch (sampler.filter) {
     case SEAMCL_FILTER_BILINEAR:
-      accumulate_bilinear(sum, tex, face_level(tex, face, 0), u, v, 1.0f, address);
+      accumulate_bilinear(sum, tex, face_level(tex, face, bilinear_level(face, sampler.lod_bias)), u, v, 1.0f, address);
       break;
     case SEAMCL_FILTER_TRILINEAR:
       accumulate_trilinear(sum, tex, face, u, v, trilinear_lod(face, f), 1.0f, address);
@@ -319,8 +339,8 @@ FilterSum filter_texture_reference(const TextureView& tex, uint32_t face_index, 
   return sum;
 }
 
-bool ewa_sides_may_contribute(float min_side, float max_side, int guard_band, float distance_u, float distance_v,
-                              float dudx, float dvdx, float dudy, float dvdy) {
+bool ewa_sides_may_contribute(float min_side, float max_side, int guard_band, float lod_bias, float distance_u,
+                              float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
   // Footprint axes by their 1-norms in uv: no shorter than their lengths, and kept by the maps
   // between faces (which only permute and negate u and v).
   const float axis_x = std::fabs(dudx) + std::fabs(dvdx);
@@ -331,8 +351,10 @@ bool ewa_sides_may_contribute(float min_side, float max_side, int guard_band, fl
   // The coarsest texel EWA's trilinear pair of levels can weigh (uv): the level where the minor
   // axis (no longer than max side x the longer 1-norm, in level-0 texels) spans a texel, and the
   // next, whose texels are up to twice that (2.01: approx_log2's error); none longer than the
-  // face. Kept multiplied by min_side (a power of two: exact), so that the kernel divides nothing.
-  const float texel_sides = std::fmin(min_side, std::fmax(2.0f, 2.01f * max_side * std::fmax(axis_x, axis_y)));
+  // face. A positive bias makes them up to bias_coarsening times longer. Kept multiplied by
+  // min_side (a power of two: exact), so that the kernel divides nothing.
+  const float texel_sides = std::fmin(
+      min_side, std::fmax(2.0f, 2.01f * max_side * std::fmax(axis_x, axis_y) * bias_coarsening(lod_bias)));
   // The ellipse spreads over both axes, its minor one grown up to max/min side times in uv by the
   // eccentricity clamp; it is widened by about a texel (the + 1 of accumulate_ewa_level): a whole one.
   const float spread = (1.0f + max_side / min_side) * axes;
@@ -345,8 +367,8 @@ bool ewa_sides_may_contribute(float min_side, float max_side, int guard_band, fl
                                counted_v * min_side >= spread * min_side + texel_reach));
 }
 
-bool axis_rules_out(float side, float cross_side, int filter, int max_aniso, int guard_band, float distance, float x_a,
-                    float x_b, float y_a, float y_b) {
+bool axis_rules_out(float side, float cross_side, int filter, int max_aniso, float lod_bias, int guard_band,
+                    float distance, float x_a, float x_b, float y_a, float y_b) {
   // The screen axes' lengths in the face's level-0 texels, bounded by their 1-norms weighted by
   // the sides: |a| side + |b| cross_side >= sqrt((a side)^2 + (b cross_side)^2).
   const float len_x = x_a * side + x_b * cross_side;
@@ -356,11 +378,16 @@ bool axis_rules_out(float side, float cross_side, int filter, int max_aniso, int
   // twice 2^lod (2.01: approx_log2's error); none longer than the side (a 1-texel level).
   // Trilinear's 2^lod is the longer axis; aniso's that divided by its N probes, N >= min(major /
   // minor, max_aniso), so at most the longer of the minor axis and major / max_aniso (whichever
-  // of the two screen axes the face's texels make the minor one: the shorter bound serves).
+  // of the two screen axes the face's texels make the minor one: the shorter bound serves). A
+  // positive bias lengthens them up to bias_coarsening times (bilinear's level then being at most
+  // ceil(bias), its texels at most that power of two long).
   const float probe_len = filter == SEAMCL_FILTER_ANISO
                               ? std::fmax(std::fmin(len_x, len_y), std::fmax(len_x, len_y) / static_cast<float>(max_aniso))
                               : std::fmax(len_x, len_y);
-  const float texel_sides = filter == SEAMCL_FILTER_BILINEAR ? 1.0f : std::fmin(side, std::fmax(2.0f, 2.01f * probe_len));
+  const float coarsening = bias_coarsening(lod_bias);
+  const float texel_sides = filter == SEAMCL_FILTER_BILINEAR
+                                ? std::fmin(side, coarsening)
+                                : std::fmin(side, std::fmax(2.0f, 2.01f * probe_len * coarsening));
   // Aniso's probes spread over half its major axis, one of the two screen axes.
   const float spread = filter == SEAMCL_FILTER_ANISO ? 0.5f * std::fmax(x_a, y_a) : 0.0f;
   // A tap weighs something only within half a texel of its probe (kTapReachTexels); band texels read as inside.
@@ -373,26 +400,27 @@ bool axis_rules_out(float side, float cross_side, int filter, int max_aniso, int
   return side > 0.0f && counted * side >= spread * side + texel_reach;
 }
 
-bool neighbor_may_contribute(const FaceGpu& other, bool swapped, int filter, int max_aniso, int guard_band,
-                             float distance_u, float distance_v, float dudx, float dvdx, float dudy, float dvdy) {
+bool neighbor_may_contribute(const FaceGpu& other, bool swapped, int filter, int max_aniso, float lod_bias,
+                             int guard_band, float distance_u, float distance_v, float dudx, float dvdx, float dudy,
+                             float dvdy) {
   if (filter == SEAMCL_FILTER_EWA) {
     return ewa_sides_may_contribute(static_cast<float>(std::min(other.width, other.height)),
-                                    static_cast<float>(std::max(other.width, other.height)), guard_band, distance_u,
-                                    distance_v, dudx, dvdx, dudy, dvdy);
+                                    static_cast<float>(std::max(other.width, other.height)), guard_band, lod_bias,
+                                    distance_u, distance_v, dudx, dvdx, dudy, dvdy);
   }
   const float x_u = std::fabs(dudx), x_v = std::fabs(dvdx), y_u = std::fabs(dudy), y_v = std::fabs(dvdy);
   if (!(x_u + x_v + y_u + y_v < INFINITY)) return true;
   // The other face's sides along this face's u and v.
   const float side_u = static_cast<float>(swapped ? other.height : other.width);
   const float side_v = static_cast<float>(swapped ? other.width : other.height);
-  return !(axis_rules_out(side_u, side_v, filter, max_aniso, guard_band, distance_u, x_u, x_v, y_u, y_v) ||
-           axis_rules_out(side_v, side_u, filter, max_aniso, guard_band, distance_v, x_v, x_u, y_v, y_u));
+  return !(axis_rules_out(side_u, side_v, filter, max_aniso, lod_bias, guard_band, distance_u, x_u, x_v, y_u, y_v) ||
+           axis_rules_out(side_v, side_u, filter, max_aniso, lod_bias, guard_band, distance_v, x_v, x_u, y_v, y_u));
 }
 
 bool map_swaps_axes(const float transform[6]) { return transform[0] == 0.0f; }
 
-int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, int guard_band, float u, float v, float dudx,
-                    float dvdx, float dudy, float dvdy) {
+int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, float lod_bias, int guard_band, float u, float v,
+                    float dudx, float dvdx, float dudy, float dvdy) {
   const float x_u = std::fabs(dudx), x_v = std::fabs(dvdx), y_u = std::fabs(dudy), y_v = std::fabs(dvdy);
   if (filter == SEAMCL_FILTER_EWA || !(x_u + x_v + y_u + y_v < INFINITY)) return 15;
   const float inside[4] = {v, 1.0f - u, 1.0f - v, u};
@@ -400,7 +428,8 @@ int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, int guard
   for (int k = 0; k < 4; ++k) {
     // Edges 0 and 2 are crossed along v, 1 and 3 along u.
     const bool along_v = k % 2 == 0;
-    const bool ruled_out = axis_rules_out(reach_side(n.reach_min_side[k]), reach_side(n.reach_max_side[k]), filter, max_aniso, guard_band,
+    const bool ruled_out = axis_rules_out(reach_side(n.reach_min_side[k]), reach_side(n.reach_max_side[k]), filter, max_aniso,
+                                          lod_bias, guard_band,
                                           inside[k], along_v ? x_v : x_u, along_v ? x_u : x_v, along_v ? y_v : y_u,
                                           along_v ? y_u : y_v);
     mask |= (ruled_out ? 0 : 1) << k;
@@ -408,12 +437,12 @@ int edges_may_reach(const FaceNeighbors& n, int filter, int max_aniso, int guard
   return mask;
 }
 
-bool lookup_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float u, float v, float dudx,
-                           float dvdx, float dudy, float dvdy) {
-  const Footprint f = footprint(face, dudx, dvdx, dudy, dvdy);
+bool lookup_may_reach_face(const FaceGpu& face, int guard_band, int filter, int max_aniso, float lod_bias, float u,
+                           float v, float dudx, float dvdx, float dudy, float dvdy) {
+  const Footprint f = footprint(face, lod_bias, dudx, dvdx, dudy, dvdy);
   switch (filter) {
     case SEAMCL_FILTER_BILINEAR:
-      return probes_reach_face(face, guard_band, 0, u, v, 0.0f, 0.0f);
+      return probes_reach_face(face, guard_band, bilinear_level(face, lod_bias), u, v, 0.0f, 0.0f);
     case SEAMCL_FILTER_TRILINEAR:
       return probes_reach_face(face, guard_band, coarser_level(face, trilinear_lod(face, f)), u, v, 0.0f, 0.0f);
     case SEAMCL_FILTER_ANISO: {
@@ -438,15 +467,16 @@ FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const Samp
   auto add_across = [&](int other, const float* t, float distance_u, float distance_v) {
     if (other < 0) return;
     const FaceGpu& g = tex.faces->at(static_cast<size_t>(other));
-    if (early_out && !neighbor_may_contribute(g, map_swaps_axes(t), sampler.filter, sampler.max_aniso, tex.guard_band, distance_u, distance_v,
-                                              dudx, dvdx, dudy, dvdy)) {
+    if (early_out && !neighbor_may_contribute(g, map_swaps_axes(t), sampler.filter, sampler.max_aniso, sampler.lod_bias,
+                                              tex.guard_band, distance_u, distance_v, dudx, dvdx, dudy, dvdy)) {
       return;
     }
     const float gu = t[0] * u + t[1] * v + t[2], gv = t[3] * u + t[4] * v + t[5];
     const float gdudx = t[0] * dudx + t[1] * dvdx, gdvdx = t[3] * dudx + t[4] * dvdx;
     const float gdudy = t[0] * dudy + t[1] * dvdy, gdvdy = t[3] * dudy + t[4] * dvdy;
     // Then the probes the filter would take there, against the other face's square.
-    if (early_out && !lookup_may_reach_face(g, tex.guard_band, sampler.filter, sampler.max_aniso, gu, gv, gdudx, gdvdx, gdudy, gdvdy)) {
+    if (early_out && !lookup_may_reach_face(g, tex.guard_band, sampler.filter, sampler.max_aniso, sampler.lod_bias, gu, gv,
+                                            gdudx, gdvdx, gdudy, gdvdy)) {
       return;
     }
     const FilterSum s = filter_texture_reference(tex, static_cast<uint32_t>(other), sampler, SEAMCL_ADDRESS_BORDER, gu,
@@ -461,7 +491,9 @@ FilterSum method_sum_reference(const TextureView& tex, uint32_t face, const Samp
   // First, from this face's record alone, the edges whose faces (across and past the ends) the
   // lookup may reach: the others' three faces are not read at all.
   const int edge_may_reach =
-      early_out ? edges_may_reach(n, sampler.filter, sampler.max_aniso, tex.guard_band, u, v, dudx, dvdx, dudy, dvdy) : 15;
+      early_out ? edges_may_reach(n, sampler.filter, sampler.max_aniso, sampler.lod_bias, tex.guard_band, u, v, dudx, dvdx,
+                                  dudy, dvdy)
+                : 15;
   for (int k = 0; k < 4; ++k) {
     if (((edge_may_reach >> k) & 1) == 0) continue;
     const bool along_v = k % 2 == 0;
@@ -484,7 +516,8 @@ glm::vec4 sample_texture_reference(const TextureView& tex, uint32_t face, const 
   FilterSum sum = method_sum_reference(tex, face, sampler, u, v, dudx, dvdx, dudy, dvdy);
   if (!sampler.renormalize) return sum.color;
   if (sum.weight == 0.0f && sampler.zero_coverage == SEAMCL_ZERO_COVERAGE_CLAMP) {
-    // Every tap fell outside: a clamped trilinear lookup at the centre clamped to the face.
+    // Every tap fell outside: a clamped trilinear lookup at the centre clamped to the face (with
+    // the sampler's bias, as every lookup).
     SamplerParams fallback = sampler;
     fallback.filter = SEAMCL_FILTER_TRILINEAR;
     sum = filter_texture_reference(tex, face, fallback, SEAMCL_ADDRESS_CLAMP, std::fmin(std::fmax(u, 0.0f), 1.0f),
