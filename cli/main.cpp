@@ -81,10 +81,6 @@ int run_render(const RenderArgs& args, const std::string& device) {
     out["estimate"] = plan.estimate_json(runtime.info().host_unified_memory);
     if (!output.empty()) out["output"] = output;
     out["memory"] = to_json(measure_memory(renderer));  // peak over everything above
-    const std::string field = frame_buffers_field(options.msaa);
-    const bool unified = runtime.info().host_unified_memory;
-    out["estimate"] = estimate_json(estimate.device_shares(field), estimate.host_shares(),
-                                    estimate.process_shares(field, unified), unified);
     std::cout << out.dump(2) << "\n";
   } else {
     const StageTimes& ms = run.median;

@@ -58,7 +58,8 @@ TEST(OptionTable, EveryKeyOfToJsonIsInTheTable) {
   options.frame = 3;
   options.displacement = DisplacementMethod::Zipper;
   options.texture = "t.ptx";
-  for (const auto& [key, value] : to_json(options).items()) {
+  const json written = to_json(options);
+  for (const auto& [key, value] : written.items()) {
     EXPECT_NE(find_option(render_option_table(), key), nullptr) << key << " is written but not declared";
   }
   // And what to_json writes parses back to the same options.

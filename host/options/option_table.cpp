@@ -137,9 +137,12 @@ json checked_list(const OptionSpec& spec, const json& value) {
         items.push_back(item);
         continue;
       }
+      // "+4" and "004" are 4, as a shell user or a C parser reads them.
+      const std::string_view digits = item[0] == '+' ? std::string_view(item).substr(1) : std::string_view(item);
       long long v = 0;
-      const auto [end, error] = std::from_chars(item.data(), item.data() + item.size(), v);
-      if (error != std::errc() || end != item.data() + item.size()) throw InputError(spec.key, "not an integer: '" + item + "'");
+      const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
+      if (digits.empty() || error != std::errc() || end != digits.data() + digits.size())
+        throw InputError(spec.key, "not an integer: '" + item + "'");
       items.push_back(v);
     }
   } else if (integers && value.is_number_integer()) {
@@ -236,7 +239,8 @@ std::string list_pattern(const OptionSpec& spec) {
   std::vector<std::string> names = spec.choices;
   for (int v : spec.integers) names.push_back(std::to_string(v));
   std::stable_sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) { return a.size() > b.size(); });
-  std::string item = "(?:";
+  // An integer item may carry a plus sign and leading zeros, as the parser reads them.
+  std::string item = spec.integers.empty() ? "(?:" : "\\+?0*(?:";
   for (size_t i = 0; i < names.size(); ++i) {
     if (i) item += "|";
     for (char c : names[i]) {
