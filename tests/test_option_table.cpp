@@ -118,9 +118,9 @@ TEST(OptionTable, CompareListsTakeCommaTextAndArraysAlike) {
     if (spec.key == "method" || spec.key == "msaa") continue;
     EXPECT_NE(find_option(compare_option_table(), spec.key), nullptr) << spec.key;
   }
-  EXPECT_EQ(field_of([] { CompareJob job({{"method", "discard"}}); }), "method");
-  EXPECT_EQ(field_of([] { CompareJob job({{"bogus", 1}}); }), "bogus");
-  EXPECT_EQ(CompareJob({{"lod_bias", 1}}).entries().front().options.lod_bias, 1.0f);
+  EXPECT_EQ(field_of([] { CompareJob job(nlohmann::json{{"method", "discard"}}); }), "method");
+  EXPECT_EQ(field_of([] { CompareJob job(nlohmann::json{{"bogus", 1}}); }), "bogus");
+  EXPECT_EQ(CompareJob(nlohmann::json{{"lod_bias", 1}}).entries().front().options.lod_bias, 1.0f);
 }
 
 // --help of render and compare: every option of the job's table as a flag, with its default.
