@@ -50,19 +50,6 @@ inline std::string given_value(const std::optional<std::string>& given, const st
   return given.value_or("");
 }
 
-// An option that acts only in another mode (with or without some other option) is refused where it
-// would be parsed and then ignored: the user meant it to change something. `options` are long names
-// ("--sweep-repeats"), each refused as the field of its name ("sweep_repeats"); `where` says when
-// it is ignored ("without --sweep").
-inline void refuse_ignored_options(const CLI::App& command, const std::vector<std::string>& options, const std::string& where) {
-  for (const std::string& option : options) {
-    if (command.count(option) == 0) continue;
-    std::string field = option.substr(option.find_first_not_of('-'));
-    for (char& c : field) c = c == '-' ? '_' : c;
-    throw InputError(field, option + " is ignored " + where + ": leave it out");
-  }
-}
-
 struct GlobalOptions {
   std::string device;  // --device, before the subcommand
 };

@@ -305,21 +305,21 @@ TEST_F(Cli, EmptyOutputPathsAreInputErrors) {
 TEST_F(Cli, OptionsThatWouldBeIgnoredAreInputErrors) {
   expect_input_error("bench --scene quad2 --size 16x16 --sweep '' --check", "sweep: must not be empty");
   expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --sweep-repeats 3 --check",
-                     "sweep_repeats: --sweep-repeats is ignored without --sweep");
+                     "sweep_repeats: is ignored without sweep");
   // The orbit's options with --sweep, which renders no orbit.
-  expect_input_error("bench --scene quad2 --sweep msaa --msaa 4 --check", "msaa: --msaa is ignored with --sweep");
-  expect_input_error("bench --scene quad2 --sweep msaa --frames 2 --check", "frames: --frames is ignored with --sweep");
-  expect_input_error("bench --scene quad2 --sweep msaa --shard 1/2 --check", "shard: --shard is ignored with --sweep");
-  expect_input_error("bench --scene quad2 --sweep msaa --no-errors --check", "no_errors: --no-errors is ignored");
+  expect_input_error("bench --scene quad2 --sweep msaa --msaa 4 --check", "msaa: is ignored with sweep");
+  expect_input_error("bench --scene quad2 --sweep msaa --frames 2 --check", "frames: is ignored with sweep");
+  expect_input_error("bench --scene quad2 --sweep msaa --shard 1/2 --check", "shard: is ignored with sweep");
+  expect_input_error("bench --scene quad2 --sweep msaa --no-errors --check", "no_errors: is ignored with sweep");
   // The pixels sweep's points have sizes of their own; faces, msaa and texels render at --size.
   expect_input_error("bench --scene quad2 --sweep pixels --size 64x64 --check",
-                     "size: --size is ignored with --sweep pixels");
+                     "size: is ignored with sweep pixels");
   expect_input_error("bench --scene quad2 --sweep msaa --sweep-repeats 0 --check", "sweep_repeats: must be in 1..100");
   // The reference's options without references.
   expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --no-errors --reference-frames 2 --check",
-                     "reference_frames: --reference-frames is ignored with --no-errors");
+                     "reference_frames: is ignored with no_errors");
   expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --no-errors --reference-msaa 4 --check",
-                     "reference_msaa: --reference-msaa is ignored with --no-errors");
+                     "reference_msaa: is ignored with no_errors");
   // --frames without --frame: the scene's own camera renders.
   expect_input_error("render --scene quad2 --size 16x16 --frames 30 -o x.png", "frames: is ignored without frame");
   expect_input_error("compare --scene quad2 --methods discard --msaa 1 --size 16x16 --repeat 1 --no-progress --no-cache "

@@ -305,7 +305,7 @@ TEST(DisplacementMetricsCli, BadInputExitsTwoNamingTheField) {
            {"--tessellation 4,0", "tessellation"},
            {"--tessellation 65", "tessellation"},
            {"--tessellation four", "tessellation"},
-           {"--level 17", "displacement_level"},
+           {"--level 17", "level"},
            {"--frames -1", "frames"},
            {"--repeat 0", "repeat"},
            {"--scene paper", "scene"},

@@ -10,12 +10,14 @@ namespace seamcl {
 nlohmann::json JobPlan::estimate_json(bool unified_device) const {
   MemoryShares separate = device;
   separate.add(host);
-  return seamcl::estimate_json(device, host, unified_device ? unified : separate, unified_device);
+  // A plan without a unified figure counts device and host apart on any device (conservative).
+  const bool has_unified = unified.total() > 0;
+  return seamcl::estimate_json(device, host, unified_device && has_unified ? unified : separate, unified_device);
 }
 
 void refuse_beyond_machine(const JobPlan& plan, const DeviceInfo& device) {
   const size_t physical = physical_memory_bytes();
-  if (device.host_unified_memory) {
+  if (device.host_unified_memory && plan.unified.total() > 0) {
     if (physical != 0 && plan.unified.total() > physical)
       throw OverBudget(plan.unified.field(), plan.what, plan.unified.total(), physical);
     return;

@@ -45,6 +45,7 @@ struct JobPlan {
   MemoryShares device, host;
   // The same bytes on a device that shares the host's memory (a CPU): each counted once, at the
   // job's peak (the scene buffers are the packed arrays themselves), with the process overhead.
+  // Empty where a job has no such figure: device and host are then counted apart everywhere.
   MemoryShares unified;
 
   // {"device_bytes", "host_bytes", "total_bytes", "unified", "total_shares"}: the figure the

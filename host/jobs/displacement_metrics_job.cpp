@@ -1,0 +1,132 @@
+#include <seamcl/jobs/displacement_metrics_job.h>
+
+#include <algorithm>
+#include <filesystem>
+
+#include <seamcl/core/input_error.h>
+#include <seamcl/eval/displacement_metrics.h>
+#include <seamcl/io/image_io.h>
+#include <seamcl/memory/render_memory.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene_generators.h>
+
+namespace seamcl {
+namespace {
+
+using nlohmann::json;
+
+constexpr int kMaxCrackFrames = 3600;
+
+}  // namespace
+
+const OptionTable& displacement_metrics_option_table() {
+  static const OptionTable table = [] {
+    OptionSpec scene = *find_option(render_option_table(), "scene");
+    scene.help = "A scene with displacement maps: built-in, a scene file, or an .obj with its maps attached";
+    scene.default_value = "displaced";
+    OptionSpec methods = make_option("methods", OptionType::List, "Comma list of displacement methods");
+    methods.choices = displacement_method_names();
+    methods.default_value = displacement_method_names();
+    OptionSpec levels = make_option("tessellation", OptionType::List, "Comma list of tessellation levels T");
+    for (int t = 1; t <= SEAMCL_MAX_TESSELLATION; ++t) levels.integers.push_back(t);
+    levels.default_value = json::array({4, 16, 64});
+    OptionSpec level = make_option("level", OptionType::Integer, "The maps' level sampled");
+    level.minimum = 0;
+    level.maximum = kMaxDisplacementLevel;
+    level.default_value = 0;
+    OptionSpec size = *find_option(render_option_table(), "size");
+    OptionSpec msaa = *find_option(render_option_table(), "msaa");
+    msaa.help = "Samples per pixel (crack pixels count a pixel when any sample sees the flag)";
+    msaa.default_value = 4;
+    OptionSpec frames = make_option("frames", OptionType::Integer,
+                                    "Orbit frames to count crack pixels over; 0: the scene's camera only");
+    frames.minimum = 0;
+    frames.maximum = kMaxCrackFrames;
+    frames.default_value = 60;
+    OptionSpec repeat = make_option("repeat", OptionType::Integer, "Timed renders per entry; the median is reported");
+    repeat.minimum = 1;
+    repeat.maximum = 100;
+    repeat.default_value = 5;
+    return OptionTable{scene, methods, levels, level, size, msaa, frames, repeat};
+  }();
+  return table;
+}
+
+DisplacementMetricsJob::DisplacementMetricsJob(const json& request) {
+  if (!request.is_object()) throw InputError("request", "must be a JSON object");
+  std::vector<std::string> known;
+  for (const OptionSpec& spec : displacement_metrics_option_table()) known.push_back(spec.key);
+  refuse_unknown_keys(request, known);
+  auto value_of = [&](const std::string& key) {
+    const OptionSpec& spec = *find_option(displacement_metrics_option_table(), key);
+    return request.contains(key) ? checked_option(spec, request.at(key)) : spec.default_value;
+  };
+  for (const json& name : value_of("methods")) methods_.push_back(*parse_displacement_method(name.get<std::string>()));
+  for (const json& t : value_of("tessellation")) levels_.push_back(t.get<int>());
+  frames_ = value_of("frames").get<int>();
+  repeat_ = value_of("repeat").get<int>();
+  frame_ = parse_render_options({{"scene", value_of("scene")},
+                                 {"size", value_of("size")},
+                                 {"msaa", value_of("msaa")},
+                                 {"displacement_method", to_string(methods_.front())},
+                                 {"displacement_level", value_of("level")}});
+}
+
+JobPlan DisplacementMetricsJob::plan(const Scene& scene) const {
+  if (frames_ > 0 && !scene.orbit)
+    throw InputError("frames", "scene '" + scene.name + "' has no orbit; pass --frames 0 to measure its camera only");
+  if (!scene.displacement) {
+    throw InputError("scene", "'" + scene.name + "' has no displacement maps (the built-in 'displaced' scene has; an "
+                                                 ".obj takes them with --displacement-map FILE.ptx)");
+  }
+  check_tessellation_levels(scene, levels_);  // the triangle bound of every level, before any render
+  RenderOptions densest = frame_;
+  densest.tessellation = *std::max_element(levels_.begin(), levels_.end());
+  const RenderMemory memory = render_memory(is_closed_mesh(scene) ? with_flag_shell(scene) : scene, densest);
+  return JobPlan{"this displacement-metrics run", memory.device_shares(frame_buffers_field(densest.msaa)),
+                 memory.host_shares()};
+}
+
+json DisplacementMetricsJob::run(ClRuntime& runtime, const Scene& scene, const JobControl& control,
+                                 const std::string& images_dir) const {
+  (void)plan(scene);  // the scene's checks, for a caller that did not plan
+  const bool closed = is_closed_mesh(scene);
+  json results = json::array();
+  const size_t total = methods_.size() * levels_.size();
+  for (int t : levels_) {
+    for (DisplacementMethod method : methods_) {
+      throw_if_stopped(control.should_stop, "before " + to_string(method) + " T " + std::to_string(t));
+      RenderOptions options = frame_;
+      options.displacement = method;
+      options.tessellation = t;
+      control.report("[" + std::to_string(results.size() + 1) + "/" + std::to_string(total) + "] " + to_string(method) +
+                     " T " + std::to_string(t));
+      json item = measure_displacement(runtime, scene, scene.camera, options, frames_, repeat_, control.device_byte_limit)
+                      .to_json();
+      if (!images_dir.empty()) {
+        // Frame 0 of the orbit with the flag shell inside (closed meshes): cracks show as magenta.
+        const Camera camera = scene.orbit ? orbit_camera(scene, 0, std::max(frames_, 1)) : scene.camera;
+        Renderer renderer(runtime);
+        renderer.set_device_byte_limit(control.device_byte_limit);
+        renderer.load_scene(closed ? with_flag_shell(scene) : scene, options.texels);
+        const RenderResult image = renderer.render(camera, options);
+        const std::filesystem::path path =
+            std::filesystem::path(images_dir) / (to_string(method) + "_T" + std::to_string(t) + ".png");
+        write_image(path.string(), image.width, image.height, image.pixels);
+        item["image"] = path.string();
+      }
+      results.push_back(item);
+    }
+  }
+  return {{"scene", scene.name},
+          {"size", std::to_string(frame_.width) + "x" + std::to_string(frame_.height)},
+          {"msaa", frame_.msaa},
+          {"level", frame_.displacement_level},
+          {"crack_frames", closed ? frames_ : 0},
+          {"closed_mesh", closed},
+          {"repeat", repeat_},
+          {"device", runtime.device_description()},
+          {"results", results}};
+}
+
+}  // namespace seamcl
