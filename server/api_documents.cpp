@@ -1,12 +1,15 @@
-// The documents that describe the service to clients: GET /openapi.json and the options part of
-// GET /v1/methods. Every option's schema comes from the jobs' option tables
-// (host/options/option_table.h), so the documents cannot drift from what the parsers take;
+// The documents that describe the service to clients: GET /openapi.json and GET /v1/methods.
+// Every option's schema comes from the jobs' option tables (host/options/option_table.h), so the
+// documents cannot drift from what the parsers take;
 // server/openapi.json holds only what no table says (paths, answers, the scene formats).
 #include "api_documents.h"
 
 #include <seamcl/jobs/compare_job.h>
 #include <seamcl/jobs/render_job.h>
 #include <seamcl/options/render_options.h>
+#include <seamcl/memory/render_memory.h>
+#include <seamcl/scene/scene.h>
+#include <seamcl/scene/scene_generators.h>
 
 namespace seamcl::server {
 namespace {
@@ -25,6 +28,19 @@ void set_options(json& properties, const OptionTable& table, const std::vector<s
     if (spec.key == "scene" || std::find(skip.begin(), skip.end(), spec.key) != skip.end()) continue;
     properties[spec.key] = option_schema(spec);
   }
+}
+
+std::string method_description(const std::string& name) {
+  if (name == "clamp") return "taps outside the face read the nearest edge texel (seams show)";
+  if (name == "black") return "taps outside the face weigh zero, no renormalisation (edges darken)";
+  if (name == "discard") return "taps outside the face weigh zero, the rest are renormalised (Toth 2013)";
+  if (name == "traverse") {
+    return "taps outside the face are fetched from the edge-adjacent faces and, past valence-4 corners, the diagonal "
+           "face (McDonald 2013, with Ptex's corners)";
+  }
+  if (name == "traverse-edges") return "taps outside the face are fetched from the edge-adjacent faces only (McDonald 2013, as the paper compares)";
+  if (name == "guardband") return "each mip level carries a band of texels from its neighbours (McDonald and Burley 2011)";
+  return "";
 }
 
 json make_openapi() {
@@ -103,6 +119,40 @@ json compare_options_document(const ServerOptions& limits) {
   options.at("repeat")["maximum"] = limits.max_compare_repeat;
   options.at("size").erase("default");
   return options;
+}
+
+json methods_document(const Scene& default_scene, const ServerOptions& limits) {
+  const RenderOptions defaults;
+  json methods = json::array();
+  // From the sizes (exactly what pack_scene stores, render_memory.h): nothing is baked or packed.
+  const SceneSizes default_sizes = scene_sizes(default_scene);
+  for (const std::string& name : method_names()) {
+    const Method method = *parse_method(name);
+    const PackedTextureMemory packed =
+        packed_texture_memory(default_sizes, TexelFormat::Rgba8, method == Method::Guardband ? defaults.guard_band : 0);
+    const size_t float_texel_bytes = 4 * sizeof(float);
+    methods.push_back({{"name", name},
+                       {"description", method_description(name)},
+                       {"texture_bytes", {{"rgba8", packed.texture_bytes}, {"rgba32f", packed.texels * float_texel_bytes}}},
+                       {"padding_bytes", {{"rgba8", packed.padding_bytes}, {"rgba32f", packed.band_texels * float_texel_bytes}}},
+                       {"adjacency_bytes", reads_adjacency(method) ? packed.adjacency_bytes : 0}});
+  }
+  std::vector<std::string> scene_names;
+  for (const GeneratorInfo& g : scene_generators()) scene_names.push_back(g.name);
+  return {
+      {"scene", defaults.scene},
+      {"methods", methods},
+      {"options", options_document(scene_names, limits)},
+      {"compare_options", compare_options_document(limits)},
+      {"limits",
+       {{"max_body_bytes", limits.max_body_bytes},
+        {"max_samples", limits.max_samples},
+        {"max_inline_faces", limits.max_inline_faces},
+        {"max_inline_texels", limits.max_inline_texels},
+        {"max_compare_pixels", limits.max_compare_pixels},
+        {"max_compare_entries", limits.max_compare_entries},
+        {"max_compare_repeat", limits.max_compare_repeat},
+        {"max_reference_samples", limits.max_reference_samples}}}};
 }
 
 }  // namespace seamcl::server

@@ -1,0 +1,331 @@
+#include "job_handlers.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include <seamcl/core/cancelled.h>
+#include <seamcl/core/input_error.h>
+#include <seamcl/memory/compare_memory.h>
+#include <seamcl/io/image_io.h>
+#include <seamcl/jobs/compare_job.h>
+#include <seamcl/jobs/render_job.h>
+#include <seamcl/memory/render_memory.h>
+#include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/scene.h>
+
+#include "connection.h"
+#include "request_hygiene.h"
+
+namespace seamcl::server {
+namespace {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// POST /v1/compare without a size: the render default (480x540) is over the compare limit, so
+// the largest size of the default's aspect within max_pixels (each side floored, at least 1).
+std::string default_compare_size(long long max_pixels) {
+  const RenderOptions defaults;
+  long long width = defaults.width, height = defaults.height;
+  if (width * height > max_pixels) {
+    const double scale = std::sqrt(static_cast<double>(max_pixels) / static_cast<double>(width * height));
+    width = std::max(1LL, static_cast<long long>(std::floor(static_cast<double>(defaults.width) * scale)));
+    height = std::max(1LL, static_cast<long long>(std::floor(static_cast<double>(defaults.height) * scale)));
+    while (width * height > max_pixels && (width > 1 || height > 1)) (width >= height ? width : height) -= 1;
+  }
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+// The answer's image format, taken out of a request: png unless `format` says exr.
+ImageFormat take_image_format(json& rest) {
+  if (!rest.contains("format")) return ImageFormat::Png;
+  const json& value = rest.at("format");
+  const auto parsed = value.is_string() ? parse_image_format(value.get<std::string>()) : std::nullopt;
+  if (!parsed) throw InputError("format", "must be \"png\" or \"exr\", got " + echo(json_text(value)));
+  rest.erase("format");
+  return *parsed;
+}
+
+}  // namespace
+
+JobHandlers::JobHandlers(ClRuntime& runtime, const ServerOptions& options, const SceneResolver& scenes, RenderSlots& slots)
+    : runtime_(runtime),
+      options_(options),
+      scenes_(scenes),
+      slots_(slots),
+      budget_(options.max_request_device_bytes, options.max_request_host_bytes) {}
+
+std::mutex& JobHandlers::reference_lock(const std::string& cache_key) {
+  return reference_locks_[std::hash<std::string>{}(cache_key) % reference_locks_.size()];
+}
+
+void JobHandlers::render(const json& request, httplib::Response& res) {
+  const Clock::time_point start = Clock::now();
+  if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
+
+  // The service's own keys (format, an inline scene); the rest is the render job's request, but
+  // the command line's timing keys: one answer is one image.
+  json rest = request;
+  const ImageFormat format = take_image_format(rest);
+  const json inline_scene = take_inline_scene(rest);
+  for (const char* key : {"repeat", "crack_orbit"})
+    if (rest.contains(key)) throw HttpError{400, key, "is the command line's (seamcl render); a request renders one image"};
+  const RenderJob job(rest);
+  RenderOptions options = job.options();
+  std::string key;
+  const std::shared_ptr<const Scene> scene = scenes_.resolve(inline_scene, options, key);
+  const bool inline_request = key.empty();  // an inline scene or an asset: held for this request only
+  // Limits after every syntax check (a malformed request is a 400 whatever its size) and before
+  // anything is packed or put on the device (an inline scene's own size is bounded by the face
+  // and texel limits checked before it is parsed).
+  if (static_cast<long long>(options.width) * options.height * options.msaa > options_.max_samples) {
+    throw HttpError{413, "size",
+                    "width x height x msaa = " + std::to_string(static_cast<long long>(options.width) * options.height * options.msaa) +
+                        " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
+  }
+  budget_.refuse_scene_over(*scene, options, inline_scene, key);
+  // The request's own copy of an inline scene or asset is held on top of the Renderer's.
+  const JobPlan plan = job.plan(*scene, inline_request ? scene_host_bytes(scene_sizes(*scene)) : 0);
+  budget_.refuse_over(plan.device, plan.host, !inline_request, plan.what);
+
+  // Wait for a render slot (or 503), render, and give the slot back before encoding.
+  const Clock::time_point queued = Clock::now();
+  RenderRun run;
+  double queue_ms = 0;
+  {
+    const std::unique_ptr<SlotLease> lease = slots_.acquire(start);
+    queue_ms = ms_since(queued);
+    // Queued for a client that has since hung up: nobody would read the image.
+    if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
+    RenderSlot& slot = lease->slot();
+    std::unique_ptr<Renderer>& renderer = key.empty() ? slot.scratch : slot.renderers[key];
+    try {
+      if (!renderer) {
+        renderer = std::make_unique<Renderer>(runtime_);
+        if (!key.empty()) renderer->load_scene(*scene, options.texels);
+      }
+      // Tile lists grow with what a frame holds, past any estimate: bounded here.
+      renderer->set_device_byte_limit(options_.max_request_device_bytes);
+      if (key.empty()) renderer->load_scene(*scene, options.texels);
+      JobControl control;
+      control.device_byte_limit = options_.max_request_device_bytes;
+      run = job.run(runtime_, *renderer, *scene, control);
+      // Hold nothing request-sized between requests: the inline scene goes, large frames too.
+      if (key.empty()) {
+        renderer->release_scene();
+      } else if (render_memory(scene_sizes(*scene), options).frame_device_bytes() > options_.keep_frame_bytes) {
+        renderer->release_frame_buffers();
+      }
+    } catch (...) {
+      renderer.reset();  // a failed Renderer is not reused: the next request gets a fresh one
+      throw;
+    }
+  }
+  const RenderResult& result = run.last;
+  const Clock::time_point encode_start = Clock::now();
+  std::string image = encode_image(format, result.width, result.height, result.pixels);
+  const double encode_ms = ms_since(encode_start);
+
+  res.set_header("X-Seamcl-Render-Ms", std::to_string(result.ms.total));
+  res.set_header("X-Seamcl-Stage-Ms", json_text(RenderJob::stage_ms_json(result.ms)));
+  res.set_header("X-Seamcl-Queue-Ms", std::to_string(queue_ms));
+  res.set_header("X-Seamcl-Encode-Ms", std::to_string(encode_ms));
+  res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
+  res.set_header("X-Seamcl-Options", json_text(to_json(options)));
+  res.set_header("X-Seamcl-Fragments", std::to_string(result.stats.fragments));
+  res.set_content(std::move(image), format == ImageFormat::Png ? "image/png" : "image/x-exr");
+}
+
+// POST /v1/compare: the compare job (host/jobs/compare_job.h) on one frame, admitted as one
+// request, answered as the JSON of `seamcl compare --json` (without server paths: no cache_path,
+// no images).
+void JobHandlers::compare(const json& request, httplib::Response& res) {
+  const Clock::time_point start = Clock::now();
+  if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
+  json rest = request;
+  if (rest.contains("format")) throw HttpError{400, "format", "compare answers JSON; format is for /v1/render"};
+  const json inline_scene = take_inline_scene(rest);
+  // No size: the render default would be over this server's compare limit, so compare's own
+  // default fits it. The answer says which size was used and where it came from.
+  const bool size_given = rest.contains("size");
+  if (!size_given) rest["size"] = default_compare_size(options_.max_compare_pixels);
+  const bool explicit_reference_msaa = rest.contains("reference_msaa");
+  CompareJob job(rest);  // every syntax check, in seamcl compare's order
+  const std::vector<MethodEntry>& entries = job.entries();
+  const size_t methods = job.methods().size();
+  if (entries.size() > static_cast<size_t>(options_.max_compare_entries)) {
+    // Named after the longer list: the one to shorten.
+    throw HttpError{400, job.rates().size() > methods ? "msaa" : "methods",
+                    std::to_string(methods) + " methods x " + std::to_string(job.rates().size()) +
+                        " msaa rates = " + std::to_string(entries.size()) +
+                        " renders exceeds this server's limit of " + std::to_string(options_.max_compare_entries)};
+  }
+  if (job.repeat() > options_.max_compare_repeat)
+    throw InputError("repeat", "must be an integer in 1.." + std::to_string(options_.max_compare_repeat) + ", got " +
+                                   std::to_string(job.repeat()));
+  ReferenceSettings& reference_settings = job.reference_settings();
+  reference_settings.cache_dir = options_.cache_dir;
+  reference_settings.cache_max_bytes = options_.cache_max_bytes;
+  RenderOptions frame = job.frame();
+  std::string key;
+  const std::shared_ptr<const Scene> scene = scenes_.resolve(inline_scene, frame, key);
+  // Limits after every syntax check: a malformed request is a 400 whatever its size.
+  check_reference_limits(frame, reference_settings, explicit_reference_msaa);
+  const long long pixels = static_cast<long long>(frame.width) * frame.height;
+  for (const MethodEntry& entry : entries) {
+    if (pixels * entry.options.msaa > options_.max_samples) {
+      throw HttpError{413, "size",
+                      "width x height x msaa = " + std::to_string(pixels * entry.options.msaa) +
+                          " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
+    }
+  }
+  budget_.refuse_scene_over(*scene, frame, inline_scene, key);
+  const JobPlan plan = job.plan(*scene);
+  budget_.refuse_over(plan.device, plan.host, !key.empty(), plan.what);
+  // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
+  const Clock::time_point deadline =
+      options_.deadline_ms > 0 ? start + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
+  JobControl control;
+  control.should_stop = [deadline] { return GuardedHttpServer::client_gone() || Clock::now() > deadline; };
+  control.device_byte_limit = options_.max_request_device_bytes;
+
+  // One admitted request for the whole compare, with a Renderer of its own (the job's): the 8x
+  // reference's buffers are freed with it, and the slot's warm Renderers keep their scenes.
+  const Clock::time_point queued = Clock::now();
+  double queue_ms = 0;
+  CompareRun run;
+  {
+    const std::unique_ptr<SlotLease> lease = slots_.acquire(start);
+    queue_ms = ms_since(queued);
+    if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
+    // Two compares of the same reference at once render it once: the second reads the first's.
+    const ReferenceLock lock_reference = [this](const std::string& cache_key) {
+      return std::unique_lock<std::mutex>(reference_lock(cache_key));
+    };
+    try {
+      run = job.run(runtime_, *scene, control, lock_reference);
+    } catch (const Cancelled&) {
+      if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
+      throw HttpError{503, "deadline", "the compare ran past this server's deadline of " + std::to_string(options_.deadline_ms) + " ms", 1};
+    }
+  }
+  json out = job.result_json(run, *scene, runtime_.device_description(), false);
+  out["size_from"] = size_given ? "request" : "default";
+  out["queue_ms"] = queue_ms;
+  out["server_ms"] = ms_since(start);
+  res.set_content(json_text(out), "application/json");
+}
+
+ReferenceSettings JobHandlers::take_reference_settings(json& rest, bool& explicit_msaa) const {
+  ReferenceSettings settings;
+  settings.cache_dir = options_.cache_dir;
+  settings.cache_max_bytes = options_.cache_max_bytes;
+  if (rest.contains("reference_method")) {
+    const json& value = rest.at("reference_method");
+    if (!value.is_string()) throw InputError("reference_method", "must be a method name, got " + echo(json_text(value)));
+    settings.method = value.get<std::string>();
+    if (!parse_method(settings.method)) {
+      throw InputError("reference_method", "unknown method '" + echo(settings.method) + "'");
+    }
+    rest.erase("reference_method");
+  }
+  explicit_msaa = false;
+  if (rest.contains("reference_msaa")) {
+    const json& value = rest.at("reference_msaa");
+    if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 16) {
+      throw InputError("reference_msaa", "must be 1, 2, 4, 8 or 16, got " + echo(json_text(value)));
+    }
+    settings.msaa = value.get<int>();
+    explicit_msaa = true;
+    rest.erase("reference_msaa");
+  }
+  return settings;
+}
+
+void JobHandlers::check_reference_limits(const RenderOptions& frame, const ReferenceSettings& settings, bool explicit_msaa) const {
+  const long long pixels = static_cast<long long>(frame.width) * frame.height;
+  if (pixels > options_.max_compare_pixels) {
+    throw HttpError{413, "size",
+                    std::to_string(frame.width) + "x" + std::to_string(frame.height) + " = " + std::to_string(pixels) +
+                        " pixels exceeds this server's compare limit of " + std::to_string(options_.max_compare_pixels) +
+                        " (the reference renders at " + std::to_string(kReferenceScale) + "x width and height)"};
+  }
+  const RenderOptions high = reference_render_options(frame, settings);
+  const long long reference_samples = static_cast<long long>(high.width) * high.height * high.msaa;
+  if (reference_samples > options_.max_reference_samples) {
+    throw HttpError{413, explicit_msaa ? "reference_msaa" : "size",
+                    "the reference renders " + std::to_string(high.width) + "x" + std::to_string(high.height) + " x " +
+                        std::to_string(high.msaa) + " samples = " + std::to_string(reference_samples) +
+                        ", over this server's limit of " + std::to_string(options_.max_reference_samples)};
+  }
+}
+
+// POST /v1/reference: the image compare measures against (the 8x render, downsampled; from the
+// cache when it is there), for viewers that show a method's error against it.
+void JobHandlers::reference(const json& request, httplib::Response& res) {
+  const Clock::time_point start = Clock::now();
+  if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
+  json rest = request;
+  for (const char* key : {"method", "methods", "msaa", "repeat"}) {
+    if (rest.contains(key)) {
+      throw HttpError{400, key, std::string("the reference is one image of the frame; ") + key + " is for /v1/render or /v1/compare"};
+    }
+  }
+  const ImageFormat format = take_image_format(rest);
+  bool explicit_reference_msaa = false;
+  ReferenceSettings settings = take_reference_settings(rest, explicit_reference_msaa);
+  if (rest.contains("reference")) {
+    const json& value = rest.at("reference");
+    const std::optional<ReferenceKind> kind =
+        value.is_string() ? parse_reference_kind(value.get<std::string>()) : std::nullopt;
+    if (kind == ReferenceKind::Analytic || kind == ReferenceKind::Seamless) {
+      throw InputError("reference", "the " + to_string(*kind) + " reference is not a downsampled render: /v1/compare measures against it");
+    }
+    if (!kind) throw InputError("reference", "must be paper or box, got " + echo(json_text(value)));
+    settings.kind = *kind;
+    rest.erase("reference");
+  }
+  const json inline_scene = take_inline_scene(rest);
+  RenderOptions frame = parse_render_options(rest);
+  std::string key;
+  const std::shared_ptr<const Scene> scene = scenes_.resolve(inline_scene, frame, key);
+  const Camera camera = frame.frame ? orbit_camera(*scene, *frame.frame, frame.frames) : scene->camera;
+  check_reference_limits(frame, settings, explicit_reference_msaa);
+  budget_.refuse_scene_over(*scene, frame, inline_scene, key);
+  const CompareMemory memory = compare_memory(scene_sizes(*scene), frame, {}, settings);
+  budget_.refuse_over(memory.device_shares, memory.host_shares, !key.empty(), "this reference");
+
+  const Clock::time_point queued = Clock::now();
+  double queue_ms = 0;
+  ReferenceImage reference;
+  {
+    const std::unique_ptr<SlotLease> lease = slots_.acquire(start);
+    queue_ms = ms_since(queued);
+    if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
+    Renderer renderer(runtime_);
+    renderer.set_device_byte_limit(options_.max_request_device_bytes);
+    renderer.load_scene(*scene, frame.texels);
+    settings.scene_hash = scene_content_hash(*scene);  // once for the lock's key and the cache's
+    const std::string cache_key = reference_cache_key(*scene, camera, frame, settings);
+    std::lock_guard lock(reference_lock(cache_key));
+    reference = reference_image(renderer, camera, frame, settings);
+  }
+  std::string image = encode_image(format, reference.width, reference.height, reference.pixels);
+  res.set_header("X-Seamcl-Reference-Method", reference.method);
+  res.set_header("X-Seamcl-Reference", reference_json(reference, false).dump());
+  res.set_header("X-Seamcl-Queue-Ms", std::to_string(queue_ms));
+  res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
+  res.set_content(std::move(image), format == ImageFormat::Png ? "image/png" : "image/x-exr");
+}
+
+}  // namespace seamcl::server

@@ -1,0 +1,53 @@
+// The routes that run the library's jobs: POST /v1/render (and GET with a query), POST
+// /v1/compare and POST /v1/reference. Each takes the service's own keys out of the request (the
+// answer's format, an inline scene), hands the rest to the job (host/jobs/), resolves the scene,
+// holds the request to this server's limits and budgets, runs the job on an admitted render slot
+// and answers what it made.
+#pragma once
+#include <array>
+#include <mutex>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include <httplib.h>
+
+#include <seamcl/cl/cl_runtime.h>
+#include <seamcl/eval/reference.h>
+#include <seamcl/options/render_options.h>
+
+#include "http_server.h"
+#include "render_slots.h"
+#include "request_budget.h"
+#include "scene_resolution.h"
+
+namespace seamcl::server {
+
+class JobHandlers {
+ public:
+  // Every reference outlives the handlers (the HttpServer owns them all).
+  JobHandlers(ClRuntime& runtime, const ServerOptions& options, const SceneResolver& scenes, RenderSlots& slots);
+
+  void render(const nlohmann::json& request, httplib::Response& res);
+  void compare(const nlohmann::json& request, httplib::Response& res);
+  void reference(const nlohmann::json& request, httplib::Response& res);
+
+ private:
+  // reference_method and reference_msaa taken out of a reference request.
+  ReferenceSettings take_reference_settings(nlohmann::json& rest, bool& explicit_msaa) const;
+  // The frame's pixels and the 8x reference's samples within this server's limits (413).
+  void check_reference_limits(const RenderOptions& frame, const ReferenceSettings& settings, bool explicit_msaa) const;
+  // Held while a reference is read from the cache or made and written to it.
+  std::mutex& reference_lock(const std::string& cache_key);
+
+  ClRuntime& runtime_;
+  const ServerOptions& options_;
+  const SceneResolver& scenes_;
+  RenderSlots& slots_;
+  RequestBudget budget_;
+  // Two requests for the same reference at once would both render it and write the same cache
+  // file: one lock per hash stripe of the cache key.
+  std::array<std::mutex, 16> reference_locks_;
+};
+
+}  // namespace seamcl::server
