@@ -31,7 +31,8 @@ struct CompareArgs {
   bool json_out = false;
 };
 
-void print_table(const json& out) {
+// `first_reference`: the name of the reference `error` is measured against.
+void print_table(const json& out, const std::string& first_reference) {
   std::printf("%s %s; seam mask: pixels whose texture footprint crosses a face edge\n",
               out["scene"].get<std::string>().c_str(), out["size"].get<std::string>().c_str());
   for (const auto& [msaa, mask] : out["seam_mask"]["by_msaa"].items()) {
@@ -41,7 +42,7 @@ void print_table(const json& out) {
   std::printf("%-9s %-10s %4s %9s %10s %10s %10s %10s %10s %6s\n", "reference", "method", "msaa", "ms", "mean",
               "seam_mean", "seam_p99", "off_mean", "off_p99", "nan");
   for (const json& r : out["results"]) {
-    const json by_reference = r.contains("errors") ? r["errors"] : json{{out["reference"].get<std::string>(), r["error"]}};
+    const json by_reference = r.contains("errors") ? r["errors"] : json{{first_reference, r["error"]}};
     for (const auto& [name, e] : by_reference.items()) {
       std::printf("%-9s %-10s %4d %9.2f %10.3e %10.3e %10.3e %10.3e %10.3e %6zu\n", name.c_str(),
                   r["method"].get<std::string>().c_str(), r["msaa"].get<int>(), r["ms"]["median"].get<double>(),
@@ -88,7 +89,7 @@ int run_compare(CompareArgs& args, const GlobalOptions& global) {
     out["memory"] = {{"peak_rss_bytes", process_memory().peak_rss_bytes}};
     std::cout << out.dump(2) << "\n";
   } else {
-    print_table(out);
+    print_table(out, to_string(job.reference_kinds().front()));
   }
   return 0;
 }

@@ -99,8 +99,8 @@ TEST(RenderOptions, MethodsAreSamplerSettings) {
 TEST(RenderOptions, RefusalsNameTheField) {
   const std::vector<BadOption> cases = {
       {{{"msaa", 3}}, "msaa", "1, 2, 4, 8 or 16"},
-      {{{"msaa", 0}}, "msaa", "1..16"},
-      {{{"msaa", 32}}, "msaa", "1..16"},
+      {{{"msaa", 0}}, "msaa", "1, 2, 4, 8 or 16"},
+      {{{"msaa", 32}}, "msaa", "1, 2, 4, 8 or 16"},
       {{{"msaa", "4"}}, "msaa", "integer"},
       {{{"msaa", 4.5}}, "msaa", "integer"},
       {{{"aniso", 17}}, "aniso", "1..16"},

@@ -430,7 +430,9 @@ TEST(ServerSchema, OpenApiDocumentsEveryEndpoint) {
   // The compare request: the render options of the frame (no method, no format) and compare's own keys.
   const json compare = doc.at("components").at("schemas").at("CompareRequest").at("properties");
   for (const auto& [key, value] : compare.items()) {
-    EXPECT_TRUE(properties.contains(key) || key == "methods" || key == "repeat" || key == "reference" || key.starts_with("reference_")) << key;
+    EXPECT_TRUE(properties.contains(key) || key == "methods" || key == "repeat" || key == "reference" ||
+                key.starts_with("reference_") || key == "constant_color")
+        << key;
   }
   EXPECT_FALSE(compare.contains("method"));
   EXPECT_FALSE(compare.contains("format"));

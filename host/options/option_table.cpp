@@ -71,7 +71,7 @@ json checked_integer(const OptionSpec& spec, const json& value) {
   long long v = 0;
   if (!spec.integers.empty()) {
     if (!integer_of(value, v) || !contains(spec.integers, v))
-      throw InputError(spec.key, "must be " + integers_text(spec.integers) + ", got " + quoted(value));
+      throw InputError(spec.key, "must be the integer " + integers_text(spec.integers) + ", got " + quoted(value));
     return v;
   }
   if (!integer_of(value, v))
