@@ -115,6 +115,17 @@ json options_document(const std::vector<std::string>& scene_names, const ServerO
 
 json compare_options_document(const ServerOptions& limits) {
   json options = options_schema(compare_option_table());
+  // A list is described by its comma form (the one a form field sends): an OptionSpec has one type.
+  for (const OptionSpec& spec : compare_option_table()) {
+    if (spec.type != OptionType::List) continue;
+    json& option = options.at(spec.key);
+    std::string text;
+    for (const json& item : spec.default_value) text += (text.empty() ? "" : ",") + (item.is_string() ? item.get<std::string>() : item.dump());
+    option = {{"type", "string"},
+              {"pattern", option.at("oneOf").at(0).at("pattern")},
+              {"default", text},
+              {"description", option.at("description").get<std::string>() + " (a comma list, or a JSON array)"}};
+  }
   options.erase("scene");
   options.at("repeat")["maximum"] = limits.max_compare_repeat;
   options.at("size").erase("default");
