@@ -307,4 +307,47 @@ typedef struct {
   cl_uint pad0;
 } TessVertex;
 
+/* Ptex's own separable filters (ptex_filter.cl): a texture as the Ptex library filters it. Every
+ * face holds every resolution 2^i x 2^j (i <= ulog2, j <= vlog2) that the library would read, made
+ * by its own reduction rules, in the file's units and channel order. */
+#define SEAMCL_PTEX_KMAX 10          /* taps per axis of a kernel (Ptex's PtexSeparableKernel::kmax) */
+#define SEAMCL_PTEX_MAX_VALENCE 10   /* faces walked around a corner (Ptex's MaxValence) */
+#define SEAMCL_PTEX_POINT 0
+#define SEAMCL_PTEX_BILINEAR 1
+#define SEAMCL_PTEX_BOX 2
+#define SEAMCL_PTEX_GAUSSIAN 3
+#define SEAMCL_PTEX_BICUBIC 4        /* sharpness 0: B-spline, 1: Catmull-Rom, 2/3: Mitchell */
+#define SEAMCL_PTEX_FLAG_CONSTANT 1u
+#define SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT 4u
+#define SEAMCL_PTEX_FLAG_SUBFACE 8u
+typedef struct {
+  cl_int adj_faces[4];   /* bottom, right, top, left; -1 none */
+  cl_int ulog2;
+  cl_int vlog2;
+  cl_uint adj_edges;     /* 2 bits per edge: the neighbour's edge */
+  cl_uint flags;         /* SEAMCL_PTEX_FLAG_* */
+  cl_uint level_base;    /* index of the face's first level offset; level (i, j) at + i * (vlog2 + 1) + j */
+  cl_uint pad0;
+} PtexFilterFace;
+
+typedef struct {
+  cl_int data_type;        /* 0 uint8, 1 uint16, 2 float16, 3 float32 */
+  cl_int channels;         /* 1 to 4 */
+  cl_int u_border_mode;    /* 0 clamp, 1 black, 2 periodic */
+  cl_int v_border_mode;
+  cl_int edge_filter_mode; /* 0 none, 1 tanvec */
+  cl_int face_count;
+  cl_float one_value;      /* 255, 65535 or 1: a texel's value for 1.0 */
+  cl_int pad0;
+} PtexFilterTexture;
+
+typedef struct {
+  cl_int face;
+  cl_int filter;           /* SEAMCL_PTEX_* */
+  cl_float u, v;           /* in the face, 0..1 */
+  cl_float uw, vw;         /* filter widths in face units */
+  cl_float sharpness;      /* SEAMCL_PTEX_BICUBIC only */
+  cl_int pad0;
+} PtexFilterQuery;
+
 #endif

@@ -161,6 +161,8 @@ struct Header {
   // The extended header (zero where the file's is shorter).
   uint32_t large_metadata_header_zip_bytes = 0, large_metadata_header_bytes = 0;
   uint64_t large_metadata_data_bytes = 0, edit_data_bytes = 0, edit_data_position = 0;
+  uint32_t minor_version = 0;
+  uint16_t u_border_mode = 0, v_border_mode = 0, edge_filter_mode = 0;
 };
 
 struct LevelInfo {
@@ -267,7 +269,7 @@ class PtexDecoder {
     header_.face_info_bytes = load_u32(h.data() + 32);
     header_.const_data_bytes = load_u32(h.data() + 36);
     header_.level_info_bytes = load_u32(h.data() + 40);
-    // +44: minor version, which changes nothing this reader reads.
+    header_.minor_version = load_u32(h.data() + 44);  // changes nothing this reader reads
     header_.level_data_bytes = load_u64(h.data() + 48);
     header_.metadata_zip_bytes = load_u32(h.data() + 56);
     header_.metadata_bytes = load_u32(h.data() + 60);
@@ -296,6 +298,9 @@ class PtexDecoder {
     std::array<uint8_t, kExtHeaderBytes> ext{};
     const std::span<const uint8_t> stored = section(kHeaderBytes, ext_bytes, "extended header");
     std::copy(stored.begin(), stored.end(), ext.begin());
+    header_.u_border_mode = load_u16(ext.data());
+    header_.v_border_mode = load_u16(ext.data() + 4);
+    header_.edge_filter_mode = load_u16(ext.data() + 6);
     header_.large_metadata_header_zip_bytes = load_u32(ext.data() + 8);
     header_.large_metadata_header_bytes = load_u32(ext.data() + 12);
     header_.large_metadata_data_bytes = load_u64(ext.data() + 16);
@@ -342,6 +347,7 @@ class PtexDecoder {
         inflate_block(section(face_info_position_, header_.face_info_bytes, "face info"), faces * kFaceInfoBytes,
                       "face info");
     out_.faces.resize(faces);
+    face_flags_.assign(faces, 0);
     for (uint32_t f = 0; f < faces; ++f) {
       const uint8_t* p = raw.data() + f * kFaceInfoBytes;
       PtexFaceInfo& info = out_.faces[f];
@@ -354,6 +360,7 @@ class PtexDecoder {
         fail(where + ": size 2^" + std::to_string(info.ulog2) + " x 2^" + std::to_string(info.vlog2) +
              " is not 1 to 2^" + std::to_string(limits_.max_side_log2) + " a side");
       if (flags & kFlagHasEdits) fail(where + ": the face has edits, which seamcl does not read");
+      face_flags_[f] = flags;
       info.constant = (flags & kFlagConstant) != 0;
       info.subface = (flags & kFlagSubface) != 0;
       for (int e = 0; e < 4; ++e) {
@@ -618,6 +625,13 @@ class PtexDecoder {
 
   // One value of the file's type as float; integers are divided by their maximum.
   float element(const uint8_t* p) const {
+    if (stored_units_) {
+      switch (out_.data_type) {
+        case PtexDataType::Uint8: return static_cast<float>(p[0]);
+        case PtexDataType::Uint16: return static_cast<float>(load_u16(p));
+        default: break;
+      }
+    }
     switch (out_.data_type) {
       case PtexDataType::Uint8: return static_cast<float>(p[0]) * (1.0f / 255.0f);
       case PtexDataType::Uint16: return static_cast<float>(load_u16(p)) * (1.0f / 65535.0f);
@@ -641,6 +655,7 @@ class PtexDecoder {
       }
     }
     glm::vec4 rgba;
+    if (stored_units_) return glm::vec4(channel[0], channel[1], channel[2], channel[3]);
     for (int o = 0; o < 4; ++o) rgba[o] = channels_.source[o] >= 0 ? channel[channels_.source[o]] : channels_.fill[o];
     return rgba;
   }
@@ -785,6 +800,47 @@ class PtexDecoder {
     return chain;
   }
 
+
+ public:
+  // Faces' stored values (PtexStored): levels the file holds, in its units and channel order.
+  static PtexStored decode_stored(std::span<const uint8_t> bytes, const PtexLimits& limits) {
+    PtexDecoder d(bytes, limits);
+    d.stored_units_ = true;
+    d.read_structure();
+    PtexStored out;
+    out.version = d.header_.version;
+    out.minor_version = d.header_.minor_version;
+    out.mesh_type = d.header_.mesh_type;
+    out.levels = d.header_.levels;
+    out.u_border_mode = d.header_.u_border_mode;
+    out.v_border_mode = d.header_.v_border_mode;
+    out.edge_filter_mode = d.header_.edge_filter_mode;
+    out.metadata_bytes = d.header_.metadata_bytes;
+    const int channels = d.out_.channels;
+    out.faces.resize(d.header_.faces);
+    for (uint32_t f = 0; f < d.header_.faces; ++f) {
+      const PtexFaceInfo& info = d.out_.faces[f];
+      PtexStoredFace& face = out.faces[f];
+      face.flags = d.face_flags_[f];
+      face.constant.assign(channels, 0.0f);
+      for (int c = 0; c < channels; ++c) face.constant[c] = d.constant_values_[f][c];
+      if (info.constant) continue;
+      const uint32_t rank = d.reduction_rank_[f];
+      for (int k = 0; k <= std::min(info.ulog2, info.vlog2); ++k) {
+        if (k > 0 && !(k < d.header_.levels && rank < d.levels_[k].faces)) break;
+        const TextureLevel level = d.stored_level(k, k == 0 ? f : rank, info, f);
+        std::vector<float> values(level.texels.size() * channels);
+        for (size_t t = 0; t < level.texels.size(); ++t)
+          for (int c = 0; c < channels; ++c) values[t * channels + c] = level.texels[t][c];
+        face.levels.push_back(std::move(values));
+      }
+    }
+    out.file = std::move(d.out_);
+    return out;
+  }
+
+ private:
+
   void read_textures() {
     out_.textures.resize(header_.faces);
     for (uint32_t f = 0; f < header_.faces; ++f) out_.textures[f] = face_chain(f);
@@ -799,6 +855,8 @@ class PtexDecoder {
   ChannelMap channels_;
   uint64_t face_info_position_ = 0, const_data_position_ = 0, level_info_position_ = 0, level_data_position_ = 0,
            metadata_position_ = 0;
+  bool stored_units_ = false;  // values in the file's units and channel order (PtexStored)
+  std::vector<uint8_t> face_flags_;
   std::vector<uint32_t> faces_by_reduction_;  // face id of each rank in the reduction levels
   std::vector<uint32_t> reduction_rank_;      // each face's rank there
   std::vector<glm::vec4> constant_values_;
@@ -834,6 +892,29 @@ PtexFile read_ptex_file(const std::string& path, const PtexLimits& limits, bool 
     return PtexDecoder::decode_deferred(std::make_shared<PtexDecoder>(view, limits, std::move(bytes)));
   } catch (const InputError& e) {
     // The message of parse_ptex's errors follows "texture: "; the path goes in front of it.
+    const std::string message = std::string(e.what()).substr(e.field().size() + 2);
+    throw InputError("texture", path + ": " + message);
+  }
+}
+
+PtexStored parse_ptex_stored(std::span<const uint8_t> bytes, const PtexLimits& limits) {
+  return PtexDecoder::decode_stored(bytes, limits);
+}
+
+PtexStored read_ptex_stored(const std::string& path, const PtexLimits& limits) {
+  RegularFile file(path);
+  if (file.refusal() != RegularFile::Refusal::None) throw InputError("texture", path + ": " + file.refusal_text());
+  if (file.size() > limits.max_file_bytes)
+    throw InputError("texture", path + ": " + str(uint64_t(file.size())) + " bytes, more than the limit of " +
+                                    str(limits.max_file_bytes));
+  std::vector<uint8_t> bytes;
+  if (!file.read_all(bytes, limits.max_file_bytes))
+    throw InputError("texture", path + ": cannot be read to its end: " + file.refusal_text());
+  if (bytes.size() > limits.max_file_bytes)
+    throw InputError("texture", path + ": more than the limit of " + str(limits.max_file_bytes) + " bytes");
+  try {
+    return parse_ptex_stored(bytes, limits);
+  } catch (const InputError& e) {
     const std::string message = std::string(e.what()).substr(e.field().size() + 2);
     throw InputError("texture", path + ": " + message);
   }

@@ -86,6 +86,32 @@ PtexFile parse_ptex(std::span<const uint8_t> bytes, const PtexLimits& limits = {
 // the path.
 PtexFile read_ptex_file(const std::string& path, const PtexLimits& limits = {}, bool defer_textures = false);
 
+// What the Ptex library's own filters read (host/ptexfilter/): the values as the file stores them,
+// in the file's units (integers as integers, not divided by their maximum), in the file's channel
+// order (no RGBA mapping, no unpremultiplying), and only the levels the file holds; the header
+// fields a filter or an inspector needs besides.
+struct PtexStoredFace {
+  uint8_t flags = 0;             // the file's face flags: 1 constant, 2 edits, 4 neighbourhood constant, 8 subface
+  std::vector<float> constant;   // the constant data (the face's 1x1 level), one value per channel
+  // levels[k]: level k (2^(ulog2-k) x 2^(vlog2-k) texels, rows of texels with channels
+  // interleaved) for every k the file stores for the face; empty for a constant face.
+  std::vector<std::vector<float>> levels;
+};
+
+struct PtexStored {
+  PtexFile file;  // faces, data type, channels, alpha, metadata, mesh; no textures
+  uint32_t version = 0, minor_version = 0, mesh_type = 0;
+  int levels = 0;                  // levels the file holds
+  int u_border_mode = 0, v_border_mode = 0;  // 0 clamp, 1 black, 2 periodic
+  int edge_filter_mode = 0;        // 0 none, 1 tanvec
+  uint32_t metadata_bytes = 0;     // inflated metadata size
+  std::vector<PtexStoredFace> faces;
+};
+
+// As parse_ptex and read_ptex_file (the same checks, the same errors), keeping stored values.
+PtexStored parse_ptex_stored(std::span<const uint8_t> bytes, const PtexLimits& limits = {});
+PtexStored read_ptex_stored(const std::string& path, const PtexLimits& limits = {});
+
 // Texels of all levels of all faces of a file's textures (16 bytes each as float RGBA), deferred
 // ones included.
 uint64_t ptex_texel_count(const PtexFile& file);

@@ -36,3 +36,8 @@ static_assert(sizeof(EnvironmentParams) == 80, "EnvironmentParams layout");
 static_assert(offsetof(EnvironmentParams, ray_dy) == 60);
 static_assert(sizeof(ReflectiveFace) == 112, "ReflectiveFace layout");
 static_assert(offsetof(ReflectiveFace, roughness) == 96);
+static_assert(sizeof(PtexFilterFace) == 40, "PtexFilterFace layout");
+static_assert(offsetof(PtexFilterFace, level_base) == 32);
+static_assert(sizeof(PtexFilterTexture) == 32, "PtexFilterTexture layout");
+static_assert(sizeof(PtexFilterQuery) == 32, "PtexFilterQuery layout");
+static_assert(offsetof(PtexFilterQuery, sharpness) == 24);

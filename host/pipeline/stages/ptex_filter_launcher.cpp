@@ -1,0 +1,73 @@
+#include "pipeline/stages/ptex_filter_launcher.h"
+
+#include <algorithm>
+
+namespace seamcl {
+namespace {
+
+constexpr size_t kGroup = 64;
+size_t round_up(size_t value, size_t multiple) { return (value + multiple - 1) / multiple * multiple; }
+
+template <typename T>
+cl::Buffer upload(ClRuntime& runtime, const std::vector<T>& data, size_t& bytes_total) {
+  // OpenCL refuses zero-sized buffers; one element of padding keeps empty arrays legal.
+  const size_t bytes = std::max<size_t>(data.size(), 1) * sizeof(T);
+  cl::Buffer buffer(runtime.context(), CL_MEM_READ_ONLY, bytes);
+  if (!data.empty()) runtime.queue().enqueueWriteBuffer(buffer, CL_TRUE, 0, data.size() * sizeof(T), data.data());
+  bytes_total += bytes;
+  return buffer;
+}
+
+}  // namespace
+
+PtexFilterLauncher::PtexFilterLauncher(ClRuntime& runtime)
+    : runtime_(runtime), kernel_(runtime.program(), "ptex_filter_lookups") {}
+
+void PtexFilterLauncher::load(const PtexFilterData& data) {
+  device_bytes_ = 0;
+  texture_ = data.texture;
+  faces_ = upload(runtime_, data.faces, device_bytes_);
+  level_offsets_ = upload(runtime_, data.level_offsets, device_bytes_);
+  texels_ = upload(runtime_, data.texels, device_bytes_);
+}
+
+void PtexFilterLauncher::set_args(const cl::Buffer& queries, int count, const cl::Buffer& out) {
+  kernel_.setArg(0, texture_);
+  kernel_.setArg(1, faces_);
+  kernel_.setArg(2, level_offsets_);
+  kernel_.setArg(3, texels_);
+  kernel_.setArg(4, queries);
+  kernel_.setArg(5, count);
+  kernel_.setArg(6, out);
+}
+
+std::vector<float> PtexFilterLauncher::run(const std::vector<PtexFilterQuery>& queries) {
+  std::vector<float> values(queries.size() * 4);
+  if (queries.empty()) return values;
+  size_t ignored = 0;
+  const cl::Buffer in = upload(runtime_, queries, ignored);
+  const cl::Buffer out(runtime_.context(), CL_MEM_WRITE_ONLY, values.size() * sizeof(float));
+  set_args(in, static_cast<int>(queries.size()), out);
+  runtime_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(round_up(queries.size(), kGroup)),
+                                        cl::NDRange(kGroup));
+  runtime_.queue().enqueueReadBuffer(out, CL_TRUE, 0, values.size() * sizeof(float), values.data());
+  return values;
+}
+
+std::vector<double> PtexFilterLauncher::time(const std::vector<PtexFilterQuery>& queries, int repeats) {
+  std::vector<double> ms;
+  if (queries.empty()) return ms;
+  size_t ignored = 0;
+  const cl::Buffer in = upload(runtime_, queries, ignored);
+  const cl::Buffer out(runtime_.context(), CL_MEM_WRITE_ONLY, queries.size() * 4 * sizeof(float));
+  set_args(in, static_cast<int>(queries.size()), out);
+  std::vector<cl::Event> events(static_cast<size_t>(std::max(repeats, 0)));
+  for (cl::Event& event : events)
+    runtime_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(round_up(queries.size(), kGroup)),
+                                          cl::NDRange(kGroup), nullptr, &event);
+  runtime_.queue().finish();
+  for (const cl::Event& event : events) ms.push_back(event_milliseconds(event));
+  return ms;
+}
+
+}  // namespace seamcl

@@ -1,0 +1,559 @@
+/* Ptex's own separable filters: ptex_filter_lookups, one work-item per lookup.
+ *
+ * Contract: query q (face, filter, u, v, uw, vw, sharpness) gives what the Ptex library's
+ * PtexFilter::eval gives on the same quad-mesh texture (uw1 = uw, vw2 = vw, uw2 = vw1 = 0, width 1,
+ * blur 0, no lerp, edge blending on): the kernel built at the resolution the filter width selects,
+ * split at face edges into the neighbours, each turned by eid - aeid + 2 quarter turns and read at
+ * the kernel's resolution (downres'd to a coarser neighbour's), corners by valence (4: the diagonal
+ * face; 5 to 10: the kernel made symmetric and applied to each corner face; 2, 3 and boundaries:
+ * dropped, the weight taken back), boundary edges merged by the file's border mode, the sum
+ * divided by the kernel's weight and the type's one value. Writes 4 floats per lookup (channels
+ * beyond the texture's are 0); a face out of range gives zeros (the host refuses it first).
+ * Host guarantees (host/ptexfilter/ptex_filter_texture.cpp): every resolution 2^i x 2^j of every
+ * face at texels + level_offsets[face.level_base + i * (vlog2 + 1) + j] (texel index; channels
+ * interleaved; the element count fits a uint); no subfaces.
+ * Twin: host/pipeline/stages/ptex_filter_twin.cpp. */
+
+#define PTEXF_BOTTOM 0
+#define PTEXF_RIGHT 1
+#define PTEXF_TOP 2
+#define PTEXF_LEFT 3
+#define PTEXF_BLACK 1
+#define PTEXF_PERIODIC 2
+
+typedef struct {
+  int ulog2, vlog2;
+  int u, v, uw, vw;
+  float ku[SEAMCL_PTEX_KMAX];
+  float kv[SEAMCL_PTEX_KMAX];
+  int rot;
+} PtexfKernel;
+
+typedef struct {
+  __global const PtexFilterFace* faces;
+  __global const uint* level_offsets;
+  __global const uchar* texels;
+  PtexFilterTexture tex;
+  float weight;
+  float result[4];
+} PtexfState;
+
+SEAMCL_INLINE float ptexf_accumulate(const float* p, int n) {
+  float sum = 0.0f;
+  for (int i = 0; i < n; ++i) sum += p[i];
+  return sum;
+}
+
+SEAMCL_INLINE float ptexf_weight(const PtexfKernel* k) {
+  return ptexf_accumulate(k->ku, k->uw) * ptexf_accumulate(k->kv, k->vw);
+}
+
+SEAMCL_INLINE void ptexf_drop_front(float* a, int n, int by) {
+  for (int i = 0; i + by < n; ++i) a[i] = a[i + by];
+}
+
+SEAMCL_INLINE void ptexf_reverse(float* a, int n) {
+  for (int i = 0, j = n - 1; i < j; ++i, --j) {
+    const float t = a[i];
+    a[i] = a[j];
+    a[j] = t;
+  }
+}
+
+SEAMCL_INLINE void ptexf_strip_zeros(PtexfKernel* k) {
+  while (k->uw > 0 && k->ku[0] == 0.0f) { ptexf_drop_front(k->ku, k->uw, 1); k->u++; k->uw--; }
+  while (k->uw > 0 && k->ku[k->uw - 1] == 0.0f) k->uw--;
+  while (k->vw > 0 && k->kv[0] == 0.0f) { ptexf_drop_front(k->kv, k->vw, 1); k->v++; k->vw--; }
+  while (k->vw > 0 && k->kv[k->vw - 1] == 0.0f) k->vw--;
+}
+
+SEAMCL_INLINE void ptexf_merge_left(PtexfKernel* k, int mode) {
+  const int w = -k->u;
+  if (mode != PTEXF_BLACK) k->ku[w] += ptexf_accumulate(k->ku, w);
+  ptexf_drop_front(k->ku, k->uw, w);
+  k->uw -= w;
+  k->u = 0;
+}
+SEAMCL_INLINE void ptexf_merge_right(PtexfKernel* k, int mode) {
+  const int w = k->uw + k->u - (1 << k->ulog2);
+  const int first = k->uw - w;
+  if (mode != PTEXF_BLACK) k->ku[first - 1] += ptexf_accumulate(k->ku + first, w);
+  k->uw -= w;
+}
+SEAMCL_INLINE void ptexf_merge_bottom(PtexfKernel* k, int mode) {
+  const int w = -k->v;
+  if (mode != PTEXF_BLACK) k->kv[w] += ptexf_accumulate(k->kv, w);
+  ptexf_drop_front(k->kv, k->vw, w);
+  k->vw -= w;
+  k->v = 0;
+}
+SEAMCL_INLINE void ptexf_merge_top(PtexfKernel* k, int mode) {
+  const int w = k->vw + k->v - (1 << k->vlog2);
+  const int first = k->vw - w;
+  if (mode != PTEXF_BLACK) k->kv[first - 1] += ptexf_accumulate(k->kv + first, w);
+  k->vw -= w;
+}
+
+SEAMCL_INLINE void ptexf_split_left(PtexfKernel* k, PtexfKernel* piece) {
+  const int w = -k->u;
+  *piece = *k;
+  if (w < k->uw) {
+    piece->u = (1 << k->ulog2) - w;
+    piece->uw = w;
+    piece->rot = 0;
+    k->u = 0;
+    ptexf_drop_front(k->ku, k->uw, w);
+    k->uw -= w;
+  } else {
+    piece->u += 1 << k->ulog2;
+    k->u = 0;
+    k->uw = 0;
+  }
+}
+SEAMCL_INLINE void ptexf_split_right(PtexfKernel* k, PtexfKernel* piece) {
+  const int w = k->u + k->uw - (1 << k->ulog2);
+  *piece = *k;
+  if (w < k->uw) {
+    piece->u = 0;
+    piece->uw = w;
+    piece->rot = 0;
+    ptexf_drop_front(piece->ku, k->uw, k->uw - w);
+    k->uw -= w;
+  } else {
+    piece->u -= 1 << k->ulog2;
+    k->u = 0;
+    k->uw = 0;
+  }
+}
+SEAMCL_INLINE void ptexf_split_bottom(PtexfKernel* k, PtexfKernel* piece) {
+  const int w = -k->v;
+  *piece = *k;
+  if (w < k->vw) {
+    piece->v = (1 << k->vlog2) - w;
+    piece->vw = w;
+    piece->rot = 0;
+    k->v = 0;
+    ptexf_drop_front(k->kv, k->vw, w);
+    k->vw -= w;
+  } else {
+    piece->v += 1 << k->vlog2;
+    k->v = 0;
+    k->vw = 0;
+  }
+}
+SEAMCL_INLINE void ptexf_split_top(PtexfKernel* k, PtexfKernel* piece) {
+  const int w = k->v + k->vw - (1 << k->vlog2);
+  *piece = *k;
+  if (w < k->vw) {
+    piece->v = 0;
+    piece->vw = w;
+    piece->rot = 0;
+    ptexf_drop_front(piece->kv, k->vw, k->vw - w);
+    k->vw -= w;
+  } else {
+    piece->v -= 1 << k->vlog2;
+    k->v = 0;
+    k->vw = 0;
+  }
+}
+
+SEAMCL_INLINE void ptexf_flip_u(PtexfKernel* k) {
+  k->u = (1 << k->ulog2) - k->u - k->uw;
+  ptexf_reverse(k->ku, k->uw);
+}
+SEAMCL_INLINE void ptexf_flip_v(PtexfKernel* k) {
+  k->v = (1 << k->vlog2) - k->v - k->vw;
+  ptexf_reverse(k->kv, k->vw);
+}
+SEAMCL_INLINE void ptexf_swap_uv(PtexfKernel* k) {
+  int t = k->ulog2; k->ulog2 = k->vlog2; k->vlog2 = t;
+  t = k->u; k->u = k->v; k->v = t;
+  t = k->uw; k->uw = k->vw; k->vw = t;
+  for (int i = 0; i < SEAMCL_PTEX_KMAX; ++i) {
+    const float f = k->ku[i];
+    k->ku[i] = k->kv[i];
+    k->kv[i] = f;
+  }
+}
+SEAMCL_INLINE void ptexf_rotate(PtexfKernel* k, int r) {
+  switch (r & 3) {
+    case 1: ptexf_flip_u(k); ptexf_swap_uv(k); break;
+    case 2: ptexf_flip_u(k); ptexf_flip_v(k); break;
+    case 3: ptexf_flip_v(k); ptexf_swap_uv(k); break;
+    default: return;
+  }
+  k->rot = (k->rot + r) & 3;
+}
+
+SEAMCL_INLINE void ptexf_downres_u(PtexfKernel* k) {
+  int src = 0, dst = 0, uw = k->uw;
+  if (k->u & 1) { dst++; src++; uw--; }
+  for (int i = uw / 2; i > 0; --i) { k->ku[dst++] = k->ku[src] + k->ku[src + 1]; src += 2; }
+  if (uw & 1) k->ku[dst++] = k->ku[src++];
+  k->u /= 2;
+  k->uw = dst;
+  k->ulog2--;
+}
+SEAMCL_INLINE void ptexf_downres_v(PtexfKernel* k) {
+  int src = 0, dst = 0, vw = k->vw;
+  if (k->v & 1) { dst++; src++; vw--; }
+  for (int i = vw / 2; i > 0; --i) { k->kv[dst++] = k->kv[src] + k->kv[src + 1]; src += 2; }
+  if (vw & 1) k->kv[dst++] = k->kv[src++];
+  k->v /= 2;
+  k->vw = dst;
+  k->vlog2--;
+}
+
+SEAMCL_INLINE float ptexf_make_symmetric(PtexfKernel* k, float initial_weight) {
+  while (k->ulog2 > k->vlog2) ptexf_downres_u(k);
+  while (k->vlog2 > k->ulog2) ptexf_downres_v(k);
+  k->uw = k->vw = min(k->uw, k->vw);
+  float new_weight = 0.0f;
+  for (int i = 0; i < k->uw; ++i) {
+    const float sum = k->ku[i] + k->kv[i];
+    k->ku[i] = k->kv[i] = sum;
+    new_weight += sum;
+  }
+  new_weight *= new_weight;
+  const float scale = new_weight == 0.0f ? 1.0f : initial_weight / new_weight;
+  if (scale < 1.0f) {
+    if (scale < -1.0f) {
+      for (int i = 0; i < k->uw; ++i) k->ku[i] *= -1.0f;
+      new_weight = -new_weight;
+    } else {
+      for (int i = 0; i < k->uw; ++i) k->ku[i] *= scale;
+      new_weight = initial_weight;
+    }
+  }
+  return new_weight;
+}
+
+SEAMCL_INLINE int ptexf_res_from_width(float w) { return 127 - ((as_int(w) >> 23) & 0xff); }
+SEAMCL_INLINE float ptexf_reciprocal_pow2(int power) { return as_float((127 - power) << 23); }
+
+SEAMCL_INLINE float ptexf_width4_fn(int filter, const float* c, float x) {
+  if (filter == SEAMCL_PTEX_GAUSSIAN) return exp(-2.0f * x * x);
+  x = fabs(x);
+  if (x < 1.0f) return (c[0] * x + c[1]) * x * x + c[2];
+  if (x < 2.0f) return ((c[3] * x + c[4]) * x + c[5]) * x + c[6];
+  return 0.0f;
+}
+
+SEAMCL_INLINE float ptexf_blur(float x) {
+  x = fabs(x);
+  return x < 1.0f ? (2.0f * x - 3.0f) * x * x + 1.0f : 0.0f;
+}
+
+/* One axis of a width-4 kernel (gaussian, bicubic), without Ptex's optional lerp. */
+SEAMCL_INLINE void ptexf_width4_axis(int filter, const float* c, int* res_log2, int* k_u, int* k_uw, float* ku,
+                                     float u, float uw, int face_log2) {
+  uw = fmax(uw, ptexf_reciprocal_pow2(face_log2));
+  *res_log2 = ptexf_res_from_width(uw);
+  const int resu = 1 << *res_log2;
+  if (uw >= 0.25f) {
+    if (uw < 0.5f) {
+      *res_log2 = 2;
+      const float upix = u * 4.0f - 0.5f;
+      int u1 = (int)ceil(upix - 2), u2 = (int)ceil(upix + 2);
+      u1 = u1 & ~1;
+      u2 = (u2 + 1) & ~1;
+      *k_u = u1;
+      *k_uw = min(u2 - u1, SEAMCL_PTEX_KMAX);
+      const float x1 = (float)u1 - upix;
+      for (int i = 0; i + 1 < *k_uw; i += 2) {
+        const float xa = x1 + (float)i, xb = xa + 1.0f;
+        ku[i] = ptexf_width4_fn(filter, c, xa);
+        ku[i + 1] = ptexf_width4_fn(filter, c, xb);
+      }
+      return;
+    }
+    if (uw < 1.0f) {
+      *res_log2 = 1;
+      const float upix = u * 2.0f - 0.5f;
+      *k_u = (int)floor(u - 0.5f) * 2;
+      *k_uw = 4;
+      const float x1 = (float)*k_u - upix;
+      const float s = 1.0f / (uw * 1.5f + 0.5f);
+      for (int i = 0; i < 4; i += 2) {
+        const float xa = x1 + (float)i, xb = xa + 1.0f;
+        ku[i] = ptexf_blur(xa * s);
+        ku[i + 1] = ptexf_blur(xb * s);
+      }
+      return;
+    }
+    *res_log2 = 0;
+    const float upix = u - 0.5f;
+    *k_uw = 2;
+    const float ui = floor(upix);
+    *k_u = (int)ui;
+    ku[0] = ptexf_blur(upix - ui);
+    ku[1] = 1.0f - ku[0];
+    return;
+  }
+  const float upix = u * (float)resu - 0.5f;
+  const float uwpix = uw * (float)resu;
+  const float dupix = 2.0f * uwpix;
+  const int u1 = (int)ceil(upix - dupix), u2 = (int)ceil(upix + dupix);
+  *k_u = u1;
+  *k_uw = min(u2 - u1, SEAMCL_PTEX_KMAX);
+  const float x1 = ((float)u1 - upix) / uwpix, step = 1.0f / uwpix;
+  for (int i = 0; i < *k_uw; ++i) ku[i] = ptexf_width4_fn(filter, c, x1 + (float)i * step);
+}
+
+SEAMCL_INLINE void ptexf_box_weights(float* kernel, int size, float f1, float f2) {
+  if (size == 1) {
+    kernel[0] = f1 + f2 - 1.0f;
+  } else {
+    kernel[0] = f1;
+    for (int i = 1; i < size - 1; ++i) kernel[i] = 1.0f;
+    kernel[size - 1] = f2;
+  }
+}
+
+SEAMCL_INLINE void ptexf_build(PtexfKernel* k, const PtexFilterQuery* q, float u, float v, float uw, float vw,
+                               int face_ulog2, int face_vlog2) {
+  if (q->filter == SEAMCL_PTEX_BILINEAR || q->filter == SEAMCL_PTEX_BOX) {
+    uw = fmax(fmin(uw, 1.0f), ptexf_reciprocal_pow2(face_ulog2));
+    vw = fmax(fmin(vw, 1.0f), ptexf_reciprocal_pow2(face_vlog2));
+    k->ulog2 = ptexf_res_from_width(uw);
+    k->vlog2 = ptexf_res_from_width(vw);
+    const float resu = (float)(1 << k->ulog2), resv = (float)(1 << k->vlog2);
+    if (q->filter == SEAMCL_PTEX_BILINEAR) {
+      const float upix = u * resu - 0.5f, vpix = v * resv - 0.5f;
+      const float ufloor = floor(upix), vfloor = floor(vpix);
+      k->u = (int)ufloor;
+      k->v = (int)vfloor;
+      k->uw = 2;
+      k->vw = 2;
+      k->ku[0] = 1.0f - (upix - ufloor);
+      k->ku[1] = upix - ufloor;
+      k->kv[0] = 1.0f - (vpix - vfloor);
+      k->kv[1] = vpix - vfloor;
+      return;
+    }
+    u = u * resu;
+    v = v * resv;
+    uw *= resu;
+    vw *= resv;
+    const float u1 = u - 0.5f * uw, u2 = u + 0.5f * uw;
+    const float v1 = v - 0.5f * vw, v2 = v + 0.5f * vw;
+    const float u1floor = floor(u1), u2ceil = ceil(u2);
+    const float v1floor = floor(v1), v2ceil = ceil(v2);
+    k->u = (int)u1floor;
+    k->v = (int)v1floor;
+    k->uw = min((int)u2ceil - k->u, 3);
+    k->vw = min((int)v2ceil - k->v, 3);
+    ptexf_box_weights(k->ku, k->uw, 1.0f - (u1 - u1floor), 1.0f - (u2ceil - u2));
+    ptexf_box_weights(k->kv, k->vw, 1.0f - (v1 - v1floor), 1.0f - (v2ceil - v2));
+    return;
+  }
+  float c[7] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  if (q->filter == SEAMCL_PTEX_BICUBIC) {
+    const float B = 1.0f - q->sharpness;
+    c[0] = 1.5f - B;
+    c[1] = 1.5f * B - 2.5f;
+    c[2] = 1.0f - (float)(1.0f / 3.0f) * B;
+    c[3] = (float)(1.0f / 3.0f) * B - 0.5f;
+    c[4] = 2.5f - 1.5f * B;
+    c[5] = 2.0f * B - 4.0f;
+    c[6] = 2.0f - (float)(2.0f / 3.0f) * B;
+  }
+  ptexf_width4_axis(q->filter, c, &k->ulog2, &k->u, &k->uw, k->ku, u, uw, face_ulog2);
+  ptexf_width4_axis(q->filter, c, &k->vlog2, &k->v, &k->vw, k->kv, v, vw, face_vlog2);
+}
+
+SEAMCL_INLINE float ptexf_texel(const PtexfState* s, uint index) {
+  switch (s->tex.data_type) {
+    case 0: return (float)s->texels[index];
+    case 1: return (float)((__global const ushort*)s->texels)[index];
+    case 2: return vload_half(index, (__global const half*)s->texels);
+    default: return ((__global const float*)s->texels)[index];
+  }
+}
+
+SEAMCL_INLINE int ptexf_adj_face(PtexFilterFace f, int e) { return f.adj_faces[e & 3]; }
+SEAMCL_INLINE int ptexf_adj_edge(PtexFilterFace f, int e) { return (int)((f.adj_edges >> (2 * (e & 3))) & 3u); }
+
+SEAMCL_INLINE uint ptexf_level(const PtexfState* s, PtexFilterFace f, int ulog2, int vlog2) {
+  return s->level_offsets[f.level_base + (uint)(ulog2 * (f.vlog2 + 1) + vlog2)];
+}
+
+SEAMCL_INLINE void ptexf_apply(PtexfState* s, PtexfKernel* k, int face) {
+  const PtexFilterFace f = s->faces[face];
+  const int nchan = s->tex.channels;
+  /* Taps past the far side of a face (a kernel wider than the neighbour) are dropped. */
+  if (k->u < 0) { const int w = min(-k->u, k->uw); ptexf_drop_front(k->ku, k->uw, w); k->uw -= w; k->u = 0; }
+  if (k->v < 0) { const int w = min(-k->v, k->vw); ptexf_drop_front(k->kv, k->vw, w); k->vw -= w; k->v = 0; }
+  if (k->u + k->uw > (1 << k->ulog2)) k->uw = max(0, (1 << k->ulog2) - k->u);
+  if (k->v + k->vw > (1 << k->vlog2)) k->vw = max(0, (1 << k->vlog2) - k->v);
+  if (k->uw <= 0 || k->vw <= 0) return;
+  while (k->ulog2 > f.ulog2) ptexf_downres_u(k);
+  while (k->vlog2 > f.vlog2) ptexf_downres_v(k);
+  float acc[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  if ((f.flags & SEAMCL_PTEX_FLAG_CONSTANT) != 0u || (k->ulog2 == 0 && k->vlog2 == 0)) {
+    const float w = ptexf_weight(k);
+    const uint base = ptexf_level(s, f, 0, 0) * (uint)nchan;
+    for (int c = 0; c < nchan; ++c) acc[c] = ptexf_texel(s, base + (uint)c) * w;
+  } else {
+    const uint base = ptexf_level(s, f, k->ulog2, k->vlog2);
+    const uint rowlen = 1u << k->ulog2;
+    for (int j = 0; j < k->vw; ++j) {
+      float row[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+      const uint first = (base + (uint)(k->v + j) * rowlen + (uint)k->u) * (uint)nchan;
+      for (int c = 0; c < nchan; ++c) row[c] = ptexf_texel(s, first + (uint)c) * k->ku[0];
+      for (int i = 1; i < k->uw; ++i)
+        for (int c = 0; c < nchan; ++c) row[c] += ptexf_texel(s, first + (uint)(i * nchan + c)) * k->ku[i];
+      for (int c = 0; c < nchan; ++c) acc[c] += row[c] * k->kv[j];
+    }
+  }
+  if (s->tex.edge_filter_mode == 1 && nchan >= 2 && k->rot > 0) {
+    if (k->rot == 1) { s->result[0] -= acc[1]; s->result[1] += acc[0]; }
+    else if (k->rot == 2) { s->result[0] -= acc[0]; s->result[1] -= acc[1]; }
+    else { s->result[0] += acc[1]; s->result[1] -= acc[0]; }
+    for (int c = 2; c < nchan; ++c) s->result[c] += acc[c];
+  } else {
+    for (int c = 0; c < nchan; ++c) s->result[c] += acc[c];
+  }
+}
+
+SEAMCL_INLINE void ptexf_across_edge(PtexfState* s, PtexfKernel* k, PtexFilterFace f, int eid) {
+  ptexf_rotate(k, eid - ptexf_adj_edge(f, eid) + 2);
+  ptexf_apply(s, k, ptexf_adj_face(f, eid));
+}
+
+SEAMCL_INLINE void ptexf_corner(PtexfState* s, PtexfKernel* k, int faceid, PtexFilterFace f, int eid) {
+  int aeid = eid;
+  PtexFilterFace af = f;
+  int cface[SEAMCL_PTEX_MAX_VALENCE];
+  int cedge[SEAMCL_PTEX_MAX_VALENCE];
+  int corners = 0;
+  for (int i = 0; i < SEAMCL_PTEX_MAX_VALENCE; ++i) {
+    const int afid = ptexf_adj_face(af, aeid);
+    aeid = (ptexf_adj_edge(af, aeid) + 1) % 4;
+    if (afid < 0 || (afid == faceid && aeid == eid)) {
+      corners = i - 2;
+      break;
+    }
+    af = s->faces[afid];
+    cface[i] = afid;
+    cedge[i] = aeid;
+  }
+  if (corners == 1) {
+    ptexf_rotate(k, eid - cedge[1] + 2);
+    ptexf_apply(s, k, cface[1]);
+  } else if (corners > 1) {
+    ptexf_rotate(k, eid + 2);
+    const float initial_weight = ptexf_weight(k);
+    const float new_weight = ptexf_make_symmetric(k, initial_weight);
+    for (int i = 1; i <= corners; ++i) {
+      PtexfKernel kc = *k;
+      ptexf_rotate(&kc, 2 - cedge[i] + 2);
+      ptexf_apply(s, &kc, cface[i]);
+    }
+    s->weight += new_weight * (float)corners - initial_weight;
+  } else {
+    s->weight -= ptexf_weight(k);
+  }
+}
+
+SEAMCL_INLINE void ptexf_split_and_apply(PtexfState* s, PtexfKernel* k, int faceid) {
+  const PtexFilterFace f = s->faces[faceid];
+  const bool split_r = k->u + k->uw > (1 << k->ulog2), split_l = k->u < 0;
+  const bool split_t = k->v + k->vw > (1 << k->vlog2), split_b = k->v < 0;
+  const int umode = s->tex.u_border_mode, vmode = s->tex.v_border_mode;
+  PtexfKernel ka, kc;
+  if (split_r) {
+    if (ptexf_adj_face(f, PTEXF_RIGHT) >= 0) {
+      ptexf_split_right(k, &ka);
+      if (split_t) {
+        if (ptexf_adj_face(f, PTEXF_TOP) >= 0) { ptexf_split_top(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_TOP); }
+        else ptexf_merge_top(&ka, vmode);
+      }
+      if (split_b) {
+        if (ptexf_adj_face(f, PTEXF_BOTTOM) >= 0) { ptexf_split_bottom(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_RIGHT); }
+        else ptexf_merge_bottom(&ka, vmode);
+      }
+      ptexf_across_edge(s, &ka, f, PTEXF_RIGHT);
+    } else {
+      ptexf_merge_right(k, umode);
+    }
+  }
+  if (split_l) {
+    if (ptexf_adj_face(f, PTEXF_LEFT) >= 0) {
+      ptexf_split_left(k, &ka);
+      if (split_t) {
+        if (ptexf_adj_face(f, PTEXF_TOP) >= 0) { ptexf_split_top(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_LEFT); }
+        else ptexf_merge_top(&ka, vmode);
+      }
+      if (split_b) {
+        if (ptexf_adj_face(f, PTEXF_BOTTOM) >= 0) { ptexf_split_bottom(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_BOTTOM); }
+        else ptexf_merge_bottom(&ka, vmode);
+      }
+      ptexf_across_edge(s, &ka, f, PTEXF_LEFT);
+    } else {
+      ptexf_merge_left(k, umode);
+    }
+  }
+  if (split_t) {
+    if (ptexf_adj_face(f, PTEXF_TOP) >= 0) { ptexf_split_top(k, &ka); ptexf_across_edge(s, &ka, f, PTEXF_TOP); }
+    else ptexf_merge_top(k, vmode);
+  }
+  if (split_b) {
+    if (ptexf_adj_face(f, PTEXF_BOTTOM) >= 0) { ptexf_split_bottom(k, &ka); ptexf_across_edge(s, &ka, f, PTEXF_BOTTOM); }
+    else ptexf_merge_bottom(k, vmode);
+  }
+  ptexf_apply(s, k, faceid);
+}
+
+__kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilterFace* faces,
+                                  __global const uint* level_offsets, __global const uchar* texels,
+                                  __global const PtexFilterQuery* queries, int count, __global float* out) {
+  const int id = (int)get_global_id(0);
+  if (id >= count) return;
+  const PtexFilterQuery q = queries[id];
+  __global float* dst = out + 4 * id;
+  for (int c = 0; c < 4; ++c) dst[c] = 0.0f;
+  if (q.face < 0 || q.face >= tex.face_count) return;
+  PtexfState s;
+  s.faces = faces;
+  s.level_offsets = level_offsets;
+  s.texels = texels;
+  s.tex = tex;
+  s.weight = 0.0f;
+  for (int c = 0; c < 4; ++c) s.result[c] = 0.0f;
+  const PtexFilterFace f = faces[q.face];
+  const int nchan = tex.channels;
+  if ((f.flags & SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT) != 0u) {
+    const uint base = ptexf_level(&s, f, 0, 0) * (uint)nchan;
+    for (int c = 0; c < nchan; ++c) dst[c] = ptexf_texel(&s, base + (uint)c) / tex.one_value;
+    return;
+  }
+  float u = q.u, v = q.v;
+  if (q.filter == SEAMCL_PTEX_POINT) {
+    const int resu = 1 << f.ulog2, resv = 1 << f.vlog2;
+    const int ui = clamp((int)(u * (float)resu), 0, resu - 1);
+    const int vi = clamp((int)(v * (float)resv), 0, resv - 1);
+    const uint base = (ptexf_level(&s, f, f.ulog2, f.vlog2) + (uint)(vi * resu + ui)) * (uint)nchan;
+    for (int c = 0; c < nchan; ++c) dst[c] = ptexf_texel(&s, base + (uint)c) / tex.one_value;
+    return;
+  }
+  bool black = false;
+  if (tex.u_border_mode == PTEXF_PERIODIC) u = u - floor(u);
+  else if (tex.u_border_mode == PTEXF_BLACK) black = u <= -1.0f || u >= 2.0f;
+  else u = clamp(u, 0.0f, 1.0f);
+  if (tex.v_border_mode == PTEXF_PERIODIC) v = v - floor(v);
+  else if (tex.v_border_mode == PTEXF_BLACK) black = black || v <= -1.0f || v >= 2.0f;
+  else v = clamp(v, 0.0f, 1.0f);
+  if (black) return;
+  PtexfKernel k;
+  k.rot = 0;
+  ptexf_build(&k, &q, u, v, fabs(q.uw), fabs(q.vw), f.ulog2, f.vlog2);
+  ptexf_strip_zeros(&k);
+  if (k.uw <= 0 || k.vw <= 0) return;
+  s.weight = ptexf_weight(&k);
+  ptexf_split_and_apply(&s, &k, q.face);
+  const float w = s.weight * tex.one_value;
+  if (!(w != 0.0f) || isinf(w) || isnan(w)) return;
+  const float scale = 1.0f / w;
+  for (int c = 0; c < nchan; ++c) dst[c] = s.result[c] * scale;
+}

@@ -1,0 +1,106 @@
+// kernels/ptex_filter.cl against its scalar twin (host/pipeline/stages/ptex_filter_twin.cpp): the
+// golden lookups of every sample, and random lookups of every filter near edges and corners
+// (cellnoise: valence 3, 4 and 9 and faces of mixed resolutions; rand_lo: uint16 with boundary
+// edges; black: float16, black border), widths from a texel to more than a face.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <random>
+#include <string>
+
+#include <seamcl/assets/ptex_file.h>
+
+#include "pipeline/stages/ptex_filter_launcher.h"
+#include "ptex_test_writer.h"
+#include "ptexfilter/ptex_filter_texture.h"
+#include "test_support.h"
+
+namespace seamcl {
+namespace {
+
+using nlohmann::json;
+using seamcl_tests::ptex_assets_dir;
+
+std::vector<PtexFilterQuery> golden_queries(const std::string& name) {
+  std::ifstream in(ptex_assets_dir() + "/golden/" + name + ".json");
+  const json g = json::parse(in);
+  std::vector<PtexFilterQuery> out;
+  for (const json& e : g["filtered"]) {
+    PtexFilterQuery q{};
+    q.face = e["face"].get<int>();
+    q.filter = e["filter"].get<std::string>() == "bilinear" ? SEAMCL_PTEX_BILINEAR : SEAMCL_PTEX_GAUSSIAN;
+    q.u = e["u"].get<float>();
+    q.v = e["v"].get<float>();
+    q.uw = e["uw"].get<float>();
+    q.vw = e["vw"].get<float>();
+    out.push_back(q);
+  }
+  return out;
+}
+
+std::vector<PtexFilterQuery> edge_queries(int faces, int count, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  const float near[] = {0.0f, 0.0004f, 0.01f, 0.03f, 0.97f, 0.99f, 0.9996f, 1.0f};
+  const int filters[] = {SEAMCL_PTEX_POINT, SEAMCL_PTEX_BILINEAR, SEAMCL_PTEX_BOX, SEAMCL_PTEX_GAUSSIAN, SEAMCL_PTEX_BICUBIC};
+  std::vector<PtexFilterQuery> out;
+  for (int i = 0; i < count; ++i) {
+    PtexFilterQuery q{};
+    q.face = static_cast<int>(random() % static_cast<unsigned>(faces));
+    q.filter = filters[i % 5];
+    q.sharpness = (i / 5) % 2 == 0 ? 0.0f : 1.0f;
+    const int place = i % 4;  // corner, u edge, v edge, anywhere
+    q.u = place == 0 || place == 1 ? near[random() % 8] : unit(random);
+    q.v = place == 0 || place == 2 ? near[random() % 8] : unit(random);
+    q.uw = std::exp2(-10.0f * unit(random) + 0.5f);
+    q.vw = i % 3 == 0 ? q.uw : std::exp2(-10.0f * unit(random) + 0.5f);
+    out.push_back(q);
+  }
+  return out;
+}
+
+TEST(PtexFilterKernel, MatchesTheTwinOnGoldenAndEdgeLookups) {
+  for (const char* name : {"black", "cellnoise", "rand_lo", "wave_lo"}) {
+    const PtexFilterData data = build_ptex_filter_data(read_ptex_stored(ptex_assets_dir() + "/" + name + ".ptx"));
+    std::vector<PtexFilterQuery> queries = golden_queries(name);
+    const std::vector<PtexFilterQuery> more = edge_queries(static_cast<int>(data.faces.size()), 2000, 11);
+    queries.insert(queries.end(), more.begin(), more.end());
+    PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
+    launcher.load(data);
+    const std::vector<float> device = launcher.run(queries);
+    ASSERT_EQ(device.size(), queries.size() * 4);
+    int nonzero = 0;
+    for (size_t i = 0; i < queries.size(); ++i) {
+      const std::array<float, 4> twin = ptex_filter_twin(data, queries[i]);
+      for (int c = 0; c < 4; ++c) {
+        ASSERT_TRUE(std::isfinite(device[4 * i + c]));
+        ASSERT_NEAR(device[4 * i + c], twin[c], 2e-6f + 2e-6f * std::fabs(twin[c]))
+            << name << " lookup " << i << " face " << queries[i].face << " filter " << queries[i].filter << " at ("
+            << queries[i].u << ", " << queries[i].v << ") widths " << queries[i].uw << " x " << queries[i].vw << " channel " << c;
+        nonzero += twin[c] != 0.0f;
+      }
+    }
+    EXPECT_GT(nonzero, static_cast<int>(queries.size()) / 2) << name;
+  }
+}
+
+TEST(PtexFilterKernel, OutOfRangeFacesGiveZerosOnTheDevice) {
+  const PtexFilterData data = build_ptex_filter_data(read_ptex_stored(ptex_assets_dir() + "/rand_lo.ptx"));
+  PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
+  launcher.load(data);
+  PtexFilterQuery bad{};
+  bad.face = 9;
+  bad.filter = SEAMCL_PTEX_BILINEAR;
+  bad.u = bad.v = 0.5f;
+  PtexFilterQuery good = bad;
+  good.face = 0;
+  const std::vector<float> out = launcher.run({bad, good});
+  for (int c = 0; c < 4; ++c) EXPECT_EQ(out[c], 0.0f);
+  EXPECT_GT(out[4], 0.0f);
+}
+
+}  // namespace
+}  // namespace seamcl
