@@ -4,6 +4,7 @@ time: the keywords of render() and compare(), their signatures and docstrings, a
 import functools
 import inspect
 import json
+import os
 
 from . import _seamcl
 
@@ -35,6 +36,8 @@ def request_value(spec, value):
         return f"{_integer(value[0])}x{_integer(value[1])}"
     if spec["type"] == "list" and isinstance(value, (tuple, list)):
         return [_integer(v) if spec["integers"] else v for v in value]
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
     if hasattr(value, "item") and callable(value.item) and not isinstance(value, (str, bytes)):
         return value.item()  # a numpy scalar
     return value

@@ -12,7 +12,7 @@ import pytest
 import seamcl
 
 A = dict(scene="quad2", size=(64, 48), method="traverse", msaa=4)
-B = dict(scene="closeup-corner", size=(56, 40), method="guardband", filter="ewa")
+B = dict(scene="closeup-corner", size=(56, 40), method="discard", msaa=2)
 
 
 def test_two_threads_render_at_once_and_get_what_each_renders_alone():
@@ -71,13 +71,12 @@ def test_ctrl_c_stops_a_running_compare():
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt):
-            seamcl.compare(scene="quad2", size=(64, 64), methods=["clamp", "black", "discard", "traverse",
-                                                                  "traverse-edges", "guardband"],
-                           msaa=[1, 2, 4, 8, 16], repeat=20, no_cache=True, progress=lines.append)
+            seamcl.compare(scene="quad2", size=(64, 64), methods=["discard", "traverse"], msaa=[1, 2, 4, 8, 16],
+                           repeat=200, no_cache=True, progress=lines.append)
     finally:
         timer.cancel()
     entries = [line for line in lines if line.startswith("entry ")]
-    assert len(entries) < 30, "the compare ran to its end"
+    assert len(entries) < 10, "the compare ran to its end"
     # The process goes on: the next job runs.
     assert seamcl.render(scene="quad2", size=(8, 8)).image.shape == (8, 8, 4)
 

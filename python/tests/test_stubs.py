@@ -1,11 +1,13 @@
 """The committed stubs (python/seamcl/__init__.pyi) are what the option tables make."""
+import importlib.util
 import pathlib
-import sys
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-import generate_stubs  # noqa: E402
+import seamcl
 
-import seamcl  # noqa: E402
+_spec = importlib.util.spec_from_file_location("generate_stubs",
+                                               pathlib.Path(__file__).resolve().parents[1] / "generate_stubs.py")
+generate_stubs = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(generate_stubs)
 
 
 def test_committed_stubs_are_generated_from_the_option_tables():
