@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
 """The library's folders depend on each other one way only, and the outside reaches it through
-<seamcl/...>. Reads every #include of host/, cli/, server/, bench/, tests/ and examples/:
+<seamcl/...>. Reads every #include of host/, cli/, server/, python/, bench/, tests/ and examples/:
 
 - a file in host/F/ (or a folder inside it, such as host/pipeline/stages/) includes only host/F/
   and the folders F may depend on (ALLOWED);
 - OpenCL headers only in host/cl/, OpenImageIO only in .cpp files of host/io/ and host/eval/;
 - a public header (listed in CMakeLists.txt) includes no private one;
 - outside host/, a public header is included as <seamcl/F/NAME.h>, never by a relative path,
-  and cli/, server/ and examples/ include no private header at all.
+  and cli/, server/, python/ and examples/ include no private header at all.
 Prints every violation and exits 1 if there is one."""
 import pathlib
 import re
@@ -90,7 +90,7 @@ def main():
             if rel in public and target not in public:
                 problems.append(f"{where}: a public header includes the private host/{target}")
 
-    for top in ("cli", "server", "bench", "tests", "examples"):
+    for top in ("cli", "server", "python", "bench", "tests", "examples"):
         for path in sorted((ROOT / top).rglob("*")):
             if path.suffix not in (".h", ".cpp"):
                 continue
@@ -101,7 +101,7 @@ def main():
                     continue
                 if target in public and kind == '"':
                     problems.append(f"{rel}: #include \"{name}\": use <seamcl/{target}>")
-                if target not in public and top in ("cli", "server", "examples"):
+                if target not in public and top in ("cli", "server", "python", "examples"):
                     problems.append(f"{rel}: #include of host/{target}, which is private to the library and its tests")
 
     for p in problems:
