@@ -35,6 +35,7 @@ def main():
     parser.add_argument("--build", required=True, type=pathlib.Path)
     parser.add_argument("--source", required=True, type=pathlib.Path)
     args = parser.parse_args()
+    args.build, args.source = args.build.resolve(), args.source.resolve()
     with tempfile.TemporaryDirectory(prefix="seamcl-pip-") as tmp:
         tmp = pathlib.Path(tmp)
         run("cmake", "--install", args.build, "--prefix", tmp / "prefix")
