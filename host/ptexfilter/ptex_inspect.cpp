@@ -69,11 +69,9 @@ json ptex_info_json(const PtexStored& stored) {
   for (const auto& [key, value] : file.metadata) metadata[key] = value;
   json faces = json::array();
   json averages = json::array();
-  bool has_mipmaps = false;
   for (size_t f = 0; f < file.faces.size(); ++f) {
     const PtexFaceInfo& info = file.faces[f];
     const PtexStoredFace& face = stored.faces[f];
-    has_mipmaps = has_mipmaps || face.levels.size() > 1;
     faces.push_back({{"face", f},
                      {"ulog2", info.ulog2},
                      {"vlog2", info.vlog2},
@@ -87,7 +85,7 @@ json ptex_info_json(const PtexStored& stored) {
                      {"adjedges", info.adjacent_edges}});
     averages.push_back(pixel(face.constant.data(), file.channels, file.data_type));
   }
-  header["has_mipmaps"] = has_mipmaps;
+  header["has_mipmaps"] = stored.levels > 1;  // Ptex's hasMipMaps: the file holds reduction levels
   json out = {{"header", header}, {"metadata", metadata}, {"face_info", faces}, {"face_average", averages}};
   if (file.mesh) out["mesh"] = {{"vertices", file.mesh->positions.size()}, {"faces", file.mesh->faces.size()}};
   return out;
