@@ -300,13 +300,13 @@ SEAMCL_INLINE void ptexf_width4_axis(int filter, const float* c, int* res_log2, 
   for (int i = 0; i < *k_uw; ++i) ku[i] = ptexf_width4_fn(filter, c, x1 + (float)i * step);
 }
 
-SEAMCL_INLINE void ptexf_box_weights(float* kernel, int size, float f1, float f2) {
+SEAMCL_INLINE void ptexf_box_weights(float* weights, int size, float f1, float f2) {
   if (size == 1) {
-    kernel[0] = f1 + f2 - 1.0f;
+    weights[0] = f1 + f2 - 1.0f;
   } else {
-    kernel[0] = f1;
-    for (int i = 1; i < size - 1; ++i) kernel[i] = 1.0f;
-    kernel[size - 1] = f2;
+    weights[0] = f1;
+    for (int i = 1; i < size - 1; ++i) weights[i] = 1.0f;
+    weights[size - 1] = f2;
   }
 }
 

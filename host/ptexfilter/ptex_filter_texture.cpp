@@ -156,6 +156,13 @@ PtexFilterData build_ptex_filter_data(const PtexStored& stored, const PtexFilter
       throw InputError("texture", "face " + std::to_string(f) +
                                       " is a subface (a quad of a split non-quad face); the Ptex filters take "
                                       "textures of quad meshes without subfaces");
+  for (const auto& [name, mode] : {std::pair<const char*, int>{"u", stored.u_border_mode}, {"v", stored.v_border_mode}})
+    if (mode < 0 || mode > 2)
+      throw InputError("texture", std::string("the ") + name + " border mode " + std::to_string(mode) +
+                                      " is none of 0 (clamp), 1 (black), 2 (periodic)");
+  if (stored.edge_filter_mode < 0 || stored.edge_filter_mode > 1)
+    throw InputError("texture", "the edge filter mode " + std::to_string(stored.edge_filter_mode) +
+                                    " is neither 0 (none) nor 1 (tanvec)");
   const uint64_t bytes = ptex_filter_data_bytes(stored);
   if (bytes > limits.max_bytes)
     throw InputError("texture", "the Ptex filters' resolutions of every face would take " + std::to_string(bytes) +

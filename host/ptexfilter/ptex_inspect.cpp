@@ -69,11 +69,9 @@ json ptex_info_json(const PtexStored& stored) {
   for (const auto& [key, value] : file.metadata) metadata[key] = value;
   json faces = json::array();
   json averages = json::array();
-  bool has_mipmaps = false;
   for (size_t f = 0; f < file.faces.size(); ++f) {
     const PtexFaceInfo& info = file.faces[f];
     const PtexStoredFace& face = stored.faces[f];
-    has_mipmaps = has_mipmaps || face.levels.size() > 1;
     faces.push_back({{"face", f},
                      {"ulog2", info.ulog2},
                      {"vlog2", info.vlog2},
@@ -87,7 +85,7 @@ json ptex_info_json(const PtexStored& stored) {
                      {"adjedges", info.adjacent_edges}});
     averages.push_back(pixel(face.constant.data(), file.channels, file.data_type));
   }
-  header["has_mipmaps"] = has_mipmaps;
+  header["has_mipmaps"] = stored.levels > 1;  // Ptex's hasMipMaps: the file holds reduction levels
   json out = {{"header", header}, {"metadata", metadata}, {"face_info", faces}, {"face_average", averages}};
   if (file.mesh) out["mesh"] = {{"vertices", file.mesh->positions.size()}, {"faces", file.mesh->faces.size()}};
   return out;
@@ -107,6 +105,14 @@ json ptex_dump_json(const PtexStored& stored, int face, std::optional<int> level
                                   std::to_string(info.ulog2) + " x 2^" + std::to_string(info.vlog2) +
                                   " texels has levels 0 to " + std::to_string(most));
   const int ulog2 = info.ulog2 - k, vlog2 = info.vlog2 - k;
+  // A JSON number per channel costs tens of bytes in memory: a 4096 x 4096 level would take
+  // gigabytes, so larger levels are refused and a coarser one is asked for.
+  constexpr int kMaxDumpTexelsLog2 = 20;
+  if (ulog2 + vlog2 > kMaxDumpTexelsLog2)
+    throw InputError("level", "level " + std::to_string(k) + " of face " + std::to_string(face) + " has 2^" +
+                                  std::to_string(ulog2 + vlog2) + " texels, more than the 2^" +
+                                  std::to_string(kMaxDumpTexelsLog2) + " a dump shows; give --level " +
+                                  std::to_string((ulog2 + vlog2 - kMaxDumpTexelsLog2 + 1) / 2 + k) + " or more");
   const std::vector<float> values = ptex_face_resolution(stored, static_cast<size_t>(face), ulog2, vlog2);
   const int width = 1 << ulog2, height = 1 << vlog2;
   json rows = json::array();
