@@ -29,6 +29,7 @@ struct ServeArgs {
   int queue = 8;
   bool quick_start = false;
   int max_connections = 256;
+  int max_connections_per_client = 64;
   double read_timeout_s = 10;
   double deadline_s = 60;
   std::optional<std::string> cache_dir;  // empty is refused, not taken for the default
@@ -36,6 +37,7 @@ struct ServeArgs {
   std::optional<std::string> assets_dir;  // empty is refused, not taken for none
   long long assets_cache_mib = 512;
   long long request_memory_mib = 1024;
+  long long memory_bound_mib = 0;  // 0: half the physical memory
 };
 
 int run_serve(const ServeArgs& args, const GlobalOptions& global) {
@@ -48,10 +50,13 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   if (args.threads < 1 || args.threads > 64) throw InputError("threads", "must be in 1..64");
   if (args.queue < 0 || args.queue > 1024) throw InputError("queue", "must be in 0..1024");
   if (args.max_connections < 1 || args.max_connections > 4096) throw InputError("max-connections", "must be in 1..4096");
+  if (args.max_connections_per_client < 0 || args.max_connections_per_client > 4096)
+    throw InputError("max-connections-per-client", "must be in 0..4096 (0: no cap)");
   if (!(args.read_timeout_s >= 0.1 && args.read_timeout_s <= 600)) throw InputError("read-timeout", "must be in 0.1..600 seconds");
   if (!(args.deadline_s >= 0 && args.deadline_s <= 3600)) throw InputError("deadline", "must be in 0..3600 seconds (0: none)");
   if (args.cache_max_mib < 0) throw InputError("cache-max-mib", "must be at least 0 (0: no bound)");
   if (args.assets_cache_mib < 0) throw InputError("assets-cache-mib", "must be at least 0 (0: cache nothing)");
+  if (args.memory_bound_mib < 0 || args.memory_bound_mib > (1LL << 24)) throw InputError("memory-bound-mib", "must be in 0..16777216 (0: half the physical memory)");
   if (args.request_memory_mib < 1 || args.request_memory_mib > (1LL << 20)) {
     throw InputError("request-memory-mib", "must be in 1..1048576");
   }
@@ -74,6 +79,7 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   options.queue = args.queue;
   options.warm_all_methods = !args.quick_start;
   options.max_connections = args.max_connections;
+  options.max_connections_per_client = args.max_connections_per_client;
   options.request_read_timeout_ms = static_cast<int>(args.read_timeout_s * 1000);
   options.deadline_ms = static_cast<int>(args.deadline_s * 1000);
   options.cache_dir = cache_dir;
@@ -82,6 +88,7 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   options.asset_cache.max_bytes = static_cast<size_t>(args.assets_cache_mib) << 20;
   options.max_request_device_bytes = static_cast<size_t>(args.request_memory_mib) << 20;
   options.max_request_host_bytes = static_cast<size_t>(args.request_memory_mib) << 20;
+  options.memory_bound_bytes = static_cast<size_t>(args.memory_bound_mib) << 20;
   server::HttpServer http(runtime, options);
   if (http.bind() < 0) {
     std::fprintf(stderr, "seamcl: cannot listen on %s:%d: the port is in use or the address is not this machine's\n",
@@ -124,6 +131,8 @@ Command add_serve_command(CLI::App& app) {
   serve->add_option("--queue", args->queue, "Renders that may wait for a thread; more get 503 [8]");
   serve->add_flag("--quick-start", args->quick_start, "Warm only the default method, not every method x filter");
   serve->add_option("--max-connections", args->max_connections, "Connections served at once; more get 503 and are closed [256]");
+  serve->add_option("--max-connections-per-client", args->max_connections_per_client,
+                    "Connections one client address may hold at once; more get 503 and are closed; 0: no cap (behind a proxy) [64]");
   serve->add_option("--read-timeout", args->read_timeout_s,
                     "Seconds a request's line, headers and body may take to arrive, however they trickle [10]");
   serve->add_option("--cache-dir", args->cache_dir,
@@ -135,6 +144,9 @@ Command add_serve_command(CLI::App& app) {
                     "Bound of the loaded assets kept between requests (least recently used go first); 0: keep none [512]");
   serve->add_option("--request-memory-mib", args->request_memory_mib,
                     "Device and host memory one request may need, estimated before anything is allocated; more: 413 [1024]");
+  serve->add_option("--memory-bound-mib", args->memory_bound_mib,
+                    "Memory the whole process may plan for: admitted requests plus the kept scenes (least recently used "
+                    "go first); a request that does not fit gets 503; 0: half the physical memory [0]");
   serve->add_option("--deadline", args->deadline_s,
                     "Seconds a request may wait for a render slot before it is answered 503; 0: no limit [60]");
   return Command{serve, [args](const GlobalOptions& global) { return run_serve(*args, global); }};

@@ -1,11 +1,15 @@
 #include "connection.h"
+#include "request_head.h"
 
 #include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cstring>
 #include <deque>
+#include <optional>
 #include <thread>
+
+#include <nlohmann/json.hpp>
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -121,12 +125,35 @@ class GuardedStream : public httplib::Stream {
     }
   }
 
+  // The whole request head (request line to the blank line), read ahead without consuming it.
+  // Empty with `too_large` false when it does not arrive in time; `too_large` when it does not
+  // fit the buffer.
+  std::string_view peek_head(bool& too_large) {
+    too_large = false;
+    for (;;) {
+      const std::string_view ahead(buffer_.data() + begin_, available());
+      // The head ends at its first empty line (CRLF, or a bare LF, which the check refuses).
+      for (size_t newline = ahead.find('\n'); newline != std::string_view::npos; newline = ahead.find('\n', newline + 1)) {
+        const std::string_view after = ahead.substr(newline + 1);
+        if (after.starts_with("\n")) return ahead.substr(0, newline + 2);
+        if (after.starts_with("\r\n")) return ahead.substr(0, newline + 3);
+      }
+      if (available() == buffer_.size()) {
+        too_large = true;
+        return {};
+      }
+      if (end_ == buffer_.size()) compact();
+      if (fill() <= 0) return {};
+    }
+  }
+
   int response_status() const {
     // "HTTP/1.1 200 OK": the status is the second token of the first line written.
     if (response_head_.size() < 12) return 0;
     return std::atoi(response_head_.c_str() + 9);
   }
   bool over_byte_limit() const { return over_byte_limit_; }
+  std::string_view buffered() const { return {buffer_.data() + begin_, available()}; }
 
   bool is_readable() const override {
     if (available() > 0) return true;
@@ -320,7 +347,21 @@ bool GuardedHttpServer::client_gone() { return current_stream != nullptr && curr
 
 bool GuardedHttpServer::request_over_byte_limit() { return current_stream != nullptr && current_stream->over_byte_limit(); }
 
+void GuardedHttpServer::widen_backlog() {
+  const socket_t listening = svr_sock_.load();
+  // listen() again on a listening socket sets its backlog (httplib's compiled-in one is 5, which
+  // drops connections under a burst; the kernel caps it at net.core.somaxconn).
+  if (listening != INVALID_SOCKET) ::listen(listening, limits_.listen_backlog);
+}
+
 bool GuardedHttpServer::process_and_close_socket(socket_t sock) {
+  // Whatever happens while serving (a bad_alloc while answering, say), the socket is closed and
+  // the counts given back: an exception must not leave a client waiting on a leaked descriptor.
+  struct Closer {
+    socket_t sock;
+    bool drain = false;
+    ~Closer() { close_socket(sock, drain); }
+  } closer{sock};
   struct OpenCount {
     std::atomic<int>& open;
     explicit OpenCount(std::atomic<int>& o) : open(o) { open.fetch_add(1); }
@@ -331,12 +372,38 @@ bool GuardedHttpServer::process_and_close_socket(socket_t sock) {
     write_json_response(sock, 503, "Service Unavailable",
                         R"json({"error":"connections: this server is serving its limit of open connections; retry later","field":"connections"})json",
                         "Retry-After: 1\r\n");
-    close_socket(sock);
+    return true;
+  }
+  // One client (one address) holds at most max_connections_per_client of them.
+  std::string peer;
+  int peer_port = 0;
+  GuardedStream stream(sock, limits_);
+  stream.get_remote_ip_and_port(peer, peer_port);
+  struct ClientCount {
+    GuardedHttpServer& server;
+    const std::string& peer;
+    int count;
+    ClientCount(GuardedHttpServer& s, const std::string& p) : server(s), peer(p) {
+      std::lock_guard lock(server.clients_mutex_);
+      count = ++server.clients_[peer];
+    }
+    ~ClientCount() {
+      std::lock_guard lock(server.clients_mutex_);
+      if (--server.clients_[peer] == 0) server.clients_.erase(peer);
+    }
+  } client(*this, peer);
+  if (limits_.max_connections_per_client > 0 && client.count > limits_.max_connections_per_client) {
+    refused_.fetch_add(1);
+    write_json_response(sock, 503, "Service Unavailable",
+                        R"json({"error":"connections: this client has its limit of open connections to this server; retry later","field":"connections"})json",
+                        "Retry-After: 1\r\n");
     return true;
   }
 
-  GuardedStream stream(sock, limits_);
-  current_stream = &stream;
+  struct CurrentStream {
+    explicit CurrentStream(GuardedStream* s) { current_stream = s; }
+    ~CurrentStream() { current_stream = nullptr; }
+  } current(&stream);
   bool answered_error = false;
   for (int served = 0; served < limits_.max_requests_per_connection && !shutting_down_.load(); ++served) {
     if (!stream.wait_for_request(served == 0 ? limits_.request_read_timeout : limits_.idle_timeout)) break;
@@ -350,6 +417,27 @@ bool GuardedHttpServer::process_and_close_socket(socket_t sock) {
                           "Allow: GET, POST\r\n");
       break;
     }
+    bool too_large = false;
+    const std::string_view head = stream.peek_head(too_large);
+    if (too_large) {
+      answered_error = true;
+      const bool line_too_long = head.find('\n') == std::string_view::npos && stream.buffered().find('\n') == std::string_view::npos;
+      if (line_too_long) {
+        write_json_response(sock, 414, "URI Too Long",
+                            R"json({"error":"path: the request line exceeds this server's limit","field":"path"})json", "");
+      } else {
+        write_json_response(sock, 431, "Request Header Fields Too Large",
+                            R"json({"error":"headers: the request head exceeds this server's limit","field":"headers"})json", "");
+      }
+      break;
+    }
+    if (head.empty()) break;
+    if (const std::optional<HeadRefusal> refusal = check_request_head(head, limits_.max_body_bytes)) {
+      answered_error = true;
+      write_json_response(sock, refusal->status, refusal->reason,
+                          nlohmann::json{{"error", refusal->message}, {"field", refusal->field}}.dump(), "");
+      break;
+    }
     bool connection_closed = false;
     const bool last = served + 1 == limits_.max_requests_per_connection;
     const bool ok = process_request(stream, last, connection_closed, nullptr);
@@ -358,8 +446,7 @@ bool GuardedHttpServer::process_and_close_socket(socket_t sock) {
     answered_error = status >= 400;
     if (!ok || connection_closed || status < 200 || status >= 400) break;
   }
-  current_stream = nullptr;
-  close_socket(sock, answered_error);
+  closer.drain = answered_error;
   return true;
 }
 

@@ -11,13 +11,20 @@
 //     byte, however they trickle, and at most max_request_bytes are read for it, in any encoding;
 //   - an error answer (4xx/5xx) ends the connection, so an unread body is never read as a request;
 //   - a method httplib does not know is answered 405 here (httplib would say 400);
-//   - the listening socket is not shared (no SO_REUSEPORT): a second server on the port fails.
+//   - the listening socket is not shared (no SO_REUSEPORT): a second server on the port fails;
+//   - its backlog is listen_backlog, not httplib's compiled-in 5 (a burst of clients is held, not
+//     dropped for a SYN retry a second later);
+//   - one address holds at most max_connections_per_client connections; one more gets 503;
+//   - every request head is checked before httplib parses it (server/request_head.h): framing
+//     two parsers could read differently is refused at once, and the connection closed;
+//   - the socket is closed whatever happens while serving, an exception included.
 #pragma once
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <string>
 
@@ -32,6 +39,9 @@ struct ConnectionLimits {
   std::chrono::milliseconds write_timeout{10'000};          // one whole response
   size_t max_request_bytes = (size_t{2} << 20) + (64 << 10);  // line + headers + body (any encoding)
   int max_requests_per_connection = 100;
+  size_t max_body_bytes = size_t{1} << 20;                  // a Content-Length over it: 413 before the body is read
+  int max_connections_per_client = 64;                      // open at once from one address; more: 503; 0: no cap
+  int listen_backlog = 1024;                                // connections the kernel holds until accepted
 };
 
 class GuardedHttpServer : public httplib::Server {
@@ -44,6 +54,8 @@ class GuardedHttpServer : public httplib::Server {
   // stops), and a server that has not started listening never will.
   void begin_shutdown();
   int open_connections() const { return open_connections_.load(); }
+  // After a bind: the listening socket's backlog raised to limits().listen_backlog.
+  void widen_backlog();
   long long connections_refused() const { return refused_.load(); }
 
   // On a thread that is serving a request: whether its client has hung up (for long handlers,
@@ -60,6 +72,8 @@ class GuardedHttpServer : public httplib::Server {
   std::atomic<int> open_connections_{0};
   std::atomic<long long> refused_{0};
   std::atomic<bool> shutting_down_{false};
+  std::mutex clients_mutex_;
+  std::map<std::string, int> clients_;  // open connections by remote address
 };
 
 }  // namespace seamcl::server

@@ -15,6 +15,7 @@
 #include "api_documents.h"
 #include "connection.h"
 #include "job_handlers.h"
+#include "memory_bound.h"
 #include "render_slots.h"
 #include "request_hygiene.h"
 #include "scene_resolution.h"
@@ -43,6 +44,8 @@ ConnectionLimits connection_limits(const ServerOptions& options) {
   limits.idle_timeout = std::chrono::milliseconds(options.idle_timeout_ms);
   // A chunked body's framing is counted too: room for the body at twice its limit, plus headers.
   limits.max_request_bytes = 2 * options.max_body_bytes + (64 << 10);
+  limits.max_body_bytes = options.max_body_bytes;
+  limits.max_connections_per_client = options.max_connections_per_client;
   return limits;
 }
 
@@ -53,6 +56,7 @@ HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
   if (options_.threads < 1) throw InputError("threads", "must be at least 1");
   if (options_.queue < 0) throw InputError("queue", "must be at least 0");
   if (options_.max_connections < 1) throw InputError("max_connections", "must be at least 1");
+  if (options_.max_connections_per_client < 0) throw InputError("max_connections_per_client", "must be at least 0 (0: no cap)");
   if (options_.request_read_timeout_ms < 1) throw InputError("request_read_timeout_ms", "must be at least 1");
   if (options_.deadline_ms < 0) throw InputError("deadline", "must be at least 0 (0: none)");
   options_.cache_dir = server_cache_dir(options_.cache_dir);
@@ -63,7 +67,8 @@ HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
   // are made and warmed after bind() (warm_up()); a slot becomes free once warm, so early
   // renders wait for it rather than build kernels themselves.
   slots_ = std::make_unique<RenderSlots>(options_.threads, options_.queue, options_.deadline_ms);
-  jobs_ = std::make_unique<JobHandlers>(runtime_, options_, *scenes_, *slots_);
+  memory_ = std::make_unique<MemoryBound>(options_.memory_bound_bytes > 0 ? options_.memory_bound_bytes : MemoryBound::default_bound());
+  jobs_ = std::make_unique<JobHandlers>(runtime_, options_, *scenes_, *slots_, *memory_);
   total_variants_ = options_.warm_all_methods ? static_cast<int>(method_names().size() * filter_names().size()) : 1;
 
   install_routes();
@@ -80,6 +85,7 @@ int HttpServer::bind() {
   } else {
     port_ = http_->bind_to_port(options_.host, options_.port) ? options_.port : -1;
   }
+  if (port_ >= 0) http_->widen_backlog();
   if (port_ >= 0 && !warm_thread_.joinable()) {
     started_ = Clock::now();
     warm_thread_ = std::thread([this] { warm_up(); });
@@ -124,7 +130,9 @@ void HttpServer::warm_up() {
       std::snprintf(line, sizeof line, "warm: %d variants in %.0f ms", warmed_variants_.load(), ms_since(start));
       log_line(line);
     }
+    variants_done_.store(true);
   } catch (const std::exception& e) {
+    variants_done_.store(true);
     const std::string message = describe_cl_exception(e);
     log_line("error: warm-up failed: " + message);
     // With some slots warm the service goes on with those (and says so in /health).
@@ -132,9 +140,21 @@ void HttpServer::warm_up() {
   }
 }
 
-bool HttpServer::ready() const { return slots_->ready(); }
+// Ready when a request can need no build: every slot warm and, when the server warms every
+// method x filter, every one of them built (before that, a render of one still building waited
+// behind the build while /ready said 200).
+bool HttpServer::ready() const { return slots_->ready() && (!options_.warm_all_methods || variants_done_.load()); }
 
-bool HttpServer::wait_ready(std::chrono::milliseconds timeout) { return slots_->wait_ready(timeout); }
+bool HttpServer::wait_ready(std::chrono::milliseconds timeout) {
+  const Clock::time_point deadline = Clock::now() + timeout;
+  if (!slots_->wait_ready(timeout)) return false;
+  // The background variants have no condition of their own: polled, they take seconds.
+  while (!ready()) {
+    if (Clock::now() >= deadline || slots_->failed()) return ready();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return true;
+}
 
 bool HttpServer::listen_after_bind() { return http_->listen_after_bind(); }
 
@@ -146,6 +166,8 @@ void HttpServer::stop() {
   }
   if (slots_) slots_->wake_all();
 }
+
+int HttpServer::open_connections() const { return http_->open_connections(); }
 
 bool HttpServer::is_running() const { return http_ && http_->is_running(); }
 
@@ -168,6 +190,7 @@ json HttpServer::health_json() const {
           {"uptime_s", std::chrono::duration<double>(Clock::now() - started_).count()},
           {"requests_served", served_.load()},
           {"renders_admitted", slots_->admitted()},
+          {"memory", memory_->to_json()},
           {"threads", options_.threads},
           {"queue", options_.queue}};
 }
@@ -193,12 +216,18 @@ void HttpServer::install_routes() {
       try {
         handler(req, res);
       } catch (const HttpError& e) {
+        if (e.field == "client") log_line("stopped: " + echo(req.path, 200) + ": " + e.message);
         if (e.retry_after_s > 0) res.set_header("Retry-After", std::to_string(e.retry_after_s));
         send_error(res, e.status, e.field, echo(e.field) + ": " + e.message);
       } catch (const OverBudget& e) {
         send_error(res, 413, e.field(), echo(e.field()) + ": " + input_error_message(e));
       } catch (const InputError& e) {
         send_error(res, 400, e.field(), echo(e.field()) + ": " + input_error_message(e));
+      } catch (const std::bad_alloc&) {
+        // Out of memory for this request: said so, and the connection closes after the answer.
+        log_line("error: out of memory while serving " + echo(req.path, 200));
+        res.set_header("Retry-After", "1");
+        send_error(res, 503, "memory", "memory: the server ran out of memory for this request; retry later");
       } catch (const std::exception& e) {
         log_line(std::string("error: ") + describe_cl_exception(e));
         send_error(res, 500, "server", "render failed: " + describe_cl_exception(e));

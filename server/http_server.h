@@ -41,6 +41,7 @@ namespace seamcl::server {
 
 class GuardedHttpServer;
 class JobHandlers;
+class MemoryBound;
 class RenderSlots;
 class SceneResolver;
 
@@ -70,9 +71,13 @@ struct ServerOptions {
   // A slot's Renderer keeps its frame buffers between requests up to this size; larger ones are
   // freed after the request, so one big request does not stay held.
   size_t keep_frame_bytes = size_t{64} << 20;
+  // The process-wide memory bound (server/memory_bound.h): admitted requests' plans plus the kept
+  // Renderers; 0: half the physical memory.
+  size_t memory_bound_bytes = 0;
   bool warm_all_methods = true;    // after start, build every method x filter (rgba8) in the background
   // Connections (server/connection.h): open at once, read deadline of one request, keep-alive wait.
   int max_connections = 256;
+  int max_connections_per_client = 64;  // open at once from one address; 0: no cap (behind a proxy)
   int request_read_timeout_ms = 10'000;
   int idle_timeout_ms = 2'000;
   // A request that has not started rendering this long after it arrived is answered 503
@@ -109,13 +114,15 @@ class HttpServer {
   // Safe from any thread (e.g. a signal-waiting thread).
   void stop();
   bool is_running() const;
-  // Every slot has the default scene and variant warm (renders no longer wait for start-up), or
-  // failed to warm while at least one did.
+  // Every slot has the default scene and variant warm and, with warm_all_methods, every method x
+  // filter is built (no render waits for a build), or the warm-up failed while at least one slot
+  // was warm.
   bool ready() const;
   // Blocks until ready() or the warm-up failed; false on failure or after timeout.
   bool wait_ready(std::chrono::milliseconds timeout);
 
   long long requests_served() const { return served_.load(); }
+  int open_connections() const;
 
  private:
   void install_routes();
@@ -129,6 +136,7 @@ class HttpServer {
   std::unique_ptr<GuardedHttpServer> http_;
   std::unique_ptr<SceneResolver> scenes_;
   std::unique_ptr<RenderSlots> slots_;
+  std::unique_ptr<MemoryBound> memory_;
   std::unique_ptr<JobHandlers> jobs_;
   int port_ = -1;
   std::chrono::steady_clock::time_point started_;
@@ -141,6 +149,7 @@ class HttpServer {
   std::thread warm_thread_;
   std::atomic<bool> stopping_{false};
   std::atomic<int> warmed_variants_{0};
+  std::atomic<bool> variants_done_{false};  // the background variants are built (or their build failed)
   int total_variants_ = 0;
 };
 

@@ -58,15 +58,67 @@ ImageFormat take_image_format(json& rest) {
 
 }  // namespace
 
-JobHandlers::JobHandlers(ClRuntime& runtime, const ServerOptions& options, const SceneResolver& scenes, RenderSlots& slots)
+JobHandlers::JobHandlers(ClRuntime& runtime, const ServerOptions& options, const SceneResolver& scenes, RenderSlots& slots,
+                         MemoryBound& memory)
     : runtime_(runtime),
       options_(options),
       scenes_(scenes),
       slots_(slots),
+      memory_(memory),
       budget_(options.max_request_device_bytes, options.max_request_host_bytes) {}
 
 std::mutex& JobHandlers::reference_lock(const std::string& cache_key) {
   return reference_locks_[std::hash<std::string>{}(cache_key) % reference_locks_.size()];
+}
+
+void JobHandlers::count_kept(RenderSlot& slot) {
+  std::map<std::string, size_t> now;
+  for (const auto& [key, renderer] : slot.renderers)
+    if (renderer) now[key] = renderer->device_bytes();
+  if (slot.scratch) now[""] = slot.scratch->device_bytes();
+  long long delta = 0;
+  for (const auto& [key, bytes] : now) delta += static_cast<long long>(bytes);
+  for (const auto& [key, bytes] : slot.counted_bytes) delta -= static_cast<long long>(bytes);
+  memory_.add_kept(delta);
+  slot.counted_bytes = std::move(now);
+}
+
+bool JobHandlers::evict_one(RenderSlot& slot) {
+  std::string oldest;
+  long long oldest_use = 0;
+  bool found = false;
+  for (const auto& [key, bytes] : slot.counted_bytes) {
+    if (bytes == 0) continue;
+    const long long use = slot.last_used.contains(key) ? slot.last_used.at(key) : 0;
+    if (!found || use < oldest_use) {
+      oldest = key;
+      oldest_use = use;
+      found = true;
+    }
+  }
+  if (!found) return false;
+  if (oldest.empty()) {
+    slot.scratch.reset();
+  } else {
+    slot.renderers.erase(oldest);
+  }
+  slot.last_used.erase(oldest);
+  count_kept(slot);
+  return true;
+}
+
+std::unique_ptr<MemoryReservation> JobHandlers::reserve(RenderSlot& slot, size_t bytes, const std::string& what) {
+  if (bytes > memory_.bound()) {
+    throw HttpError{413, "memory", what + " needs about " + std::to_string(bytes >> 20) + " MiB, over this server's memory bound of " +
+                                       std::to_string(memory_.bound() >> 20) + " MiB"};
+  }
+  while (!memory_.try_reserve(bytes)) {
+    if (!evict_one(slot)) {
+      throw HttpError{503, "memory", "the server's memory bound (" + std::to_string(memory_.bound() >> 20) +
+                                         " MiB) is taken by the requests in flight; retry later", 1};
+    }
+  }
+  return std::make_unique<MemoryReservation>(memory_, bytes);
 }
 
 void JobHandlers::render(const json& request, httplib::Response& res) {
@@ -101,13 +153,28 @@ void JobHandlers::render(const json& request, httplib::Response& res) {
   // Wait for a render slot (or 503), render, and give the slot back before encoding.
   const Clock::time_point queued = Clock::now();
   RenderRun run;
-  double queue_ms = 0;
+  double queue_ms = 0, build_ms = 0;
   {
     const std::unique_ptr<SlotLease> lease = slots_.acquire(start);
     queue_ms = ms_since(queued);
     // Queued for a client that has since hung up: nobody would read the image.
     if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
     RenderSlot& slot = lease->slot();
+    // Admitted under the memory bound: what this slot keeps goes first, least recently used.
+    const size_t planned = plan.unified.total() > 0 ? plan.unified.total() : plan.device.total() + plan.host.total();
+    // Counted again however the request ends (after its reservation is given back); the kept
+    // caches then give back what is over.
+    struct Recount {
+      JobHandlers& jobs;
+      RenderSlot& slot;
+      ~Recount() {
+        jobs.count_kept(slot);
+        while (jobs.memory_.kept_over() && jobs.evict_one(slot)) {
+        }
+      }
+    } recount{*this, slot};
+    const std::unique_ptr<MemoryReservation> reserved = reserve(slot, planned, plan.what);
+    slot.last_used[key] = ++slot.uses;
     std::unique_ptr<Renderer>& renderer = key.empty() ? slot.scratch : slot.renderers[key];
     try {
       if (!renderer) {
@@ -119,7 +186,18 @@ void JobHandlers::render(const json& request, httplib::Response& res) {
       if (key.empty()) renderer->load_scene(*scene, options.texels);
       JobControl control;
       control.device_byte_limit = options_.max_request_device_bytes;
-      run = job.run(runtime_, *renderer, *scene, control);
+      // The kernels it needs, built here (if the warm-up has not built them yet) and timed: a
+      // render that waits for a build says so (X-Seamcl-Build-Ms), never a silent stall.
+      const Clock::time_point build_start = Clock::now();
+      renderer->warm_up(options);
+      build_ms = ms_since(build_start);
+      // A render whose client has gone stops at the next stage boundary, like a compare.
+      control.should_stop = [] { return GuardedHttpServer::client_gone(); };
+      try {
+        run = job.run(runtime_, *renderer, *scene, control);
+      } catch (const Cancelled& e) {
+        throw HttpError{503, "client", std::string("the client has gone; render ") + e.what(), 0};
+      }
       // Hold nothing request-sized between requests: the inline scene goes, large frames too.
       if (key.empty()) {
         renderer->release_scene();
@@ -139,6 +217,7 @@ void JobHandlers::render(const json& request, httplib::Response& res) {
   res.set_header("X-Seamcl-Render-Ms", std::to_string(result.ms.total));
   res.set_header("X-Seamcl-Stage-Ms", json_text(RenderJob::stage_ms_json(result.ms)));
   res.set_header("X-Seamcl-Queue-Ms", std::to_string(queue_ms));
+  res.set_header("X-Seamcl-Build-Ms", std::to_string(build_ms));
   res.set_header("X-Seamcl-Encode-Ms", std::to_string(encode_ms));
   res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
   res.set_header("X-Seamcl-Options", json_text(to_json(options)));
@@ -208,6 +287,8 @@ void JobHandlers::compare(const json& request, httplib::Response& res) {
     const std::unique_ptr<SlotLease> lease = slots_.acquire(start);
     queue_ms = ms_since(queued);
     if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
+    const size_t planned = plan.unified.total() > 0 ? plan.unified.total() : plan.device.total() + plan.host.total();
+    const std::unique_ptr<MemoryReservation> reserved = reserve(lease->slot(), planned, plan.what);
     // Two compares of the same reference at once render it once: the second reads the first's.
     const ReferenceLock lock_reference = [this](const std::string& cache_key) {
       return std::unique_lock<std::mutex>(reference_lock(cache_key));
@@ -312,6 +393,8 @@ void JobHandlers::reference(const json& request, httplib::Response& res) {
     const std::unique_ptr<SlotLease> lease = slots_.acquire(start);
     queue_ms = ms_since(queued);
     if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
+    const std::unique_ptr<MemoryReservation> reserved =
+        reserve(lease->slot(), memory.device_shares.total() + memory.host_shares.total(), "this reference");
     Renderer renderer(runtime_);
     renderer.set_device_byte_limit(options_.max_request_device_bytes);
     renderer.load_scene(*scene, frame.texels);

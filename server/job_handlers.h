@@ -18,6 +18,7 @@
 
 #include "http_server.h"
 #include "render_slots.h"
+#include "memory_bound.h"
 #include "request_budget.h"
 #include "scene_resolution.h"
 
@@ -26,7 +27,8 @@ namespace seamcl::server {
 class JobHandlers {
  public:
   // Every reference outlives the handlers (the HttpServer owns them all).
-  JobHandlers(ClRuntime& runtime, const ServerOptions& options, const SceneResolver& scenes, RenderSlots& slots);
+  JobHandlers(ClRuntime& runtime, const ServerOptions& options, const SceneResolver& scenes, RenderSlots& slots,
+              MemoryBound& memory);
 
   void render(const nlohmann::json& request, httplib::Response& res);
   void compare(const nlohmann::json& request, httplib::Response& res);
@@ -39,11 +41,19 @@ class JobHandlers {
   void check_reference_limits(const RenderOptions& frame, const ReferenceSettings& settings, bool explicit_msaa) const;
   // Held while a reference is read from the cache or made and written to it.
   std::mutex& reference_lock(const std::string& cache_key);
+  // What `slot` keeps, counted against the memory bound again after a request changed it.
+  void count_kept(RenderSlot& slot);
+  // The slot's least recently used Renderer freed: false when it keeps none.
+  bool evict_one(RenderSlot& slot);
+  // `bytes` reserved under the memory bound for a request on `slot`, evicting what the slot keeps
+  // (least recently used first) until they fit; 503 "memory" when they do not.
+  std::unique_ptr<MemoryReservation> reserve(RenderSlot& slot, size_t bytes, const std::string& what);
 
   ClRuntime& runtime_;
   const ServerOptions& options_;
   const SceneResolver& scenes_;
   RenderSlots& slots_;
+  MemoryBound& memory_;
   RequestBudget budget_;
   // Two requests for the same reference at once would both render it and write the same cache
   // file: one lock per hash stripe of the cache key.

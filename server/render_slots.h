@@ -27,6 +27,11 @@ struct RenderSlot {
   ~RenderSlot();
   std::map<std::string, std::unique_ptr<Renderer>> renderers;
   std::unique_ptr<Renderer> scratch;
+  // For the memory bound (server/memory_bound.h): when each Renderer was last used (a count of
+  // the slot's requests) and the bytes it was counted with ("" for the scratch one).
+  std::map<std::string, long long> last_used;
+  std::map<std::string, size_t> counted_bytes;
+  long long uses = 0;
 };
 
 class RenderSlots;

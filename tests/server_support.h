@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -29,8 +30,19 @@ inline double seconds_since(Clock::time_point start) { return std::chrono::durat
 // A raw TCP connection to the server, for what httplib::Client will not send.
 class RawConnection {
  public:
-  explicit RawConnection(int port) {
+  // `source`: the loopback address to connect from (any of 127/8), as another client would.
+  explicit RawConnection(int port, const char* source = nullptr) {
     fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    if (source) {
+      sockaddr_in local{};
+      local.sin_family = AF_INET;
+      ::inet_pton(AF_INET, source, &local.sin_addr);
+      if (::bind(fd_, reinterpret_cast<sockaddr*>(&local), sizeof local) != 0) {
+        ::close(fd_);
+        fd_ = -1;
+        return;
+      }
+    }
     sockaddr_in address{};
     address.sin_family = AF_INET;
     address.sin_port = htons(static_cast<uint16_t>(port));
@@ -96,13 +108,18 @@ struct LiveServer {
   std::mutex log_mutex;
   std::vector<std::string> log;
 
-  explicit LiveServer(seamcl::server::ServerOptions options, bool wait_until_ready = true) {
+  // `tap`: also called with every log line, on the thread that logs it (after it is kept).
+  explicit LiveServer(seamcl::server::ServerOptions options, bool wait_until_ready = true,
+                      std::function<void(const std::string&)> tap = {}) {
     options.host = "127.0.0.1";
     options.port = 0;  // an ephemeral port: tests run side by side
     options.warm_all_methods = false;
-    options.log = [this](const std::string& line) {
-      std::lock_guard lock(log_mutex);
-      log.push_back(line);
+    options.log = [this, tap = std::move(tap)](const std::string& line) {
+      {
+        std::lock_guard lock(log_mutex);
+        log.push_back(line);
+      }
+      if (tap) tap(line);
     };
     http = std::make_unique<seamcl::server::HttpServer>(shared_runtime(), options);
     if (http->bind() <= 0) throw std::runtime_error("cannot bind");

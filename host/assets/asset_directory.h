@@ -3,8 +3,17 @@
 // gives, resolves here: an absolute path, a `..` component or a symlink that leads out of the
 // directory is refused, naming the field. Loaded scenes are cached, bounded in bytes and entries,
 // so repeated requests do not read the files again.
+//
+// A name is opened relative to the directory's descriptor, never by its path: openat2 with
+// RESOLVE_BENEATH where the kernel has it (symlinks inside the directory followed, none out of
+// it), else one openat with O_NOFOLLOW per component (no symlink followed at all). The checks
+// (a regular file) are made on the opened descriptor, and the loaders read that descriptor (by a
+// private link to /proc/self/fd/N, since they take paths): a name swapped for a symlink after
+// the check cannot make them read another file. Errors name files relative to the directory,
+// never by the server's paths.
 #pragma once
 #include <cstddef>
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <list>
@@ -40,12 +49,15 @@ class AssetDirectory {
 
   // `root` must be an existing directory: InputError("assets") otherwise.
   explicit AssetDirectory(const std::string& root, AssetCacheLimits limits = {}, FileStamper stamp = file_stamp);
+  ~AssetDirectory();
+  AssetDirectory(const AssetDirectory&) = delete;
+  AssetDirectory& operator=(const AssetDirectory&) = delete;
 
   const std::string& root() const { return root_; }
 
   // Every .json, .obj and .ptx file under the directory, sorted by name: at most kMaxListed, no
-  // hidden files or directories, symlinked directories not entered, symlinked files only when they
-  // resolve inside the directory.
+  // hidden files or directories, symlinked directories not entered, symlinked files (under their
+  // own name) only when they resolve inside the directory.
   static constexpr size_t kMaxListed = 1000;
   std::vector<AssetEntry> list() const;
 
@@ -77,7 +89,14 @@ class AssetDirectory {
     std::shared_ptr<const FileStamps> files;
   };
 
+  struct OpenedFiles;  // one load's descriptors and the private links the loaders read them by
+  // `name` (relative to `relative_to`) opened beneath the directory and checked on its descriptor.
+  int open_checked(const std::string& name, const std::string& relative_to, const std::string& field, std::string& relative) const;
+
   std::string root_;  // canonical
+  int root_fd_ = -1;  // the directory, opened once (O_PATH)
+  std::string links_dir_;  // private (0700): per load, a link to each opened descriptor
+  mutable std::atomic<long long> link_sequence_{0};
   AssetCacheLimits limits_;
   FileStamper stamp_;
   mutable std::mutex mutex_;

@@ -1,5 +1,7 @@
 #include <seamcl/jobs/render_job.h>
 
+#include "pipeline/stage_stop.h"
+
 #include <algorithm>
 
 #include <seamcl/core/input_error.h>
@@ -81,6 +83,10 @@ JobPlan RenderJob::plan(const Scene& scene, size_t held_scene_bytes) const {
 RenderRun RenderJob::run(ClRuntime& runtime, Renderer& renderer, const Scene& scene, const JobControl& control,
                          bool measure_watertightness) const {
   const Camera view = camera(scene);
+  // The renderer asks the same between its stages (a long cube-map bake, kernel builds), for this
+  // run only (host/pipeline/stage_stop.h).
+  const StageStopScope stage_stop(control.should_stop);
+  throw_if_stopped(control.should_stop, "before the kernels");
   renderer.warm_up(options_);
   RenderRun run;
   // Each run's times, and only the last run's image: holding every frame kept `repeat` images

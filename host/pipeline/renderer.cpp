@@ -18,6 +18,7 @@
 #include "pipeline/stages/tessellate_launcher.h"
 #include "pipeline/stages/triangle_setup_launcher.h"
 #include <seamcl/pipeline/packed_cube.h>
+#include "pipeline/stage_stop.h"
 
 namespace seamcl {
 
@@ -322,13 +323,17 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     throw InputError("method", reads + "no two of the " + std::to_string(scene.faces.size()) + " faces of scene '" +
                                    scene.name + "' share an edge (faces are neighbours through shared vertex indices)");
   }
+  throw_if_stage_stopped("packing");
   if (repack) {
     impl_->pack_and_upload(options.texels, sampler.guard_band, std::move(adjacency), keep_adjacency);
   } else if (!adjacency.empty()) {
     impl_->add_adjacency(std::move(adjacency));
   }
+  throw_if_stage_stopped("the cube map");
   impl_->upload_cube(impl_->scene->environment ? std::optional(cube_bake(options.cube_method)) : std::nullopt);
+  throw_if_stage_stopped("the kernels");
   impl_->use_kernels(options.texels, sampler, with_seam_mask);
+  throw_if_stage_stopped("the frame");
   impl_->displaced = options.displacement.has_value();
   if (impl_->displaced) {
     const DisplacementSettings settings{*options.displacement, options.tessellation, options.displacement_level};

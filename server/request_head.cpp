@@ -1,0 +1,91 @@
+#include "request_head.h"
+
+#include <algorithm>
+#include <cctype>
+
+namespace seamcl::server {
+namespace {
+
+// RFC 9110 5.6.2: a header name is a token.
+bool is_token_char(unsigned char c) {
+  if (std::isalnum(c)) return true;
+  return std::string_view("!#$%&'*+-.^_`|~").find(static_cast<char>(c)) != std::string_view::npos;
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+  return s;
+}
+
+bool equals_ignoring_case(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+         });
+}
+
+HeadRefusal bad(std::string field, std::string message) { return {400, "Bad Request", std::move(field), std::move(message)}; }
+
+}  // namespace
+
+std::optional<HeadRefusal> check_request_head(std::string_view head, size_t max_body_bytes) {
+  int content_lengths = 0, transfer_encodings = 0;
+  std::string_view content_length, transfer_encoding;
+  bool first_line = true;
+  for (size_t at = 0; at < head.size();) {
+    const size_t newline = head.find('\n', at);
+    if (newline == std::string_view::npos) return bad("headers", "the request head does not end in an empty line");
+    std::string_view line = head.substr(at, newline - at);
+    at = newline + 1;
+    // cpp-httplib skips a line that ends in a bare LF: a proxy may not, so it is refused.
+    if (line.empty() || line.back() != '\r') return bad("headers", "every line of the request head must end in CRLF");
+    line.remove_suffix(1);
+    if (line.find('\r') != std::string_view::npos || line.find('\0') != std::string_view::npos)
+      return bad("headers", "a bare CR or a NUL byte in the request head");
+    if (first_line) {
+      first_line = false;
+      continue;  // the request line: cpp-httplib checks its form
+    }
+    if (line.empty()) break;  // the end of the head
+    if (line.front() == ' ' || line.front() == '\t') return bad("headers", "a folded header line (obsolete line folding is refused)");
+    const size_t colon = line.find(':');
+    if (colon == std::string_view::npos) return bad("headers", "a header line without a colon");
+    const std::string_view name = line.substr(0, colon);
+    if (name.empty() || !std::all_of(name.begin(), name.end(), [](char c) { return is_token_char(static_cast<unsigned char>(c)); }))
+      return bad("headers", "a header name that is empty, holds whitespace before the colon or is not a token");
+    const std::string_view value = trim(line.substr(colon + 1));
+    if (equals_ignoring_case(name, "Content-Length")) {
+      ++content_lengths;
+      content_length = value;
+    } else if (equals_ignoring_case(name, "Transfer-Encoding")) {
+      ++transfer_encodings;
+      transfer_encoding = value;
+    } else if (equals_ignoring_case(name, "Range")) {
+      if (value.find(',') != std::string_view::npos)
+        return bad("Range", "Range: more than one range is not served (ask for one range at a time)");
+    }
+  }
+  if (content_lengths > 0 && transfer_encodings > 0)
+    return bad("Content-Length", "Content-Length: must not come with Transfer-Encoding");
+  if (content_lengths > 1) return bad("Content-Length", "Content-Length: given more than once");
+  if (transfer_encodings > 1) return bad("Transfer-Encoding", "Transfer-Encoding: given more than once");
+  if (transfer_encodings == 1 && !equals_ignoring_case(transfer_encoding, "chunked"))
+    return bad("Transfer-Encoding", "Transfer-Encoding: must be chunked, and only chunked");
+  if (content_lengths == 1) {
+    if (content_length.empty() ||
+        !std::all_of(content_length.begin(), content_length.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      return bad("Content-Length", "Content-Length: must be a decimal number of bytes");
+    // Leading zeros aside, more digits than the limit has is over it; the rest is compared.
+    const std::string_view digits = content_length.substr(std::min(content_length.find_first_not_of('0'), content_length.size()));
+    bool over = digits.size() > 19;
+    if (!over) {
+      unsigned long long length = 0;
+      for (char c : digits) length = length * 10 + static_cast<unsigned>(c - '0');
+      over = length > max_body_bytes;
+    }
+    if (over) return HeadRefusal{413, "Payload Too Large", "body", "body: the request body exceeds this server's limit"};
+  }
+  return std::nullopt;
+}
+
+}  // namespace seamcl::server
