@@ -67,5 +67,6 @@ Command add_merge_command(CLI::App& app);    // cli/merge_command.cpp
 Command add_cube_command(CLI::App& app);     // cli/cube_command.cpp
 Command add_displacement_command(CLI::App& app);  // cli/displacement_command.cpp
 Command add_ptx_command(CLI::App& app);      // cli/ptx_command.cpp
+Command add_warmup_command(CLI::App& app);   // cli/warmup_command.cpp
 
 }  // namespace seamcl::cli

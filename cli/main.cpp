@@ -155,6 +155,7 @@ int main(int argc, char** argv) {
   extra_commands.push_back(seamcl::cli::add_cube_command(app));
   extra_commands.push_back(seamcl::cli::add_displacement_command(app));
   extra_commands.push_back(seamcl::cli::add_ptx_command(app));
+  extra_commands.push_back(seamcl::cli::add_warmup_command(app));
 
   try {
     app.parse(argc, argv);

@@ -13,9 +13,10 @@
  * functions) stops PoCL from vectorising the work-group loop around it. */
 #define SEAMCL_INLINE inline __attribute__((always_inline))
 /* A prefetch of the cache line at p, to read it or to write it: clang's builtin is the one PoCL
- * turns into an instruction; OpenCL C's own prefetch() is the portable fallback for compilers
- * without it. */
-#if defined(__has_builtin)
+ * turns into an instruction; everywhere else OpenCL C's own prefetch(). Only under PoCL
+ * (POCL_DEVICE_ADDRESS_BITS is its macro): the builtin is a clang extension, and for SPIR-V it
+ * becomes an LLVM intrinsic the translator refuses (tests/kernel_portability_test.sh). */
+#if defined(__has_builtin) && defined(POCL_DEVICE_ADDRESS_BITS)
 #if __has_builtin(__builtin_prefetch)
 #define SEAMCL_PREFETCH(p) __builtin_prefetch(p)
 #define SEAMCL_PREFETCH_WRITE(p) __builtin_prefetch(p, 1)

@@ -21,6 +21,11 @@ EXPECTED_TARGETS = [
     "discard 16x / 1x", "discard 8x / 1x", "traverse / discard, every rate",
     "pixels x32.0*", "faces x40.0*", "peak RSS of render --scene paper",
     "peak RSS of paper <= floor + 2x packed", "peak RSS of paper_99k <= floor + 2x packed",
+    "reference wall / device time, paper", "compare wall / (reference + entries), paper",
+    "reference wall / device time, mixed", "compare wall / (reference + entries), mixed",
+    "reference wall / device time, closeup-seam", "compare wall / (reference + entries), closeup-seam",
+    "warmup, empty program cache (ms)", "warmup, warm program cache (ms)",
+    "first render of a fresh process / a repeated one",
 ]
 LOOKUP_TARGETS = [f"{what}, {texels}" for texels in ("rgba8", "rgba32f")
                   for what in ("aniso16 / OIIO aniso", "trilinear / OIIO trilinear", "aniso16 / (trilinear / *")]

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -196,30 +198,100 @@ ClRuntime::ClRuntime(const std::string& device_filter) {
   info_ = chosen->info;
   context_ = cl::Context(device_);
   queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
+  driver_version_ = trimmed(device_.getInfo<CL_DRIVER_VERSION>());
+  std::string cache_dir = (std::filesystem::path(default_cache_dir()) / "programs").string();
+  if (const char* use = std::getenv("SEAMCL_PROGRAM_CACHE"); use && (lower(use) == "0" || lower(use) == "off")) {
+    cache_dir.clear();
+  }
+  program_cache_ = std::make_unique<ProgramCache>(cache_dir);
 }
 
 std::string ClRuntime::device_description() const {
   return info_.name + " (" + info_.platform + ", " + info_.version + ")";
 }
 
-const cl::Program& ClRuntime::program(const std::string& options) {
+std::string ClRuntime::full_build_options(const std::string& options) const {
+  std::string all_options = "-cl-std=CL1.2 " + options;
+  if (const char* extra = std::getenv("SEAMCL_EXTRA_BUILD_OPTIONS")) all_options += std::string(" ") + extra;
+  return all_options;
+}
+
+ProgramCacheKey ClRuntime::program_cache_key(const std::string& options) const {
+  return ProgramCacheKey{info_.platform, info_.name, info_.version, driver_version_, fnv64_hex(program_source()),
+                         full_build_options(options)};
+}
+
+void ClRuntime::set_program_cache_dir(const std::string& directory) {
   std::lock_guard<std::mutex> lock(programs_mutex_);
-  std::unique_ptr<cl::Program>& slot = programs_[options];
-  if (!slot) {
-    const auto start = std::chrono::steady_clock::now();
-    auto program = std::make_unique<cl::Program>(context_, program_source());
-    std::string all_options = "-cl-std=CL1.2 " + options;
-    if (const char* extra = std::getenv("SEAMCL_EXTRA_BUILD_OPTIONS")) all_options += std::string(" ") + extra;
-    program->build(std::vector<cl::Device>{device_}, all_options.c_str());
-    build_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    slot = std::move(program);
+  program_cache_ = std::make_unique<ProgramCache>(directory);
+}
+
+std::string ClRuntime::program_cache_dir() const {
+  std::lock_guard<std::mutex> lock(programs_mutex_);
+  return program_cache_->directory();
+}
+
+const cl::Program& ClRuntime::program(const std::string& options) {
+  ProgramSlot* slot = nullptr;
+  ProgramCache cache("");
+  {
+    std::lock_guard<std::mutex> lock(programs_mutex_);
+    std::unique_ptr<ProgramSlot>& held = programs_[options];
+    if (!held) held = std::make_unique<ProgramSlot>();
+    slot = held.get();  // slots are never removed: the pointer stays valid
+    cache = *program_cache_;
   }
-  return *slot;
+  std::lock_guard<std::mutex> building(slot->mutex);
+  if (slot->program) return *slot->program;
+  const auto start = std::chrono::steady_clock::now();
+  const ProgramCacheKey key = program_cache_key(options);
+  const std::string all_options = key.build_options;
+  ProgramStats counted;
+  std::unique_ptr<cl::Program> program;
+  if (std::optional<std::vector<unsigned char>> binary = cache.load(key)) {
+    try {
+      auto loaded = std::make_unique<cl::Program>(context_, std::vector<cl::Device>{device_},
+                                                  cl::Program::Binaries{std::move(*binary)});
+      loaded->build(std::vector<cl::Device>{device_}, all_options.c_str());
+      program = std::move(loaded);
+      counted.loaded = 1;
+    } catch (const cl::Error&) {
+      // A binary the driver refuses (an entry from an older driver under the same version
+      // string, or damaged inside a valid frame) is built again from source and replaced.
+      counted.cache_rejected = 1;
+    }
+  } else if (cache.enabled()) {
+    std::error_code ec;
+    if (std::filesystem::exists(cache.path(key), ec)) counted.cache_rejected = 1;  // there, but not whole
+  }
+  if (!program) {
+    program = std::make_unique<cl::Program>(context_, program_source());
+    program->build(std::vector<cl::Device>{device_}, all_options.c_str());
+    counted.built = 1;
+    if (cache.enabled()) {
+      std::vector<std::vector<unsigned char>> binaries = program->getInfo<CL_PROGRAM_BINARIES>();
+      if (binaries.size() == 1 && cache.store(key, binaries.front())) counted.stored = 1;
+    }
+  }
+  counted.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  slot->program = std::move(program);
+  std::lock_guard<std::mutex> lock(programs_mutex_);
+  stats_.built += counted.built;
+  stats_.loaded += counted.loaded;
+  stats_.cache_rejected += counted.cache_rejected;
+  stats_.stored += counted.stored;
+  stats_.ms += counted.ms;
+  return *slot->program;
 }
 
 double ClRuntime::program_build_ms() const {
   std::lock_guard<std::mutex> lock(programs_mutex_);
-  return build_ms_;
+  return stats_.ms;
+}
+
+ClRuntime::ProgramStats ClRuntime::program_stats() const {
+  std::lock_guard<std::mutex> lock(programs_mutex_);
+  return stats_;
 }
 
 double event_milliseconds(const cl::Event& event) {

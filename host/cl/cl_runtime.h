@@ -9,6 +9,8 @@
 
 #include <CL/opencl.hpp>
 
+#include <seamcl/cl/program_cache.h>
+
 namespace seamcl {
 
 struct DeviceInfo {
@@ -45,19 +47,45 @@ class ClRuntime {
 
   // Builds program_source() with `options` (e.g. "-DSEAMCL_TEXELS_F32=1") once per distinct
   // options (plus $SEAMCL_EXTRA_BUILD_OPTIONS, for experiments); later calls return the same
-  // program. Thread-safe. The milliseconds the builds took
-  // are kept for --json and the first-start figure.
+  // program. Thread-safe, and calls for different options build in parallel (a call for options
+  // being built waits for that build). With a program cache (set_program_cache_dir), the binary
+  // is loaded from it when a whole entry for this device, driver, source and options is there,
+  // else built from source and stored (host/cl/program_cache.h).
   const cl::Program& program(const std::string& options = "");
-  double program_build_ms() const;
+  double program_build_ms() const;  // wall time of every build and cache load so far
+
+  // Where program binaries are kept: default_cache_dir()/programs, unless $SEAMCL_PROGRAM_CACHE
+  // is "0" or "off"; empty: none. Programs already built stay.
+  void set_program_cache_dir(const std::string& directory);
+  std::string program_cache_dir() const;
+  // The cache key of the program built with `options` on this device.
+  ProgramCacheKey program_cache_key(const std::string& options) const;
+
+  struct ProgramStats {
+    int built = 0;           // from source
+    int loaded = 0;          // from the program cache
+    int cache_rejected = 0;  // entries there that failed to load (corrupt, truncated): built instead
+    int stored = 0;          // entries written
+    double ms = 0;           // as program_build_ms()
+  };
+  ProgramStats program_stats() const;
 
  private:
+  struct ProgramSlot {
+    std::mutex mutex;  // held while this variant is built or loaded
+    std::unique_ptr<cl::Program> program;
+  };
+  std::string full_build_options(const std::string& options) const;
+
   cl::Context context_;
   cl::Device device_;
   cl::CommandQueue queue_;
   DeviceInfo info_;
-  std::map<std::string, std::unique_ptr<cl::Program>> programs_;
-  double build_ms_ = 0.0;
-  mutable std::mutex programs_mutex_;
+  std::string driver_version_;
+  std::map<std::string, std::unique_ptr<ProgramSlot>> programs_;
+  std::unique_ptr<ProgramCache> program_cache_;
+  ProgramStats stats_;
+  mutable std::mutex programs_mutex_;  // programs_, program_cache_ and stats_
 };
 
 // Milliseconds between an event's start and end (from CL_QUEUE_PROFILING_ENABLE).

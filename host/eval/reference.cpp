@@ -1,6 +1,10 @@
 #include <seamcl/eval/reference.h>
 
 #include <algorithm>
+#include <condition_variable>
+#include <exception>
+#include <memory>
+#include <mutex>
 #include <functional>
 #include <map>
 #include <optional>
@@ -25,6 +29,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/version.h>
 #include "cl/kernel_sources.h"
+#include "pipeline/stages/downsample_twin.h"
 
 namespace seamcl {
 namespace {
@@ -283,12 +288,6 @@ std::string default_reference_method() { return parse_method("traverse") ? "trav
 
 int default_reference_msaa(const std::string& method) { return method == "traverse" ? 1 : 16; }
 
-std::string default_cache_dir() {
-  if (const char* dir = std::getenv("SEAMCL_CACHE_DIR"); dir && *dir) return dir;
-  if (const char* home = std::getenv("HOME"); home && *home) return (fs::path(home) / ".cache" / "seamcl").string();
-  return (fs::temp_directory_path() / "seamcl-cache").string();
-}
-
 RenderOptions reference_render_options(const RenderOptions& frame, const ReferenceSettings& settings) {
   const std::string method = settings.method.empty() ? default_reference_method() : settings.method;
   if (!parse_method(method)) {
@@ -337,8 +336,33 @@ std::string reference_cache_key(const Scene& scene, const Camera& camera, const 
   return key.dump();
 }
 
-ReferenceImage reference_image(const Scene& scene, const Camera& camera, const RenderOptions& frame,
-                               const ReferenceSettings& settings, const HighResRender& render) {
+namespace {
+
+// A reference being made: whoever asks for the same key meanwhile waits for it and shares it.
+struct Flight {
+  std::mutex mutex;
+  std::condition_variable done_cv;
+  bool done = false;
+  std::optional<ReferenceImage> result;
+  std::exception_ptr failure;
+};
+
+std::mutex flights_mutex;
+std::map<std::string, std::shared_ptr<Flight>>& flights() {
+  static std::map<std::string, std::shared_ptr<Flight>> in_flight;
+  return in_flight;
+}
+
+// The high-resolution frame reduced to the frame's size: by the render itself (the device
+// downsample) or on the host (a HighResRender that hands back the 8x image).
+using ReducedRender = std::function<RenderResult(const RenderOptions& high, const DownsampleTaps& taps)>;
+
+double device_ms(const StageTimes& t) {
+  return t.setup + t.binning + t.raster + t.shade + t.readback + t.tessellate + t.downsample;
+}
+
+ReferenceImage make_reference(const Scene& scene, const Camera& camera, const RenderOptions& frame,
+                              const ReferenceSettings& settings, const ReducedRender& reduced) {
   if (settings.kind != ReferenceKind::Paper && settings.kind != ReferenceKind::Box) {
     throw InputError("reference", "the " + to_string(settings.kind) + " reference is not a downsampled render "
                                   "(reference_images and seamless_reference make it)");
@@ -350,46 +374,118 @@ ReferenceImage reference_image(const Scene& scene, const Camera& camera, const R
   ref.height = frame.height;
   ref.method = to_string(high.method);
   ref.msaa = high.msaa;
-  std::string key;
-  if (settings.use_cache) {
-    key = reference_cache_key(scene, camera, frame, settings);
-    const std::string dir = settings.cache_dir.empty() ? default_cache_dir() : settings.cache_dir;
-    ref.cache_path = (fs::path(dir) / ("reference-" + text_hash(key) + ".exr")).string();
-    if (auto cached = read_cached(ref.cache_path, key, ref.width, ref.height)) {
-      ref.pixels = std::move(*cached);
-      ref.from_cache = true;
-      std::error_code ec;  // the last use, for trim_reference_cache's LRU order
-      fs::last_write_time(ref.cache_path, fs::file_time_type::clock::now(), ec);
-      return ref;
+  // The key names the reference for the cache and for requests made at the same time; without a
+  // cache and without the scene's hash at hand it is not worth a hash of every face.
+  const bool keyed = settings.use_cache || !settings.scene_hash.empty();
+  const std::string key = keyed ? reference_cache_key(scene, camera, frame, settings) : std::string();
+
+  std::shared_ptr<Flight> flight;
+  bool leader = true;
+  if (keyed) {
+    std::lock_guard<std::mutex> lock(flights_mutex);
+    std::shared_ptr<Flight>& slot = flights()[key];
+    if (slot) {
+      flight = slot;
+      leader = false;
+    } else {
+      slot = flight = std::make_shared<Flight>();
     }
   }
-  const auto start = std::chrono::steady_clock::now();
-  {
+  if (!leader) {
+    std::unique_lock<std::mutex> lock(flight->mutex);
+    flight->done_cv.wait(lock, [&] { return flight->done; });
+    if (flight->failure) std::rethrow_exception(flight->failure);
+    ReferenceImage shared = *flight->result;
+    shared.shared = true;
+    return shared;
+  }
+  // Whatever happens, the waiters are answered and the key leaves the table.
+  auto finish = [&](const std::optional<ReferenceImage>& result, std::exception_ptr failure) {
+    if (!flight) return;
+    {
+      std::lock_guard<std::mutex> lock(flights_mutex);
+      flights().erase(key);
+    }
+    std::lock_guard<std::mutex> lock(flight->mutex);
+    flight->result = result;
+    flight->failure = failure;
+    flight->done = true;
+    flight->done_cv.notify_all();
+  };
+  try {
+    if (settings.use_cache) {
+      const std::string dir = settings.cache_dir.empty() ? default_cache_dir() : settings.cache_dir;
+      ref.cache_path = (fs::path(dir) / ("reference-" + text_hash(key) + ".exr")).string();
+      if (auto cached = read_cached(ref.cache_path, key, ref.width, ref.height)) {
+        ref.pixels = std::move(*cached);
+        ref.from_cache = true;
+        std::error_code ec;  // the last use, for trim_reference_cache's LRU order
+        fs::last_write_time(ref.cache_path, fs::file_time_type::clock::now(), ec);
+        finish(ref, nullptr);
+        return ref;
+      }
+    }
+    const auto start = std::chrono::steady_clock::now();
+    {
+      const RenderResult small = reduced(high, settings.kind == ReferenceKind::Box ? box_taps() : mitchell_taps());
+      if (small.width != frame.width || small.height != frame.height) {
+        throw std::runtime_error("reference render returned " + std::to_string(small.width) + "x" +
+                                 std::to_string(small.height) + ", asked for " + std::to_string(frame.width) + "x" +
+                                 std::to_string(frame.height));
+      }
+      ref.pixels = small.pixels;
+      ref.kernel_ms = device_ms(small.ms);
+    }
+    ref.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (settings.use_cache) {
+      if (write_cached(ref.cache_path, key, ref.width, ref.height, ref.pixels)) {
+        trim_reference_cache(fs::path(ref.cache_path).parent_path().string(), settings.cache_max_bytes,
+                             settings.cache_max_entries);
+      }
+      std::error_code ec;
+      if (!fs::is_regular_file(ref.cache_path, ec)) ref.cache_path.clear();
+    }
+  } catch (...) {
+    finish(std::nullopt, std::current_exception());
+    throw;
+  }
+  finish(ref, nullptr);
+  return ref;
+}
+
+}  // namespace
+
+DownsampleTaps mitchell_taps() {
+  return separable_taps(kReferenceScale, kMitchellWidth / 2.0, [](double x) { return mitchell_netravali(x); });
+}
+
+DownsampleTaps box_taps() {
+  return separable_taps(kReferenceScale, 0.5, [](double) { return 1.0; });
+}
+
+ReferenceImage reference_image(const Scene& scene, const Camera& camera, const RenderOptions& frame,
+                               const ReferenceSettings& settings, const HighResRender& render) {
+  return make_reference(scene, camera, frame, settings, [&](const RenderOptions& high, const DownsampleTaps&) {
     const RenderResult big = render(high);
     if (big.width != high.width || big.height != high.height) {
       throw std::runtime_error("reference render returned " + std::to_string(big.width) + "x" +
                                std::to_string(big.height) + ", asked for " + std::to_string(high.width) + "x" +
                                std::to_string(high.height));
     }
-    ref.pixels = settings.kind == ReferenceKind::Box ? downsample_box(big.pixels, big.width, big.height, kReferenceScale)
-                                                     : downsample_mitchell(big.pixels, big.width, big.height, kReferenceScale);
-  }
-  ref.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  if (settings.use_cache) {
-    if (write_cached(ref.cache_path, key, ref.width, ref.height, ref.pixels)) {
-      trim_reference_cache(fs::path(ref.cache_path).parent_path().string(), settings.cache_max_bytes,
-                           settings.cache_max_entries);
-    }
-    std::error_code ec;
-    if (!fs::is_regular_file(ref.cache_path, ec)) ref.cache_path.clear();
-  }
-  return ref;
+    RenderResult small;
+    small.width = big.width / kReferenceScale;
+    small.height = big.height / kReferenceScale;
+    small.ms = big.ms;
+    small.pixels = settings.kind == ReferenceKind::Box ? downsample_box(big.pixels, big.width, big.height, kReferenceScale)
+                                                       : downsample_mitchell(big.pixels, big.width, big.height, kReferenceScale);
+    return small;
+  });
 }
 
 ReferenceImage reference_image(Renderer& renderer, const Camera& camera, const RenderOptions& frame,
                                const ReferenceSettings& settings) {
-  return reference_image(renderer.scene(), camera, frame, settings, [&](const RenderOptions& high) {
-    RenderResult result = renderer.render(camera, high);
+  return make_reference(renderer.scene(), camera, frame, settings, [&](const RenderOptions& high, const DownsampleTaps& taps) {
+    RenderResult result = renderer.render_downsampled(camera, high, taps);
     // The 8x frame's buffers are 64x a frame's: not kept for the renders that follow.
     renderer.release_frame_buffers();
     return result;
@@ -461,11 +557,17 @@ std::vector<glm::vec4> analytic_image(Renderer& renderer, const Scene& scene) {
 
 std::vector<ReferenceImage> reference_images(Renderer& renderer, const Camera& camera, const RenderOptions& frame,
                                              const ReferenceSettings& settings, const std::vector<ReferenceKind>& kinds) {
-  // One 8x render, made when the first reference needs it and kept until the last is done.
+  // One 8x render, made when the first reference needs it and kept on the device until the last
+  // is done; each kind reduces it with its own filter there.
   std::optional<RenderResult> high_res;
-  auto render_once = [&](const RenderOptions& high) {
-    if (!high_res) high_res = renderer.render(camera, high);
-    return *high_res;
+  auto render_once = [&](const RenderOptions& high, const DownsampleTaps& taps) {
+    if (!high_res) {
+      high_res = renderer.render_downsampled(camera, high, taps);
+      return *high_res;
+    }
+    RenderResult again = renderer.downsample_last_frame(taps);
+    again.ms.total += high_res->ms.total;
+    return again;
   };
   std::vector<ReferenceImage> images;
   for (ReferenceKind kind : kinds) {
@@ -475,7 +577,7 @@ std::vector<ReferenceImage> reference_images(Renderer& renderer, const Camera& c
       throw InputError("reference", "the seamless reference is rendered per measured rate (seamless_reference)");
     }
     if (kind != ReferenceKind::Analytic) {
-      images.push_back(reference_image(renderer.scene(), camera, frame, kind_settings, render_once));
+      images.push_back(make_reference(renderer.scene(), camera, frame, kind_settings, render_once));
       continue;
     }
     const Scene& scene = renderer.scene();
@@ -701,7 +803,12 @@ nlohmann::json reference_json(const ReferenceImage& reference, bool with_cache_p
     out["B"] = kMitchellB;
     out["C"] = kMitchellC;
   }
-  if (with_cache_path) out["cache_path"] = reference.cache_path;
+  if (with_cache_path) {
+    out["cache_path"] = reference.cache_path;
+    // The command line's timing figures; the service's schema (server/openapi.json) lists its keys.
+    out["kernel_ms"] = reference.kernel_ms;
+    out["shared"] = reference.shared;
+  }
   return out;
 }
 

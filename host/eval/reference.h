@@ -24,11 +24,14 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include <seamcl/cl/program_cache.h>
 #include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene.h>
 
 namespace seamcl {
+
+struct DownsampleTaps;
 
 // The references an image can be measured against, each named in the results:
 //   paper    - the reference method (traverse) at 8x width and height, 1 sample per pixel, then a
@@ -98,8 +101,7 @@ struct ReferenceSettings {
 // background. Costs one bake of every face.
 std::string scene_content_hash(const Scene& scene);
 
-// $SEAMCL_CACHE_DIR, else $HOME/.cache/seamcl, else <temp>/seamcl-cache.
-std::string default_cache_dir();
+// default_cache_dir() (host/cl/program_cache.h): $SEAMCL_CACHE_DIR, else $HOME/.cache/seamcl.
 
 // The options of the high-resolution render for a measured frame: the frame's options with the
 // reference method and msaa, 8x the size, pixel shading. InputError("size", ...) when that is
@@ -123,12 +125,28 @@ struct ReferenceImage {
   bool from_cache = false;
   std::string cache_path;         // empty when not cached
   double render_ms = 0;           // wall time of the 8x render + downsample (0 from cache)
+  double kernel_ms = 0;           // the device time in it: every stage, the downsample, the read-back
+  bool shared = false;            // another request's render of the same reference, waited for
 };
 
-// Renders a high-resolution frame (the options come from reference_render_options).
+// Renders a high-resolution frame (the options come from reference_render_options); the host
+// then downsamples it (downsample_mitchell or downsample_box).
 using HighResRender = std::function<RenderResult(const RenderOptions&)>;
 
-// The reference for `frame` of `scene` seen from `camera`. With use_cache, a cache entry whose
+// The reference filters as taps of the device downsample (kernels/downsample.cl): Mitchell at
+// kMitchellWidth output pixels (32 taps a side at 8x) and the box (8 taps of 1/8). The device's
+// result stays within 2e-6 of downsample_mitchell / downsample_box relative to the image's largest
+// value (OIIO sums the 2D filter in one pass, the device in two separable float passes;
+// tests/test_downsample.cpp holds both to this).
+DownsampleTaps mitchell_taps();
+DownsampleTaps box_taps();
+
+// The reference for `frame` of `scene` seen from `camera`. Requests for the same reference at
+// the same time (the same key, reference_cache_key: scene content hash, camera, size and the
+// rest of the reference render's options, reference method and rate, texels, scale, filter,
+// kernel sources and version) make it once: the first renders, the others wait and get its
+// image (shared = true), in this process. Keyed when the cache is used or settings.scene_hash is
+// given (a key costs a hash of every face otherwise). With use_cache, a cache entry whose
 // stored key matches is returned without calling `render` (and its last use set to now); a
 // missing, unreadable or mismatched entry is rendered again and rewritten (atomically: temporary
 // file and rename), then the cache is trimmed to the settings' bound. cache_path is empty when
@@ -152,7 +170,8 @@ struct CacheTrim {
 // removed meanwhile, a missing directory) are ignored: the cache is an optimisation.
 CacheTrim trim_reference_cache(const std::string& dir, std::uintmax_t max_bytes, size_t max_entries);
 
-// The usual HighResRender: `renderer` (with `scene` loaded) renders `camera`, then releases its
+// The usual way: `renderer` (with `scene` loaded) renders `camera` at 8x and downsamples on the
+// device (Renderer::render_downsampled: only the small image is read back), then releases its
 // frame buffers (Renderer::release_frame_buffers): the 8x frame's are not kept.
 ReferenceImage reference_image(Renderer& renderer, const Camera& camera, const RenderOptions& frame,
                                const ReferenceSettings& settings);

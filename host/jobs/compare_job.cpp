@@ -1,6 +1,7 @@
 #include <seamcl/jobs/compare_job.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 
 #include <seamcl/core/input_error.h>
@@ -137,6 +138,9 @@ JobPlan CompareJob::plan(const Scene& scene) const {
 
 CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobControl& control,
                            const ReferenceLock& lock_reference) {
+  using Clock = std::chrono::steady_clock;
+  const auto ms_since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
+  const Clock::time_point start = Clock::now();
   const Camera view = camera(scene);
   // Hashed once for the lock's key and every reference kind's cache key (hashing bakes every face).
   if (reference_.use_cache && reference_.scene_hash.empty()) reference_.scene_hash = scene_content_hash(scene);
@@ -144,20 +148,26 @@ CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobCont
   renderer.set_device_byte_limit(control.device_byte_limit);
   renderer.load_scene(scene, frame_.texels);
   CompareRun run;
+  run.timing.setup_ms = ms_since(start);
+  const Clock::time_point targets_start = Clock::now();
   {
     std::unique_lock<std::mutex> lock;
     if (lock_reference) lock = lock_reference(reference_cache_key(scene, view, frame_, reference_));
     run.targets = prepare_targets(runtime, renderer, view, frame_, entries_, reference_, kinds_, control.progress);
   }
+  run.timing.targets_ms = ms_since(targets_start);
   throw_if_stopped(control.should_stop, "before the entries");
   const TargetsFor targets_for = [&](const MethodEntry& entry) { return run.targets.for_entry(entry); };
+  const Clock::time_point entries_start = Clock::now();
   run.measured = compare_methods(renderer, scene, view, entries_, targets_for, repeat_, control.should_stop, control.progress);
+  run.timing.entries_ms = ms_since(entries_start);
   // Watertightness of the displaced surface at this camera (docs/displacement.md), at the first rate.
   if (frame_.displacement) {
     control.report("displacement: gap and crack pixels of " + to_string(*frame_.displacement));
     run.displacement =
         measure_displacement(runtime, scene, view, entries_.front().options, 0, 0, renderer.device_byte_limit()).to_json();
   }
+  run.timing.total_ms = ms_since(start);
   return run;
 }
 
@@ -177,6 +187,12 @@ json CompareJob::result_json(const CompareRun& run, const Scene& scene, const st
     out["frames"] = frame_.frames;
   }
   if (!run.displacement.is_null()) out["displacement"] = run.displacement;
+  if (with_cache_path) {
+    out["timing"] = {{"setup_ms", run.timing.setup_ms},
+                     {"targets_ms", run.timing.targets_ms},
+                     {"entries_ms", run.timing.entries_ms},
+                     {"total_ms", run.timing.total_ms}};
+  }
   return out;
 }
 

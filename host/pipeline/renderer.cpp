@@ -12,6 +12,7 @@
 #include "pipeline/adjacency.h"
 #include "pipeline/frame_params.h"
 #include "pipeline/stages/binning_launcher.h"
+#include "pipeline/stages/downsample_launcher.h"
 #include "pipeline/stages/raster_launcher.h"
 #include "pipeline/stages/shade_resolve_launcher.h"
 #include "pipeline/stages/stage_buffers.h"
@@ -52,6 +53,9 @@ struct Renderer::Impl {
   bool displaced = false;        // this frame runs the tessellation stage
   std::string program_key;       // the current program variant's build options
   bool direction_output = false;  // render_directions: SEAMCL_CUBE_DIRECTION
+  // render_downsampled: the stage that reduces the image on the device before the read-back.
+  DownsampleLauncher downsampler{runtime};
+  const DownsampleTaps* downsample_taps = nullptr;
 
   explicit Impl(ClRuntime& rt) : runtime(rt) {
     const auto& table = srgb_to_linear_table();
@@ -69,6 +73,7 @@ struct Renderer::Impl {
     binning.use_program(options);
     raster.use_program(options);
     shade.use_program(options);
+    if (downsample_taps) downsampler.use_program(options);
   }
 
   // Packs and uploads the loaded scene in `format` with `guard_band` texels of band per level, from
@@ -156,6 +161,7 @@ struct Renderer::Impl {
     binning.release();
     raster.release();
     shade.release();
+    downsampler.release();
     // The tessellated vertices are sized by the request too (packed again on the next render).
     tessellation.release();
     tessellation_settings.reset();
@@ -200,7 +206,7 @@ struct Renderer::Impl {
 
   // Queues one frame; returns the events of each stage in order.
   struct StageEvents {
-    std::vector<cl::Event> setup, binning, raster, shade, readback, tessellate;
+    std::vector<cl::Event> setup, binning, raster, shade, readback, tessellate, downsample;
   };
 
   StageEvents enqueue_frame(const FrameParams& p, std::vector<glm::vec4>& pixels, std::vector<uint8_t>* mask) {
@@ -222,7 +228,11 @@ struct Renderer::Impl {
     raster.enqueue(frame_params, setup.setups(), binning, p, ev.raster);
     shade.enqueue(frame_params, setup.setups(), shade_scene_buffers(), raster.sample_triangle(), stats, p, mask != nullptr,
                   ev.shade);
-    shade.enqueue_readback(p, pixels, mask, ev.readback);
+    if (downsample_taps) {
+      downsampler.enqueue(shade.image(), p.width, p.height, *downsample_taps, pixels, ev.downsample, ev.readback);
+    } else {
+      shade.enqueue_readback(p, pixels, mask, ev.readback);
+    }
     queue.finish();
     return ev;
   }
@@ -267,7 +277,7 @@ size_t Renderer::device_bytes() const {
     bytes += buffer_bytes(*buffer);
   }
   return bytes + i.setup.device_bytes() + i.binning.device_bytes() + i.raster.device_bytes() + i.shade.device_bytes() +
-         i.tessellation.device_bytes();
+         i.tessellation.device_bytes() + i.downsampler.device_bytes();
 }
 
 const Scene& Renderer::scene() const {
@@ -382,6 +392,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     result.ms.shade = sum(ev.shade);
     result.ms.readback = sum(ev.readback);
     result.ms.tessellate = sum(ev.tessellate);
+    result.ms.downsample = sum(ev.downsample);
     const cl_ulong first = ev.setup.front().getProfilingInfo<CL_PROFILING_COMMAND_START>();
     const cl_ulong last = ev.readback.back().getProfilingInfo<CL_PROFILING_COMMAND_END>();
     result.ms.total = static_cast<double>(last - first) * 1e-6;
@@ -411,6 +422,42 @@ RenderResult Renderer::render_directions(const Camera& camera, const RenderOptio
     impl_->direction_output = false;
     throw;
   }
+}
+
+RenderResult Renderer::render_downsampled(const Camera& camera, const RenderOptions& options, const DownsampleTaps& taps) {
+  const int f = taps.factor;
+  if (f < 1 || options.width % f != 0 || options.height % f != 0) {
+    throw std::invalid_argument("render_downsampled: " + std::to_string(options.width) + "x" +
+                                std::to_string(options.height) + " is not a multiple of " + std::to_string(f));
+  }
+  impl_->downsample_taps = &taps;
+  try {
+    RenderResult result = render(camera, options);
+    impl_->downsample_taps = nullptr;
+    result.width = options.width / f;
+    result.height = options.height / f;
+    return result;
+  } catch (...) {
+    impl_->downsample_taps = nullptr;
+    throw;
+  }
+}
+
+RenderResult Renderer::downsample_last_frame(const DownsampleTaps& taps) {
+  const FrameParams& p = impl_->last_params;
+  if (p.width == 0 || impl_->program_key.empty()) throw std::logic_error("downsample_last_frame without a frame");
+  impl_->downsampler.use_program(impl_->program_key);
+  RenderResult result;
+  std::vector<cl::Event> passes, readback;
+  impl_->downsampler.enqueue(impl_->shade.image(), p.width, p.height, taps, result.pixels, passes, readback);
+  impl_->runtime.queue().finish();
+  for (const cl::Event& e : passes) result.ms.downsample += event_milliseconds(e);
+  for (const cl::Event& e : readback) result.ms.readback += event_milliseconds(e);
+  result.ms.total = static_cast<double>(readback.back().getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                                        passes.front().getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-6;
+  result.width = p.width / taps.factor;
+  result.height = p.height / taps.factor;
+  return result;
 }
 
 void Renderer::warm_up(const RenderOptions& options) {

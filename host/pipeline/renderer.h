@@ -35,7 +35,11 @@ struct StageTimes {
   double readback = 0;  // image to host
   double total = 0;     // first command's start to last command's end
   double tessellate = 0;  // displacement renders: the tessellation kernel (its setup counts in setup)
+  double downsample = 0;  // render_downsampled: the downsample stage's two passes
 };
+
+// One axis's filter of the downsample stage (host/pipeline/stages/downsample_twin.h).
+struct DownsampleTaps;
 
 struct RenderResult {
   int width = 0;
@@ -106,6 +110,17 @@ class Renderer {
   // renders without it pay nothing). The mask reads the faces' own texels without guard bands:
   // with Method::Guardband it throws InputError("method"); any other method gives the same mask.
   RenderResult render(const Camera& camera, const RenderOptions& options, bool with_seam_mask = false);
+
+  // The frame at `options`' size, resolved on the device and reduced there by taps.factor on
+  // both axes (kernels/downsample.cl), then read back small: the result's width, height and
+  // pixels are the reduced image's, ms.downsample its two passes, ms.readback the small read.
+  // The references' 8x frames never cross to the host. The size must be a multiple of the factor
+  // (std::invalid_argument otherwise).
+  RenderResult render_downsampled(const Camera& camera, const RenderOptions& options, const DownsampleTaps& taps);
+  // The last frame's image (still on the device until release_frame_buffers) reduced again with
+  // other taps: a second filter of one 8x render (the paper and box references). Only width,
+  // height, pixels, ms.downsample, ms.readback and ms.total are set. std::logic_error without a frame.
+  RenderResult downsample_last_frame(const DownsampleTaps& taps);
 
   // For the analytic reference of scenes with an environment (host/eval/cube_metrics.h): every
   // environment lookup (reflective fragments, skybox) writes its unit direction times

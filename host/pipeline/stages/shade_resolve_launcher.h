@@ -44,6 +44,9 @@ class ShadeResolveLauncher {
   void enqueue_readback(const FrameParams& p, std::vector<glm::vec4>& pixels, std::vector<uint8_t>* mask,
                         std::vector<cl::Event>& events);
 
+  // The resolved image of the last frame, for a stage that reads it on the device (downsample).
+  const cl::Buffer& image() const { return image_; }
+
   void release();
   size_t device_bytes() const;
 

@@ -1,0 +1,72 @@
+#include "pipeline/stages/downsample_launcher.h"
+
+#include <stdexcept>
+
+#include "pipeline/stages/stage_buffers.h"
+
+namespace seamcl {
+
+void DownsampleLauncher::use_program(const std::string& program_options) {
+  auto it = kernels_.find(program_options);
+  if (it == kernels_.end()) {
+    const cl::Program& program = runtime_.program(program_options);
+    it = kernels_.emplace(program_options, std::make_pair(cl::Kernel(program, "downsample_rows"),
+                                                          cl::Kernel(program, "downsample_columns"))).first;
+  }
+  rows_ = it->second.first;
+  columns_ = it->second.second;
+}
+
+void DownsampleLauncher::enqueue(const cl::Buffer& image, int width, int height, const DownsampleTaps& taps,
+                                 std::vector<glm::vec4>& out, std::vector<cl::Event>& passes,
+                                 std::vector<cl::Event>& readback) {
+  const int f = taps.factor;
+  if (f < 1 || width < f || height < f || width % f != 0 || height % f != 0 || taps.weights.empty() ||
+      taps.weights.size() > 64) {
+    throw std::invalid_argument("downsample: " + std::to_string(width) + "x" + std::to_string(height) +
+                                " is not a multiple of " + std::to_string(f));
+  }
+  const int out_w = width / f, out_h = height / f;
+  cl::CommandQueue& queue = runtime_.queue();
+  weights_ = cl::Buffer(runtime_.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, taps.weights.size() * sizeof(float),
+                        const_cast<float*>(taps.weights.data()));
+  grow_buffer(mid_, mid_capacity_, static_cast<size_t>(out_w) * height, sizeof(cl_float4), runtime_.context());
+  grow_buffer(out_, out_capacity_, static_cast<size_t>(out_w) * out_h, sizeof(cl_float4), runtime_.context());
+  const cl_int taps_n = static_cast<cl_int>(taps.weights.size());
+  rows_.setArg(0, image);
+  rows_.setArg(1, cl_int{width});
+  rows_.setArg(2, cl_int{height});
+  rows_.setArg(3, cl_int{out_w});
+  rows_.setArg(4, cl_int{f});
+  rows_.setArg(5, cl_int{taps.first});
+  rows_.setArg(6, taps_n);
+  rows_.setArg(7, weights_);
+  rows_.setArg(8, mid_);
+  queue.enqueueNDRangeKernel(rows_, cl::NullRange, cl::NDRange(static_cast<size_t>(out_w), static_cast<size_t>(height)),
+                             cl::NullRange, nullptr, &passes.emplace_back());
+  columns_.setArg(0, mid_);
+  columns_.setArg(1, cl_int{height});
+  columns_.setArg(2, cl_int{out_w});
+  columns_.setArg(3, cl_int{out_h});
+  columns_.setArg(4, cl_int{f});
+  columns_.setArg(5, cl_int{taps.first});
+  columns_.setArg(6, taps_n);
+  columns_.setArg(7, weights_);
+  columns_.setArg(8, out_);
+  queue.enqueueNDRangeKernel(columns_, cl::NullRange, cl::NDRange(static_cast<size_t>(out_w), static_cast<size_t>(out_h)),
+                             cl::NullRange, nullptr, &passes.emplace_back());
+  out.resize(static_cast<size_t>(out_w) * out_h);
+  queue.enqueueReadBuffer(out_, CL_FALSE, 0, out.size() * sizeof(cl_float4), out.data(), nullptr,
+                          &readback.emplace_back());
+}
+
+void DownsampleLauncher::release() {
+  weights_ = mid_ = out_ = cl::Buffer();
+  mid_capacity_ = out_capacity_ = 0;
+}
+
+size_t DownsampleLauncher::device_bytes() const {
+  return buffer_bytes(weights_) + buffer_bytes(mid_) + buffer_bytes(out_);
+}
+
+}  // namespace seamcl
