@@ -17,6 +17,7 @@
 #include <seamcl/jobs/render_job.h>
 #include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
+#include <seamcl/pipeline/stage_stop.h>
 #include <seamcl/scene/scene.h>
 
 #include "connection.h"
@@ -186,14 +187,18 @@ void JobHandlers::render(const json& request, httplib::Response& res) {
       if (key.empty()) renderer->load_scene(*scene, options.texels);
       JobControl control;
       control.device_byte_limit = options_.max_request_device_bytes;
-      // The kernels it needs, built here (if the warm-up has not built them yet) and timed: a
-      // render that waits for a build says so (X-Seamcl-Build-Ms), never a silent stall.
-      const Clock::time_point build_start = Clock::now();
-      renderer->warm_up(options);
-      build_ms = ms_since(build_start);
       // A render whose client has gone stops at the next stage boundary, like a compare.
       control.should_stop = [] { return GuardedHttpServer::client_gone(); };
       try {
+        // What it needs before its frame, made here and timed: kernel variants the warm-up has
+        // not built yet and an environment's cube map. A render that waits for them says so
+        // (X-Seamcl-Build-Ms), never a silent stall.
+        {
+          const StageStopScope stop_between_stages(control.should_stop);
+          const Clock::time_point build_start = Clock::now();
+          renderer->warm_up(options);
+          build_ms = ms_since(build_start);
+        }
         run = job.run(runtime_, *renderer, *scene, control);
       } catch (const Cancelled& e) {
         throw HttpError{503, "client", std::string("the client has gone; render ") + e.what(), 0};
