@@ -199,10 +199,14 @@ ClRuntime::ClRuntime(const std::string& device_filter) {
   context_ = cl::Context(device_);
   queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
   driver_version_ = trimmed(device_.getInfo<CL_DRIVER_VERSION>());
-  std::string cache_dir = (std::filesystem::path(default_cache_dir()) / "programs").string();
-  if (const char* use = std::getenv("SEAMCL_PROGRAM_CACHE"); use && (lower(use) == "0" || lower(use) == "off")) {
-    cache_dir.clear();
-  }
+  // PoCL keeps its own build cache, and asking it for CL_PROGRAM_BINARIES compiles every kernel of
+  // the program, not only those a run launches (docs/benchmarks.md has the cost), so seamcl keeps
+  // binaries by default for other drivers only. SEAMCL_PROGRAM_CACHE=1 (or on) keeps them on PoCL too; 0 (or off) nowhere.
+  const char* use = std::getenv("SEAMCL_PROGRAM_CACHE");
+  const std::string wanted = use ? lower(use) : "";
+  const bool pocl = info_.platform.find("Portable Computing Language") != std::string::npos;
+  const bool keep = wanted == "1" || wanted == "on" || (!pocl && wanted != "0" && wanted != "off");
+  const std::string cache_dir = keep ? (std::filesystem::path(default_cache_dir()) / "programs").string() : "";
   program_cache_ = std::make_unique<ProgramCache>(cache_dir);
 }
 

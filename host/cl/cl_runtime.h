@@ -54,8 +54,9 @@ class ClRuntime {
   const cl::Program& program(const std::string& options = "");
   double program_build_ms() const;  // wall time of every build and cache load so far
 
-  // Where program binaries are kept: default_cache_dir()/programs, unless $SEAMCL_PROGRAM_CACHE
-  // is "0" or "off"; empty: none. Programs already built stay.
+  // Where program binaries are kept: default_cache_dir()/programs by default on drivers other than
+  // PoCL (which caches its own builds), on PoCL too with $SEAMCL_PROGRAM_CACHE "1" or "on", nowhere
+  // with "0" or "off"; empty: none. Programs already built stay.
   void set_program_cache_dir(const std::string& directory);
   std::string program_cache_dir() const;
   // The cache key of the program built with `options` on this device.
