@@ -362,11 +362,26 @@ SEAMCL_INLINE void ptexf_build(PtexfKernel* k, const PtexFilterQuery* q, float u
   ptexf_width4_axis(q->filter, c, &k->vlog2, &k->v, &k->vw, k->kv, v, vw, face_vlog2);
 }
 
+/* Half texels are decoded from their bits: vload_half is core OpenCL C, but some offline compilers
+ * (clang 14 with every extension disabled) leave it undeclared. */
+SEAMCL_INLINE float ptexf_half_to_float(uint h) {
+  const uint sign = (h & 0x8000u) << 16;
+  const uint exponent = (h >> 10) & 0x1fu;
+  const uint mantissa = h & 0x3ffu;
+  float magnitude;
+  if (exponent == 0u) {
+    magnitude = (float)mantissa * 5.9604644775390625e-8f; /* 2^-24 */
+  } else {
+    magnitude = as_float(exponent == 31u ? (0xffu << 23) | (mantissa << 13) : ((exponent + 112u) << 23) | (mantissa << 13));
+  }
+  return sign ? -magnitude : magnitude;
+}
+
 SEAMCL_INLINE float ptexf_texel(const PtexfState* s, uint index) {
   switch (s->tex.data_type) {
     case 0: return (float)s->texels[index];
     case 1: return (float)((__global const ushort*)s->texels)[index];
-    case 2: return vload_half(index, (__global const half*)s->texels);
+    case 2: return ptexf_half_to_float(((__global const ushort*)s->texels)[index]);
     default: return ((__global const float*)s->texels)[index];
   }
 }

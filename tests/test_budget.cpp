@@ -30,6 +30,7 @@
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 
+#include "pipeline/stages/downsample_twin.h"
 #include "test_support.h"
 
 namespace {
@@ -468,12 +469,12 @@ TEST(Budget, CompareMemoryBoundsWhatTheCompareHolds) {
   }
   EXPECT_EQ(renderer.packed_scene().neighbors.size(), scene.faces.size());
   renderer.release_frame_buffers();  // as prepare_targets does before the references
-  const ReferenceImage reference = reference_image(scene, scene.camera, frame, settings, [&](const RenderOptions& high) {
-    RenderResult r = renderer.render(scene.camera, high);
-    phase1 = std::max(phase1, renderer.device_bytes());
-    renderer.release_frame_buffers();
-    return r;
-  });
+  // The reference as reference_images makes it: the 8x frame reduced on the device.
+  const RenderResult reference = renderer.render_downsampled(scene.camera, reference_render_options(frame, settings),
+                                                             mitchell_taps());
+  ASSERT_EQ(reference.pixels.size(), size_t{24 * 16});
+  phase1 = std::max(phase1, renderer.device_bytes());
+  renderer.release_frame_buffers();
   EXPECT_EQ(phase1, expected.device_bytes);  // the reference phase is the larger, and exact
   size_t phase2 = 0;
   const std::vector<EntryResult> results =
@@ -485,8 +486,8 @@ TEST(Budget, CompareMemoryBoundsWhatTheCompareHolds) {
   EXPECT_EQ(results.size(), 6u);
   EXPECT_GT(phase2, 0u);
   EXPECT_LE(phase2, expected.device_bytes);
-  // Host: at least the 8x read-back and every entry's image.
-  EXPECT_GE(expected.host_bytes, expected.reference.host_image + expected.reference.host_scene);
+  // Host: at least the reduced reference, read back and copied, and the scene.
+  EXPECT_GE(expected.host_bytes, 2 * reference.pixels.size() * sizeof(glm::vec4) + expected.reference.host_scene);
 }
 
 TEST(Budget, CompareMemoryCountsTheAnalyticAndSeamlessReferences) {
@@ -943,9 +944,14 @@ TEST(Budget, CompareMemoryNamesWhatDrivesEachFigure) {
   for (const RenderMemory& entry : small.entries) EXPECT_GE(small.device_bytes, entry.device_bytes());
   EXPECT_GE(small.device_bytes, small.reference.device_bytes());
   EXPECT_GE(small.device_bytes_bound, small.device_bytes);
-  EXPECT_GE(small.host_bytes, small.reference.host_image);
-  // The 8x reference's phase: its samples and image are all of the frame's share.
-  EXPECT_EQ(small.device_shares.share("size"), small.reference.tiles + small.reference.samples + small.reference.image);
+  // The device reduces the 8x frame: the host reads back, keeps and copies a frame-sized image.
+  const size_t frame_image = size_t{64} * 64 * sizeof(glm::vec4);
+  EXPECT_GE(small.host_bytes, 2 * frame_image);
+  // The 8x reference's phase: its samples and image, and the downsample's row pass (8 frame
+  // images), result and weights, are all of the frame's share.
+  EXPECT_EQ(small.device_shares.share("size"), small.reference.tiles + small.reference.samples +
+                                                   small.reference.image + 9 * frame_image +
+                                                   mitchell_taps().weights.size() * sizeof(float));
   // A scene whose packing outweighs the frames, on the device and in the Renderer's packed copy.
   SceneSizes textured = quad2;
   for (auto& face : textured.faces) face = {4096, 4096};

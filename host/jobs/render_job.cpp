@@ -1,13 +1,12 @@
 #include <seamcl/jobs/render_job.h>
 
-#include "pipeline/stage_stop.h"
-
 #include <algorithm>
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/memory/render_memory.h>
+#include <seamcl/pipeline/stage_stop.h>
 
 namespace seamcl {
 namespace {

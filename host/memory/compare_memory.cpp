@@ -5,6 +5,7 @@
 
 #include <seamcl/pipeline/gpu_types.h>
 #include "memory/process_overhead.h"
+#include "pipeline/stages/downsample_twin.h"
 
 namespace seamcl {
 
@@ -26,6 +27,7 @@ struct PhaseDevice {
   size_t scene = 0, constants = 0;  // the largest packing's buffers, and the per-Renderer constants
   RenderMemory frames;              // the largest of each frame buffer (its scene buffers stay 0)
   std::string multisample_field = "size";  // of the render with the most samples
+  size_t downsample = 0;                    // render_downsampled's row-pass and result buffers
   void include(const RenderMemory& m, const std::string& field) {
     if (m.samples > frames.samples) multisample_field = field;
     include_scene(m);
@@ -46,6 +48,7 @@ struct PhaseDevice {
   MemoryShares shares(bool tile_lists_at_bound) const {
     MemoryShares out = frames.device_shares(multisample_field, tile_lists_at_bound);
     out.add("scene", add(scene, constants));
+    out.add("size", downsample);
     return out;
   }
 };
@@ -61,6 +64,9 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   if (seamless && !seamless_scene) throw std::logic_error("compare_memory: the seamless reference needs its scene's sizes");
   const bool high_res = std::any_of(kinds.begin(), kinds.end(), [](ReferenceKind k) { return k != ReferenceKind::Seamless; });
   if (kinds.empty()) throw std::logic_error("compare_memory: no reference");
+
+  const size_t pixels = mul(static_cast<size_t>(std::max(frame.width, 1)), static_cast<size_t>(std::max(frame.height, 1)));
+  const size_t frame_image = mul(pixels, sizeof(glm::vec4));
 
   CompareMemory out;
   RenderOptions face_map_options = frame;  // as render_face_map renders it
@@ -95,7 +101,17 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   }
   // Phase 1, the references.
   phase1.include(render_memory(scene, loaded), "size");
-  if (high_res) phase1.include(out.reference, "size");
+  if (high_res) {
+    phase1.include(out.reference, "size");
+    // The row pass keeps the 8x frame's height at the frame's width; the result is frame-sized;
+    // the taps' weights are the largest filter's.
+    size_t weights = 0;
+    for (ReferenceKind kind : kinds) {
+      if (kind == ReferenceKind::Box) weights = std::max(weights, box_taps().weights.size());
+      if (kind == ReferenceKind::Paper) weights = std::max(weights, mitchell_taps().weights.size());
+    }
+    phase1.downsample = add(mul(frame_image, kReferenceScale + 1), mul(weights, sizeof(float)));
+  }
   if (analytic) phase1.include(out.analytic, "size");
   int largest_rate = 1;
   std::vector<int> rates;
@@ -130,8 +146,6 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   out.device_bytes = out.device_shares.total();
   out.device_bytes_bound = out.device_bound_shares.total();
 
-  const size_t pixels = mul(static_cast<size_t>(std::max(frame.width, 1)), static_cast<size_t>(std::max(frame.height, 1)));
-  const size_t frame_image = mul(pixels, sizeof(glm::vec4));
   const size_t mask = pixels;  // one byte a pixel
   const size_t masks = mul(mask, std::max<size_t>(rates.size(), 1));  // one seam mask per measured rate
   // Every reference is kept at the frame's size: one per high-resolution kind, one per rate for seamless.
@@ -143,12 +157,11 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
       "size", add(add(out.face_map.host_image, mul(pixels, sizeof(uint32_t))), mul(pixels, sizeof(int32_t))));
   face_map.add("scene", add(out.face_map.setups, mul(mul(scene.triangle_count(), SEAMCL_CLIP_SLOTS), sizeof(uint32_t))));
   face_map.add("size", masks);
-  // The 8x read-back and the downsample's two frame-sized buffers; with the analytic reference,
-  // also its 8x render's read-back, winners (one uint a pixel at 1 sample), setups and albedo image.
+  // The device reduces the 8x frame (render_downsampled): its read-back is frame-sized, kept once
+  // and copied to each kind. The analytic reference reads back its 8x render, the winners (one
+  // uint a pixel at 1 sample), the setups, and makes an albedo image of the 8x frame.
   MemoryShares high_res_host("size", add(masks, references));
-  // reference_images keeps the 8x render for every kind and hands each a copy (HighResRender
-  // returns by value): two read-backs at once.
-  if (high_res) high_res_host.add("size", add(mul(out.reference.host_image, 2), mul(frame_image, 2)));
+  if (high_res) high_res_host.add("size", mul(frame_image, 2));
   if (analytic) {
     const size_t fine_pixels = out.analytic.host_image / sizeof(glm::vec4);
     high_res_host.add("size", add(mul(out.analytic.host_image, 2), mul(fine_pixels, sizeof(uint32_t))));

@@ -19,7 +19,7 @@
 #include "pipeline/stages/tessellate_launcher.h"
 #include "pipeline/stages/triangle_setup_launcher.h"
 #include <seamcl/pipeline/packed_cube.h>
-#include "pipeline/stage_stop.h"
+#include <seamcl/pipeline/stage_stop.h>
 
 namespace seamcl {
 
