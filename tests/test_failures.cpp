@@ -1,4 +1,4 @@
-// Where the seam methods fail, measured on scenes built to provoke each failure (README "Where
+// Where the seam methods fail, measured on scenes built to provoke each failure (docs/methods.md "Where
 // methods fail", docs/results/failures/README.md): zero coverage (helper pixels, the paper's
 // Figure 8), magnification at the texture edge (Figure 6), grazing angles beyond 16x anisotropy,
 // guard bands too thin for wide footprints, and frame-to-frame change near seams over an orbit.
