@@ -6,7 +6,7 @@ per stage, from OpenCL profiling events; the cells run in turn --rounds times (t
 each round) and each figure is the median over the rounds, because on a shared machine the load
 moves between processes more than within one. 11 renders by default: in a process's first few
 renders after its warm-up frame, and now and then later, a stage can take up to twice its usual
-time (docs/speed-log.md, session 32), and a median of 5 can land on those. Then the time to a first image in a fresh process
+time (docs/performance.md, "How to measure"), and a median of 5 can land on those. Then the time to a first image in a fresh process
 with a cold PoCL kernel cache against a second start that finds the cache warm.
 
     examples/measure_render.py [--seamcl build/seamcl] [--repeat 11] [--rounds 3] > table.md
