@@ -123,7 +123,7 @@ SEAMCL_INLINE float approx_log2(float x) {
 /* weight * texel into sum, each channel TIED to the one before (see TIE). One fused multiply-add
  * a channel, rounded once as the twin's std::fma is: with FP_CONTRACT off a product and a sum
  * were two instructions and two roundings, and the aniso probe loop, which runs scalar, does
- * 22-26% more lookups a second without them (docs/speed-log.md, session 29). */
+ * 22-26% more lookups a second without them (docs/performance.md, "What was tried"). */
 SEAMCL_INLINE void add_texel(FilterSum* sum, TEXEL_BUFFER texels, __global const float* srgb_to_linear, uint index,
                              float weight) {
 #if SEAMCL_TEXELS_F32
