@@ -115,11 +115,14 @@ def main():
                 check(paper["met"] == (paper["values"][0] <= 350), f"paper RSS verdict: {paper}")
             for name in ("sweep.json", "render_quad2_discard.json", "render_paper_traverse.json"):
                 check(os.path.getsize(os.path.join(out, name)) > 0, f"{name} kept under --out")
-            # Every verdict follows from its value and goal ("<= x" or ">= x").
+            # Every verdict follows from its value and goal ("<= x", "< x", ">= x" or "> x").
+            compare = {"<=": lambda v, b: v <= b, "<": lambda v, b: v < b, ">=": lambda v, b: v >= b,
+                       ">": lambda v, b: v > b}
             for r in report["targets"]:
                 op, bound = r["goal"].split()[0], float(r["goal"].split()[1])
+                check(op in compare, f"{r['target']}: a goal this test can read, got {r['goal']!r}")
                 for value in r["values"][:1]:
-                    check(r["met"] == (value <= bound if op == "<=" else value >= bound),
+                    check(op in compare and r["met"] == compare[op](value, bound),
                           f"{r['target']}: verdict {r['met']} for {value} against {r['goal']}")
             # One table line per row, each with its verdict.
             lines = [line for line in text.splitlines() if any(line.startswith(r["target"]) for r in report["targets"])]
