@@ -74,17 +74,20 @@ class PtexGoldenTally {
 
   void add(const PtexGoldenLookup& l, const float* got, int channels) {
     double difference = 0.0;
-    for (int c = 0; c < channels; ++c)
-      difference = std::max(difference, std::fabs(static_cast<double>(got[c]) - l.value[static_cast<size_t>(c)]));
+    int worst_channel = 0;
+    for (int c = 0; c < channels; ++c) {
+      const double d = std::fabs(static_cast<double>(got[c]) - l.value[static_cast<size_t>(c)]);
+      if (d > difference) difference = d, worst_channel = c;
+    }
     Worst& w = worst_[l.filter];
     w.lookups++;
     if (!(difference <= tolerance_)) w.over++;
     if (!(difference <= w.difference)) {
       w.difference = difference;
       char s[256];
-      std::snprintf(s, sizeof s, "face %d at (%.9g, %.9g) widths %.9g x %.9g, %s: %.7g vs the library's %.7g",
-                    l.query.face, l.query.u, l.query.v, l.query.uw, l.query.vw, l.where.c_str(),
-                    static_cast<double>(got[0]), l.value[0]);
+      std::snprintf(s, sizeof s, "face %d at (%.9g, %.9g) widths %.9g x %.9g, %s, channel %d: %.7g vs the library's %.7g",
+                    l.query.face, l.query.u, l.query.v, l.query.uw, l.query.vw, l.where.c_str(), worst_channel,
+                    static_cast<double>(got[worst_channel]), l.value[static_cast<size_t>(worst_channel)]);
       w.lookup = s;
     }
   }
