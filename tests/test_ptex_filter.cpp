@@ -1,6 +1,8 @@
 // Ptex's own filters (host/pipeline/stages/ptex_filter_twin.*, host/ptexfilter/): every value of
 // the Ptex library's filters in tests/assets/ptex/golden/ (written by the library itself, 96 per
-// file, a third of them within 2% of an edge) is matched within 1e-4; the kernels' normalisation
+// file, a third of them within 2% of an edge) and in tests/assets/ptex/golden_filters/ (1,200 per
+// file: every filter near edges, corners of every valence and resolution changes) is matched
+// within 1e-4; the kernels' normalisation
 // holds across edges and corners of every valence for every filter; bad textures are refused.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -17,6 +19,7 @@
 #include <seamcl/assets/ptex_file.h>
 #include <seamcl/core/input_error.h>
 
+#include "ptex_golden_lookups.h"
 #include "ptex_test_writer.h"
 #include "ptexfilter/ptex_filter_texture.h"
 
@@ -86,6 +89,25 @@ TEST(PtexFilter, MatchesThePtexLibraryOnEveryGoldenValue) {
   }
 }
 
+// Values of the file's scale (0..1 for integer files, as the library returns them): 1e-4 is well
+// under a uint8 step and the float rounding of a wide kernel's sums stays far below it.
+TEST(PtexFilter, MatchesThePtexLibraryOnEveryFilterNearEdgesCornersAndResolutionChanges) {
+  for (const char* name : kSamples) {
+    const PtexFilterData& data = filter_sample(name);
+    const std::vector<seamcl_tests::PtexGoldenLookup> lookups = seamcl_tests::ptex_golden_filter_lookups(name);
+    ASSERT_GE(lookups.size(), 1000u) << name;
+    seamcl_tests::PtexGoldenTally tally(name, 1e-4);
+    for (const seamcl_tests::PtexGoldenLookup& l : lookups) {
+      ASSERT_EQ(l.value.size(), static_cast<size_t>(data.texture.channels)) << name;
+      const std::array<float, 4> value = ptex_filter_twin(data, l.query);
+      tally.add(l, value.data(), data.texture.channels);
+    }
+    tally.print("twin");
+    EXPECT_EQ(tally.failures(), "");
+    EXPECT_EQ(tally.lookups(), static_cast<int>(lookups.size()));
+  }
+}
+
 // The same texture with every texel (every resolution) set to one value: whatever the filter, the
 // point and the widths, near any edge or corner (cube_text: valence 3, 4, 5 and 6; cellnoise: 3, 4
 // and 9, faces of mixed resolutions), the weights Ptex applies must sum to what it divides by.
@@ -147,6 +169,38 @@ TEST(PtexFilter, UnstoredResolutionsHalveInTheFilesTypeRoundingDown) {
   }
   EXPECT_GT(checked, 500);
   EXPECT_GT(odd_pairs, 50);  // pairs where rounding down differs from the mean
+}
+
+// A float16 file's unstored resolutions round the mean of two halves as the library's PtexHalf
+// does: to the nearest half, ties away from zero (IEEE's ties to even moves about half the texels
+// of black.ptx's 4x2 level by a half step, 5e-4 near 1).
+TEST(PtexFilter, UnstoredFloat16ResolutionsRoundTiesAwayFromZero) {
+  const PtexStored& stored = stored_sample("black");
+  const PtexFilterData& data = filter_sample("black");
+  ASSERT_EQ(stored.faces[0].levels.size(), 1u);  // no mip levels: every coarser one is made here
+  const PtexFilterFace& face = data.faces[0];
+  ASSERT_EQ(face.ulog2, 2);
+  ASSERT_EQ(face.vlog2, 2);
+  const size_t offset = data.level_offsets[face.level_base + 2 * (face.vlog2 + 1) + 1];  // 4x2
+  const std::vector<float>& level0 = stored.faces[0].levels.at(0);
+  int ties = 0;
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double a = level0[(size_t(2 * y) * 4 + x) * 3 + c], b = level0[(size_t(2 * y + 1) * 4 + x) * 3 + c];
+        const double mean = 0.5 * (a + b);
+        ASSERT_GT(mean, std::ldexp(1.0, -14));  // normal halves: a step of 2^(exponent - 10)
+        const double step = std::ldexp(1.0, static_cast<int>(std::floor(std::log2(mean))) - 10);
+        const double steps = mean / step;
+        ties += steps - std::floor(steps) == 0.5;
+        const double expected = std::floor(steps + 0.5) * step;
+        uint16_t h;
+        std::memcpy(&h, &data.texels[2 * ((offset + size_t(y) * 4 + x) * 3 + c)], 2);
+        const int exponent = (h >> 10) & 0x1f;
+        const double got = std::ldexp(1024.0 + (h & 0x3ff), exponent - 25);
+        ASSERT_EQ(got, expected) << "texel (" << x << ", " << y << ") channel " << c;
+      }
+  EXPECT_GE(ties, 6);
 }
 
 TEST(PtexFilter, RefusesSubfacesUnknownModesAndTexturesOverTheLimitNamingTexture) {

@@ -1,7 +1,8 @@
 // kernels/ptex_filter.cl against its scalar twin (host/pipeline/stages/ptex_filter_twin.cpp): the
 // golden lookups of every sample, and random lookups of every filter near edges and corners
 // (cellnoise: valence 3, 4 and 9 and faces of mixed resolutions; rand_lo: uint16 with boundary
-// edges; black: float16, black border), widths from a texel to more than a face.
+// edges; black: float16, black border), widths from a texel to more than a face; and the device
+// against the Ptex library itself on every value of tests/assets/ptex/golden_filters/.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -14,6 +15,7 @@
 #include <seamcl/assets/ptex_file.h>
 
 #include "pipeline/stages/ptex_filter_launcher.h"
+#include "ptex_golden_lookups.h"
 #include "ptex_test_writer.h"
 #include "ptexfilter/ptex_filter_texture.h"
 #include "test_support.h"
@@ -84,6 +86,29 @@ TEST(PtexFilterKernel, MatchesTheTwinOnGoldenAndEdgeLookups) {
       }
     }
     EXPECT_GT(nonzero, static_cast<int>(queries.size()) / 2) << name;
+  }
+}
+
+// One launch per file (the launcher's compile dominates the time); the twin's own test holds the
+// same values, so a failure here alone points at the kernel.
+TEST(PtexFilterKernel, MatchesThePtexLibraryOnEveryFilterNearEdgesCornersAndResolutionChanges) {
+  PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
+  for (const char* name : {"black", "cellnoise", "cube_text", "rand_lo", "wave_lo"}) {
+    const PtexFilterData data = build_ptex_filter_data(read_ptex_stored(ptex_assets_dir() + "/" + name + ".ptx"));
+    const std::vector<seamcl_tests::PtexGoldenLookup> lookups = seamcl_tests::ptex_golden_filter_lookups(name);
+    ASSERT_GE(lookups.size(), 1000u) << name;
+    std::vector<PtexFilterQuery> queries;
+    for (const seamcl_tests::PtexGoldenLookup& l : lookups) queries.push_back(l.query);
+    launcher.load(data);
+    const std::vector<float> device = launcher.run(queries);
+    ASSERT_EQ(device.size(), queries.size() * 4);
+    seamcl_tests::PtexGoldenTally tally(name, 1e-4);
+    for (size_t i = 0; i < lookups.size(); ++i) {
+      ASSERT_EQ(lookups[i].value.size(), static_cast<size_t>(data.texture.channels)) << name;
+      tally.add(lookups[i], &device[4 * i], data.texture.channels);
+    }
+    tally.print("device");
+    EXPECT_EQ(tally.failures(), "");
   }
 }
 

@@ -28,24 +28,25 @@ uint64_t face_texels(const PtexFaceInfo& info) {
   return ((uint64_t(2) << info.ulog2) - 1) * ((uint64_t(2) << info.vlog2) - 1);
 }
 
+// Float to half as the Ptex library rounds it (PtexHalf::fromFloat): to nearest with ties away
+// from zero, not IEEE ties to even. Halving two halves of one binade gives a tie half the time, so
+// the rule shows in most texels of the resolutions made on demand.
 uint16_t float_to_half(float f) {
   uint32_t x;
   std::memcpy(&x, &f, sizeof x);
   const uint32_t sign = (x >> 16) & 0x8000u;
   const uint32_t abs = x & 0x7fffffffu;
-  if (abs >= 0x7f800000u) return static_cast<uint16_t>(sign | 0x7c00u | (abs > 0x7f800000u ? 0x200u : 0u));
-  if (abs >= 0x477ff000u) return static_cast<uint16_t>(sign | 0x7c00u);  // rounds past 65504
-  if (abs < 0x38800000u) {  // a subnormal half (or zero): round to a multiple of 2^-24
+  if (abs == 0) return 0;
+  if (abs >= 0x7f800000u) return static_cast<uint16_t>(sign | 0x7c00u | ((abs & 0x7fffffu) >> 13));
+  const int exponent = static_cast<int>(abs >> 23) - 127 + 15;
+  if (exponent <= 0) {  // a subnormal half (or zero): a multiple of 2^-24, ties away from zero
     float a;
     std::memcpy(&a, &abs, sizeof a);
-    const float scaled = std::nearbyint(a * 16777216.0f);  // ties to even
-    return static_cast<uint16_t>(sign | static_cast<uint32_t>(scaled));
+    return static_cast<uint16_t>(sign | static_cast<uint32_t>(static_cast<double>(a) * 16777216.0 + 0.5));
   }
-  const uint32_t mantissa = abs & 0x7fffffu;
-  uint32_t h = ((abs >> 23) - 127 + 15) << 10 | (mantissa >> 13);
-  const uint32_t rest = mantissa & 0x1fffu;
-  if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h;
-  return static_cast<uint16_t>(sign | h);
+  if (exponent >= 31) return static_cast<uint16_t>(sign | 0x7c00u);
+  // A carry out of the mantissa moves into the exponent (65520 and up become infinity).
+  return static_cast<uint16_t>((sign | (static_cast<uint32_t>(exponent) << 10)) + (((abs & 0x7fffffu) + 0x1000u) >> 13));
 }
 
 float half_to_float(uint16_t h) {
