@@ -620,6 +620,23 @@ def run(base, chromium, profile, shots, t, deadline):
         t.check("luminance" in units, "the colour bar names its units", units)
         shot(page4, "10-inspect-signed.png")
 
+        # Relative error (over B's RGB magnitude, at least 1e-3), and one channel's absolute error.
+        set_control(page4, "error_mode", "relative")
+        page4.wait("document.getElementById('insp_stats').dataset.mode === 'relative'", timeout=5, what="the relative error")
+        s = stats()
+        want = python_stats([rgb_distance(fa, fb, k) / max(1e-3, math.hypot(fb[4 * k], fb[4 * k + 1], fb[4 * k + 2]))
+                             for k in range(fw * fh)])
+        t.check(close(float(s["max"]), want["max"]) and close(float(s["mean"]), want["mean"]),
+                "the relative error equals Python's", "page %r, python %r" % (s, want))
+        set_controls(page4, {"error_mode": "abs", "channel": "g"})
+        page4.wait("document.getElementById('insp_stats').dataset.channel === 'g' && "
+                   "document.getElementById('insp_stats').dataset.mode === 'abs'", timeout=5, what="the green channel")
+        s = stats()
+        want = python_stats([abs(fa[4 * k + 1] - fb[4 * k + 1]) for k in range(fw * fh)])
+        t.check(close(float(s["max"]), want["max"]) and close(float(s["mean"]), want["mean"]),
+                "the green channel's absolute error equals Python's", "page %r, python %r" % (s, want))
+        set_control(page4, "channel", "rgb")
+
         # Against the reference (when the server has one): the reference is fetched as f32 too.
         if ref_status != 404:
             set_controls(page4, {"error_mode": "abs", "heat_pair": "a_ref"})
