@@ -4,6 +4,7 @@
 // server/openapi.json holds only what no table says (paths, answers, the scene formats).
 #include "api_documents.h"
 
+#include <seamcl/io/image_encoding.h>
 #include <seamcl/jobs/compare_job.h>
 #include <seamcl/jobs/render_job.h>
 #include <seamcl/options/render_options.h>
@@ -18,7 +19,24 @@ using nlohmann::json;
 
 // The answer's image format (/v1/render, /v1/reference): the service's own option.
 json format_schema() {
-  return {{"type", "string"}, {"enum", {"png", "exr"}}, {"default", "png"}, {"description", "The answer's image format"}};
+  return {{"type", "string"},
+          {"enum", image_encoding_names()},
+          {"default", to_string(ImageEncoding::Png)},
+          {"description",
+           "The answer's image format: png (sRGB 8-bit), exr (linear half or float), f32 (linear little-endian float32 "
+           "RGBA, rows top first, no header: the size is in X-Seamcl-Width and X-Seamcl-Height)"}};
+}
+
+// An image answer's bodies, one per encoding, and the headers that give its size: from the list
+// the parser takes, so a new encoding is documented where it is accepted.
+void set_image_answer(json& response) {
+  json content = json::object();
+  for (const std::string& name : image_encoding_names())
+    content[media_type(*parse_image_encoding(name))] = {{"schema", {{"type", "string"}, {"format", "binary"}}}};
+  response["content"] = content;
+  json& headers = response["headers"];
+  headers["X-Seamcl-Width"] = {{"description", "the image's width in pixels"}, {"schema", {{"type", "integer"}}}};
+  headers["X-Seamcl-Height"] = {{"description", "the image's height in pixels (f32 rows, top first)"}, {"schema", {{"type", "integer"}}}};
 }
 
 // `table`'s options as the properties of a request body, but `skip`; `scene` keeps the
@@ -47,6 +65,9 @@ json make_openapi() {
   json doc = json::parse(openapi_template());
   json& schemas = doc.at("components").at("schemas");
   const ServerOptions limits;
+
+  set_image_answer(doc.at("components").at("responses").at("Image"));
+  set_image_answer(doc.at("paths").at("/v1/reference").at("post").at("responses").at("200"));
 
   json& render = schemas.at("RenderRequest").at("properties");
   set_options(render, render_option_table(), {});

@@ -12,7 +12,7 @@
 #include <seamcl/core/cancelled.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/memory/compare_memory.h>
-#include <seamcl/io/image_io.h>
+#include <seamcl/io/image_encoding.h>
 #include <seamcl/jobs/compare_job.h>
 #include <seamcl/jobs/render_job.h>
 #include <seamcl/memory/render_memory.h>
@@ -47,14 +47,26 @@ std::string default_compare_size(long long max_pixels) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
 
-// The answer's image format, taken out of a request: png unless `format` says exr.
-ImageFormat take_image_format(json& rest) {
-  if (!rest.contains("format")) return ImageFormat::Png;
+// The answer's image encoding, taken out of a request: png unless `format` names another.
+ImageEncoding take_image_encoding(json& rest) {
+  if (!rest.contains("format")) return ImageEncoding::Png;
   const json& value = rest.at("format");
-  const auto parsed = value.is_string() ? parse_image_format(value.get<std::string>()) : std::nullopt;
-  if (!parsed) throw InputError("format", "must be \"png\" or \"exr\", got " + echo(json_text(value)));
+  const auto parsed = value.is_string() ? parse_image_encoding(value.get<std::string>()) : std::nullopt;
+  if (!parsed) {
+    std::string names;
+    for (const std::string& name : image_encoding_names()) names += (names.empty() ? "\"" : ", \"") + name + "\"";
+    throw InputError("format", "must be one of " + names + ", got " + echo(json_text(value)));
+  }
   rest.erase("format");
   return *parsed;
+}
+
+// The image as the answer's body, with its size in headers: an f32 body carries no header of its
+// own, and a client reads the size before it reads the pixels.
+void set_image(httplib::Response& res, ImageEncoding encoding, int width, int height, const std::vector<glm::vec4>& pixels) {
+  res.set_header("X-Seamcl-Width", std::to_string(width));
+  res.set_header("X-Seamcl-Height", std::to_string(height));
+  res.set_content(encode_image(encoding, width, height, pixels), media_type(encoding));
 }
 
 }  // namespace
@@ -129,7 +141,7 @@ void JobHandlers::render(const json& request, httplib::Response& res) {
   // The service's own keys (format, an inline scene); the rest is the render job's request, but
   // the command line's timing keys: one answer is one image.
   json rest = request;
-  const ImageFormat format = take_image_format(rest);
+  const ImageEncoding format = take_image_encoding(rest);
   const json inline_scene = take_inline_scene(rest);
   for (const char* key : {"repeat", "crack_orbit"})
     if (rest.contains(key)) throw HttpError{400, key, "is the command line's (seamcl render); a request renders one image"};
@@ -216,7 +228,7 @@ void JobHandlers::render(const json& request, httplib::Response& res) {
   }
   const RenderResult& result = run.last;
   const Clock::time_point encode_start = Clock::now();
-  std::string image = encode_image(format, result.width, result.height, result.pixels);
+  set_image(res, format, result.width, result.height, result.pixels);
   const double encode_ms = ms_since(encode_start);
 
   res.set_header("X-Seamcl-Render-Ms", std::to_string(result.ms.total));
@@ -227,7 +239,6 @@ void JobHandlers::render(const json& request, httplib::Response& res) {
   res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
   res.set_header("X-Seamcl-Options", json_text(to_json(options)));
   res.set_header("X-Seamcl-Fragments", std::to_string(result.stats.fragments));
-  res.set_content(std::move(image), format == ImageFormat::Png ? "image/png" : "image/x-exr");
 }
 
 // POST /v1/compare: the compare job (host/jobs/compare_job.h) on one frame, admitted as one
@@ -367,7 +378,7 @@ void JobHandlers::reference(const json& request, httplib::Response& res) {
       throw HttpError{400, key, std::string("the reference is one image of the frame; ") + key + " is for /v1/render or /v1/compare"};
     }
   }
-  const ImageFormat format = take_image_format(rest);
+  const ImageEncoding format = take_image_encoding(rest);
   bool explicit_reference_msaa = false;
   ReferenceSettings settings = take_reference_settings(rest, explicit_reference_msaa);
   if (rest.contains("reference")) {
@@ -408,12 +419,11 @@ void JobHandlers::reference(const json& request, httplib::Response& res) {
     std::lock_guard lock(reference_lock(cache_key));
     reference = reference_image(renderer, camera, frame, settings);
   }
-  std::string image = encode_image(format, reference.width, reference.height, reference.pixels);
+  set_image(res, format, reference.width, reference.height, reference.pixels);
   res.set_header("X-Seamcl-Reference-Method", reference.method);
   res.set_header("X-Seamcl-Reference", reference_json(reference, false).dump());
   res.set_header("X-Seamcl-Queue-Ms", std::to_string(queue_ms));
   res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
-  res.set_content(std::move(image), format == ImageFormat::Png ? "image/png" : "image/x-exr");
 }
 
 }  // namespace seamcl::server

@@ -19,6 +19,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/reference.h>
+#include <seamcl/io/image_encoding.h>
 #include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
@@ -91,13 +92,12 @@ TEST(OpenApi, EnumsAreTheParsersNames) {
     EXPECT_EQ(option.at("enum").get<std::vector<std::string>>(), displacement_method_names()) << where;
     EXPECT_FALSE(option.contains("default")) << where;
   }
-  // format is the server's own option: exactly the names parse_image_format takes.
+  // format is the server's own option: exactly the names parse_image_encoding takes.
   for (const auto& [where, option] : option_schemas("format")) {
     ASSERT_TRUE(option.contains("enum")) << where;
-    EXPECT_EQ(option.at("enum").get<std::vector<std::string>>(),
-              (std::vector<std::string>{to_string(ImageFormat::Png), to_string(ImageFormat::Exr)}))
-        << where;
-    for (const json& name : option.at("enum")) EXPECT_TRUE(parse_image_format(name.get<std::string>())) << where;
+    EXPECT_EQ(option.at("enum").get<std::vector<std::string>>(), image_encoding_names()) << where;
+    EXPECT_EQ(option.at("enum").get<std::vector<std::string>>(), (std::vector<std::string>{"png", "exr", "f32"})) << where;
+    for (const json& name : option.at("enum")) EXPECT_TRUE(parse_image_encoding(name.get<std::string>())) << where;
   }
   // compare's reference method is a method name too.
   const json reference_method = schema("CompareRequest").at("properties").at("reference_method");

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -577,6 +578,55 @@ TEST_F(Server, RenderExr) {
   EXPECT_EQ(w, 40);
   EXPECT_EQ(h, 30);
   EXPECT_FALSE(all_zero(pixels));
+}
+
+// f32: the render's own floats, 16 bytes a pixel, rows top first, the size in headers; the same
+// frame as the PNG answer (which is those floats in sRGB 8-bit).
+TEST_F(Server, RenderF32IsTheRendersFloats) {
+  httplib::Client c = client();
+  const json request = {{"scene", "quad2"}, {"method", "discard"}, {"size", "24x16"}, {"texels", "rgba32f"}};
+  json f32_request = request;
+  f32_request["format"] = "f32";
+  auto res = post_json(c, f32_request.dump());
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  EXPECT_EQ(res->get_header_value("Content-Type"), "application/octet-stream");
+  EXPECT_EQ(res->get_header_value("X-Seamcl-Width"), "24");
+  EXPECT_EQ(res->get_header_value("X-Seamcl-Height"), "16");
+  ASSERT_EQ(res->body.size(), size_t{24} * 16 * 16);
+  auto at = [&](size_t offset) {
+    uint32_t bits = 0;
+    for (size_t byte = 0; byte < 4; ++byte) bits |= static_cast<uint32_t>(static_cast<unsigned char>(res->body[offset + byte])) << (8 * byte);
+    return std::bit_cast<float>(bits);
+  };
+  const RenderOptions options = parse_render_options(request);
+  const Scene scene = generate_scene(options.scene, GeneratorOptions{});
+  Renderer renderer(seamcl_tests::shared_runtime());
+  renderer.load_scene(scene, options.texels);
+  const RenderResult expected = renderer.render(scene.camera, options);
+  ASSERT_EQ(expected.pixels.size(), size_t{24} * 16);
+  EXPECT_FALSE(all_zero(expected.pixels));
+  for (size_t i = 0; i < expected.pixels.size(); ++i)
+    for (int ch = 0; ch < 4; ++ch) ASSERT_NEAR(at(16 * i + 4 * static_cast<size_t>(ch)), expected.pixels[i][ch], 1e-6f) << i << "," << ch;
+  // The PNG answer of the same request is those floats, rounded to sRGB 8-bit.
+  auto png = post_json(c, request.dump());
+  ASSERT_TRUE(png);
+  ASSERT_EQ(png->status, 200);
+  EXPECT_EQ(png->get_header_value("X-Seamcl-Width"), "24");
+  EXPECT_EQ(png->body, encode_image(ImageFormat::Png, expected.width, expected.height, expected.pixels));
+  // GET takes it too; a bad value names format and lists what is taken.
+  auto get = c.Get("/v1/render?scene=quad2&method=discard&size=24x16&texels=rgba32f&format=f32");
+  ASSERT_TRUE(get);
+  ASSERT_EQ(get->status, 200);
+  EXPECT_EQ(get->body, res->body);
+  for (const char* bad : {R"("F32")", R"("float")", "32", "null"}) {
+    auto refused = post_json(c, std::string(R"({"scene": "quad2", "size": "8x8", "format": )") + bad + "}");
+    ASSERT_TRUE(refused);
+    EXPECT_EQ(refused->status, 400) << bad;
+    const json error = json::parse(refused->body);
+    EXPECT_EQ(error.at("field"), "format") << bad;
+    EXPECT_NE(error.at("error").get<std::string>().find("\"f32\""), std::string::npos) << error;
+  }
 }
 
 TEST_F(Server, InlineSceneMatchesTheSceneFile) {

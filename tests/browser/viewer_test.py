@@ -11,8 +11,12 @@ works it through the DOM after the page's scripts ran:
 - a compare fills the Figure 5 and speed/error chart data; changing the scene clears it; a size
   over the server's compare limit is refused on the page, not compared at another size;
 - an error answer ({"error", "field"}) is shown; the reference is used, or said to be unavailable.
+- the inspect view fetches the renders as f32: its pixel readout is the f32 answer's floats at that
+  pixel; a wheel zoom keeps the pixel under the cursor and zooms A, B and the difference together,
+  a drag pans them together; its error statistics (absolute, signed, a dragged rectangle, against
+  the reference) equal the ones computed here from the same f32 answers.
 
-Loopback only, bounded in time (about a minute). Exits 0 on success, 1 on failure.
+Loopback only, bounded in time (a few minutes). Exits 0 on success, 1 on failure.
 
     tests/browser/viewer_test.py --seamcl build/seamcl [--chromium chromium] [--screenshots DIR]
 """
@@ -39,7 +43,7 @@ from cdp import Browser, CdpError  # noqa: E402
 
 SIZE = "64x64"
 COMPARE_SIZE = "32x32"  # compare renders an 8x reference: keep it small
-BUDGET_S = 200  # the whole test, server start included (renders share 2 cores with other tests in CI)
+BUDGET_S = 230  # the whole test, server start included (renders share 2 cores with other tests in CI)
 
 
 def free_port():
@@ -73,6 +77,18 @@ def get(url, body=None):
             return r.status, r.read()
     except urllib.error.HTTPError as e:
         return e.code, e.read()
+
+
+def fetch_f32(url, body=None):
+    """An f32 answer: its floats (r, g, b, a per pixel, rows top first), width and height, checked
+    against its headers."""
+    request = urllib.request.Request(url, data=None if body is None else json.dumps(body).encode(),
+                                     headers={"Content-Type": "application/json"})
+    with urllib.request.urlopen(request, timeout=60) as r:
+        data, width, height = r.read(), int(r.headers["X-Seamcl-Width"]), int(r.headers["X-Seamcl-Height"])
+        assert r.headers["Content-Type"] == "application/octet-stream", r.headers["Content-Type"]
+    assert len(data) == width * height * 16, "%d bytes for %dx%d" % (len(data), width, height)
+    return list(struct.unpack("<%df" % (width * height * 4), data)), width, height
 
 
 def decode_png_rgb(data):
@@ -483,6 +499,159 @@ def run(base, chromium, profile, shots, t, deadline):
         finally:
             proxy.shutdown()
             proxy.server_close()
+
+        step(12)
+        # 12. Inspect: the renders as f32. The pixel readout is the f32 answer's value there; a
+        # wheel zoom keeps the pixel under the cursor; the error statistics equal Python's from
+        # the same f32 answers.
+        page4 = browser.open(base + "/#size=%s&a=%s&b=%s&view=inspect&zoom=0" % (SIZE, a0, b0))
+        wait_idle(page4, min(40, left()), "the inspect view's render")
+        page4.wait("document.body.dataset.inspect === 'ready'", timeout=min(20, left()), what="the inspect view's floats")
+        fa, fw, fh = fetch_f32(base + image_info(page4, "image_a")["src"] + "&format=f32")
+        fb, _, _ = fetch_f32(base + image_info(page4, "image_b")["src"] + "&format=f32")
+        t.check("%dx%d" % (fw, fh) == SIZE, "the f32 answer's size headers", "%dx%d" % (fw, fh))
+
+        def panel(id_):
+            return page4.eval("(() => { const c = document.getElementById(%s), r = c.getBoundingClientRect(); "
+                              "return {left: r.left + c.clientLeft, top: r.top + c.clientTop, zoom: Number(c.dataset.zoom), ox: Number(c.dataset.ox), "
+                              "oy: Number(c.dataset.oy)}; })()" % json.dumps(id_))
+
+        def at_pixel(p, x, y):  # the client position of an image pixel's centre on a panel (300 px, canvas.width)
+            return p["left"] + (x + 0.5 - p["ox"]) * p["zoom"], p["top"] + (y + 0.5 - p["oy"]) * p["zoom"]
+
+        def readout():
+            return page4.eval("({...document.getElementById('insp_readout').dataset})")
+
+        px, py = 21, 37
+        cx, cy = at_pixel(panel("insp_a"), px, py)
+        page4.mouse("mouseMoved", cx, cy)
+        page4.wait("document.getElementById('insp_readout').dataset.x === '%d'" % px, timeout=3, what="the readout")
+        r = readout()
+        i = py * fw + px
+        t.check((int(r["x"]), int(r["y"])) == (px, py), "the readout names the pixel under the pointer", str(r))
+        t.check(json.loads(r["a"]) == fa[4 * i:4 * i + 4] and json.loads(r["b"]) == fb[4 * i:4 * i + 4],
+                "the readout is the f32 answers' floats", "%s vs %r / %r" % (r, fa[4 * i:4 * i + 4], fb[4 * i:4 * i + 4]))
+
+        # Wheel in at a point off the pixel centre: the pixel stays under the cursor, and every panel zooms.
+        before = panel("insp_a")
+        wx, wy = at_pixel(before, px, py)
+        wx, wy = wx + 0.3 * before["zoom"], wy - 0.2 * before["zoom"]
+        for _ in range(3):
+            page4.send("Input.dispatchMouseEvent", {"type": "mouseWheel", "x": wx, "y": wy, "deltaX": 0, "deltaY": -120})
+        page4.wait("Number(document.getElementById('insp_a').dataset.zoom) > %r" % (before["zoom"] * 2), timeout=3,
+                   what="the wheel zoom")
+        after = panel("insp_a")
+        under = (math.floor(after["ox"] + (wx - after["left"]) / after["zoom"]),
+                 math.floor(after["oy"] + (wy - after["top"]) / after["zoom"]))
+        page4.mouse("mouseMoved", wx, wy)
+        r = readout()
+        t.check(under == (px, py) and (int(r["x"]), int(r["y"])) == (px, py),
+                "a wheel zoom keeps the image pixel under the cursor", "zoom %g -> %g, pixel %r, readout (%s, %s)" % (
+                    before["zoom"], after["zoom"], under, r.get("x"), r.get("y")))
+        b_panel, d_panel = panel("insp_b"), panel("insp_diff")
+        t.check(all((q["zoom"], q["ox"], q["oy"]) == (after["zoom"], after["ox"], after["oy"]) for q in (b_panel, d_panel)),
+                "the zoom is the same in A, B and the difference", "%r %r %r" % (after, b_panel, d_panel))
+        # A drag pans every panel by the pointer's travel (whole pixels: the page may get a
+        # pointer position rounded).
+        gx, gy = round(wx), round(wy)
+        page4.mouse("mousePressed", gx, gy, buttons=1)
+        page4.mouse("mouseMoved", gx - 20, gy - 10, buttons=1)
+        page4.mouse("mouseMoved", gx - 40, gy - 20, buttons=1)
+        page4.mouse("mouseReleased", gx - 40, gy - 20)
+        panned = panel("insp_b")
+        t.check(abs(panned["ox"] - (after["ox"] + 40 / after["zoom"])) < 1e-9 and
+                abs(panned["oy"] - (after["oy"] + 20 / after["zoom"])) < 1e-9, "a drag pans A, B and the difference together",
+                "%r -> %r" % (after, panned))
+        shot(page4, "8-inspect-zoomed.png")
+
+        # Statistics of the whole image (fit), absolute RGB error A vs B.
+        page4.eval("document.getElementById('inspect_fit').click()")
+
+        def stats():
+            return page4.eval("({...document.getElementById('insp_stats').dataset})")
+
+        def python_stats(errors):
+            values = sorted(e for e in errors if math.isfinite(e))
+            n = len(values)
+            return {"max": values[-1], "min": values[0], "mean": sum(values) / n, "p99": values[max(0, math.ceil(0.99 * n) - 1)]}
+
+        def close(x, y):
+            return abs(x - y) <= 1e-12 + 1e-9 * abs(y)
+
+        def rgb_distance(p, q, k):
+            return math.sqrt(sum((p[4 * k + c] - q[4 * k + c]) ** 2 for c in range(3)))
+
+        s = stats()
+        abs_errors = [rgb_distance(fa, fb, k) for k in range(fw * fh)]
+        want = python_stats(abs_errors)
+        t.check(s.get("where") == "visible" and s.get("region") == "0,0,%d,%d" % (fw, fh) and s.get("mode") == "abs"
+                and all(close(float(s[k]), want[k]) for k in ("max", "mean", "p99")) and want["max"] > 0,
+                "max, mean and p99 of the absolute error A vs B equal Python's from the f32 answers", "page %r, python %r" % (s, want))
+
+        # A shift-dragged rectangle: the statistics of those pixels only.
+        p = panel("insp_a")
+        x0, y0, x1, y1 = 8, 12, 30, 40
+        for kind, (x, y) in (("mousePressed", (x0, y0)), ("mouseMoved", (x1, y1)), ("mouseReleased", (x1, y1))):
+            cx, cy = at_pixel(p, x, y)
+            page4.send("Input.dispatchMouseEvent", {"type": kind, "x": cx, "y": cy, "button": "left", "modifiers": 8,
+                                                    "buttons": 1 if kind != "mouseReleased" else 0, "clickCount": 1})
+        s = stats()
+        want = python_stats([abs_errors[y * fw + x] for y in range(y0, y1 + 1) for x in range(x0, x1 + 1)])
+        t.check(s.get("where") == "selection" and s.get("region") == "%d,%d,%d,%d" % (x0, y0, x1 + 1, y1 + 1)
+                and close(float(s["max"]), want["max"]) and close(float(s["mean"]), want["mean"]),
+                "a dragged rectangle's statistics equal Python's", "page %r, python %r" % (s, want))
+        shot(page4, "9-inspect-selection.png")
+
+        # Signed luminance error, whole image again (a shift-click clears the rectangle).
+        cx, cy = at_pixel(p, 5, 5)
+        for kind in ("mousePressed", "mouseReleased"):
+            page4.send("Input.dispatchMouseEvent", {"type": kind, "x": cx, "y": cy, "button": "left", "modifiers": 8,
+                                                    "buttons": 1 if kind == "mousePressed" else 0, "clickCount": 1})
+        set_control(page4, "error_mode", "signed")
+        page4.wait("document.getElementById('insp_stats').dataset.mode === 'signed'", timeout=5, what="the signed error")
+        s = stats()
+
+        def luminance(v, k):
+            return 0.2126 * v[4 * k] + 0.7152 * v[4 * k + 1] + 0.0722 * v[4 * k + 2]
+        want = python_stats([luminance(fa, k) - luminance(fb, k) for k in range(fw * fh)])
+        t.check(s.get("where") == "visible" and close(float(s["min"]), want["min"]) and close(float(s["max"]), want["max"]),
+                "the signed error's extremes equal Python's", "page %r, python %r" % (s, want))
+        units = page4.eval("document.getElementById('insp_bar').dataset.units")
+        t.check("luminance" in units, "the colour bar names its units", units)
+        shot(page4, "10-inspect-signed.png")
+
+        # Relative error (over B's RGB magnitude, at least 1e-3), and one channel's absolute error.
+        set_control(page4, "error_mode", "relative")
+        page4.wait("document.getElementById('insp_stats').dataset.mode === 'relative'", timeout=5, what="the relative error")
+        s = stats()
+        want = python_stats([rgb_distance(fa, fb, k) / max(1e-3, math.hypot(fb[4 * k], fb[4 * k + 1], fb[4 * k + 2]))
+                             for k in range(fw * fh)])
+        t.check(close(float(s["max"]), want["max"]) and close(float(s["mean"]), want["mean"]),
+                "the relative error equals Python's", "page %r, python %r" % (s, want))
+        set_controls(page4, {"error_mode": "abs", "channel": "g"})
+        page4.wait("document.getElementById('insp_stats').dataset.channel === 'g' && "
+                   "document.getElementById('insp_stats').dataset.mode === 'abs'", timeout=5, what="the green channel")
+        s = stats()
+        want = python_stats([abs(fa[4 * k + 1] - fb[4 * k + 1]) for k in range(fw * fh)])
+        t.check(close(float(s["max"]), want["max"]) and close(float(s["mean"]), want["mean"]),
+                "the green channel's absolute error equals Python's", "page %r, python %r" % (s, want))
+        set_control(page4, "channel", "rgb")
+
+        # Against the reference (when the server has one): the reference is fetched as f32 too.
+        if ref_status != 404:
+            set_controls(page4, {"error_mode": "abs", "heat_pair": "a_ref"})
+            page4.wait("document.getElementById('insp_stats').dataset.pair === 'a_ref' && "
+                       "document.body.dataset.inspect === 'ready'", timeout=min(40, left()), what="A vs the reference")
+            body = {"scene": page4.eval("document.getElementById('scene').value"), "size": SIZE,
+                    "aniso": options["aniso"]["default"], "filter": options["filter"]["default"],
+                    "texels": options["texels"]["default"], "format": "f32"}
+            fr, _, _ = fetch_f32(base + "/v1/reference", body)
+            want = python_stats([rgb_distance(fa, fr, k) for k in range(fw * fh)])
+            s = stats()
+            t.check(close(float(s["max"]), want["max"]) and close(float(s["mean"]), want["mean"]),
+                    "the absolute error A vs the reference equals Python's", "page %r, python %r" % (s, want))
+        t.check(not page4.errors(), "no script errors in the inspect view", str(page4.errors()))
+        page4.close()
     finally:
         browser.close()
 
