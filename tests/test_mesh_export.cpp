@@ -4,6 +4,7 @@
 // two patches share must carry the same float bits from both sides for the watertight methods, and
 // must not for naive (so the check can fail).
 #include <array>
+#include <cstdlib>
 #include <charconv>
 #include <cstdint>
 #include <cstring>
@@ -16,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -353,6 +355,34 @@ TEST(MeshExport, BadRequestsAreRefusedNamingTheFieldAndWriteNothing) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 0) << "nothing written";
   fs::remove_all(dir);
   fs::remove_all(dir.string() + ".obj");
+}
+
+// The command line: exit 2 with one line naming export_mesh, and no file, for each refusal; a
+// displaced render writes the file (the OBJ's vertex lines are patches * (T+1)^2).
+TEST(MeshExport, CommandLineRefusesNamingTheFieldAndWrites) {
+  const fs::path dir = scratch_file("cli");
+  fs::create_directories(dir);
+  const fs::path err = dir / "err.txt";
+  auto run = [&](const std::string& args) {
+    const std::string command = std::string(SEAMCL_BINARY) + " render --scene displaced --size 16x16 " + args + " >/dev/null 2>" +
+                                err.string() + " </dev/null";
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  const std::string obj = (dir / "m.obj").string();
+  for (const std::string& args : {std::string("--displacement-method fixed --export-mesh ''"),
+                                  "--displacement-method fixed --export-mesh " + (dir / "m.stl").string(),
+                                  "--displacement-method fixed --export-mesh " + (dir / "none" / "m.obj").string(),
+                                  "--export-mesh " + obj}) {
+    EXPECT_EQ(run(args), 2) << args;
+    EXPECT_NE(slurp(err).find("export_mesh"), std::string::npos) << args << ": " << slurp(err);
+  }
+  fs::remove(err);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 0) << "a refusal wrote something";
+  ASSERT_EQ(run("--displacement-method zipper --tessellation 2 --export-mesh " + obj), 0) << slurp(err);
+  const ReadMesh mesh = read_obj(obj);
+  EXPECT_EQ(mesh.vertices.size(), generate_scene("displaced", {}).faces.size() * 9);
+  fs::remove_all(dir);
 }
 
 }  // namespace
