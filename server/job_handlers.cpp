@@ -145,6 +145,9 @@ void JobHandlers::render(const json& request, httplib::Response& res) {
   const json inline_scene = take_inline_scene(rest);
   for (const char* key : {"repeat", "crack_orbit"})
     if (rest.contains(key)) throw HttpError{400, key, "is the command line's (seamcl render); a request renders one image"};
+  // A path the render job would write: a client must never name a file on the server's disk.
+  if (rest.contains("export_mesh"))
+    throw HttpError{400, "export_mesh", "is the command line's (seamcl render --export-mesh): the server writes no file a request names"};
   const RenderJob job(rest);
   RenderOptions options = job.options();
   std::string key;

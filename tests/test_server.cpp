@@ -861,6 +861,10 @@ std::vector<Malformed> malformed_requests() {
       post(R"({"frames": 0})", 400, "frames"),
       post(R"({"tint": "yes"})", 400, "tint"),
       post(R"({"centroid": true, "shading": "sample"})", 400, "centroid"),
+      // The command line's file output: never a path on the server's disk, displaced or not.
+      post(R"({"export_mesh": "/tmp/seamcl-server-export.obj"})", 400, "export_mesh"),
+      post(R"({"scene": "displaced", "displacement_method": "fixed", "export_mesh": "x.ply"})", 400, "export_mesh"),
+      post(R"({"export_mesh": ""})", 400, "export_mesh"),
       post(R"({"scene": {"faces": []}})", 400, "scene."),
       post(R"({"scene": {"generator": "nope"}})", 400, "scene."),
       post(R"({"scene": {"generator": "paper", "a\u0000b": 1}})", 400, "scene."),
@@ -884,6 +888,7 @@ std::vector<Malformed> malformed_requests() {
       get("msaa=4&msaa=8", 400, "msaa"),
       get("unknown=1", 400, "unknown"),
       get("tint=maybe", 400, "tint"),
+      get("scene=displaced&displacement_method=fixed&export_mesh=%2Ftmp%2Fseamcl-server-export.obj", 400, "export_mesh"),
       get("scene=..%2F..%2Fetc%2Fpasswd", 400, "scene"),
       get("frame=NaN", 400, "frame"),
       get("format=gif", 400, "format"),
@@ -946,6 +951,32 @@ TEST_F(Server, MalformedRequestsAreRefusedNamingTheField) {
   ASSERT_EQ(res->status, 200);
   int w = 0, h = 0;
   EXPECT_TRUE(decode(res->body, ".png", w, h) == library_image({{"scene", "quad2"}, {"size", "32x32"}}));
+}
+
+// export_mesh names a file on the machine that renders: the command line's own. Over HTTP it is a
+// 400 naming the field, for a request that would otherwise render (a displaced scene), and no file
+// appears at the path, not even a partial one.
+TEST_F(Server, ExportMeshIsRefusedAndWritesNothing) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("seamcl-server-export-" + std::to_string(::getpid()) + ".ply");
+  std::filesystem::remove(path);
+  httplib::Client c = client();
+  const json request = {{"scene", "displaced"}, {"displacement_method", "ownership"}, {"tessellation", 2},
+                        {"size", "16x16"}, {"export_mesh", path.string()}};
+  auto res = post_json(c, request.dump());
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 400) << res->body;
+  const json body = json::parse(res->body);
+  EXPECT_EQ(body.value("field", ""), "export_mesh");
+  EXPECT_NE(body.value("error", "").find("export_mesh"), std::string::npos) << res->body;
+  EXPECT_FALSE(std::filesystem::exists(path));
+  EXPECT_FALSE(std::filesystem::exists(path.string() + ".partial"));
+  // The same request without it renders: the refusal is the field's, not the scene's.
+  json without = request;
+  without.erase("export_mesh");
+  auto ok = post_json(c, without.dump());
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200) << ok->body.substr(0, 200);
 }
 
 // An inline generator scene over the request-memory budget (issue 14): 413 naming the option

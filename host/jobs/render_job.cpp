@@ -7,6 +7,9 @@
 #include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/stage_stop.h>
+#include "io/mesh_export.h"
+#include "pipeline/displacement_packing.h"
+#include "pipeline/stages/tessellate_launcher.h"
 
 namespace seamcl {
 namespace {
@@ -24,7 +27,12 @@ const OptionTable& render_own_options() {
     crack_orbit.minimum = 0;
     crack_orbit.maximum = 3600;
     crack_orbit.default_value = 0;
-    return OptionTable{repeat, crack_orbit};
+    // A path on the machine that renders: the command line's (and the Python module's) only, the
+    // HTTP service refuses it (a client must not name files on the server's disk).
+    OptionSpec export_mesh = make_option("export_mesh", OptionType::String,
+                                         "Displacement: write the frame's tessellated patches, not merged, to a .obj or .ply file");
+    export_mesh.absent = "none";
+    return OptionTable{repeat, crack_orbit, export_mesh};
   }();
   return table;
 }
@@ -48,6 +56,7 @@ RenderJob::RenderJob(const json& request) {
       const json checked = checked_option(*own, value);
       if (key == "repeat") repeat_ = checked.get<int>();
       if (key == "crack_orbit") crack_orbit_ = checked.get<int>();
+      if (key == "export_mesh") export_mesh_ = checked.get<std::string>();
     } else {
       render_request[key] = value;
     }
@@ -57,6 +66,12 @@ RenderJob::RenderJob(const json& request) {
   options_ = parse_render_options(render_request);
   if (crack_orbit_ > 0 && !options_.displacement)
     throw InputError("crack_orbit", "counts the cracks of a displaced render: give displacement_method too");
+  if (!export_mesh_.empty()) {
+    // Refused here, before any work: a render that ends in a bad path wastes the render.
+    check_mesh_path(export_mesh_, "export_mesh");
+    if (!options_.displacement)
+      throw InputError("export_mesh", "writes the tessellated patches of a displaced render: give displacement_method too");
+  }
 }
 
 GeneratorOptions RenderJob::generator_options() const {
@@ -112,6 +127,19 @@ RenderRun RenderJob::run(ClRuntime& runtime, Renderer& renderer, const Scene& sc
     report.frame_ms = run.median.total;
     report.tessellate_ms = run.median.tessellate;
     run.displacement = report.to_json();
+  }
+  if (!export_mesh_.empty()) {
+    // The frame's patches tessellated once more by the same kernel on the same packed patches:
+    // each vertex is one work item's function of the packed patches alone, built without
+    // contraction, so these are the rendered frame's vertices bit for bit (the test holds the file
+    // to the stage's read-back), read without touching the Renderer's buffers.
+    throw_if_stopped(control.should_stop, "before the mesh export");
+    control.report("export_mesh: " + export_mesh_);
+    TessellateLauncher stage(runtime);
+    stage.load(pack_displacement(scene, {*options_.displacement, options_.tessellation, options_.displacement_level}));
+    const std::vector<TessVertex> vertices = stage.tessellate(program_options(options_.texels, sampler_params(options_), false));
+    stage.release();
+    write_patch_mesh(export_mesh_, vertices, options_.tessellation, "export_mesh");
   }
   return run;
 }

@@ -16,7 +16,8 @@
 
 namespace seamcl {
 
-// The render request's options: every render option, and the job's own: repeat, crack_orbit.
+// The render request's options: every render option, and the job's own: repeat, crack_orbit,
+// export_mesh (the command line's: the HTTP service refuses them).
 const OptionTable& render_job_option_table();
 
 struct RenderRun {
@@ -44,8 +45,9 @@ class RenderJob {
 
   // Renders with `renderer`, which has `scene` loaded: a warm-up (the kernels built, untimed),
   // then `repeat` timed renders. With `measure_watertightness` and a displaced frame, the gap and
-  // crack pixels too (over crack_orbit frames of the orbit when given). Cancelled between renders
-  // when control.should_stop says so.
+  // crack pixels too (over crack_orbit frames of the orbit when given). With export_mesh, the
+  // frame's tessellated patches are written there last (host/io/mesh_export.h). Cancelled between
+  // renders when control.should_stop says so.
   RenderRun run(ClRuntime& runtime, Renderer& renderer, const Scene& scene, const JobControl& control,
                 bool measure_watertightness = false) const;
 
@@ -60,6 +62,7 @@ class RenderJob {
   RenderOptions options_;
   int repeat_ = 1;
   int crack_orbit_ = 0;
+  std::string export_mesh_;  // empty: no export
 };
 
 }  // namespace seamcl
