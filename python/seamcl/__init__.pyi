@@ -71,6 +71,7 @@ def render(
     displacement_level: int = ...,  # Displacement: the maps' level every patch samples
     repeat: int = ...,  # Render N times and report the median time per stage
     crack_orbit: int = ...,  # Displacement: count crack pixels over N frames of the scene's orbit instead of this frame
+    export_mesh: Optional[str] = ...,  # Displacement: write the frame's tessellated patches, not merged, to a .obj or .ply file
     device: Optional[str] = ...,
     displacement_map: Optional[str] = ...,
     progress: Optional[Callable[[str], None]] = ...,
