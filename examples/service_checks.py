@@ -3,17 +3,21 @@
 latency behind slow clients, and RSS over a soak of mixed renders and compares. Loopback only;
 each check starts its own server on a free port and stops it.
 
-    examples/service_checks.py --seamcl build/seamcl [--checks start,overload,slowloris,soak,protocol]
-        [--soak-minutes 10] [--json]
+    examples/service_checks.py --seamcl build/seamcl [--checks start,overload,slowloris,soak,protocol,kept]
+        [--soak-minutes 10] [--overload-seconds 60] [--memory-bound-mib 2048] [--json]
 
 - start: time until the port answers /health, until the first render of the default scene, and
   until /health says "ready": once with an empty PoCL kernel cache (cold), once warm.
-- overload: 32 connections send renders back to back to a server with --threads 2 --queue 8;
-  latency of the 503 answers (p50, p99) and of the 200s.
+- overload: 32 connections send renders back to back to a server with --threads 2 --queue 8 for
+  --overload-seconds; latency of the 503 answers (p50, p99, max) and of the 200s.
 - slowloris: 2 x (threads + queue + 4) connections trickle header bytes (httplib's old pool had
   threads + queue + 4 threads); /health latency meanwhile (p50, p99, max).
 - soak: renders (built-in and inline scenes, all methods) and compares from 4 clients for the
-  given minutes; the server's RSS every 5 s (first, max, last).
+  given minutes; the server's RSS every 5 s (first, max, last), and its growth after warm-up (the
+  first fifth of the run): the largest later sample over the warm-up's last.
+- kept: 18 renders at 64x64 (rgba32f texels, guardband 16), every built-in scene twice, two at a
+  time, on a server with --threads 2 and --memory-bound-mib; the RSS after each pair, the steady
+  RSS at the end, and /health's memory figures, against the bound.
 - protocol: GET /%ff (does the process survive), an unknown method whose body holds a request
   (how many answers), a 16 MiB chunked body (how much is sent before the close, the status),
   /health behind 28 trickling connections, and a second server on the same port.
@@ -111,7 +115,7 @@ def check_start(seamcl):
     return out
 
 
-def check_overload(seamcl, clients=32, seconds=20):
+def check_overload(seamcl, clients=32, seconds=60):
     server = Server(seamcl, ["--threads", "2", "--queue", "8", "--quick-start"])
     try:
         server.wait(lambda: server.health().get("status") == "ready")
@@ -138,7 +142,8 @@ def check_overload(seamcl, clients=32, seconds=20):
         for t in threads:
             t.join()
         return {"clients": clients, "seconds": seconds,
-                **{k: {"count": len(v), "p50_ms": round(percentile(v, 50), 2), "p99_ms": round(percentile(v, 99), 2)}
+                **{k: {"count": len(v), "p50_ms": round(percentile(v, 50), 2), "p99_ms": round(percentile(v, 99), 2),
+                       "max_ms": round(max(v), 2) if v else float("nan")}
                    for k, v in results.items()}}
     finally:
         server.stop()
@@ -238,8 +243,49 @@ def check_soak(seamcl, minutes):
         for t in threads:
             t.join()
         rss.append(round(server.rss_mib(), 1))
-        return {"minutes": minutes, "requests": counts, "rss_mib": {"first": rss[0], "max": max(rss), "last": rss[-1],
-                                                                     "samples": rss}}
+        warm = rss[max(0, len(rss) // 5 - 1)]
+        after = rss[len(rss) // 5:] or rss[-1:]
+        return {"minutes": minutes, "requests": counts,
+                "rss_mib": {"first": rss[0], "warm": warm, "max_after_warm": max(after), "last": rss[-1],
+                            "growth_after_warm": round(max(after) / warm - 1, 4), "samples": rss}}
+    finally:
+        server.stop()
+
+
+def check_kept(seamcl, bound_mib):
+    server = Server(seamcl, ["--threads", "2", "--queue", "8", "--memory-bound-mib", str(bound_mib)])
+    try:
+        server.wait(lambda: server.health().get("status") == "ready")
+        scenes = json.loads(server.request("GET", "/v1/scenes")[1])
+        names = [s["name"] for s in (scenes if isinstance(scenes, list) else scenes["scenes"])]
+        queue = [name for name in names for _ in range(2)][:18]
+        while len(queue) < 18:
+            queue.append(names[len(queue) % len(names)])
+        statuses, rss_after_pair = {}, []
+        start_rss = round(server.rss_mib(), 1)
+        for i in range(0, len(queue), 2):
+            pair = queue[i:i + 2]
+            answers = [None] * len(pair)
+
+            def render(k):
+                answers[k] = server.request("GET", "/v1/render?size=64x64&texels=rgba32f&method=guardband"
+                                                   "&guard_band=16&scene=" + pair[k])[0]
+
+            threads = [threading.Thread(target=render, args=(k,)) for k in range(len(pair))]
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join()
+            for status in answers:
+                statuses[str(status)] = statuses.get(str(status), 0) + 1
+            rss_after_pair.append(round(server.rss_mib(), 1))
+        time.sleep(2)
+        memory = server.health().get("memory", {})
+        steady = round(server.rss_mib(), 1)
+        return {"renders": len(queue), "scenes": names, "statuses": statuses, "bound_mib": bound_mib,
+                "rss_mib": {"before": start_rss, "after_each_pair": rss_after_pair, "steady": steady},
+                "steady_under_bound": steady < bound_mib,
+                "health_memory_mib": {k: round(v / 2 ** 20, 1) for k, v in memory.items() if isinstance(v, (int, float))}}
     finally:
         server.stop()
 
@@ -306,15 +352,18 @@ def main():
     parser.add_argument("--seamcl", default="build/seamcl")
     parser.add_argument("--checks", default="start,overload,slowloris")
     parser.add_argument("--soak-minutes", type=float, default=10.0)
+    parser.add_argument("--overload-seconds", type=float, default=60.0)
+    parser.add_argument("--memory-bound-mib", type=int, default=2048, help="the kept check's server bound")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
-    checks = {"start": lambda: check_start(args.seamcl), "overload": lambda: check_overload(args.seamcl),
+    checks = {"start": lambda: check_start(args.seamcl), "overload": lambda: check_overload(args.seamcl, seconds=args.overload_seconds),
+              "kept": lambda: check_kept(args.seamcl, args.memory_bound_mib),
               "protocol": lambda: check_protocol(args.seamcl),
               "slowloris": lambda: check_slowloris(args.seamcl), "soak": lambda: check_soak(args.seamcl, args.soak_minutes)}
     out = {}
     for name in args.checks.split(","):
         if name not in checks:
-            parser.error("unknown check %r (start, overload, slowloris, soak, protocol)" % name)
+            parser.error("unknown check %r (start, overload, slowloris, soak, protocol, kept)" % name)
         out[name] = checks[name]()
         if not args.json:
             print(name, json.dumps(out[name]), flush=True)
