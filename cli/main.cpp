@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <future>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -64,6 +65,8 @@ int run_render(const RenderArgs& args, const std::string& device) {
   // A render this machine cannot hold is refused before it allocates.
   const JobPlan plan = job.plan(scene);
   refuse_beyond_machine(plan, runtime.info());
+  // The render's kernels build while the scene packs.
+  const std::future<void> programs = build_programs_ahead(runtime, scene, {{options, false}});
   Renderer renderer(runtime);
   limit_to_machine(renderer, runtime.info());
   // Handed over, not copied: image faces' float chains exist once (scene() reads them back).

@@ -14,7 +14,8 @@ each check starts its own server on a free port and stops it.
   threads + queue + 4 threads); /health latency meanwhile (p50, p99, max).
 - soak: renders (built-in and inline scenes, all methods) and compares from 4 clients for the
   given minutes; the server's RSS every 5 s (first, max, last), and its growth after warm-up (the
-  first fifth of the run): the largest later sample over the warm-up's last.
+  first fifth of the run): the median of the last fifth over the median of the second, and the
+  largest sample after warm-up over that second fifth's median.
 - kept: 18 renders at 64x64 (rgba32f texels, guardband 16), every built-in scene twice, two at a
   time, on a server with --threads 2 and --memory-bound-mib; the RSS after each pair, the steady
   RSS at the end, and /health's memory figures, against the bound.
@@ -243,11 +244,14 @@ def check_soak(seamcl, minutes):
         for t in threads:
             t.join()
         rss.append(round(server.rss_mib(), 1))
-        warm = rss[max(0, len(rss) // 5 - 1)]
-        after = rss[len(rss) // 5:] or rss[-1:]
+        # RSS swings with the requests in flight, so windows' medians compare, not single samples.
+        fifth = max(1, len(rss) // 5)
+        warm = statistics.median(rss[fifth:2 * fifth] or rss[-1:])
+        end = statistics.median(rss[-fifth:])
         return {"minutes": minutes, "requests": counts,
-                "rss_mib": {"first": rss[0], "warm": warm, "max_after_warm": max(after), "last": rss[-1],
-                            "growth_after_warm": round(max(after) / warm - 1, 4), "samples": rss}}
+                "rss_mib": {"first": rss[0], "warm_median": warm, "end_median": end, "max_after_warm": max(rss[fifth:] or rss),
+                            "growth_after_warm": round(end / warm - 1, 4),
+                            "max_over_warm": round(max(rss[fifth:] or rss) / warm - 1, 4), "samples": rss}}
     finally:
         server.stop()
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <future>
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/memory/compare_memory.h>
@@ -144,6 +145,20 @@ CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobCont
   const Camera view = camera(scene);
   // Hashed once for the lock's key and every reference kind's cache key (hashing bakes every face).
   if (reference_.use_cache && reference_.scene_hash.empty()) reference_.scene_hash = scene_content_hash(scene);
+  // The variants of the entries, of their seam masks and, when no cache can hold it, of the
+  // reference build while the scene packs.
+  std::vector<ProgramNeed> needs;
+  for (const MethodEntry& entry : entries_) {
+    needs.push_back({entry.options, false});
+    RenderOptions mask = entry.options;
+    mask.method = Method::Black;  // footprint_seam_mask's render
+    needs.push_back({mask, true});
+  }
+  const bool renders_reference = std::any_of(kinds_.begin(), kinds_.end(), [](ReferenceKind kind) {
+    return kind == ReferenceKind::Paper || kind == ReferenceKind::Box;
+  });
+  if (renders_reference && !reference_.use_cache) needs.push_back({reference_render_options(frame_, reference_), false});
+  const std::future<void> programs = build_programs_ahead(runtime, scene, needs);
   Renderer renderer(runtime);
   renderer.set_device_byte_limit(control.device_byte_limit);
   renderer.load_scene(scene, frame_.texels);

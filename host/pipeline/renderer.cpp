@@ -400,6 +400,27 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   }
 }
 
+std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, const std::vector<ProgramNeed>& needs) {
+  std::vector<std::string> variants;
+  for (const ProgramNeed& need : needs) {
+    const std::string options = program_options(need.options.texels, sampler_params(need.options), need.with_seam_mask,
+                                                 scene.environment.has_value());
+    if (std::find(variants.begin(), variants.end(), options) == variants.end()) variants.push_back(options);
+  }
+  return std::async(std::launch::async, [&runtime, variants = std::move(variants)] {
+    std::vector<std::future<void>> builds;
+    for (const std::string& options : variants) {
+      builds.push_back(std::async(std::launch::async, [&runtime, options] {
+        try {
+          runtime.program(options);
+        } catch (...) {  // the render that uses it builds it again and reports the error
+        }
+      }));
+    }
+    for (std::future<void>& build : builds) build.wait();
+  });
+}
+
 std::string program_options(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask, bool environment) {
   return std::string(format == TexelFormat::Rgba32f ? "-DSEAMCL_TEXELS_F32=1" : "-DSEAMCL_TEXELS_F32=0") +
          " -DSEAMCL_SAMPLER_FILTER=" + std::to_string(sampler.filter) +

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <future>
 #include <memory>
 #include <vector>
 
@@ -62,6 +63,19 @@ struct RenderResult {
 // shade stage's environment branch is compiled in (-DSEAMCL_CUBE=1).
 std::string program_options(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask = false,
                             bool environment = false);
+
+// A render about to be made, for build_programs_ahead.
+struct ProgramNeed {
+  RenderOptions options;
+  bool with_seam_mask = false;
+};
+
+// Starts building (or loading from a cache) the program variants of `needs` on `scene`, each on a
+// thread of its own, and returns at once, so that work needing no kernel (making and packing the
+// scene) overlaps the builds, which a first render would otherwise wait for in turn. The future is
+// ready when every build has ended. A build that fails is not reported here: the render that uses
+// the variant builds it again and throws its error with the build log.
+std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, const std::vector<ProgramNeed>& needs);
 
 class Renderer {
  public:
