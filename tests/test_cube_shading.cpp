@@ -114,7 +114,7 @@ TEST(CubeMethodOption, ParsesItsNamesAndRefusesOthers) {
     EXPECT_EQ(to_string(o.cube_method), name);
     EXPECT_EQ(to_json(o)["cube_method"], name);
   }
-  EXPECT_EQ(cube_method_names().size(), 6u);
+  EXPECT_EQ(cube_method_names().size(), 10u);
   EXPECT_EQ(RenderOptions{}.cube_method, CubeMethod::Seamless);
   try {
     parse_render_options({{"cube_method", "seamless"}});
