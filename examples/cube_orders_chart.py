@@ -10,9 +10,10 @@ One column per cube size n, one marker per method, both axes log:
 The post's trade-off (stretch and warp remove the zero-order seam but keep a first-order one) is
 a marker that moves left without moving down.
 
-    /usr/bin/python3 examples/cube_orders_chart.py docs/results/cubemap/cube_orders.json -o docs/results/cubemap/zero_vs_first_order.png
+    /usr/bin/python3 examples/cube_orders_chart.py docs/results/cubemap/cube_metrics.json -o docs/results/cubemap/zero_vs_first_order.png
 """
 import argparse
+import math
 import os
 import sys
 
@@ -60,13 +61,17 @@ def main():
         for row, key, label in ((0, "first_order_band", "first-order band error (mean |slope - true slope|, per texel)"),
                                 (1, "first_order_jump", "first-order jump (older measure)")):
             ax = axes[row][column]
+            # Methods that land on one spot (clamp and discard, seamless and border, ...) share one label.
+            spots = {}
             for r in rows:
                 x = max(r["seam_step"][0], FLOOR)
                 y = max(r[key], FLOOR)
                 ax.scatter([x], [y], color=colours[r["cube_method"]], marker=markers[r["cube_method"]], s=70,
                            label=r["cube_method"], zorder=3)
-                ax.annotate(r["cube_method"].replace("cube-", ""), (x, y), textcoords="offset points", xytext=(5, 4),
-                            fontsize=7)
+                spot = (round(math.log10(x) * 20), round(math.log10(y) * 20))
+                spots.setdefault(spot, (x, y, []))[2].append(r["cube_method"].replace("cube-", ""))
+            for x, y, names in spots.values():
+                ax.annotate(" / ".join(names), (x, y), textcoords="offset points", xytext=(5, 4), fontsize=7)
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.set_xlabel(f"zero order: seam step at lod 0 (mean; {FLOOR:g} = none)")

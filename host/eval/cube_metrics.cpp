@@ -83,14 +83,16 @@ EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environme
   const std::vector<Edge> edges = cube_edges();
   auto along = [&](int k) { return -1.0f + (2.0f * static_cast<float>(k) + 1.0f) / static_cast<float>(points); };
 
-  // Zero order, per lod: both sides 1e-4 face widths from the edge.
-  for (int lod = 0; lod < cube.level_count(); ++lod) {
+  // Zero order, per lod: both sides 1e-4 face widths from the edge; at every integer lod, then
+  // half-way between each two (where trilinear mixes two levels and one coordinate scale cannot
+  // suit both).
+  for (int step = 0; step < 2 * cube.level_count() - 1; ++step) {
+    const float lod = step < cube.level_count() ? static_cast<float>(step) : static_cast<float>(step - cube.level_count()) + 0.5f;
     std::vector<CubeLookup> batch;
     for (const Edge& e : edges) {
       for (int k = 0; k < points; ++k) {
         for (bool face_a : {true, false}) {
-          batch.push_back({edge_point(e, along(k), face_a, 2e-4f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f,
-                           static_cast<float>(lod)});
+          batch.push_back({edge_point(e, along(k), face_a, 2e-4f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, lod});
         }
       }
     }
@@ -101,8 +103,12 @@ EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environme
       sum += step;
       worst = std::max(worst, step);
     }
-    out.seam_step_mean.push_back(sum / static_cast<double>(values.size() / 2));
-    out.seam_step_max.push_back(worst);
+    if (step < cube.level_count()) {
+      out.seam_step_mean.push_back(sum / static_cast<double>(values.size() / 2));
+      out.seam_step_max.push_back(worst);
+    } else {
+      out.seam_step_half_lod.push_back(sum / static_cast<double>(values.size() / 2));
+    }
   }
 
   // First order at lod 0: points 0.25 and 0.75 level-0 texels (2/n face units each) inside.

@@ -23,6 +23,7 @@ struct EdgeMeasures {
   size_t cube_bytes = 0;
   std::vector<double> seam_step_mean;  // per lod 0..log2(n): mean |f(face A) - f(face B)| (RGB 2-norm)
   std::vector<double> seam_step_max;
+  std::vector<double> seam_step_half_lod;  // the mean at lod 0.5, 1.5, .., log2(n) - 0.5
   // At lod 0: the one-sided slopes (per level-0 texel) from points 0.25 and 0.75 texel inside
   // each face; the jump is slope_B - slope_A (oriented from A to B) minus the environment's own
   // jump there, mean of its RGB 2-norm. Stretch and warp trade the zero-order seam for this.

@@ -139,6 +139,7 @@ json CubeMetricsJob::run(ClRuntime& runtime, const Scene& source, const JobContr
                          {"border", cube_preparation(method).border},
                          {"seam_step", edges.seam_step_mean},
                          {"seam_step_max", edges.seam_step_max},
+                         {"seam_step_half_lod", edges.seam_step_half_lod},
                          {"first_order_jump", edges.first_order_jump},
                          {"environment_first_order_jump", edges.environment_first_order_jump},
                          {"first_order_band", edges.first_order_band},
