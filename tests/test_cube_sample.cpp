@@ -1,12 +1,14 @@
 // The cube-map lookup (kernels/cube_sample.cl) against its twin for every method and filter, and
 // what the methods promise at the cube's edges: direction pairs straddling each of the 12 edges
 // and 8 corners converge for seamless, stretch, warp and fixup and not for clamp; the fixup lands
-// on stretch-baked texel centres at integer lods; a constant environment stays exact.
+// on stretch-baked texel centres at integer lods; a constant environment stays exact; the edge
+// measures (host/eval/cube_metrics.h) tell the methods apart in zero and first order.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
+#include <seamcl/eval/cube_metrics.h>
 #include <seamcl/pipeline/cube_lookups.h>
 #include <seamcl/pipeline/packed_cube.h>
 #include "test_support.h"
@@ -255,6 +257,31 @@ TEST(CubeSample, BorderReadsWhatSeamlessReadsWithinATexelOfTheEdge) {
   EXPECT_EQ(cube_bytes(CubeMethod::Border, n), cube_texel_count(n, true) * 16);
   EXPECT_EQ(cube_bytes(CubeMethod::Clamp, n), cube.texel_count() * 16);
   EXPECT_EQ(pack_cube_texels(cube, true).size(), cube_texel_count(n, true) * 4);
+}
+
+TEST(CubeEdgeMeasures, FirstOrderBandSeesTheFlatBandTheZeroOrderStepDoesNot) {
+  // The default analytic sky at n = 16, 8 points per edge.
+  const Environment sky;
+  auto measure = [&](CubeMethod method) { return measure_cube_edges(shared_runtime(), sky, method, 16, 8); };
+  const EdgeMeasures clamp = measure(CubeMethod::Clamp), stretch = measure(CubeMethod::Stretch),
+                     seamless = measure(CubeMethod::Seamless), fixup = measure(CubeMethod::Fixup);
+  // Stretch has no zero-order seam at lod 0 ...
+  EXPECT_LT(stretch.seam_step_mean[0], 1e-6);
+  EXPECT_GT(clamp.seam_step_mean[0], 1e-3);
+  // ... and keeps clamp's flat band: lookups constant over the last half texel of each face,
+  // about half the environment's own slope there, twice seamless's and more than fixup's.
+  EXPECT_GT(stretch.first_order_band, 0.9 * clamp.first_order_band);
+  EXPECT_GT(stretch.first_order_band, 0.35 * stretch.environment_band_slope);
+  EXPECT_GT(stretch.first_order_band, 1.8 * seamless.first_order_band);
+  EXPECT_LT(fixup.first_order_band, seamless.first_order_band);
+  // Half lods: the post's one fixup scale leaves a step, the per-level scale none.
+  const EdgeMeasures fixup_level = measure(CubeMethod::FixupLevel);
+  ASSERT_EQ(fixup.seam_step_half_lod.size(), 4u);
+  EXPECT_GT(fixup.seam_step_half_lod[0], 1e-3);
+  EXPECT_LT(fixup_level.seam_step_half_lod[0], 1e-4);
+  // The costs: bytes of the packed cube.
+  EXPECT_EQ(measure(CubeMethod::Border).cube_bytes, cube_texel_count(16, true) * 16);
+  EXPECT_EQ(clamp.cube_bytes, cube_texel_count(16, false) * 16);
 }
 
 TEST(CubeSample, SeamlessCornerIsTheMeanOfThreeEqualTexels) {
