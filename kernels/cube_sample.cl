@@ -9,8 +9,10 @@
  * bilinear (level 0), trilinear (log2 of the longer axis) or anisotropic (N probes along the
  * longer axis, each trilinear at log2(major / N)). A roughness lengthens both axes first (glossy).
  * The seam methods differ only in what a bilinear tap outside the face reads (cube_tap) and, for
- * fixup, in the coordinates: see SEAMCL_CUBE_* in seamcl_types.h.
- * Host guarantees: size a power of two, level_count = log2(size) + 1, texels of the whole cube.
+ * fixup, fixup-level and fov, in the coordinates (cube_trilinear, cube_level_scale): see
+ * SEAMCL_CUBE_* in seamcl_types.h.
+ * Host guarantees: size a power of two, level_count = log2(size) + 1, texels of the whole cube
+ * (with every level's border for SEAMCL_CUBE_BORDER).
  * Only texels of the cube are read, whatever the direction (NaN and zero included).
  * Twin: host/pipeline/stages/cube_sample_twin.cpp. */
 
@@ -92,6 +94,16 @@ SEAMCL_INLINE uint cube_texel_index(int size, int face, int level, int i, int j)
   return face_start + level_start + (uint)j * m + (uint)i;
 }
 
+/* cube-border's layout: every m x m level stored as (m + 2) x (m + 2), i, j in -1..m. */
+SEAMCL_INLINE uint cube_border_texel_index(int size, int face, int level, int i, int j) {
+  const uint n = (uint)size;
+  const uint m = max(n >> level, 1u);
+  const uint levels = (uint)(31 - clz(n)) + 1u;
+  const uint face_texels = (4u * n * n - 1u) / 3u + 8u * n - 4u + 4u * levels;
+  const uint level_start = 4u * (n * n - m * m) / 3u + 8u * (n - m) + 4u * (uint)level;
+  return (uint)face * face_texels + level_start + (uint)(j + 1) * (m + 2u) + (uint)(i + 1);
+}
+
 SEAMCL_INLINE void cube_add_texel(FilterSum* sum, __global const float* texels, uint index, float weight) {
   sum->r += weight * texels[4 * index];
   sum->g += weight * texels[4 * index + 1];
@@ -139,7 +151,11 @@ CUBE_CALL void cube_tap(FilterSum* sum, __global const float* texels, int size, 
   const int out_i = i < 0 || i >= m;
   const int out_j = j < 0 || j >= m;
   const int ci = clamp(i, 0, m - 1), cj = clamp(j, 0, m - 1);
-  if (!out_i && !out_j) {
+  if (method == SEAMCL_CUBE_BORDER) {
+    /* The border holds what seamless reads one texel out; further out (aniso probes past the
+     * face) clamps to the border. */
+    cube_add_texel(sum, texels, cube_border_texel_index(size, face, level, clamp(i, -1, m), clamp(j, -1, m)), w);
+  } else if (!out_i && !out_j) {
     cube_add_texel(sum, texels, cube_texel_index(size, face, level, i, j), w);
   } else if (method == SEAMCL_CUBE_DISCARD) {
     /* border zero: neither colour nor weight */
@@ -157,9 +173,23 @@ CUBE_CALL void cube_tap(FilterSum* sum, __global const float* texels, int size, 
   }
 }
 
+/* The coordinate scale of an m x m level for the methods that scale per level: fixup-level's
+ * (m - 1) / m puts a stretch-baked texel's direction on its texel centre at this level (the
+ * post's 1 - exp2(lod) / n at this level's integer lod); fov's (m - 0.5) / m undoes the post's
+ * FOV tweak, which spread the texel centres over m / (m - 0.5) of the face. 1 for the others. */
+SEAMCL_INLINE float cube_level_scale(int method, int m) {
+  if (method == SEAMCL_CUBE_FIXUP_LEVEL) return 1.0f - 1.0f / (float)m;
+  if (method == SEAMCL_CUBE_FOV) return 1.0f - 0.5f / (float)m;
+  return 1.0f;
+}
+
 CUBE_CALL void cube_bilinear(FilterSum* sum, __global const float* texels, int size, int face, int level, float s,
                                  float t, float weight, int method) {
   const int m = max(size >> level, 1);
+  /* fixup-level and fov: this level's own scale about the face centre (see cube_level_scale). */
+  const float scale = cube_level_scale(method, m);
+  s = 0.5f + (s - 0.5f) * scale;
+  t = 0.5f + (t - 0.5f) * scale;
   /* Seamless taps may reach one face width round an edge; for the others two texels out is as
    * far as clamp and border can tell apart. fmax also turns NaN into the bound. */
   const float lo = method == SEAMCL_CUBE_SEAMLESS ? -(float)m : -2.0f;

@@ -159,10 +159,21 @@ typedef struct {
 /* Not a seam method: shade writes the lookup direction instead of the lookup (host/eval's
  * analytic reference evaluates the environment along it). */
 #define SEAMCL_CUBE_DIRECTION 6
+/* More seam methods (after DIRECTION, whose value stays). */
+#define SEAMCL_CUBE_FOV 7          /* faces baked with the post's FOV 2 atan(m / (m - 0.5)) per level; lookups
+                                    * scaled by (m - 0.5) / m per level to match, clamp */
+#define SEAMCL_CUBE_AVERAGE 8      /* texel-centre faces whose edge texels are averaged across the edge (corners:
+                                    * the three) after the bake, CubeMapGen-style; clamp */
+#define SEAMCL_CUBE_FIXUP_LEVEL 9  /* fixup with each trilinear level's own scale (m - 1) / m */
+#define SEAMCL_CUBE_BORDER 10      /* faces stored with a one-texel border of their neighbours' texels
+                                    * (layout below); taps read within the bordered face */
 
 /* A cube map's lookup. Texels: linear RGBA32F, face-major (+X, -X, +Y, -Y, +Z, -Z), each face's
  * levels n, n/2, .., 1 in turn, rows top to bottom (t = 0 first): face f, level l starts at
- * texel f * (4 n^2 - 1) / 3 + 4 (n^2 - (n >> l)^2) / 3. */
+ * texel f * (4 n^2 - 1) / 3 + 4 (n^2 - (n >> l)^2) / 3. SEAMCL_CUBE_BORDER: each m x m level is stored
+ * as (m + 2) x (m + 2) with its one-texel border, texel (i, j), i, j in -1..m, at (j + 1) (m + 2) + i + 1;
+ * a face holds (4 n^2 - 1) / 3 + 8 n - 4 + 4 (log2 n + 1) texels and level l starts
+ * 4 (n^2 - m^2) / 3 + 8 (n - m) + 4 l into it. */
 typedef struct {
   cl_int size;          /* level-0 face size n, a power of two; 0: the scene has no cube map */
   cl_int level_count;   /* log2(n) + 1 */

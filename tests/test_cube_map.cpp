@@ -100,6 +100,77 @@ TEST(CubeMap, StretchedEdgeTexelsAreSharedByBothFaces) {
   }
 }
 
+TEST(CubeMap, AveragedEdgeTexelsAreEqualAcrossEveryEdgeAndCorner) {
+  std::mt19937 rng(17);
+  // Noise: neighbouring texels differ, so an average of the wrong texels shows.
+  const CubeMap baked = bake_cube_map(
+      [&](glm::vec3) { return glm::vec4(uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1), 1.0f); }, 8,
+      CubeBake::Centres);
+  CubeMap averaged = baked;
+  average_cube_edges(averaged);
+  int edge_pairs = 0, corner_groups = 0;
+  for (int level = 0; level < averaged.level_count(); ++level) {
+    const int m = averaged.size >> level;
+    for (int f = 0; f < kCubeFaces; ++f) {
+      for (int j = 0; j < m; ++j) {
+        for (int i = 0; i < m; ++i) {
+          const glm::vec4 value = averaged.faces[f].levels[level].at(i, j);
+          const std::vector<CubeTexel> partners = cube_edge_partners(f, m, i, j);
+          if (partners.empty()) {
+            EXPECT_EQ(value, baked.faces[f].levels[level].at(i, j)) << "interior texel changed";
+            continue;
+          }
+          glm::vec4 mean = baked.faces[f].levels[level].at(i, j);
+          for (const CubeTexel& p : partners) {
+            // Bit for bit: a clamped lookup at the edge reads the same value from either face.
+            EXPECT_EQ(averaged.faces[p.face].levels[level].at(p.i, p.j), value)
+                << "level " << level << " face " << f << " (" << i << ", " << j << ") vs face " << p.face;
+            mean += baked.faces[p.face].levels[level].at(p.i, p.j);
+            if (m > 1) {
+              // The partner is the texel across the edge: the two centres are half a texel either
+              // side of it, at the same place along it (sqrt(2) / m apart in space).
+              const glm::vec3 here = cube_direction(f, cube_map1(static_cast<float>(i), m), cube_map1(static_cast<float>(j), m));
+              const glm::vec3 there =
+                  cube_direction(p.face, cube_map1(static_cast<float>(p.i), m), cube_map1(static_cast<float>(p.j), m));
+              EXPECT_NEAR(glm::length(here - there), std::sqrt(2.0f) / static_cast<float>(m), 1e-5f);
+            }
+          }
+          mean /= static_cast<float>(partners.size() + 1);
+          EXPECT_LT(glm::length(value - mean), 1e-6f);
+          if (m > 1) (partners.size() == 1 ? edge_pairs : corner_groups) += 1;
+        }
+      }
+    }
+  }
+  // 12 edges x (m - 2) texels x 2 faces, and 8 corners x 3 faces, summed over m = 8, 4, 2.
+  EXPECT_EQ(edge_pairs, 24 * (6 + 2 + 0));
+  EXPECT_EQ(corner_groups, 24 * 3);
+}
+
+TEST(CubeMap, PostsFovPutsEdgeTexelCentresAQuarterTexelShortOfTheEdge) {
+  for (int n : {2, 16, 256}) {
+    const float nf = static_cast<float>(n);
+    // The post's FOV 2 atan(n / (n - 0.5)): the face plane spans n / (n - 0.5), texel centres
+    // spread uniformly over it. The last one lands at (n - 1) / (n - 0.5), not at 1 ...
+    EXPECT_NEAR(cube_map_fov(nf - 1.0f, n), (nf - 1.0f) / (nf - 0.5f), 1e-6f) << n;
+    const float tweaked_texel = 2.0f / (nf - 0.5f);
+    EXPECT_NEAR((1.0f - cube_map_fov(nf - 1.0f, n)) / tweaked_texel, 0.25f, 1e-4f) << n;
+    EXPECT_NEAR(cube_map_fov(0.0f, n), -cube_map_fov(nf - 1.0f, n), 1e-6f) << n;
+    // ... while the FOV 2 atan(n / (n - 1)) puts them on the edge, and that is map_2 (stretch).
+    for (int x = 0; x < n; ++x) {
+      EXPECT_NEAR(cube_map1(static_cast<float>(x), n) * nf / (nf - 1.0f), cube_map2(static_cast<float>(x), n), 1e-6f);
+    }
+  }
+}
+
+TEST(CubeMap, BorderedLayoutCountsEveryLevelsBorder) {
+  // Faces hold 341 texels at n = 16 (16^2 + 8^2 + 4^2 + 2^2 + 1), bordered 18^2 + 10^2 + 6^2 + 4^2 + 3^2 = 485.
+  EXPECT_EQ(cube_texel_count(16, false), 6u * 341);
+  EXPECT_EQ(cube_texel_count(16, true), 6u * 485);
+  EXPECT_EQ(cube_texel_count(1, true), 6u * 9);
+  EXPECT_EQ(cube_texel_count(0, true), 0u);
+}
+
 TEST(CubeMap, RefusesSizesThatAreNotPowersOfTwo) {
   try {
     bake_cube_map([](glm::vec3) { return glm::vec4(1.0f); }, 12, CubeBake::Centres);

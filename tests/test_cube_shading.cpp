@@ -6,7 +6,9 @@
 #include <cmath>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
+#include <seamcl/scene/cube_map.h>
 #include <seamcl/scene/envmap_scene.h>
 #include <seamcl/scene/scene_generators.h>
 #include <seamcl/scene/scene_json.h>
@@ -108,13 +110,34 @@ TEST(EnvmapScene, SkyboxShowsTheEnvironmentAndMethodsDifferOnlyNearEdges) {
   EXPECT_LT(same, seamless.pixels.size());
 }
 
+TEST(EnvmapScene, MemoryEstimateCoversTheBorderedCube) {
+  const Scene scene = small_envmap();
+  Renderer renderer(shared_runtime());
+  renderer.load_scene(scene);
+  size_t estimated[2], used[2];
+  int k = 0;
+  for (CubeMethod method : {CubeMethod::Clamp, CubeMethod::Border}) {
+    const RenderOptions options = small_render(method, 1);
+    renderer.render(scene.camera, options);
+    used[k] = renderer.cube_texels().size() * sizeof(float);
+    estimated[k] = render_memory(scene, options).environment;
+    // The plan is never below what the render holds.
+    EXPECT_GE(estimated[k], used[k]) << to_string(method);
+    ++k;
+  }
+  // The border's price, texel for texel: every level one texel wider on each side.
+  EXPECT_EQ(used[0], cube_texel_count(16, false) * 16);
+  EXPECT_EQ(used[1], cube_texel_count(16, true) * 16);
+  EXPECT_GE(estimated[1] - estimated[0], used[1] - used[0]);
+}
+
 TEST(CubeMethodOption, ParsesItsNamesAndRefusesOthers) {
   for (const std::string& name : cube_method_names()) {
     const RenderOptions o = parse_render_options({{"cube_method", name}});
     EXPECT_EQ(to_string(o.cube_method), name);
     EXPECT_EQ(to_json(o)["cube_method"], name);
   }
-  EXPECT_EQ(cube_method_names().size(), 6u);
+  EXPECT_EQ(cube_method_names().size(), 10u);
   EXPECT_EQ(RenderOptions{}.cube_method, CubeMethod::Seamless);
   try {
     parse_render_options({{"cube_method", "seamless"}});

@@ -127,7 +127,8 @@ TEST(JobsCube, PlanAndTinyRun) {
   ASSERT_EQ(out["results"].size(), 2u);
   for (const json& r : out["results"])
     expect_keys(r, {"cube_size", "cube_method", "bake", "seam_step", "seam_step_max", "first_order_jump",
-                    "environment_first_order_jump", "ms", "cube_bytes", "error", "edge_error"});
+                    "environment_first_order_jump", "first_order_band", "environment_band_slope", "seam_step_half_lod", "ms",
+                    "cube_bytes", "bake_ms", "edges_averaged", "border", "error", "edge_error"});
   expect_finite_numbers(out, "cube-metrics");
 }
 

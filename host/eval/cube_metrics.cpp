@@ -1,6 +1,7 @@
 #include <seamcl/eval/cube_metrics.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -67,22 +68,31 @@ std::vector<glm::vec3> disk_directions(glm::vec3 d, float angle) {
 EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environment, CubeMethod method, int size,
                                 int points) {
   const DirectionFunction radiance = environment_function(environment);
-  const CubeMap cube = bake_cube_map(radiance, size, cube_bake(method), environment.bake_samples);
-  CubeLookups lookups(runtime, cube);
+  const auto bake_start = std::chrono::steady_clock::now();
+  const CubeMap cube = bake_cube_for(method, radiance, size, environment.bake_samples);
+  const bool border = cube_preparation(method).border;
+  const size_t packed_floats = pack_cube_texels(cube, border).size();
+  const double bake_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - bake_start).count();
+  CubeLookups lookups(runtime, cube, border);
   const CubeSampler sampler = cube_sampler(method, Filter::Trilinear, 16, size);
   EdgeMeasures out;
   out.size = size;
+  out.bake_ms = bake_ms;
+  out.cube_bytes = packed_floats * sizeof(float);
   const std::vector<Edge> edges = cube_edges();
   auto along = [&](int k) { return -1.0f + (2.0f * static_cast<float>(k) + 1.0f) / static_cast<float>(points); };
 
-  // Zero order, per lod: both sides 1e-4 face widths from the edge.
-  for (int lod = 0; lod < cube.level_count(); ++lod) {
+  // Zero order, per lod: both sides 1e-4 face widths from the edge; at every integer lod, then
+  // half-way between each two (where trilinear mixes two levels and one coordinate scale cannot
+  // suit both).
+  for (int step = 0; step < 2 * cube.level_count() - 1; ++step) {
+    const float lod = step < cube.level_count() ? static_cast<float>(step) : static_cast<float>(step - cube.level_count()) + 0.5f;
     std::vector<CubeLookup> batch;
     for (const Edge& e : edges) {
       for (int k = 0; k < points; ++k) {
         for (bool face_a : {true, false}) {
-          batch.push_back({edge_point(e, along(k), face_a, 2e-4f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f,
-                           static_cast<float>(lod)});
+          batch.push_back({edge_point(e, along(k), face_a, 2e-4f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, lod});
         }
       }
     }
@@ -93,8 +103,12 @@ EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environme
       sum += step;
       worst = std::max(worst, step);
     }
-    out.seam_step_mean.push_back(sum / static_cast<double>(values.size() / 2));
-    out.seam_step_max.push_back(worst);
+    if (step < cube.level_count()) {
+      out.seam_step_mean.push_back(sum / static_cast<double>(values.size() / 2));
+      out.seam_step_max.push_back(worst);
+    } else {
+      out.seam_step_half_lod.push_back(sum / static_cast<double>(values.size() / 2));
+    }
   }
 
   // First order at lod 0: points 0.25 and 0.75 level-0 texels (2/n face units each) inside.
@@ -129,6 +143,41 @@ EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environme
   const double count = static_cast<double>(values.size() / 4);
   out.first_order_jump = jump_sum / count;
   out.environment_first_order_jump = environment_sum / count;
+
+  // The band: kBandSteps lookups per level-0 texel on a path straight across the edge, one texel
+  // deep into each face; the slope of each step within a face (none straddles the edge, whose
+  // step is zero order) against the environment's own slope there.
+  constexpr int kBandSteps = 8;
+  std::vector<CubeLookup> band;
+  std::vector<glm::vec3> band_directions;
+  for (const Edge& e : edges) {
+    for (int k = 0; k < points; ++k) {
+      for (bool face_a : {true, false}) {
+        for (int s = 0; s < kBandSteps; ++s) {
+          const float inside = (static_cast<float>(s) + 0.5f) / kBandSteps * texel;
+          band_directions.push_back(edge_point(e, along(k), face_a, inside));
+          band.push_back({band_directions.back(), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, 0.0f});
+        }
+      }
+    }
+  }
+  const std::vector<glm::vec4> band_values = lookups.sample(band, sampler);
+  double deviation_sum = 0, slope_sum = 0;
+  size_t steps = 0;
+  for (size_t run = 0; run < band_values.size(); run += kBandSteps) {
+    for (int s = 0; s + 1 < kBandSteps; ++s) {
+      // Per level-0 texel: a step is 1 / kBandSteps of one.
+      const glm::vec4 slope = (band_values[run + s + 1] - band_values[run + s]) * static_cast<float>(kBandSteps);
+      const glm::vec4 truth = (radiance(glm::normalize(band_directions[run + s + 1])) -
+                               radiance(glm::normalize(band_directions[run + s]))) *
+                              static_cast<float>(kBandSteps);
+      deviation_sum += rgb_norm(slope - truth);
+      slope_sum += rgb_norm(truth);
+      ++steps;
+    }
+  }
+  out.first_order_band = deviation_sum / static_cast<double>(steps);
+  out.environment_band_slope = slope_sum / static_cast<double>(steps);
   return out;
 }
 

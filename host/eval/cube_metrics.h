@@ -17,13 +17,25 @@ namespace seamcl {
 // an explicit lod) just inside each of the two faces, 1e-4 face widths from the edge.
 struct EdgeMeasures {
   int size = 0;
+  // The method's cube on the host: bake (every level of every face from the environment), edge
+  // averaging and packing, in ms on this machine; and the packed cube's bytes.
+  double bake_ms = 0;
+  size_t cube_bytes = 0;
   std::vector<double> seam_step_mean;  // per lod 0..log2(n): mean |f(face A) - f(face B)| (RGB 2-norm)
   std::vector<double> seam_step_max;
+  std::vector<double> seam_step_half_lod;  // the mean at lod 0.5, 1.5, .., log2(n) - 0.5
   // At lod 0: the one-sided slopes (per level-0 texel) from points 0.25 and 0.75 texel inside
   // each face; the jump is slope_B - slope_A (oriented from A to B) minus the environment's own
   // jump there, mean of its RGB 2-norm. Stretch and warp trade the zero-order seam for this.
   double first_order_jump = 0;
   double environment_first_order_jump = 0;  // the analytic environment's own mean |jump|
+  // At lod 0, the first-order error of the band one level-0 texel either side of the edge, where
+  // clamped taps flatten the lookup (every method that clamps: a slope of zero over the last half
+  // texel of each face): lookups 1/8 texel apart on a path straight across the edge, and the mean
+  // RGB 2-norm of (lookup slope - environment slope) per level-0 texel over the steps within each
+  // face. The jump above compares two slopes and misses the flat band; this sees it.
+  double first_order_band = 0;
+  double environment_band_slope = 0;  // the environment's own mean |slope| over the same steps
 };
 EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environment, CubeMethod method, int size,
                                 int points = 32);

@@ -21,8 +21,6 @@ using nlohmann::json;
 const std::vector<std::pair<std::string, json>> kFrameDefaults = {
     {"scene", "envmap"}, {"size", "160x180"}, {"filter", "aniso"}, {"msaa", 1}, {"frame", 0}, {"frames", 1}};
 
-// Six faces of n x n texels and their mips, as float4.
-size_t cube_bytes(int n) { return static_cast<size_t>(kCubeFaces) * (4 * static_cast<size_t>(n) * n - 1) / 3 * 16; }
 
 }  // namespace
 
@@ -83,7 +81,10 @@ JobPlan CubeMetricsJob::plan(const Scene& scene) const {
   const RenderMemory measured = render_memory(scene, frame_), supersampled = render_memory(scene, reference);
   MemoryShares device = larger(measured.device_shares(frame_buffers_field(frame_.msaa)), supersampled.device_shares("size"));
   MemoryShares host = larger(measured.host_shares(), supersampled.host_shares());
-  const size_t largest_cube = cube_bytes(*std::max_element(sizes_.begin(), sizes_.end()));
+  size_t largest_cube = 0;
+  for (CubeMethod method : methods_) {
+    largest_cube = std::max(largest_cube, cube_bytes(method, *std::max_element(sizes_.begin(), sizes_.end())));
+  }
   device.add("scene", largest_cube);
   host.add("scene", largest_cube);
   return JobPlan{"this cube-metrics run", device, host};
@@ -134,12 +135,18 @@ json CubeMetricsJob::run(ClRuntime& runtime, const Scene& source, const JobContr
       results.push_back({{"cube_size", n},
                          {"cube_method", to_string(method)},
                          {"bake", to_string(cube_bake(method))},
+                         {"edges_averaged", cube_preparation(method).average_edges},
+                         {"border", cube_preparation(method).border},
                          {"seam_step", edges.seam_step_mean},
                          {"seam_step_max", edges.seam_step_max},
+                         {"seam_step_half_lod", edges.seam_step_half_lod},
                          {"first_order_jump", edges.first_order_jump},
                          {"environment_first_order_jump", edges.environment_first_order_jump},
+                         {"first_order_band", edges.first_order_band},
+                         {"environment_band_slope", edges.environment_band_slope},
                          {"ms", {{"median", ms[ms.size() / 2]}, {"min", ms.front()}, {"max", ms.back()}}},
-                         {"cube_bytes", cube_bytes(n)},
+                         {"cube_bytes", edges.cube_bytes},
+                         {"bake_ms", edges.bake_ms},
                          // The statistics skip NaN pixels; their counts say whether there were any.
                          {"error",
                           {{"mean", errors.all.mean},

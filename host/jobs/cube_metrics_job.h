@@ -36,8 +36,9 @@ class CubeMetricsJob {
   // Measures every method at every cube size; with `images_dir` (an existing directory) also
   // writes reference.png, cube_edge_mask.png and METHOD-SIZE.png there. Returns {scene, size,
   // filter, msaa, reference_scale, edge_pixels, device, results: [{cube_size, cube_method, bake,
-  // seam_step, seam_step_max, first_order_jump, environment_first_order_jump, ms: {median, min,
-  // max}, cube_bytes, error: {mean, p99, max, nan_pixels}, edge_error: {mean, p99, max, pixels,
+  // edges_averaged, border, seam_step, seam_step_max, seam_step_half_lod, first_order_jump,
+  // environment_first_order_jump, first_order_band, environment_band_slope, ms: {median, min,
+  // max}, cube_bytes, bake_ms, error: {mean, p99, max, nan_pixels}, edge_error: {mean, p99, max, pixels,
   // nan_pixels}}]}. Cancelled between entries when control.should_stop says so.
   nlohmann::json run(ClRuntime& runtime, const Scene& scene, const JobControl& control,
                      const std::string& images_dir = "") const;

@@ -6,6 +6,7 @@
 
 #include <seamcl/core/over_budget.h>
 #include <seamcl/pipeline/gpu_types.h>
+#include <seamcl/pipeline/packed_cube.h>
 #include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/renderer.h>
 #include "memory/process_overhead.h"
@@ -233,8 +234,8 @@ RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options
   m.neighbors = device_array(adjacency_faces, sizeof(FaceNeighbors));
   m.level_offsets = device_array(m.textures.levels, sizeof(uint32_t));
   m.texels = device_array(m.textures.texels, options.texels == TexelFormat::Rgba8 ? sizeof(uint32_t) : 4 * sizeof(float));
-  const size_t cube_side = static_cast<size_t>(std::max(scene.cube_size, 0));
-  const size_t cube_texels = scene.cube_size > 0 ? 6 * (4 * cube_side * cube_side - 1) / 3 : 0;
+  // cube-border's faces carry a one-texel border at every level.
+  const size_t cube_texels = cube_texel_count(scene.cube_size, cube_preparation(options.cube_method).border);
   m.environment = add(device_array(scene.reflective_faces, sizeof(ReflectiveFace)),
                       device_array(mul(cube_texels, 4), sizeof(float)));
 

@@ -48,13 +48,17 @@ constexpr std::array<std::pair<TexelFormat, const char*>, 2> kTexelFormats{
     {{TexelFormat::Rgba8, "rgba8"}, {TexelFormat::Rgba32f, "rgba32f"}}};
 constexpr std::array<std::pair<ShadingMode, const char*>, 3> kShadingModes{
     {{ShadingMode::Pixel, "pixel"}, {ShadingMode::Centroid, "centroid"}, {ShadingMode::Sample, "sample"}}};
-constexpr std::array<std::pair<CubeMethod, const char*>, 6> kCubeMethods{
+constexpr std::array<std::pair<CubeMethod, const char*>, 10> kCubeMethods{
     {{CubeMethod::Clamp, "cube-clamp"},
      {CubeMethod::Seamless, "cube-seamless"},
      {CubeMethod::Stretch, "cube-stretch"},
      {CubeMethod::Warp, "cube-warp"},
      {CubeMethod::Fixup, "cube-fixup"},
-     {CubeMethod::Discard, "cube-discard"}}};
+     {CubeMethod::Discard, "cube-discard"},
+     {CubeMethod::FixupLevel, "cube-fixup-level"},
+     {CubeMethod::Fov, "cube-fov"},
+     {CubeMethod::Average, "cube-average"},
+     {CubeMethod::Border, "cube-border"}}};
 constexpr std::array<std::pair<ImageFormat, const char*>, 2> kFormats{{{ImageFormat::Png, "png"}, {ImageFormat::Exr, "exr"}}};
 
 }  // namespace

@@ -46,8 +46,15 @@ enum class ImageFormat { Png, Exr };
 //   cube-warp     - faces baked with the cubic warp of the texel centres, clamp;
 //   cube-fixup    - stretch-baked faces, lookup coordinates scaled by 1 - exp2(lod)/n;
 //   cube-discard  - taps outside the face weigh zero, the rest renormalised (Toth 2013 where its
-//                   assumption, a geometric edge under the seam, fails).
-enum class CubeMethod { Clamp, Seamless, Stretch, Warp, Fixup, Discard };
+//                   assumption, a geometric edge under the seam, fails);
+//   cube-fixup-level - fixup with each trilinear level's own scale (m - 1) / m;
+//   cube-fov      - faces baked with the post's FOV 2 atan(m / (m - 0.5)) per level, lookups scaled
+//                   to match, clamp;
+//   cube-average  - texel-centre faces whose edge texels are averaged across each edge and corner
+//                   after the bake (CubeMapGen), clamp;
+//   cube-border   - faces stored with a one-texel border of their neighbours' texels (the texture
+//                   borders the post starts from): seamless within a texel of the edge.
+enum class CubeMethod { Clamp, Seamless, Stretch, Warp, Fixup, Discard, FixupLevel, Fov, Average, Border };
 
 std::optional<Method> parse_method(std::string_view name);
 std::string to_string(Method method);

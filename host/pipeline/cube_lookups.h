@@ -19,8 +19,8 @@ struct CubeLookup {
 
 class CubeLookups {
  public:
-  // Uploads the cube's texels once.
-  CubeLookups(ClRuntime& runtime, const CubeMap& cube);
+  // Uploads the cube's texels once; `border`: in cube-border's layout (for that method only).
+  CubeLookups(ClRuntime& runtime, const CubeMap& cube, bool border = false);
 
   // What sample_cube returns for each lookup; `kernel_ms` gets the kernel's time. sampler.size
   // must be the cube's.

@@ -35,7 +35,7 @@ struct Renderer::Impl {
   cl::Buffer positions, faces, neighbors, level_offsets, texels, srgb_table;
   // The environment: reflective faces (with the scene) and the cube map baked for the method.
   cl::Buffer reflective_faces, cube_texels;
-  std::optional<CubeBake> cube_bake_uploaded;
+  std::optional<CubePreparation> cube_bake_uploaded;
 
   // The frame's constants and counters, which every stage reads; each stage's launcher holds the
   // buffers it writes, grown on demand.
@@ -140,20 +140,22 @@ struct Renderer::Impl {
     tessellation_settings.reset();
   }
 
-  // Bakes and uploads the environment's cube map as `bake` unless it is the one there; a scene
-  // without an environment gets a one-element stand-in (the kernels never read it).
-  void upload_cube(std::optional<CubeBake> bake) {
-    if (cube_texels() != nullptr && cube_bake_uploaded == bake) return;
+  // Bakes and uploads the environment's cube map as `preparation` says unless it is the one
+  // there; a scene without an environment gets a one-element stand-in (the kernels never read it).
+  void upload_cube(std::optional<CubePreparation> preparation) {
+    if (cube_texels() != nullptr && cube_bake_uploaded == preparation) return;
     drain_queue();
     cube_texels = cl::Buffer();
     cube_host = {};
-    if (bake) {
+    if (preparation) {
       const Environment& environment = *scene->environment;
-      cube_host = pack_cube_texels(
-          bake_cube_map(environment_function(environment), environment.cube_size, *bake, environment.bake_samples));
+      CubeMap cube =
+          bake_cube_map(environment_function(environment), environment.cube_size, preparation->bake, environment.bake_samples);
+      if (preparation->average_edges) average_cube_edges(cube);
+      cube_host = pack_cube_texels(cube, preparation->border);
     }
     cube_texels = upload_shared(cube_host);
-    cube_bake_uploaded = bake;
+    cube_bake_uploaded = preparation;
   }
 
   void release_frame_buffers() {
@@ -340,7 +342,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     impl_->add_adjacency(std::move(adjacency));
   }
   throw_if_stage_stopped("the cube map");
-  impl_->upload_cube(impl_->scene->environment ? std::optional(cube_bake(options.cube_method)) : std::nullopt);
+  impl_->upload_cube(impl_->scene->environment ? std::optional(cube_preparation(options.cube_method)) : std::nullopt);
   throw_if_stage_stopped("the kernels");
   impl_->use_kernels(options.texels, sampler, with_seam_mask);
   throw_if_stage_stopped("the frame");

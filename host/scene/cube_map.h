@@ -8,6 +8,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -39,6 +40,10 @@ enum class CubeBake {
   Centres,  // map_1(x) = (x + 0.5) * 2 / n - 1: the texel centre (cube-clamp, -seamless, -discard)
   Stretch,  // map_2(x) = 2 x / (n - 1) - 1: edge texels on the cube edge (cube-stretch, -fixup)
   Warp,     // warp3(map_1(x)), warp3(u) = u + a u^3, a = n^2 / (n - 1)^3 (cube-warp)
+  Fov,      // map_1(x) n / (n - 0.5): the face rendered with the post's (Ysaneya's) FOV 2 atan(n / (n - 0.5))
+            // (cube-fov). Its edge texel centres land at (n - 1) / (n - 0.5), a quarter of a tweaked
+            // texel short of the edge, not on it: the FOV that puts them there is 2 atan(n / (n - 1)),
+            // which is map_2, the stretch bake.
 };
 std::string to_string(CubeBake bake);
 
@@ -46,6 +51,7 @@ float cube_map1(float x, int n);
 float cube_map2(float x, int n);// 0 (the face centre) for n = 1
 float cube_warp_coefficient(int n);  // n^2 / (n - 1)^3; 0 for n = 1
 float cube_warp3(float u, int n);
+float cube_map_fov(float x, int n);  // map_1(x, n) * n / (n - 0.5)
 // The face coordinate texel x of an n-texel level stands for under `bake`.
 float cube_bake_coordinate(CubeBake bake, float x, int n);
 
@@ -70,5 +76,28 @@ struct CubeMap {
 // power of two in 1..kMaxCubeSize.
 inline constexpr int kMaxCubeSize = 512;  // 6 (4 n^2 - 1) / 3 texels: 2^21 for 512
 CubeMap bake_cube_map(const DirectionFunction& radiance, int size, CubeBake bake, int samples = 1);
+
+// The texel across the edge: for texel (i, j) of an m x m level of `face` on the face's border,
+// the texels of the adjacent faces that share its edge (one) or corner (two), each as
+// (face, i, j). Empty for an interior texel; for m = 1 every face's texel meets every edge, and
+// the other five faces are returned.
+struct CubeTexel {
+  int face, i, j;
+  bool operator<(const CubeTexel& o) const {
+    return face != o.face ? face < o.face : j != o.j ? j < o.j : i < o.i;
+  }
+};
+std::vector<CubeTexel> cube_edge_partners(int face, int m, int i, int j);
+
+// CubeMapGen's edge averaging, at every level: each border texel becomes the mean of itself and
+// its partners (cube_edge_partners), summed in one order for all of them, so the texels either
+// side of an edge hold the same value bit for bit and the three at a corner too. With clamp
+// lookups this closes the zero-order seam at the edge and shifts the edge texels' content by up to
+// half a texel (the average stands where each face's own texel centre is).
+void average_cube_edges(CubeMap& cube);
+
+// Texels of a cube of level-0 size n (a power of two) in the kernels' layout: 6 (4 n^2 - 1) / 3,
+// and with a one-texel border at every level 6 ((4 n^2 - 1) / 3 + 8 n - 4 + 4 (log2 n + 1)).
+size_t cube_texel_count(int size, bool border);
 
 }  // namespace seamcl

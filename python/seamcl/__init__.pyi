@@ -65,7 +65,7 @@ def render(
     frame: Optional[int] = ...,  # Orbit frame K (0-based) of frames
     frames: int = ...,  # Frames in the orbit
     tint: bool = ...,  # Built-in scenes: tint each face a different base colour
-    cube_method: Literal['cube-clamp', 'cube-seamless', 'cube-stretch', 'cube-warp', 'cube-fixup', 'cube-discard'] = ...,  # Cube-map seam method of scenes with an environment (envmap)
+    cube_method: Literal['cube-clamp', 'cube-seamless', 'cube-stretch', 'cube-warp', 'cube-fixup', 'cube-discard', 'cube-fixup-level', 'cube-fov', 'cube-average', 'cube-border'] = ...,  # Cube-map seam method of scenes with an environment (envmap)
     displacement_method: Optional[Literal['naive', 'zipper', 'ownership', 'fixed', 'ptex-filter']] = ...,  # Tessellate every patch and displace it by the scene's maps with this seam method
     tessellation: int = ...,  # Displacement: each patch a (T+1)^2 grid
     displacement_level: int = ...,  # Displacement: the maps' level every patch samples
@@ -93,7 +93,7 @@ def compare(
     frame: Optional[int] = ...,  # Orbit frame K (0-based) of frames
     frames: int = ...,  # Frames in the orbit
     tint: bool = ...,  # Built-in scenes: tint each face a different base colour
-    cube_method: Literal['cube-clamp', 'cube-seamless', 'cube-stretch', 'cube-warp', 'cube-fixup', 'cube-discard'] = ...,  # Cube-map seam method of scenes with an environment (envmap)
+    cube_method: Literal['cube-clamp', 'cube-seamless', 'cube-stretch', 'cube-warp', 'cube-fixup', 'cube-discard', 'cube-fixup-level', 'cube-fov', 'cube-average', 'cube-border'] = ...,  # Cube-map seam method of scenes with an environment (envmap)
     displacement_method: Optional[Literal['naive', 'zipper', 'ownership', 'fixed', 'ptex-filter']] = ...,  # Tessellate every patch and displace it by the scene's maps with this seam method
     tessellation: int = ...,  # Displacement: each patch a (T+1)^2 grid
     displacement_level: int = ...,  # Displacement: the maps' level every patch samples

@@ -43,7 +43,10 @@ void tap(FilterSum& sum, const std::vector<float>& texels, int size, int face, i
   const bool out_i = i < 0 || i >= m;
   const bool out_j = j < 0 || j >= m;
   const int ci = std::clamp(i, 0, m - 1), cj = std::clamp(j, 0, m - 1);
-  if (!out_i && !out_j) {
+  if (method == SEAMCL_CUBE_BORDER) {
+    // The border holds what seamless reads one texel out; further out clamps to the border.
+    add_texel(sum, texels, cube_border_texel_index(size, face, level, std::clamp(i, -1, m), std::clamp(j, -1, m)), w);
+  } else if (!out_i && !out_j) {
     add_texel(sum, texels, cube_texel_index(size, face, level, i, j), w);
   } else if (method == SEAMCL_CUBE_DISCARD) {
     // border zero
@@ -63,6 +66,10 @@ void tap(FilterSum& sum, const std::vector<float>& texels, int size, int face, i
 void bilinear(FilterSum& sum, const std::vector<float>& texels, int size, int face, int level, float s, float t,
               float weight, int method) {
   const int m = std::max(size >> level, 1);
+  // fixup-level and fov: this level's own scale about the face centre.
+  const float scale = cube_level_scale(method, m);
+  s = 0.5f + (s - 0.5f) * scale;
+  t = 0.5f + (t - 0.5f) * scale;
   const float lo = method == SEAMCL_CUBE_SEAMLESS ? -static_cast<float>(m) : -2.0f;
   const float hi = method == SEAMCL_CUBE_SEAMLESS ? 2.0f * static_cast<float>(m) - 2.0f : static_cast<float>(m) + 1.0f;
   const float x = std::fmin(std::fmax(s * static_cast<float>(m) - 0.5f, lo), hi);
@@ -130,6 +137,24 @@ uint32_t cube_texel_index(int size, int face, int level, int i, int j) {
   const uint32_t face_start = static_cast<uint32_t>(face) * ((4u * n * n - 1u) / 3u);
   const uint32_t level_start = 4u * (n * n - m * m) / 3u;
   return face_start + level_start + static_cast<uint32_t>(j) * m + static_cast<uint32_t>(i);
+}
+
+uint32_t cube_border_texel_index(int size, int face, int level, int i, int j) {
+  const uint32_t n = static_cast<uint32_t>(size);
+  const uint32_t m = std::max(n >> level, 1u);
+  assert(i >= -1 && j >= -1 && i <= static_cast<int>(m) && j <= static_cast<int>(m));
+  uint32_t levels = 0;
+  for (uint32_t k = n; k >= 1; k /= 2) ++levels;
+  const uint32_t face_texels = (4u * n * n - 1u) / 3u + 8u * n - 4u + 4u * levels;
+  const uint32_t level_start = 4u * (n * n - m * m) / 3u + 8u * (n - m) + 4u * static_cast<uint32_t>(level);
+  return static_cast<uint32_t>(face) * face_texels + level_start + static_cast<uint32_t>(j + 1) * (m + 2u) +
+         static_cast<uint32_t>(i + 1);
+}
+
+float cube_level_scale(int method, int m) {
+  if (method == SEAMCL_CUBE_FIXUP_LEVEL) return 1.0f - 1.0f / static_cast<float>(m);
+  if (method == SEAMCL_CUBE_FOV) return 1.0f - 0.5f / static_cast<float>(m);
+  return 1.0f;
 }
 
 uint32_t cube_fold_texel(int size, int face, int level, int m, int i, int j) {

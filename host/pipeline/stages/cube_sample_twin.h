@@ -22,6 +22,10 @@ CubeUv cube_project(glm::vec3 d, glm::vec3 ddx, glm::vec3 ddy);
 
 // First texel of (face, level) plus (i, j) in the cube's texel array (layout: CubeSampler).
 uint32_t cube_texel_index(int size, int face, int level, int i, int j);
+// cube-border's layout: texel (i, j), i, j in -1..m, of (face, level) stored with its border.
+uint32_t cube_border_texel_index(int size, int face, int level, int i, int j);
+// The per-level coordinate scale of fixup-level ((m - 1) / m) and fov ((m - 0.5) / m); 1 otherwise.
+float cube_level_scale(int method, int m);
 // The texel of the adjacent face a seamless tap (i, j) of an m x m level reaches, the tap being
 // outside the face in exactly one axis and at most m texels out.
 uint32_t cube_fold_texel(int size, int face, int level, int m, int i, int j);
