@@ -124,8 +124,8 @@ typedef struct {
 
 /* A face's neighbours, for traverse: 48 bytes, packed for every face of the scene, so kept small
  * (six floats a map and float sides took 256 bytes a face). Edge k runs from corner k to corner
- * k+1 (uv (0,0), (1,0), (1,1), (0,1)): edge 0 is v = 0, 1 is u = 1, 2 is v = 1, 3 is u = 0. neighbor[k] is the
- * face across it (-1 at a boundary or a non-manifold edge); edge_map[k] maps this face's uv to the
+ * k+1 (uv (0,0), (1,0), (1,1), (0,1)): edge 0 is v = 0, 1 is u = 1, 2 is v = 1, 3 is u = 0.
+ * neighbor[k] is the face across it (-1 at a boundary or a non-manifold edge); edge_map[k] maps this face's uv to the
  * neighbour's (SEAMCL_MAP_*).
  * corner[k] is the diagonal face past corner k when that corner's vertex has valence 4 (four
  * faces around it, a closed ring), else -1: at any other valence, or at a mesh boundary, there is
