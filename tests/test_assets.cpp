@@ -283,7 +283,7 @@ TEST(Assets, SamplePairsLoadWithTheFilesAdjacencyAgreeingWithTheMesh) {
 
 TEST(Assets, FaceCountsMustMatchAndADisagreeingAdjacencyNamesBothFaces) {
   const std::string counts = input_error([] { load_scene_source(sample("plane.obj"), sample("cube_text.ptx")); }, "texture");
-  EXPECT_TRUE(names_all(counts, {"'cube_text.ptx'", "72 faces", "'plane.obj'", "has 9"}));
+  EXPECT_TRUE(names_all(counts, {"cube_text.ptx'", "72 faces", "plane.obj'", "has 9"}));
 
   // rand_lo on plane.obj, with face 4's right neighbour moved in the file only.
   PtexFile file = read_ptex_file(sample("rand_lo.ptx"));
