@@ -24,8 +24,8 @@
 // set_aniso_grouped); its time is the wall time of the planning pass, the host's ordering of the
 // lookups and the kernels of every count.
 //
-// Run: build/seamcl_bench_lookups   (about 1-2 minutes; --benchmark_filter=seamcl or =oiio to
-// run one side; --benchmark_format=json sends the ratios to stderr).
+// Run: build/seamcl_bench_lookups   (minutes: every filter on both sides; --benchmark_filter=
+// seamcl or =oiio to run one side; --benchmark_format=json sends the ratios to stderr).
 #include <benchmark/benchmark.h>
 
 #include <OpenImageIO/imageio.h>

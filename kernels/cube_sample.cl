@@ -17,8 +17,9 @@
  * Twin: host/pipeline/stages/cube_sample_twin.cpp. */
 
 /* The cube path is compiled as calls, not inlined: a fold can run at three taps of four in two
- * levels of up to 16 probes, and inlining every copy into shade_resolve made PoCL's compile take
- * minutes. It does not vectorise in any case (its probe loop has a per-item trip count). */
+ * levels of up to 16 probes, and inlining every copy into shade_resolve made PoCL's compile of
+ * that kernel many times slower. It does not vectorise in any case (its probe loop has a
+ * per-item trip count). */
 #define CUBE_CALL __attribute__((noinline))
 
 /* A direction on its face. */

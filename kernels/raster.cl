@@ -305,8 +305,8 @@ __kernel void raster(__constant FrameParams* frame, __global const TriangleSetup
   }
   const int16 sample_x = vload16(0, offset_x), sample_y = vload16(0, offset_y);
   /* The tile's output lines, fetched to write while the list is walked: at 16x the copy below
-   * writes 16 KiB per tile, and 14% of this stage's samples sat on its stores, each waiting for
-   * its line to be read first. The prefetch took 5% off the stage at 16x. */
+   * writes 16 KiB per tile, and without the prefetch each of its stores waits for its line to be
+   * read first (docs/performance.md, "MSAA" rows). */
   for (int r = 0; r < rows; ++r) {
     __global const uint* out = sample_triangle + ((size_t)(y0 + r) * (size_t)frame->width + (size_t)x0) * (size_t)samples;
     for (int w = 0; w < lanes * samples; w += 16) SEAMCL_PREFETCH_WRITE(out + w);

@@ -47,7 +47,8 @@ typedef float cl_float;
  * contraction (kernels and twins alike; Sampler.ProbeCountLog2TableIsTheKernelsPolynomial checks
  * each entry). An aniso lookup's lod is log2(major) - log2(N), and N, the last step of a chain of
  * divide, square root and ceiling, is on the path from the footprint to the first texel's address:
- * a table read there in place of six dependent multiply-adds took about 7% off shade on paper. */
+ * a table read there in place of six dependent multiply-adds shortens that path (measured in
+ * docs/performance.md, "lookups" rows). */
 #define SEAMCL_LOG2_PROBE_COUNTS                                                                  \
   {0x0p+0f,        0x1p+0f,        0x1.95c02p+0f,  0x1p+1f,        0x1.2934f6p+1f, 0x1.4ae01p+1f,  \
    0x1.67575ep+1f, 0x1.8p+1f,      0x1.95c02p+1f,  0x1.a934f6p+1f, 0x1.bace9ap+1f, 0x1.cae01p+1f,  \
@@ -121,10 +122,10 @@ typedef struct {
 #define SEAMCL_SIDE_NONE 0
 #define SEAMCL_SIDE_BIAS 128
 
-/* A face's neighbours, for traverse (48 bytes: at 99,037 faces 4.75 MB, where six floats a map
- * and float sides took 256 bytes a face). Edge k runs from corner k to corner k+1 (uv (0,0),
- * (1,0), (1,1), (0,1)): edge 0 is v = 0, 1 is u = 1, 2 is v = 1, 3 is u = 0. neighbor[k] is the
- * face across it (-1 at a boundary or a non-manifold edge); edge_map[k] maps this face's uv to the
+/* A face's neighbours, for traverse: 48 bytes, packed for every face of the scene, so kept small
+ * (six floats a map and float sides took 256 bytes a face). Edge k runs from corner k to corner
+ * k+1 (uv (0,0), (1,0), (1,1), (0,1)): edge 0 is v = 0, 1 is u = 1, 2 is v = 1, 3 is u = 0.
+ * neighbor[k] is the face across it (-1 at a boundary or a non-manifold edge); edge_map[k] maps this face's uv to the
  * neighbour's (SEAMCL_MAP_*).
  * corner[k] is the diagonal face past corner k when that corner's vertex has valence 4 (four
  * faces around it, a closed ring), else -1: at any other valence, or at a mesh boundary, there is

@@ -135,9 +135,9 @@ SEAMCL_INLINE float3 shade_sky(__constant FrameParams* frame, __global const flo
  * each of pixel x + 1's four finest levels (whose table). The lod is not known yet; at 99,037 faces
  * a face's levels are a few lines each (8x16 texels at level 0), so the lines a lookup reads are
  * mostly these. PoCL runs a group's work-items in x order. Prefetches change no result; the first
- * three steps took 4-7% off this stage's CPU time (paper at 2,474 and 99,037 faces), about 3% at
- * 16x, nothing with traverse; the texel step a further 2-7% at 99,037 faces (eight alternating
- * runs, median of the pairs 4.6%), nothing measurable on paper, at 16x or with traverse. */
+ * three steps pay on paper at both face counts, less at 16x and not with traverse; the texel step
+ * only at 99,037 faces, whose small faces make these lines most of what a lookup reads
+ * (docs/performance.md, "traverse" and "faces" rows). */
 SEAMCL_INLINE void prefetch_ahead(__constant FrameParams* frame, __global const TriangleSetup* setups,
                                   __global const FaceGpu* faces, __global const uint* level_offsets,
                                   TEXEL_BUFFER texels, __global const uint* ids, int x) {
@@ -302,7 +302,7 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
                    __global FrameStats* stats, __global uchar* seam_mask,
                    __global const ReflectiveFace* reflective_faces, __global const float* cube_texels) {
   /* Fragments are summed per work-group without atomics: a locked add per pixel waits for the
-   * pixel's image store to drain, and took 7% of this stage at 99,037 faces. */
+   * pixel's image store to drain (docs/performance.md, "faces" rows). */
   __local uint group_fragments[SEAMCL_TILE_SIZE * SEAMCL_TILE_SIZE];
   const int x = (int)get_global_id(0);
   const int y = (int)get_global_id(1);

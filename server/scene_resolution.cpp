@@ -88,7 +88,8 @@ std::shared_ptr<const Scene> SceneResolver::builtin_scene(const std::string& nam
   GeneratorOptions generator_options;
   generator_options.tint = tint;
   // Deferred: a slot's Renderer packs each face from the generator, so no float copy of the
-  // scene's textures is held for the server's life (all of them together were about 700 MB).
+  // scene's textures is held for the server's life (the built-in scenes' float textures together
+  // would be most of the service's memory).
   generator_options.defer_textures = true;
   auto scene = std::make_shared<const Scene>(generate_scene(name, generator_options));
   scenes_[key] = scene;

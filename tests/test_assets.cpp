@@ -66,6 +66,17 @@ std::string input_error(Run run, const std::string& field) {
   return {};
 }
 
+// Whether `message` names each of `figures`: what makes it about this input (an index with what it
+// counts, a line, a size, a quoted word, the file) and, where cases differ only by it, the word for
+// the rule broken. The sentence around them is free to change.
+::testing::AssertionResult names_all(const std::string& message, const std::vector<std::string>& figures) {
+  std::string missing;
+  for (const std::string& figure : figures)
+    if (message.find(figure) == std::string::npos) missing += (missing.empty() ? "" : ", ") + ("\"" + figure + "\"");
+  if (missing.empty()) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "the message does not name " << missing << ": " << message;
+}
+
 // The refusals of the two methods that read neighbours (traverse, guardband), each checked to name
 // `method`, for a 32x32 render of `scene`.
 std::vector<std::string> neighbour_method_refusals(const Scene& scene) {
@@ -179,12 +190,11 @@ TEST(Assets, ObjRefusesAFaceThatIsNotAQuadNamingItsIndexAndLine) {
   const std::string text = "version 1\nsurface subd per-face cage crafted\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\n"
                            "f 1 2 3 4\nf 2 5 3 4\n# a triangle next\nf 1 2 3\n";
   const std::string message = input_error([&] { parse_obj(text, "crafted.obj"); }, "scene");
-  EXPECT_NE(message.find("'crafted.obj': face 2 (0-based; line 11) has 3 vertices; only quads are supported"), std::string::npos)
-      << message;
+  EXPECT_TRUE(names_all(message, {"'crafted.obj'", "face 2", "line 11", "3 vertices", "quads"}));
   const std::string missing = input_error([] { parse_obj("v 0 0 0\nf 1 2 3 4\n", "m.obj", "mesh"); }, "mesh");
-  EXPECT_NE(missing.find("face 0 (0-based; line 2) names a vertex that does not exist"), std::string::npos) << missing;
-  EXPECT_NE(input_error([] { parse_obj("v 0 0 0\n", "empty.obj"); }, "scene").find("has no faces"), std::string::npos);
-  EXPECT_NE(input_error([] { read_obj_file("/nonexistent/x.obj"); }, "scene").find("no such file"), std::string::npos);
+  EXPECT_TRUE(names_all(missing, {"'m.obj'", "face 0", "line 2", "does not exist"}));
+  EXPECT_TRUE(names_all(input_error([] { parse_obj("v 0 0 0\n", "empty.obj"); }, "scene"), {"'empty.obj'", "no faces"}));
+  EXPECT_TRUE(names_all(input_error([] { read_obj_file("/nonexistent/x.obj"); }, "scene"), {"/nonexistent/x.obj", "no such file"}));
 }
 
 // tinyobjloader reads an index with atoi (which wraps) and a number as its longest numeric prefix or 0;
@@ -192,48 +202,44 @@ TEST(Assets, ObjRefusesAFaceThatIsNotAQuadNamingItsIndexAndLine) {
 TEST(Assets, ObjRefusesBadNumbersAndIndicesNamingTheLineAndTheWord) {
   const std::string quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
   struct Case {
-    std::string text, expected;
+    std::string text;
+    std::vector<std::string> figures;
   };
   for (const Case& c : {
-           Case{quad + "f 99999999999999999999 2 3 4\n",
-                "'bad.obj': face 0 (0-based; line 5) names a vertex that does not exist: '99999999999999999999'; "
-                "the file has 4 vertices"},
-           Case{quad + "f 4294967297 2 3 4\n",
-                "'bad.obj': face 0 (0-based; line 5) names a vertex that does not exist: '4294967297'; the file has 4 vertices"},
-           Case{"v nan 0 0\n" + quad + "f 1 2 3 4\n", "'bad.obj': vertex 0 (0-based; line 1): 'nan' is not a finite number"},
-           Case{quad + "v inf 0 0\nf 1 2 3 4\n", "'bad.obj': vertex 4 (0-based; line 5): 'inf' is not a finite number"},
-           Case{quad + "v 0x10 0 0\nf 1 2 3 4\n", "'bad.obj': vertex 4 (0-based; line 5): '0x10' is not a decimal number"},
-           Case{quad + "v 1,5 0 0\nf 1 2 3 4\n", "'bad.obj': vertex 4 (0-based; line 5): '1,5' is not a decimal number"},
+           Case{quad + "f 99999999999999999999 2 3 4\n", {"'bad.obj'", "face 0", "line 5", "'99999999999999999999'", "4 vertices"}},
+           Case{quad + "f 4294967297 2 3 4\n", {"'bad.obj'", "face 0", "line 5", "'4294967297'", "4 vertices"}},
+           Case{"v nan 0 0\n" + quad + "f 1 2 3 4\n", {"'bad.obj'", "vertex 0", "line 1", "'nan'", "finite"}},
+           Case{quad + "v inf 0 0\nf 1 2 3 4\n", {"'bad.obj'", "vertex 4", "line 5", "'inf'", "finite"}},
+           Case{quad + "v 0x10 0 0\nf 1 2 3 4\n", {"'bad.obj'", "vertex 4", "line 5", "'0x10'", "decimal"}},
+           Case{quad + "v 1,5 0 0\nf 1 2 3 4\n", {"'bad.obj'", "vertex 4", "line 5", "'1,5'", "decimal"}},
            // More of the same kind.
-           Case{quad + "v 0 -INF 0\nf 1 2 3 4\n", "vertex 4 (0-based; line 5): '-INF' is not a finite number"},
-           Case{quad + "v 0 0 1e39\nf 1 2 3 4\n", "vertex 4 (0-based; line 5): '1e39' is out of the range of a 32-bit float"},
-           Case{quad + "v 1 2\nf 1 2 3 4\n", "vertex 4 (0-based; line 5) has 2 numbers"},
-           Case{quad + "f 1 2 3 0\n", "face 0 (0-based; line 5) names vertex '0'; OBJ indices start at 1"},
-           Case{quad + "f 1 2 3 4.0\n", "face 0 (0-based; line 5) has a vertex index '4.0' that is not an integer"},
-           Case{quad + "f 1 2 3 -5\n", "face 0 (0-based; line 5) names a vertex that does not exist: '-5' counts back past the 4 "
-                                       "vertices before line 5"},
-           Case{quad + "f 1 2 3 4\nf 1 2 3 -4294967295\n", "face 1 (0-based; line 6) names a vertex that does not exist: '-4294967295'"},
-           Case{quad + "f 1/x 2 3 4\n", "face 0 (0-based; line 5) has a texture coordinate index 'x' in corner '1/x' "
-                                        "that is not an integer"},
-           Case{quad + "f 1/0 2 3 4\n", "face 0 (0-based; line 5) names texture coordinate '0' in corner '1/0'"},
-           Case{"vn 0 0 1\n" + quad + "f 1//x 2 3 4\n", "face 0 (0-based; line 6) has a normal index 'x' in corner '1//x'"},
-           Case{quad + "f 1/1/1/1 2 3 4\n", "face 0 (0-based; line 5) has a corner '1/1/1/1' that is not i, i/j, i//k or i/j/k"},
+           Case{quad + "v 0 -INF 0\nf 1 2 3 4\n", {"vertex 4", "line 5", "'-INF'", "finite"}},
+           Case{quad + "v 0 0 1e39\nf 1 2 3 4\n", {"vertex 4", "line 5", "'1e39'", "32-bit float"}},
+           Case{quad + "v 1 2\nf 1 2 3 4\n", {"vertex 4", "line 5", "2 numbers"}},
+           Case{quad + "f 1 2 3 0\n", {"face 0", "line 5", "'0'", "start at 1"}},
+           Case{quad + "f 1 2 3 4.0\n", {"face 0", "line 5", "'4.0'", "integer"}},
+           Case{quad + "f 1 2 3 -5\n", {"face 0", "line 5", "'-5'", "4 vertices"}},
+           Case{quad + "f 1 2 3 4\nf 1 2 3 -4294967295\n", {"face 1", "line 6", "'-4294967295'", "does not exist"}},
+           Case{quad + "f 1/x 2 3 4\n", {"face 0", "line 5", "texture coordinate", "'x'", "'1/x'", "integer"}},
+           Case{quad + "f 1/0 2 3 4\n", {"face 0", "line 5", "texture coordinate", "'0'", "'1/0'"}},
+           Case{"vn 0 0 1\n" + quad + "f 1//x 2 3 4\n", {"face 0", "line 6", "normal", "'x'", "'1//x'"}},
+           Case{quad + "f 1/1/1/1 2 3 4\n", {"face 0", "line 5", "'1/1/1/1'"}},
            // A lone carriage return ends a line for tinyobjloader, so it does here: no line hides behind a comment.
-           Case{"# a comment\rv nan 0 0\r\n" + quad + "f 1 2 3 4\n", "vertex 0 (0-based; line 2): 'nan' is not a finite number"},
+           Case{"# a comment\rv nan 0 0\r\n" + quad + "f 1 2 3 4\n", {"vertex 0", "line 2", "'nan'", "finite"}},
        }) {
     SCOPED_TRACE(c.text);
     const std::string message = input_error([&] { parse_obj(c.text, "bad.obj"); }, "scene");
-    EXPECT_NE(message.find(c.expected), std::string::npos) << message;
+    EXPECT_TRUE(names_all(message, c.figures));
   }
   // A hostile word is quoted cut short and without control characters, so the message stays one short line.
   const std::string long_word = input_error([&] { parse_obj(quad + "v 1 2 3" + std::string(1000, '\x01') + "\nf 1 2 3 4\n", "bad.obj"); }, "scene");
-  EXPECT_NE(long_word.find("vertex 4 (0-based; line 5): '3???"), std::string::npos) << long_word;
+  EXPECT_TRUE(names_all(long_word, {"vertex 4", "line 5", "'3???"}));
   EXPECT_LT(long_word.size(), 200u) << long_word;
   // Through read_obj_file and the field a scene file names, as a mesh on disk is read.
   TempDir dir;
   const std::string path = dir.write("nan.obj", quad + "v nan 0 0\nf 1 2 3 4\n");
   const std::string message = input_error([&] { read_obj_file(path, "mesh"); }, "mesh");
-  EXPECT_NE(message.find("'" + path + "': vertex 4 (0-based; line 5): 'nan' is not a finite number"), std::string::npos) << message;
+  EXPECT_TRUE(names_all(message, {"'" + path + "'", "vertex 4", "line 5", "'nan'", "finite"}));
 }
 
 TEST(Assets, ObjStillReadsSlashedRelativeAndForwardIndicesWAndVertexColours) {
@@ -277,8 +283,7 @@ TEST(Assets, SamplePairsLoadWithTheFilesAdjacencyAgreeingWithTheMesh) {
 
 TEST(Assets, FaceCountsMustMatchAndADisagreeingAdjacencyNamesBothFaces) {
   const std::string counts = input_error([] { load_scene_source(sample("plane.obj"), sample("cube_text.ptx")); }, "texture");
-  EXPECT_NE(counts.find("has 72 faces but the mesh"), std::string::npos) << counts;
-  EXPECT_NE(counts.find("has 9"), std::string::npos) << counts;
+  EXPECT_TRUE(names_all(counts, {"cube_text.ptx'", "72 faces", "plane.obj'", "has 9"}));
 
   // rand_lo on plane.obj, with face 4's right neighbour moved in the file only.
   PtexFile file = read_ptex_file(sample("rand_lo.ptx"));
@@ -287,8 +292,7 @@ TEST(Assets, FaceCountsMustMatchAndADisagreeingAdjacencyNamesBothFaces) {
   file.faces[4].adjacent_faces[1] = 0;
   const std::string message = input_error(
       [&] { scene_from_ptex(read_obj_file(sample("plane.obj")), file, "plane.obj", "rand_lo.ptx"); }, "texture");
-  EXPECT_NE(message.find("face 4 edge 1 (right) meets face 0 edge"), std::string::npos) << message;
-  EXPECT_NE(message.find("but face " + std::to_string(old_neighbor) + " edge"), std::string::npos) << message;
+  EXPECT_TRUE(names_all(message, {"face 4 edge 1", "face 0 edge", "face " + std::to_string(old_neighbor) + " edge"}));
 }
 
 // Faces that share an edge, but only an edge of three faces: nothing links them, and the refusal
@@ -306,9 +310,7 @@ TEST(Assets, TraverseRefusesAMeshWhoseOnlySharedEdgeIsNonManifoldSayingSo) {
   EXPECT_EQ(non_manifold.example_faces, 3u);
   for (const std::string& message : neighbour_method_refusals(scene)) {
     EXPECT_EQ(message.find("no two of"), std::string::npos) << message;
-    EXPECT_NE(message.find("its only shared edge, between vertices 0 and 1 (0-based), is shared by 3 faces"),
-              std::string::npos)
-        << message;
+    EXPECT_TRUE(names_all(message, {"vertices 0 and 1", "3 faces"}));
   }
   // A manifold mesh has none.
   EXPECT_EQ(non_manifold_edges(load_scene_source(sample("plane.obj"))).count, 0u);
@@ -318,7 +320,7 @@ TEST(Assets, TraverseRefusesAMeshWhoseOnlySharedEdgeIsNonManifoldSayingSo) {
   const std::string folded = dir.write("folded.obj", "v 0 0 0\nv 0 1 0\nv 1 1 0\nv -1 0 0\nv -1 1 0\n"
                                                      "f 1 2 1 3\nf 2 1 4 5\n");
   const std::string refusal = input_error([&] { load_scene_source(folded); }, "faces[0].vertices");
-  EXPECT_NE(refusal.find("the quad is degenerate (zero area)"), std::string::npos) << refusal;
+  EXPECT_TRUE(names_all(refusal, {"zero area"}));
 }
 
 TEST(Assets, TraverseAndGuardbandRefuseAMeshWithoutSharedEdgesSingleQuadsStillRender) {
@@ -330,7 +332,7 @@ TEST(Assets, TraverseAndGuardbandRefuseAMeshWithoutSharedEdgesSingleQuadsStillRe
   const std::vector<std::string> refusals = neighbour_method_refusals(scene);
   ASSERT_EQ(refusals.size(), 2u);
   for (const std::string& message : refusals) {
-    EXPECT_NE(message.find("no two of the 2 faces of scene 'split' share an edge"), std::string::npos) << message;
+    EXPECT_TRUE(names_all(message, {"2 faces", "'split'", "share an edge"}));
   }
   Renderer renderer(shared_runtime());
   renderer.load_scene(scene);
@@ -343,22 +345,20 @@ TEST(Assets, TraverseAndGuardbandRefuseAMeshWithoutSharedEdgesSingleQuadsStillRe
   // adjacency packed and kept), a guardband band that is not 1..16.
   for (Method method : {Method::Guardband, Method::Traverse, Method::TraverseEdges}) {
     options.method = method;
-    EXPECT_NE(input_error([&] { renderer.render(scene.camera, options); }, "method").find("share an edge"),
-              std::string::npos);
+    EXPECT_TRUE(names_all(input_error([&] { renderer.render(scene.camera, options); }, "method"), {"2 faces", "'split'"}));
   }
   options.method = Method::Black;
   EXPECT_EQ(renderer.render(scene.camera, options, true).seam_mask.size(), size_t{32 * 32});
   EXPECT_EQ(renderer.packed_scene().neighbors.size(), 2u);
   for (Method method : {Method::Traverse, Method::Guardband}) {
     options.method = method;
-    EXPECT_NE(input_error([&] { renderer.render(scene.camera, options); }, "method").find("share an edge"),
-              std::string::npos);
+    EXPECT_TRUE(names_all(input_error([&] { renderer.render(scene.camera, options); }, "method"), {"2 faces", "'split'"}));
   }
   options.method = Method::Guardband;
   for (int band : {0, -1, 17}) {
     options.guard_band = band;
-    EXPECT_NE(input_error([&] { renderer.render(scene.camera, options); }, "guard_band").find("1..16"),
-              std::string::npos);
+    EXPECT_TRUE(names_all(input_error([&] { renderer.render(scene.camera, options); }, "guard_band"),
+                          {"1..16", "got " + std::to_string(band)}));
   }
   options.guard_band = 4;
   options.method = Method::Discard;
@@ -535,14 +535,13 @@ TEST(Assets, MeshSceneFilesNamePathsRelativeToTheFile) {
   EXPECT_EQ(framed.camera.eye, glm::vec3(0, 0, 3));
   EXPECT_TRUE(framed.orbit.has_value());
   const std::string unknown = dir.write("scenes/bad.json", R"({"mesh": "x.obj", "lights": 1})");
-  EXPECT_NE(input_error([&] { load_scene_source(unknown); }, "lights").find("unknown field"), std::string::npos);
+  EXPECT_TRUE(names_all(input_error([&] { load_scene_source(unknown); }, "lights"), {"unknown field", "mesh"}));
   const std::string missing = dir.write("scenes/missing.json", R"({"mesh": "nowhere.obj"})");
-  EXPECT_NE(input_error([&] { load_scene_source(missing); }, "mesh").find("(in '"), std::string::npos);
+  EXPECT_TRUE(names_all(input_error([&] { load_scene_source(missing); }, "mesh"), {"nowhere.obj", "'" + missing + "'"}));
   // As strict as every scene file: a repeated key (the last would win unseen) is refused.
   const std::string twice = dir.write("scenes/twice.json", R"({"mesh": ")" + mesh + R"(", "mesh": "nowhere.obj"})");
-  EXPECT_NE(input_error([&] { load_scene_source(twice); }, "scene").find("key 'mesh' is given twice"), std::string::npos);
-  EXPECT_NE(input_error([&] { load_scene_source("paper", sample("wave_lo.ptx")); }, "texture").find("goes with an .obj scene"),
-            std::string::npos);
+  EXPECT_TRUE(names_all(input_error([&] { load_scene_source(twice); }, "scene"), {"'mesh'", "twice"}));
+  EXPECT_TRUE(names_all(input_error([&] { load_scene_source("paper", sample("wave_lo.ptx")); }, "texture"), {".obj", "'paper'"}));
 }
 
 TEST(Assets, ImageFacesAreReadUprightRelativeToTheSceneFile) {
@@ -570,11 +569,11 @@ TEST(Assets, ImageFacesAreReadUprightRelativeToTheSceneFile) {
 
   const std::string odd = input_error([&] { load_scene_source(dir.write("odd.json", scene_with("tiles/odd.exr").dump())); },
                                       "faces[0].texture.image");
-  EXPECT_NE(odd.find("3 texels wide; each side must be a power of two"), std::string::npos) << odd;
+  EXPECT_TRUE(names_all(odd, {"3 texels", "power of two"}));
   input_error([&] { load_scene_source(dir.write("gone.json", scene_with("tiles/gone.png").dump())); }, "faces[0].texture.image");
   // host/scene alone reads no file: an inline scene cannot name one.
   const std::string inline_message = input_error([&] { parse_scene_json(scene_with("tiles/tile.exr")); }, "faces[0].texture.image");
-  EXPECT_NE(inline_message.find("cannot be read here"), std::string::npos);
+  EXPECT_TRUE(names_all(inline_message, {"inline"}));
   nlohmann::json both = scene_with("tiles/tile.exr");
   both["faces"][0]["texture"]["width"] = 4;
   input_error([&] { parse_scene_json(both); }, "faces[0].texture.width");
@@ -666,26 +665,25 @@ TEST(Assets, AnImageFaceThatChangedOrWentBeforeItIsPackedIsAnInputError) {
   Scene scene = fresh();
   write_image(image, 8, 8, varied_pixels(8, 8, 5));
   fs::last_write_time(image, fs::last_write_time(image) + std::chrono::seconds(2));
-  EXPECT_NE(input_error([&] { face_texture(scene, 0); }, field).find("changed since the scene was read"), std::string::npos);
+  EXPECT_TRUE(names_all(input_error([&] { face_texture(scene, 0); }, field), {"face.png", "changed"}));
   Renderer renderer(shared_runtime());
-  EXPECT_NE(input_error([&] { renderer.load_scene(scene); }, field).find("face.png"), std::string::npos);
+  EXPECT_TRUE(names_all(input_error([&] { renderer.load_scene(scene); }, field), {"face.png", "changed"}));
 
   // Only touched (same bytes, later time): refused as well; the stamp is all that is compared.
   scene = fresh();
   fs::last_write_time(image, fs::last_write_time(image) + std::chrono::seconds(2));
-  EXPECT_NE(input_error([&] { face_texture(scene, 0); }, field).find("modified again"), std::string::npos);
+  EXPECT_TRUE(names_all(input_error([&] { face_texture(scene, 0); }, field), {"face.png", "modified"}));
 
   // Another size.
   scene = fresh();
   write_image(image, 16, 8, varied_pixels(16, 8, 4));
-  EXPECT_NE(input_error([&] { face_texture(scene, 0); }, field).find("changed since"), std::string::npos);
+  EXPECT_TRUE(names_all(input_error([&] { face_texture(scene, 0); }, field), {"face.png", "changed", " bytes"}));
 
   // Gone.
   scene = fresh();
   fs::remove(image);
-  EXPECT_NE(input_error([&] { face_texture(scene, 0); }, field).find("is gone"), std::string::npos);
-  EXPECT_NE(input_error([&] { Renderer(shared_runtime()).load_scene(std::move(scene)); }, field).find("is gone"),
-            std::string::npos);
+  EXPECT_TRUE(names_all(input_error([&] { face_texture(scene, 0); }, field), {"face.png", "gone"}));
+  EXPECT_TRUE(names_all(input_error([&] { Renderer(shared_runtime()).load_scene(std::move(scene)); }, field), {"face.png", "gone"}));
 
   // Each of them names the scene file, as the errors found when it is parsed do.
   scene = fresh();
@@ -736,9 +734,7 @@ TEST(Assets, AnImageFaceSwappedForALargerOneIsRefusedAtItsHeaderBeforeAnyPixelIs
   const std::string field = "faces[0].texture.image";
   for (const std::string& message :
        {input_error([&] { face_texture(scene, 0); }, field), input_error([&] { Renderer(shared_runtime()).load_scene(scene); }, field)}) {
-    EXPECT_NE(message.find("changed since the scene was read (64x64, 4 channels -> 128x128, 4 channels)"), std::string::npos)
-        << message;
-    EXPECT_NE(message.find("face.png"), std::string::npos) << message;
+    EXPECT_TRUE(names_all(message, {"face.png", "64x64, 4 channels", "128x128, 4 channels"}));
   }
 }
 
@@ -767,7 +763,7 @@ TEST(Assets, ImageFacesWithBadPixelsAreRefusedWhenParsedOrWhenDeferredWhenMade) 
   write_image((dir.path() / "nan.exr").string(), 4, 4, pixels);
   const std::string nan = dir.write("nan.json", image_cube_scene({"nan.exr"}).dump());
   const std::string eager_message = input_error([&] { load_scene_source(nan); }, "faces[0].texture");
-  EXPECT_NE(eager_message.find("mip level 0 has a non-finite texel"), std::string::npos) << eager_message;
+  EXPECT_TRUE(names_all(eager_message, {"level 0", "non-finite"}));
   const Scene with_nan = load_scene_source(nan, "", deferring());
   // The whole message, the scene file's name included (it is a pack-time error of a scene file).
   EXPECT_EQ(input_error([&] { face_texture(with_nan, 0); }, "faces[0].texture"), eager_message);
@@ -876,14 +872,13 @@ TEST(Assets, TheAssetDirectoryRefusesNamesThatLeaveItAndCachesWhatItLoads) {
   for (const AssetEntry& entry : assets.list()) listed.push_back(entry.name + ":" + to_string(entry.kind));
   EXPECT_EQ(listed, (std::vector<std::string>{"maps/wave_lo.ptx:ptex", "plane.obj:mesh", "scenes/out.json:scene"}));
 
-  EXPECT_NE(input_error([&] { assets.resolve("../" + outside.path().filename().string() + "/secret.obj", "", "scene"); }, "scene")
-                .find("'..' is not allowed"), std::string::npos);
-  EXPECT_NE(input_error([&] { assets.resolve(secret, "", "scene"); }, "scene").find("not an absolute path"), std::string::npos);
-  EXPECT_NE(input_error([&] { assets.resolve("escape.obj", "", "scene"); }, "scene").find("leads out of the asset directory"),
-            std::string::npos);
-  EXPECT_NE(input_error([&] { assets.resolve("linked_dir/secret.obj", "", "texture"); }, "texture").find("leads out"),
-            std::string::npos);
-  EXPECT_NE(input_error([&] { assets.resolve("nothing.obj", "", "scene"); }, "scene").find("no asset"), std::string::npos);
+  EXPECT_TRUE(names_all(input_error([&] { assets.resolve("../" + outside.path().filename().string() + "/secret.obj", "", "scene"); },
+                                    "scene"), {"'..'"}));
+  EXPECT_TRUE(names_all(input_error([&] { assets.resolve(secret, "", "scene"); }, "scene"), {"absolute"}));
+  EXPECT_TRUE(names_all(input_error([&] { assets.resolve("escape.obj", "", "scene"); }, "scene"), {"'escape.obj'", "leads out"}));
+  EXPECT_TRUE(names_all(input_error([&] { assets.resolve("linked_dir/secret.obj", "", "texture"); }, "texture"),
+                        {"'linked_dir/secret.obj'", "leads out"}));
+  EXPECT_TRUE(names_all(input_error([&] { assets.resolve("nothing.obj", "", "scene"); }, "scene"), {"'nothing.obj'", "no asset"}));
   // A scene file inside cannot reach out either.
   input_error([&] { assets.load("scenes/out.json", "", {}); }, "mesh");
 

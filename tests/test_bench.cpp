@@ -262,9 +262,10 @@ TEST_F(Bench, CompareTakesGuardBandCubeMethodAndCentroid) {
   EXPECT_NE(bad.err.find("guard_band"), std::string::npos) << bad.err;
 }
 
-// compare's loop moved into host/eval/comparison.cpp; this is the loop as it stood in
-// cli/compare_command.cpp before the move, and compare must still print what it computed.
-TEST_F(Bench, CompareOutputIsThePreRefactorLoopsButTimings) {
+// Every entry of `compare --json`, its timings aside, is what the library's parts give for it
+// rendered and scored one by one here (Renderer, footprint_seam_mask, compare_images): compare
+// prints what it computed, for every method and rate.
+TEST_F(Bench, CompareJsonIsEachEntryRenderedAndScoredDirectlyButTimings) {
   const BenchProcess c = run_cli(*dir_, "compare --scene quad2 --methods discard,clamp,traverse,guardband --msaa 1,4 "
                                         "--size 64x64 --repeat 1 --json");
   ASSERT_EQ(c.exit_code, 0) << c.err;
@@ -280,7 +281,7 @@ TEST_F(Bench, CompareOutputIsThePreRefactorLoopsButTimings) {
   const ReferenceImage reference = reference_image(renderer, scene.camera, frame, settings);
   EXPECT_TRUE(reference.from_cache);
   const std::vector<double> xs = error_curve_thresholds();
-  json legacy = json::array();
+  json direct = json::array();
   for (const std::string method : {"discard", "clamp", "traverse", "guardband"}) {
     for (int msaa : {1, 4}) {
       json r = request;
@@ -297,7 +298,7 @@ TEST_F(Bench, CompareOutputIsThePreRefactorLoopsButTimings) {
       json curve = json::array(), seam_curve = json::array();
       for (size_t i = 0; i < xs.size(); ++i) curve.push_back({xs[i], errors.all.curve[i]});
       for (size_t i = 0; i < xs.size(); ++i) seam_curve.push_back({xs[i], errors.seam.curve[i]});
-      legacy.push_back({{"method", method},
+      direct.push_back({{"method", method},
                         {"msaa", options.msaa},
                         {"aniso", options.aniso},
                         {"filter", to_string(options.filter)},
@@ -322,14 +323,14 @@ TEST_F(Bench, CompareOutputIsThePreRefactorLoopsButTimings) {
                         {"seam_curve", seam_curve}});
     }
   }
-  ASSERT_EQ(cj["results"].size(), legacy.size());
-  for (size_t i = 0; i < legacy.size(); ++i) {
+  ASSERT_EQ(cj["results"].size(), direct.size());
+  for (size_t i = 0; i < direct.size(); ++i) {
     json printed = cj["results"][i];
     ASSERT_TRUE(printed.contains("ms"));
     EXPECT_EQ(printed["ms"]["runs"], 1);
     printed.erase("ms");
     // Through text and back, as the CLI's numbers went.
-    EXPECT_EQ(printed, json::parse(legacy[i].dump())) << i;
+    EXPECT_EQ(printed, json::parse(direct[i].dump())) << i;
   }
 }
 

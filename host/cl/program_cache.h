@@ -1,6 +1,7 @@
 // Built OpenCL programs kept on disk (CL_PROGRAM_BINARIES), so that a process builds each program
-// variant once per machine rather than once per start: a build is 0.5 s and up per variant with
-// PoCL (237 s for every variant on an empty cache), loading a binary a few milliseconds.
+// variant once per machine rather than once per start: building a variant from source costs far
+// more than loading its binary, and a start on an empty cache builds every variant
+// (docs/benchmarks.md#compare-and-start has the figures and the commands that measured them).
 //
 // An entry is keyed by everything the binary depends on: the device's name, its platform, its
 // OpenCL and driver versions (CL_DRIVER_VERSION), a hash of the kernel source and the full build

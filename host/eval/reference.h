@@ -86,7 +86,7 @@ struct ReferenceSettings {
   std::string cache_dir;   // empty: default_cache_dir()
   bool use_cache = true;
   // The cache's bound, applied after every write (trim_reference_cache): at most this many bytes
-  // and this many entries. 0: unbounded. A 480x540 reference is about 4 MiB (zip float EXR).
+  // and this many entries. 0: unbounded. An entry is one zip float EXR of the compare's size.
   std::uintmax_t cache_max_bytes = kDefaultReferenceCacheBytes;
   size_t cache_max_entries = 0;
   // scene_content_hash of the scene the references are of, when the caller has it; trusted as

@@ -19,8 +19,8 @@ namespace seamcl {
 namespace {
 
 // The pixels as a format stores them: sRGB 8-bit for PNG (encoded with encode_srgb8, the one
-// sRGB encoding of the project: a table, where OIIO's per-pixel colour conversion took several
-// times as long), linear float for EXR (stored as half, or as float when some value lies beyond
+// sRGB encoding of the project: a table, cheaper than OIIO's per-pixel colour conversion),
+// linear float for EXR (stored as half, or as float when some value lies beyond
 // half's range, 65504, which half would store as infinity).
 struct Encoded {
   OIIO::ImageSpec spec;
@@ -45,8 +45,8 @@ Encoded encode_pixels(ImageFormat format, int width, int height, const std::vect
     return out;
   }
   out.spec = OIIO::ImageSpec(width, height, 4, OIIO::TypeDesc::UINT8);
-  // zlib level 1: on a 256x256 render 3.8 ms and 110 KB, against 5.3 ms and 107 KB at level 3
-  // and more at OIIO's default (6); what the HTTP service pays on every image.
+  // zlib level 1: higher levels cost more time for files barely smaller, and the HTTP service
+  // pays this on every image (docs/performance.md, "service" rows).
   out.spec.attribute("png:compressionLevel", 1);
   out.srgb8.resize(pixels.size() * 4);
   for (size_t i = 0; i < pixels.size(); ++i) {

@@ -1,8 +1,8 @@
 // The warm-up job: every program variant built (or loaded from the program cache, host/cl/
 // program_cache.h) ahead of the first request, on every core, then one tiny frame of each rendered
 // so that the driver compiles each kernel for its local size too (PoCL does this on a kernel's
-// first enqueue: 20-250 ms each when its own cache is cold). What `seamcl warmup` runs; a service
-// runs the same before it says it is ready.
+// first enqueue, and with its own cache cold that is slow enough to show in a timed frame). What
+// `seamcl warmup` runs; a service runs the same before it says it is ready.
 #pragma once
 #include <functional>
 #include <string>

@@ -150,8 +150,8 @@ MemoryShares RenderMemory::process_shares(const std::string& multisample_field, 
 
 void add_process_overhead(MemoryShares& figure) {
   // RSS beyond the arrays and buffers themselves: allocator and driver bookkeeping, page rounding,
-  // the packing threads' arenas. tests/estimate_table.py found renders of 15-225 MiB growing by
-  // up to 0.8 MiB more than their exact buffers on PoCL (2026-12-01, before this share existed).
+  // the packing threads' arenas. Without this share tests/estimate_table.py found renders growing
+  // by a little more than their exact buffers (docs/compare.md has the figures).
   figure.add(figure.field(), figure.total() / 64);
 }
 

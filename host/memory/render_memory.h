@@ -199,7 +199,8 @@ size_t scene_held_bytes(const Scene& scene);
 
 // What this process holds, as Linux counts it: VmHWM and VmRSS of /proc/self/status (where that
 // cannot be read, getrusage's ru_maxrss for the peak and 0 for the current). The peak includes the
-// OpenCL runtime's own (PoCL's floor: about 227 MB for the two-face quad2 render).
+// OpenCL runtime's own, which on PoCL is most of a small render's peak (docs/compare.md gives the
+// measured floor, the quad2 render).
 struct ProcessMemory {
   size_t peak_rss_bytes = 0;
   size_t rss_bytes = 0;
@@ -243,8 +244,9 @@ void refuse_beyond_machine(const MemoryShares& device_bytes, const MemoryShares&
 // Makes the allocator give blocks of 1 MiB and more back to the system as soon as they are freed
 // (glibc: a fixed mmap threshold; nothing elsewhere). glibc raises its threshold to the largest
 // block freed so far, so the float chains and decoded images of large deferred faces, made and
-// freed one by one while packing, were kept in its arenas and held through the render: 54 MB of
-// peak RSS for six 1024x1024 image faces. For a process's start, before any thread allocates.
+// freed one by one while packing, were kept in its arenas and held through the render, raising
+// the peak RSS of scenes with large image faces (measured in docs/compare.md). For a process's
+// start, before any thread allocates.
 void return_large_blocks_at_once();
 
 // What one loaded scene costs, measured after a render: for `render --json` and the benches.

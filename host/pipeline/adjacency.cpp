@@ -33,9 +33,9 @@ struct EdgeRef {
 // Every face's edges by their undirected vertex pair, sorted: the faces that share an edge lie
 // side by side. A collapsed edge (both ends one vertex: a triangle written as a quad) is left
 // out: it has no length for a footprint to cross, and faces that meet only at that vertex (the
-// quads around a sphere's pole) would otherwise read as sharing it. 16 bytes an edge: a
-// std::map of vectors, held while the packed texels were already there, took traverse's peak at
-// 99,037 faces 4.8 MB higher.
+// quads around a sphere's pole) would otherwise read as sharing it. A flat array of 16-byte
+// entries rather than a std::map of vectors: this runs while the packed texels are already held,
+// so whatever it allocates adds to traverse's peak memory (docs/performance.md, "memory" rows).
 std::vector<EdgeRef> sorted_edges(const Scene& scene) {
   std::vector<EdgeRef> edges;
   edges.reserve(scene.faces.size() * 4);

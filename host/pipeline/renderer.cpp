@@ -184,8 +184,8 @@ struct Renderer::Impl {
 
   // A packed array that stays on the host (every array of `packed`, the cube's texels): on a device
   // that shares the host's memory (PoCL on the CPU) the buffer is the array itself
-  // (CL_MEM_USE_HOST_PTR), so it is held once rather than twice (issue 14: at 99,037 faces the
-  // adjacency and face records alone were 30 MB a copy); the array outlives the buffer
+  // (CL_MEM_USE_HOST_PTR), so it is held once rather than twice (issue 14: a second copy of
+  // large scenes' tables showed in the peak memory); the array outlives the buffer
   // (release_scene_buffers and upload_cube drop the buffers first, and renders wait for their
   // commands). Elsewhere a device copy, as upload() makes.
   template <typename T>

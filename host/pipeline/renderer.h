@@ -144,7 +144,7 @@ class Renderer {
 
   // Renders one tiny frame of the loaded scene with these options (method, filter, texels) so
   // that the program variant is built and PoCL compiles every kernel for its local size now
-  // (20-250 ms each, cold) rather than inside the first timed frame.
+  // (slow on a cold cache) rather than inside the first timed frame.
   void warm_up(const RenderOptions& options);
 
   // The intermediate buffers of the last frame, for the kernel tests.
