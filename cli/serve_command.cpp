@@ -81,7 +81,10 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   // renders hold every core. Raising a nice value needs no privilege; nothing else changes.
   std::thread([] {
     setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), getpriority(PRIO_PROCESS, 0) + kDeviceWorkerNiceSteps);
-    list_devices();
+    try {
+      list_devices();
+    } catch (...) {  // ClRuntime below lists them again and reports the error
+    }
   }).join();
   ClRuntime runtime(global.device);
   server::ServerOptions options;

@@ -4,11 +4,12 @@ from its own OpenAPI document (valid and invalid data, methods it does not route
 documented status, the documented content type and headers, and a body that matches the
 documented schema; invalid data must be refused with a 4xx.
 
-Usage: schemathesis_test.py --seamcl build/seamcl [--max-time 100] [--seed 1]
+Usage: schemathesis_test.py --seamcl build/seamcl [--max-time 100] [--seed 1] [--warm-all]
 
-Starts `seamcl serve --port <free port> --quick-start --threads 2`, waits until GET /health answers
-200, runs `python -m schemathesis.cli run` with this interpreter, prints the figures (requests,
-5xx, failures) and stops the server. Exit 0: nothing found; 1: a failure; 77: schemathesis is not
+Starts `seamcl serve --port <free port> --quick-start --threads 2` (without --quick-start given
+--warm-all), waits until GET /health answers 200 and no longer says "starting", runs `python -m
+schemathesis.cli run` with this interpreter, prints the figures (requests, 5xx, failures) and
+stops the server. Exit 0: nothing found; 1: a failure; 77: schemathesis is not
 installed for this interpreter (scripts/install-deps installs it), so CTest reports a skip.
 """
 import argparse
@@ -86,6 +87,9 @@ def main():
     parser.add_argument("--max-examples", type=int, default=100, help="test cases per operation and phase")
     parser.add_argument("--seed", type=int, default=1, help="hypothesis seed, for a reproducible run")
     parser.add_argument("--startup-timeout", type=int, default=120, help="seconds to wait for /health")
+    parser.add_argument("--warm-all", action="store_true",
+                        help="build every kernel variant before fuzzing (no --quick-start), so that no request of a "
+                             "long run waits for a build; give --startup-timeout room for it")
     args = parser.parse_args()
 
     try:
@@ -99,7 +103,8 @@ def main():
     work = tempfile.mkdtemp(prefix="seamcl-schemathesis-")
     env = dict(os.environ, SEAMCL_CACHE_DIR=os.path.join(work, "cache"))
     server_log = open(os.path.join(work, "server.log"), "w+", encoding="utf-8", errors="replace")
-    server = subprocess.Popen([args.seamcl, "serve", "--port", str(port), "--quick-start", "--threads", "2"],
+    warm = [] if args.warm_all else ["--quick-start"]
+    server = subprocess.Popen([args.seamcl, "serve", "--port", str(port), *warm, "--threads", "2"],
                               stdout=server_log, stderr=subprocess.STDOUT, env=env)
     try:
         wait_for_health(base, server, args.startup_timeout)

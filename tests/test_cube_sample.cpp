@@ -253,7 +253,7 @@ TEST(CubeSample, BorderReadsWhatSeamlessReadsWithinATexelOfTheEdge) {
   const std::vector<glm::vec4> seamless = plain.sample(batch, cube_sampler(CubeMethod::Seamless, Filter::Trilinear, 16, n));
   const std::vector<glm::vec4> border = bordered.sample(batch, cube_sampler(CubeMethod::Border, Filter::Trilinear, 16, n));
   for (size_t k = 0; k < batch.size(); ++k) EXPECT_LT(distance(seamless[k], border[k]), 1e-5f) << k;
-  // The price: every level of every face one texel wider on each side (+42% at n = 8).
+  // The price: every level of every face one texel wider on each side (+42% at n = 16).
   EXPECT_EQ(cube_bytes(CubeMethod::Border, n), cube_texel_count(n, true) * 16);
   EXPECT_EQ(cube_bytes(CubeMethod::Clamp, n), cube.texel_count() * 16);
   EXPECT_EQ(pack_cube_texels(cube, true).size(), cube_texel_count(n, true) * 4);

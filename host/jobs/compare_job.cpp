@@ -143,22 +143,24 @@ CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobCont
   const auto ms_since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
   const Clock::time_point start = Clock::now();
   const Camera view = camera(scene);
-  // Hashed once for the lock's key and every reference kind's cache key (hashing bakes every face).
-  if (reference_.use_cache && reference_.scene_hash.empty()) reference_.scene_hash = scene_content_hash(scene);
-  // The variants of the entries, of their seam masks and, when no cache can hold it, of the
-  // reference build while the scene packs.
+  // The variants this compare renders with build while the scene is hashed and packed, in the
+  // order prepare_targets and compare_methods first use them: the seam masks, the reference (when
+  // no cache can hold it), the entries.
   std::vector<ProgramNeed> needs;
   for (const MethodEntry& entry : entries_) {
-    needs.push_back({entry.options, false});
     RenderOptions mask = entry.options;
     mask.method = Method::Black;  // footprint_seam_mask's render
     needs.push_back({mask, true});
   }
-  const bool renders_reference = std::any_of(kinds_.begin(), kinds_.end(), [](ReferenceKind kind) {
-    return kind == ReferenceKind::Paper || kind == ReferenceKind::Box;
-  });
-  if (renders_reference && !reference_.use_cache) needs.push_back({reference_render_options(frame_, reference_), false});
+  const auto asks_for = [&](ReferenceKind kind) { return std::find(kinds_.begin(), kinds_.end(), kind) != kinds_.end(); };
+  // Analytic is never cached; paper and box are rendered unless the cache holds them.
+  const bool renders_reference = asks_for(ReferenceKind::Analytic) ||
+                                 (!reference_.use_cache && (asks_for(ReferenceKind::Paper) || asks_for(ReferenceKind::Box)));
+  if (renders_reference) needs.push_back({reference_render_options(frame_, reference_), false});
+  for (const MethodEntry& entry : entries_) needs.push_back({entry.options, false});
   const std::future<void> programs = build_programs_ahead(runtime, scene, needs);
+  // Hashed once for the lock's key and every reference kind's cache key (hashing bakes every face).
+  if (reference_.use_cache && reference_.scene_hash.empty()) reference_.scene_hash = scene_content_hash(scene);
   Renderer renderer(runtime);
   renderer.set_device_byte_limit(control.device_byte_limit);
   renderer.load_scene(scene, frame_.texels);

@@ -410,16 +410,12 @@ std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, c
     if (std::find(variants.begin(), variants.end(), options) == variants.end()) variants.push_back(options);
   }
   return std::async(std::launch::async, [&runtime, variants = std::move(variants)] {
-    std::vector<std::future<void>> builds;
     for (const std::string& options : variants) {
-      builds.push_back(std::async(std::launch::async, [&runtime, options] {
-        try {
-          runtime.program(options);
-        } catch (...) {  // the render that uses it builds it again and reports the error
-        }
-      }));
+      try {
+        runtime.program(options);
+      } catch (...) {  // the render that uses it builds it again and reports the error
+      }
     }
-    for (std::future<void>& build : builds) build.wait();
   });
 }
 

@@ -70,11 +70,14 @@ struct ProgramNeed {
   bool with_seam_mask = false;
 };
 
-// Starts building (or loading from a cache) the program variants of `needs` on `scene`, each on a
-// thread of its own, and returns at once, so that work needing no kernel (making and packing the
-// scene) overlaps the builds, which a first render would otherwise wait for in turn. The future is
-// ready when every build has ended. A build that fails is not reported here: the render that uses
-// the variant builds it again and throws its error with the build log.
+// Starts building (or loading from a cache) the program variants of `needs` on `scene`, in the
+// order given, one after another on one thread of its own, and returns at once: work that needs no
+// kernel (making and packing the scene) overlaps the builds, which a first render would otherwise
+// wait for. One thread, not one per variant: the packing keeps the other cores, and LLVM builds
+// hold memory no plan counts. The future is ready (and its destructor returns) when every build has
+// ended, so a caller that stops early still waits for the build under way. A build that fails is
+// not reported here: the render that uses the variant builds it again and throws its error with
+// the build log.
 std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, const std::vector<ProgramNeed>& needs);
 
 class Renderer {
