@@ -12,8 +12,6 @@
 #include <thread>
 
 #include <pthread.h>
-#include <sys/resource.h>
-#include <unistd.h>
 
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
@@ -23,8 +21,6 @@
 namespace seamcl::cli {
 
 namespace {
-
-constexpr int kDeviceWorkerNiceSteps = 5;
 
 struct ServeArgs {
   std::string host = "127.0.0.1";
@@ -75,17 +71,6 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   std::signal(SIGPIPE, SIG_IGN);  // a client that hangs up must not end the process
 
   const auto start = std::chrono::steady_clock::now();
-  // A CPU device (PoCL) makes its worker threads when its devices are first listed, and they keep
-  // the priority of the thread that listed them. Listing them from a thread a few steps below
-  // lets the threads that answer connections (refusals, /health, request heads) run first while
-  // renders hold every core. Raising a nice value needs no privilege; nothing else changes.
-  std::thread([] {
-    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), getpriority(PRIO_PROCESS, 0) + kDeviceWorkerNiceSteps);
-    try {
-      list_devices();
-    } catch (...) {  // ClRuntime below lists them again and reports the error
-    }
-  }).join();
   ClRuntime runtime(global.device);
   server::ServerOptions options;
   options.host = args.host;
