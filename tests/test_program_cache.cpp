@@ -193,6 +193,28 @@ TEST(ProgramCache, ConcurrentRequestsForOneVariantBuildItOnce) {
   EXPECT_EQ(runtime.program_stats().built + runtime.program_stats().loaded, 1);
 }
 
+// build_programs_ahead builds each distinct variant of the renders it is given once (two renders
+// that share one, and a seam-mask render that needs another), and the renders that follow find
+// every variant built.
+TEST(ProgramCache, VariantsBuiltAheadAreTheOnesTheRendersUse) {
+  ClRuntime runtime;
+  runtime.set_program_cache_dir("");  // builds only: PoCL keeps its own cache
+  const Scene scene = generate_scene("quad2", GeneratorOptions{});
+  RenderOptions plain;
+  plain.width = plain.height = 16;
+  RenderOptions mask = plain;
+  mask.method = Method::Black;  // footprint_seam_mask's render
+  build_programs_ahead(runtime, scene, {{plain, false}, {plain, false}, {mask, true}}).get();
+  const ClRuntime::ProgramStats ahead = runtime.program_stats();
+  EXPECT_EQ(ahead.built + ahead.loaded, 2);
+  Renderer renderer(runtime);
+  renderer.load_scene(scene);
+  renderer.render(scene.camera, plain);
+  renderer.render(scene.camera, mask, true);
+  const ClRuntime::ProgramStats after = runtime.program_stats();
+  EXPECT_EQ(after.built + after.loaded, 2) << "a render built a variant the builds ahead did not";
+}
+
 TEST(Warmup, VariantsCoverEveryMethodAndFilterOnce) {
   const std::vector<WarmupVariant> variants = warmup_variants();
   EXPECT_EQ(variants.size(), method_names().size() * filter_names().size() + filter_names().size());
