@@ -41,6 +41,7 @@ set(SEAMCL_HOST_ONLY_TESTS
   ClRuntime.ErrorNames
   ClRuntime.KernelDirMustHoldEveryFile
   ClRuntime.EmbeddedSourcesAreTheKernelFiles
+  KernelPrograms.EveryFileIsInAProgramAndEachProgramKeepsTheBuildOrder
   Cli.UnknownMethodIsInputError
   Cli.BadMsaaIsInputError
   Cli.BadSizeIsInputError

@@ -312,18 +312,3 @@ SEAMCL_INLINE float4 sample_cube(__global const float* texels, CubeSampler cube,
   const float inv_weight = 1.0f / sum.weight;
   return (float4)(sum.r * inv_weight, sum.g * inv_weight, sum.b * inv_weight, sum.a * inv_weight);
 }
-
-/* Lookups for tests and measurements, one per work-item: lookups[11 i ..] = direction (3),
- * d/dx (3), d/dy (3), roughness, explicit lod (< 0: from the footprint); out[i] = the colour. */
-__kernel void cube_lookup_batch(__global const float* texels, CubeSampler cube, __global const float* lookups,
-                                uint count, __global float4* out) {
-  const uint i = get_global_id(0);
-  if (i >= count) return;
-  __global const float* q = lookups + 11 * i;
-  const float4 c = sample_cube(texels, cube, q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8], q[9], q[10]);
-  __global float* o = (__global float*)out + 4 * i;
-  o[0] = c.x;
-  o[1] = c.y;
-  o[2] = c.z;
-  o[3] = c.w;
-}

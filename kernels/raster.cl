@@ -25,18 +25,7 @@
  * (else it re-runs);
  * global size (tiles_x, tiles_y), work-groups of one; image sides <= 16384 (kMaxImageSide), so
  * fixed-point sample positions fit 32 bits and convert to float exactly.
- * Twin: host/pipeline/stages/raster_twin.cpp. */
-
-/* The D3D11 sample pattern (sample_offsets, sample_pattern_row) is defined in triangle_setup.cl,
- * whose cull reads it too. */
-
-/* Fixed-point position of sample s of pixel (x, y). */
-SEAMCL_INLINE long sample_fixed_x(int x, int row, int s) {
-  return (long)x * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2 + sample_offsets[row][s][0] * (SEAMCL_SUBPIXEL_ONE / 16);
-}
-SEAMCL_INLINE long sample_fixed_y(int y, int row, int s) {
-  return (long)y * SEAMCL_SUBPIXEL_ONE + SEAMCL_SUBPIXEL_ONE / 2 + sample_offsets[row][s][1] * (SEAMCL_SUBPIXEL_ONE / 16);
-}
+ * Twin: host/pipeline/stages/raster_twin.cpp. The sample pattern is sample_pattern.h's. */
 
 #if SEAMCL_TILE_SIZE != 16
 #error "raster keeps one tile row in a 16-wide vector"

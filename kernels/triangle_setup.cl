@@ -55,19 +55,6 @@ SEAMCL_INLINE long floor_div_subpixel(long value) {
   return value >= 0 ? value / SEAMCL_SUBPIXEL_ONE : -((-value + SEAMCL_SUBPIXEL_ONE - 1) / SEAMCL_SUBPIXEL_ONE);
 }
 
-/* D3D11 standard sample positions in 1/16 pixel from the pixel centre, y down; rows for 1, 2,
- * 4, 8 and 16 samples (row = log2(count)). */
-__constant char sample_offsets[5][SEAMCL_MAX_SAMPLES][2] = {
-    {{0, 0}},
-    {{4, 4}, {-4, -4}},
-    {{-2, -6}, {6, -2}, {-6, 2}, {2, 6}},
-    {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, 7}, {7, -7}},
-    {{1, 1}, {-1, -3}, {-3, 2}, {4, -1}, {-5, -2}, {2, 5}, {5, 3}, {3, -5},
-     {-2, 6}, {0, -7}, {-4, -6}, {-6, 4}, {-8, 0}, {7, -4}, {6, 7}, {-7, -8}}};
-
-SEAMCL_INLINE int sample_pattern_row(int sample_count) {
-  return sample_count == 1 ? 0 : sample_count == 2 ? 1 : sample_count == 4 ? 2 : sample_count == 8 ? 3 : 4;
-}
 
 
 /* Whether the fixed-point box [min_x, max_x] x [min_y, max_y] holds a sample position of the

@@ -1,9 +1,13 @@
 // The OpenCL runtime layer: device choice and errors that say what failed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
 
 #include <seamcl/cl/cl_runtime.h>
 #include "cl/kernel_sources.h"
@@ -86,7 +90,7 @@ TEST(ClRuntime, BuildFailureCarriesTheCallTheErrorNameAndTheBuildLog) {
   ScopedEnv env("SEAMCL_KERNEL_DIR", dir.string());
   ClRuntime runtime;
   try {
-    runtime.program();
+    runtime.program(KernelProgram::Geometry);
     FAIL() << "a broken program built";
   } catch (const std::exception& e) {
     const std::string message = describe_cl_exception(e);
@@ -102,7 +106,7 @@ TEST(ClRuntime, BuildFailureCarriesTheCallTheErrorNameAndTheBuildLog) {
 TEST(ClRuntime, KernelDirMustHoldEveryFile) {
   ScopedEnv env("SEAMCL_KERNEL_DIR", "/nonexistent-seamcl-dir");
   try {
-    program_source();
+    program_source(KernelProgram::Geometry);
     FAIL() << "a missing kernel dir was accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent-seamcl-dir/seamcl_types.h"), std::string::npos) << e.what();
@@ -118,4 +122,56 @@ TEST(ClRuntime, EmbeddedSourcesAreTheKernelFiles) {
     EXPECT_EQ(text, file.text) << file.name;
   }
   EXPECT_GE(embedded_kernel_sources().size(), 6u);
+}
+
+TEST(KernelPrograms, EveryFileIsInAProgramAndEachProgramKeepsTheBuildOrder) {
+  const std::vector<KernelSourceFile>& files = embedded_kernel_sources();
+  std::set<std::string> used;
+  for (KernelProgram program : {KernelProgram::Geometry, KernelProgram::Shading, KernelProgram::Sampling,
+                                KernelProgram::PtexFilter, KernelProgram::Downsample}) {
+    SCOPED_TRACE(kernel_program_name(program));
+    const std::vector<std::string> names = kernel_program_files(program);
+    ASSERT_FALSE(names.empty());
+    EXPECT_EQ(names.front(), "seamcl_types.h") << "the shared structs come first";
+    size_t last = 0;
+    for (const std::string& name : names) {
+      const auto it = std::find_if(files.begin(), files.end(), [&](const KernelSourceFile& f) { return name == f.name; });
+      ASSERT_NE(it, files.end()) << name << " is not embedded";
+      const size_t position = static_cast<size_t>(it - files.begin());
+      EXPECT_GE(position, last) << name << " comes before a file listed ahead of it";
+      last = position;
+      used.insert(name);
+    }
+    const std::string source = program_source(program);
+    for (const std::string& name : names) EXPECT_NE(source.find("#line 1 \"" + name + "\""), std::string::npos) << name;
+  }
+  for (const KernelSourceFile& file : files) EXPECT_EQ(used.count(file.name), 1u) << file.name << " is in no program";
+}
+
+// Each program builds on its own, from only its files, and holds the kernels its launchers create:
+// a kernel moved to another file, or a file that needs one it is not built with, fails here.
+TEST(KernelPrograms, EachBuildsAloneWithItsKernels) {
+  ClRuntime runtime;
+  runtime.set_program_cache_dir("");
+  const std::map<KernelProgram, std::pair<std::string, std::set<std::string>>> expected = {
+      {KernelProgram::Geometry,
+       {"",
+        {"triangle_setup", "bin_count", "bin_scan", "bin_fill", "raster", "sample_pattern", "tessellate",
+         "tessellated_setup"}}},
+      {KernelProgram::Shading, {"-DSEAMCL_CUBE=1 -DSEAMCL_SEAM_MASK=1", {"shade_resolve"}}},
+      {KernelProgram::Sampling,
+       {"", {"neighbor_bytes_decoded", "texture_lookup_batch", "texture_filter_batch", "cube_lookup_batch"}}},
+      {KernelProgram::PtexFilter, {"", {"ptex_filter_lookups"}}},
+      {KernelProgram::Downsample, {"", {"downsample_rows", "downsample_columns"}}},
+  };
+  for (const auto& [program, wanted] : expected) {
+    SCOPED_TRACE(kernel_program_name(program));
+    const cl::Program& built = runtime.program(program, wanted.first);
+    std::set<std::string> kernels;
+    std::stringstream names(built.getInfo<CL_PROGRAM_KERNEL_NAMES>());
+    for (std::string name; std::getline(names, name, ';');) {
+      if (!name.empty()) kernels.insert(name);
+    }
+    EXPECT_EQ(kernels, wanted.second);
+  }
 }

@@ -38,12 +38,10 @@ const Scene& displaced() {
   return scene;
 }
 
-std::string default_program() { return program_options(TexelFormat::Rgba8, sampler_params(RenderOptions{}), false); }
-
 std::vector<TessVertex> device_tessellation(const Scene& scene, const DisplacementSettings& settings, PackedDisplacement* packed_out = nullptr) {
   TessellateLauncher stage(shared_runtime());
   stage.load(pack_displacement(scene, settings));
-  std::vector<TessVertex> out = stage.tessellate(default_program());
+  std::vector<TessVertex> out = stage.tessellate();
   if (packed_out) *packed_out = stage.packed();
   return out;
 }

@@ -31,9 +31,7 @@ std::vector<glm::vec4> random_image(int width, int height, unsigned seed) {
 
 std::vector<glm::vec4> on_device(const std::vector<glm::vec4>& image, int width, int height, const DownsampleTaps& taps) {
   ClRuntime& runtime = shared_runtime();
-  const RenderOptions defaults;
   DownsampleLauncher launcher(runtime);
-  launcher.use_program(program_options(defaults.texels, sampler_params(defaults)));
   cl::Buffer buffer(runtime.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, image.size() * sizeof(glm::vec4),
                     const_cast<glm::vec4*>(image.data()));
   std::vector<glm::vec4> out;

@@ -207,7 +207,7 @@ TEST(SamplePattern, HostAndKernelTablesAreTheD3D11StandardPatterns) {
       {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, 7}, {7, -7}},
       {{1, 1}, {-1, -3}, {-3, 2}, {4, -1}, {-5, -2}, {2, 5}, {5, 3}, {3, -5},
        {-2, 6}, {0, -7}, {-4, -6}, {-6, 4}, {-8, 0}, {7, -4}, {6, 7}, {-7, -8}}};
-  cl::Kernel kernel(shared_runtime().program(), "sample_pattern");
+  cl::Kernel kernel(shared_runtime().program(KernelProgram::Geometry), "sample_pattern");
   cl::Buffer out(shared_runtime().context(), CL_MEM_WRITE_ONLY, sizeof(cl_int) * 2 * SEAMCL_MAX_SAMPLES);
   for (size_t row = 0; row < standard.size(); ++row) {
     const int count = 1 << row;

@@ -175,7 +175,7 @@ std::vector<TessVertex> stage_vertices(const Scene& scene, DisplacementMethod me
   RenderOptions options;
   TessellateLauncher stage(shared_runtime());
   stage.load(pack_displacement(scene, {method, t, 0}));
-  return stage.tessellate(program_options(options.texels, sampler_params(options), false));
+  return stage.tessellate();
 }
 
 // Grid point (i, j) of step k (0..T) along a patch's edge e, counted from corner e.

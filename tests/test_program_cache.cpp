@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstring>
 #include <filesystem>
@@ -72,10 +73,10 @@ TEST(ProgramCache, HitSkipsTheBuildAndRendersTheSameImage) {
   first.set_program_cache_dir(dir.path.string());
   const std::vector<glm::vec4> built_image = tiny_frame(first);
   const ClRuntime::ProgramStats built = first.program_stats();
-  EXPECT_EQ(built.built, 1);
+  EXPECT_EQ(built.built, 2) << "a frame builds the geometry program and one shading variant";
   EXPECT_EQ(built.loaded, 0);
-  EXPECT_EQ(built.stored, 1);
-  const fs::path entry = ProgramCache(dir.path.string()).path(first.program_cache_key(options));
+  EXPECT_EQ(built.stored, 2);
+  const fs::path entry = ProgramCache(dir.path.string()).path(first.program_cache_key(KernelProgram::Shading, options));
   ASSERT_TRUE(fs::is_regular_file(entry)) << entry;
 
   ClRuntime second;  // a new process, as far as the cache can tell: nothing built yet
@@ -83,7 +84,7 @@ TEST(ProgramCache, HitSkipsTheBuildAndRendersTheSameImage) {
   const std::vector<glm::vec4> loaded_image = tiny_frame(second);
   const ClRuntime::ProgramStats loaded = second.program_stats();
   EXPECT_EQ(loaded.built, 0) << "a whole entry was there: nothing may be built from source";
-  EXPECT_EQ(loaded.loaded, 1);
+  EXPECT_EQ(loaded.loaded, 2);
   EXPECT_EQ(loaded.stored, 0);
   ASSERT_EQ(loaded_image.size(), built_image.size());
   EXPECT_EQ(0, std::memcmp(loaded_image.data(), built_image.data(), built_image.size() * sizeof(glm::vec4)))
@@ -95,9 +96,9 @@ TEST(ProgramCache, TruncatedCorruptOrRefusedEntryIsBuiltAgainAndReplaced) {
   const std::string options = default_variant();
   ClRuntime writer;
   writer.set_program_cache_dir(dir.path.string());
-  writer.program(options);
+  writer.program(KernelProgram::Shading, options);
   const ProgramCache cache(dir.path.string());
-  const ProgramCacheKey key = writer.program_cache_key(options);
+  const ProgramCacheKey key = writer.program_cache_key(KernelProgram::Shading, options);
   const fs::path entry = cache.path(key);
   const std::vector<char> whole = read_bytes(entry);
   ASSERT_GT(whole.size(), 200u);
@@ -116,7 +117,7 @@ TEST(ProgramCache, TruncatedCorruptOrRefusedEntryIsBuiltAgainAndReplaced) {
     EXPECT_FALSE(cache.load(key).has_value());
     ClRuntime reader;
     reader.set_program_cache_dir(dir.path.string());
-    reader.program(options);
+    reader.program(KernelProgram::Shading, options);
     const ClRuntime::ProgramStats stats = reader.program_stats();
     EXPECT_EQ(stats.cache_rejected, 1);
     EXPECT_EQ(stats.built, 1);
@@ -129,7 +130,7 @@ TEST(ProgramCache, TruncatedCorruptOrRefusedEntryIsBuiltAgainAndReplaced) {
   ASSERT_TRUE(cache.store(key, std::vector<unsigned char>(4096, 0xab)));
   ClRuntime reader;
   reader.set_program_cache_dir(dir.path.string());
-  reader.program(options);
+  reader.program(KernelProgram::Shading, options);
   EXPECT_EQ(reader.program_stats().cache_rejected, 1);
   EXPECT_EQ(reader.program_stats().built, 1);
   const std::optional<std::vector<unsigned char>> replaced = cache.load(key);
@@ -139,14 +140,17 @@ TEST(ProgramCache, TruncatedCorruptOrRefusedEntryIsBuiltAgainAndReplaced) {
 
 TEST(ProgramCache, KeyFollowsBuildOptionsSourceDeviceAndDriver) {
   ClRuntime runtime;
-  const ProgramCacheKey a = runtime.program_cache_key("-DSEAMCL_TEXELS_F32=0");
-  const ProgramCacheKey b = runtime.program_cache_key("-DSEAMCL_TEXELS_F32=1");
+  const ProgramCacheKey a = runtime.program_cache_key(KernelProgram::Shading, "-DSEAMCL_TEXELS_F32=0");
+  const ProgramCacheKey b = runtime.program_cache_key(KernelProgram::Shading, "-DSEAMCL_TEXELS_F32=1");
+  EXPECT_NE(a.key(), runtime.program_cache_key(KernelProgram::Sampling, "-DSEAMCL_TEXELS_F32=0").key())
+      << "programs of other files under the same options share a key";
   EXPECT_NE(a.key(), b.key());
   EXPECT_NE(a.file_name(), b.file_name());
   EXPECT_NE(a.build_options.find("-DSEAMCL_TEXELS_F32=0"), std::string::npos);
   EXPECT_EQ(a.device, runtime.info().name);
   EXPECT_FALSE(a.driver_version.empty());
-  EXPECT_EQ(a.key(), runtime.program_cache_key("-DSEAMCL_TEXELS_F32=0").key()) << "the key must be stable";
+  EXPECT_EQ(a.key(), runtime.program_cache_key(KernelProgram::Shading, "-DSEAMCL_TEXELS_F32=0").key())
+      << "the key must be stable";
   for (std::string ProgramCacheKey::*field : {&ProgramCacheKey::platform, &ProgramCacheKey::device,
                                               &ProgramCacheKey::device_version, &ProgramCacheKey::driver_version,
                                               &ProgramCacheKey::source_hash}) {
@@ -187,7 +191,7 @@ TEST(ProgramCache, ConcurrentRequestsForOneVariantBuildItOnce) {
   const std::string options = default_variant();
   std::vector<const cl::Program*> seen(4);
   std::vector<std::thread> threads;
-  for (size_t i = 0; i < seen.size(); ++i) threads.emplace_back([&, i] { seen[i] = &runtime.program(options); });
+  for (size_t i = 0; i < seen.size(); ++i) threads.emplace_back([&, i] { seen[i] = &runtime.program(KernelProgram::Shading, options); });
   for (std::thread& t : threads) t.join();
   for (const cl::Program* p : seen) EXPECT_EQ(p, seen.front());
   EXPECT_EQ(runtime.program_stats().built + runtime.program_stats().loaded, 1);
@@ -206,13 +210,13 @@ TEST(ProgramCache, VariantsBuiltAheadAreTheOnesTheRendersUse) {
   mask.method = Method::Black;  // footprint_seam_mask's render
   build_programs_ahead(runtime, scene, {{plain, false}, {plain, false}, {mask, true}}).get();
   const ClRuntime::ProgramStats ahead = runtime.program_stats();
-  EXPECT_EQ(ahead.built + ahead.loaded, 2);
+  EXPECT_EQ(ahead.built + ahead.loaded, 3) << "the geometry program and two shading variants";
   Renderer renderer(runtime);
   renderer.load_scene(scene);
   renderer.render(scene.camera, plain);
   renderer.render(scene.camera, mask, true);
   const ClRuntime::ProgramStats after = runtime.program_stats();
-  EXPECT_EQ(after.built + after.loaded, 2) << "a render built a variant the builds ahead did not";
+  EXPECT_EQ(after.built + after.loaded, 3) << "a render built a program the builds ahead did not";
 }
 
 TEST(Warmup, VariantsCoverEveryMethodAndFilterOnce) {
@@ -243,10 +247,14 @@ TEST(Warmup, BuildsInParallelThenRendersEachWithProgress) {
   EXPECT_EQ(report.built + report.loaded, static_cast<int>(std::set<std::string>{three[0].build_options,
                                                                                  three[1].build_options,
                                                                                  three[2].build_options}
-                                                                 .size()));
-  ASSERT_EQ(lines.size(), 6u);  // three built, three rendered
-  EXPECT_NE(lines[0].find("built 1/3"), std::string::npos) << lines[0];
-  EXPECT_NE(lines[5].find("rendered 3/3: " + three[2].name), std::string::npos) << lines[5];
+                                                                 .size()) + 1)
+      << "each distinct shading variant and the geometry program they share";
+  ASSERT_EQ(lines.size(), 7u);  // four built (the geometry program among them), three rendered
+  EXPECT_NE(lines[0].find("built 1/4"), std::string::npos) << lines[0];
+  EXPECT_EQ(std::count_if(lines.begin(), lines.end(),
+                          [](const std::string& l) { return l.find(": geometry stages") != std::string::npos; }),
+            1);
+  EXPECT_NE(lines[6].find("rendered 3/3: " + three[2].name), std::string::npos) << lines[6];
   EXPECT_EQ(report.cache_dir, dir.path.string());
   EXPECT_GE(report.total_ms, report.build_ms + report.render_ms - 1.0);
 

@@ -127,7 +127,7 @@ std::vector<uint32_t> run_raster_kernel(const std::vector<TriangleSetup>& setups
   cl::Buffer rows_buffer = input(rows.data(), rows.size() * sizeof(cl_ushort));
   const size_t samples = static_cast<size_t>(frame.width) * frame.height * frame.sample_count;
   cl::Buffer winners(context, CL_MEM_WRITE_ONLY, samples * sizeof(cl_uint));
-  cl::Kernel kernel(shared_runtime().program(), "raster");
+  cl::Kernel kernel(shared_runtime().program(KernelProgram::Geometry), "raster");
   kernel.setArg(0, frame_buffer);
   kernel.setArg(1, setup_buffer);
   kernel.setArg(2, count_buffer);

@@ -243,7 +243,7 @@ TEST(Adjacency, MapsAndSidesRoundTripThroughTheirBytes) {
 TEST(Adjacency, KernelsDecodeEveryByteAsTheHostDoes) {
   // Every byte as a map and as a reach side, decoded by the kernels' decode_uv_map and reach_side:
   // the same floats, bit for bit (signed zeros included), as map_coefficients and reach_side.
-  cl::Kernel kernel(shared_runtime().program(), "neighbor_bytes_decoded");
+  cl::Kernel kernel(shared_runtime().program(KernelProgram::Sampling), "neighbor_bytes_decoded");
   cl::Buffer out(shared_runtime().context(), CL_MEM_WRITE_ONLY, sizeof(float) * 7 * 256);
   kernel.setArg(0, out);
   shared_runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(256));

@@ -220,8 +220,8 @@ std::string ClRuntime::full_build_options(const std::string& options) const {
   return all_options;
 }
 
-ProgramCacheKey ClRuntime::program_cache_key(const std::string& options) const {
-  return ProgramCacheKey{info_.platform, info_.name, info_.version, driver_version_, fnv64_hex(program_source()),
+ProgramCacheKey ClRuntime::program_cache_key(KernelProgram program, const std::string& options) const {
+  return ProgramCacheKey{info_.platform, info_.name, info_.version, driver_version_, fnv64_hex(program_source(program)),
                          full_build_options(options)};
 }
 
@@ -235,12 +235,12 @@ std::string ClRuntime::program_cache_dir() const {
   return program_cache_->directory();
 }
 
-const cl::Program& ClRuntime::program(const std::string& options) {
+const cl::Program& ClRuntime::program(KernelProgram which, const std::string& options) {
   ProgramSlot* slot = nullptr;
   ProgramCache cache("");
   {
     std::lock_guard<std::mutex> lock(programs_mutex_);
-    std::unique_ptr<ProgramSlot>& held = programs_[options];
+    std::unique_ptr<ProgramSlot>& held = programs_[{which, options}];
     if (!held) held = std::make_unique<ProgramSlot>();
     slot = held.get();  // slots are never removed: the pointer stays valid
     cache = *program_cache_;
@@ -248,7 +248,7 @@ const cl::Program& ClRuntime::program(const std::string& options) {
   std::lock_guard<std::mutex> building(slot->mutex);
   if (slot->program) return *slot->program;
   const auto start = std::chrono::steady_clock::now();
-  const ProgramCacheKey key = program_cache_key(options);
+  const ProgramCacheKey key = program_cache_key(which, options);
   const std::string all_options = key.build_options;
   ProgramStats counted;
   std::unique_ptr<cl::Program> program;
@@ -269,7 +269,7 @@ const cl::Program& ClRuntime::program(const std::string& options) {
     if (std::filesystem::exists(cache.path(key), ec)) counted.cache_rejected = 1;  // there, but not whole
   }
   if (!program) {
-    program = std::make_unique<cl::Program>(context_, program_source());
+    program = std::make_unique<cl::Program>(context_, program_source(which));
     program->build(std::vector<cl::Device>{device_}, all_options.c_str());
     counted.built = 1;
     if (cache.enabled()) {

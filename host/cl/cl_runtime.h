@@ -9,6 +9,7 @@
 
 #include <CL/opencl.hpp>
 
+#include <seamcl/cl/kernel_program.h>
 #include <seamcl/cl/program_cache.h>
 
 namespace seamcl {
@@ -45,13 +46,14 @@ class ClRuntime {
   const DeviceInfo& info() const { return info_; }
   std::string device_description() const;  // "<device> (<platform>, <version>)"
 
-  // Builds program_source() with `options` (e.g. "-DSEAMCL_TEXELS_F32=1") once per distinct
-  // options (plus $SEAMCL_EXTRA_BUILD_OPTIONS, for experiments); later calls return the same
-  // program. Thread-safe, and calls for different options build in parallel (a call for options
-  // being built waits for that build). With a program cache (set_program_cache_dir), the binary
-  // is loaded from it when a whole entry for this device, driver, source and options is there,
-  // else built from source and stored (host/cl/program_cache.h).
-  const cl::Program& program(const std::string& options = "");
+  // Builds program_source(program) with `options` (e.g. "-DSEAMCL_TEXELS_F32=1") once per
+  // distinct program and options (plus $SEAMCL_EXTRA_BUILD_OPTIONS, for experiments); later calls
+  // return the same program. Thread-safe, and calls for different variants build in parallel (a
+  // call for a variant being built waits for that build). With a program cache
+  // (set_program_cache_dir), the binary is loaded from it when a whole entry for this device,
+  // driver, source and options is there, else built from source and stored
+  // (host/cl/program_cache.h).
+  const cl::Program& program(KernelProgram program, const std::string& options = "");
   double program_build_ms() const;  // wall time of every build and cache load so far
 
   // Where program binaries are kept: default_cache_dir()/programs by default on drivers other than
@@ -59,8 +61,8 @@ class ClRuntime {
   // with "0" or "off"; empty: none. Programs already built stay.
   void set_program_cache_dir(const std::string& directory);
   std::string program_cache_dir() const;
-  // The cache key of the program built with `options` on this device.
-  ProgramCacheKey program_cache_key(const std::string& options) const;
+  // The cache key of `program` built with `options` on this device.
+  ProgramCacheKey program_cache_key(KernelProgram program, const std::string& options) const;
 
   struct ProgramStats {
     int built = 0;           // from source
@@ -83,7 +85,7 @@ class ClRuntime {
   cl::CommandQueue queue_;
   DeviceInfo info_;
   std::string driver_version_;
-  std::map<std::string, std::unique_ptr<ProgramSlot>> programs_;
+  std::map<std::pair<KernelProgram, std::string>, std::unique_ptr<ProgramSlot>> programs_;
   std::unique_ptr<ProgramCache> program_cache_;
   ProgramStats stats_;
   mutable std::mutex programs_mutex_;  // programs_, program_cache_ and stats_

@@ -31,7 +31,7 @@ struct ProgramCacheKey {
   std::string device;
   std::string device_version;  // CL_DEVICE_VERSION
   std::string driver_version;  // CL_DRIVER_VERSION
-  std::string source_hash;     // fnv64_hex of the whole program text
+  std::string source_hash;     // fnv64_hex of the program's text (program_source)
   std::string build_options;   // exactly as passed to clBuildProgram
   std::string key() const;
   std::string file_name() const;  // "program-<fnv64 of key()>.bin"

@@ -194,8 +194,7 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   report.triangles = packed.triangle_count();
   TessellateLauncher stage(runtime);
   stage.load(std::move(packed));
-  const std::vector<TessVertex> vertices =
-      stage.tessellate(program_options(options.texels, sampler_params(options), false));
+  const std::vector<TessVertex> vertices = stage.tessellate();
   report.gap = measure_gap(stage.packed(), vertices);
   report.vertices = vertices.size();
   for (const TessVertex& v : vertices) report.samples += v.samples;

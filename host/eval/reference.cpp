@@ -322,7 +322,7 @@ std::string reference_cache_key(const Scene& scene, const Camera& camera, const 
   using nlohmann::json;
   const json key = {
       {"version", SEAMCL_VERSION},
-      {"kernels", text_hash(program_source())},
+      {"kernels", text_hash(all_kernel_sources())},
       {"scene", settings.scene_hash.empty() ? scene_content_hash(scene) : settings.scene_hash},
       {"camera",
        {camera.eye.x, camera.eye.y, camera.eye.z, camera.target.x, camera.target.y, camera.target.z, camera.up.x,

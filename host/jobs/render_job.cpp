@@ -137,7 +137,7 @@ RenderRun RenderJob::run(ClRuntime& runtime, Renderer& renderer, const Scene& sc
     control.report("export_mesh: " + export_mesh_);
     TessellateLauncher stage(runtime);
     stage.load(pack_displacement(scene, {*options_.displacement, options_.tessellation, options_.displacement_level}));
-    const std::vector<TessVertex> vertices = stage.tessellate(program_options(options_.texels, sampler_params(options_), false));
+    const std::vector<TessVertex> vertices = stage.tessellate();
     stage.release();
     write_patch_mesh(export_mesh_, vertices, options_.tessellation, "export_mesh");
   }

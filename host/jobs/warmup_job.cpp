@@ -90,23 +90,29 @@ WarmupReport WarmupJob::run(ClRuntime& runtime, const std::vector<WarmupVariant>
   report.variants = static_cast<int>(variants.size());
   report.cache_dir = runtime.program_cache_dir();
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  report.threads = std::clamp(threads_ == 0 ? cores : threads_, 1, std::max(1, report.variants));
+  report.threads = std::clamp(threads_ == 0 ? cores : threads_, 1, report.variants + 1);
   const ClRuntime::ProgramStats before = runtime.program_stats();
 
   std::atomic<size_t> next{0};
   std::atomic<int> done{0};
   std::mutex report_mutex;  // progress lines and the first error
   std::exception_ptr failure;
+  // Build 0 is the geometry program every variant shares; build i > 0 is variant i - 1's shading.
+  const size_t builds = variants.size() + 1;
   auto build = [&] {
-    for (size_t i = next++; i < variants.size(); i = next++) {
+    for (size_t i = next++; i < builds; i = next++) {
       const Clock::time_point one = Clock::now();
       const ClRuntime::ProgramStats was = runtime.program_stats();
       try {
-        runtime.program(variants[i].build_options);
+        if (i == 0) {
+          runtime.program(KernelProgram::Geometry);
+        } else {
+          runtime.program(KernelProgram::Shading, variants[i - 1].build_options);
+        }
       } catch (...) {
         std::lock_guard<std::mutex> lock(report_mutex);
         if (!failure) failure = std::current_exception();
-        next = variants.size();  // the others stop after their current build
+        next = builds;  // the others stop after their current build
         return;
       }
       const int finished = ++done;
@@ -114,8 +120,9 @@ WarmupReport WarmupJob::run(ClRuntime& runtime, const std::vector<WarmupVariant>
         // Another thread may have counted meanwhile: "loaded" is a hint, the totals are exact.
         const bool loaded = runtime.program_stats().loaded > was.loaded;
         char line[256];
-        std::snprintf(line, sizeof line, "built %d/%zu: %s (%.0f ms%s)", finished, variants.size(),
-                      variants[i].name.c_str(), ms_since(one), loaded ? ", from the program cache" : "");
+        std::snprintf(line, sizeof line, "built %d/%zu: %s (%.0f ms%s)", finished, builds,
+                      i == 0 ? "geometry stages" : variants[i - 1].name.c_str(), ms_since(one),
+                      loaded ? ", from the program cache" : "");
         std::lock_guard<std::mutex> lock(report_mutex);
         progress(line);
       }

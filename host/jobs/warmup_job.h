@@ -1,8 +1,8 @@
-// The warm-up job: every program variant built (or loaded from the program cache, host/cl/
-// program_cache.h) ahead of the first request, on every core, then one tiny frame of each rendered
-// so that the driver compiles each kernel for its local size too (PoCL does this on a kernel's
-// first enqueue, and with its own cache cold that is slow enough to show in a timed frame). What
-// `seamcl warmup` runs; a service runs the same before it says it is ready.
+// The warm-up job: the geometry program and every shading variant built (or loaded from the
+// program cache, host/cl/program_cache.h) ahead of the first request, on every core, then one tiny
+// frame of each rendered so that the driver compiles each kernel for its local size too (PoCL does
+// this on a kernel's first enqueue, and with its own cache cold that is slow enough to show in a
+// timed frame). What `seamcl warmup` runs; a service runs the same before it says it is ready.
 #pragma once
 #include <functional>
 #include <string>
@@ -45,7 +45,8 @@ struct WarmupReport {
   nlohmann::json to_json() const;
 };
 
-// One line per finished variant ("built 3/28: traverse trilinear (812 ms, from source)").
+// One line per finished build ("built 3/29: traverse trilinear (812 ms)"; the geometry stages'
+// program, which every variant shares, is one of them) and per tiny frame.
 using WarmupProgress = std::function<void(const std::string&)>;
 
 class WarmupJob {

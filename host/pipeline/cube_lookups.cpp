@@ -10,7 +10,7 @@ CubeLookups::CubeLookups(ClRuntime& runtime, const CubeMap& cube, bool border) :
   // The batch kernel does not depend on the patch sampler's build options: the default render
   // variant's program serves (and is usually built already).
   const RenderOptions defaults;
-  kernel_ = cl::Kernel(runtime.program(program_options(defaults.texels, sampler_params(defaults))), "cube_lookup_batch");
+  kernel_ = cl::Kernel(runtime.program(KernelProgram::Sampling, program_options(defaults.texels, sampler_params(defaults))), "cube_lookup_batch");
   std::vector<float> texels = pack_cube_texels(cube, border);
   texels_ = cl::Buffer(runtime.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, texels.size() * sizeof(float),
                        texels.data());

@@ -51,7 +51,7 @@ struct Renderer::Impl {
   TessellateLauncher tessellation{runtime};
   std::optional<DisplacementSettings> tessellation_settings;  // what `tessellation` holds
   bool displaced = false;        // this frame runs the tessellation stage
-  std::string program_key;       // the current program variant's build options
+  std::string program_key;       // the current shading program variant's build options
   bool direction_output = false;  // render_directions: SEAMCL_CUBE_DIRECTION
   // render_downsampled: the stage that reduces the image on the device before the read-back.
   DownsampleLauncher downsampler{runtime};
@@ -65,15 +65,12 @@ struct Renderer::Impl {
     stats = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, sizeof(FrameStats));
   }
 
-  // Makes the kernels of the program variant for this texel format and sampler current.
+  // Makes the shading kernel of the program variant for this texel format and sampler current
+  // (the other stages' programs have no variants).
   void use_kernels(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask) {
     const std::string options = program_options(format, sampler, with_seam_mask, scene->environment.has_value());
     program_key = options;
-    setup.use_program(options);
-    binning.use_program(options);
-    raster.use_program(options);
     shade.use_program(options);
-    if (downsample_taps) downsampler.use_program(options);
   }
 
   // Packs and uploads the loaded scene in `format` with `guard_band` texels of band per level, from
@@ -221,7 +218,7 @@ struct Renderer::Impl {
     queue.enqueueWriteBuffer(stats, CL_FALSE, 0, sizeof(FrameStats), &zero_stats, nullptr, &ev.setup.emplace_back());
 
     if (displaced) {
-      tessellation.enqueue(program_key, frame_params, setup.setups(), setup.slot_counts(), stats, p.input_triangles,
+      tessellation.enqueue(frame_params, setup.setups(), setup.slot_counts(), stats, p.input_triangles,
                            ev.tessellate, ev.setup);
     } else {
       setup.enqueue(frame_params, positions, faces, stats, p.input_triangles, ev.setup);
@@ -410,11 +407,10 @@ std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, c
     if (std::find(variants.begin(), variants.end(), options) == variants.end()) variants.push_back(options);
   }
   return std::async(std::launch::async, [&runtime, variants = std::move(variants)] {
-    for (const std::string& options : variants) {
-      try {
-        runtime.program(options);
-      } catch (...) {  // the render that uses it builds it again and reports the error
-      }
+    try {
+      runtime.program(KernelProgram::Geometry);  // every render's first stages
+      for (const std::string& options : variants) runtime.program(KernelProgram::Shading, options);
+    } catch (...) {  // the render that uses it builds it again and reports the error
     }
   });
 }
@@ -465,7 +461,6 @@ RenderResult Renderer::render_downsampled(const Camera& camera, const RenderOpti
 RenderResult Renderer::downsample_last_frame(const DownsampleTaps& taps) {
   const FrameParams& p = impl_->last_params;
   if (p.width == 0 || impl_->program_key.empty()) throw std::logic_error("downsample_last_frame without a frame");
-  impl_->downsampler.use_program(impl_->program_key);
   RenderResult result;
   std::vector<cl::Event> passes, readback;
   impl_->downsampler.enqueue(impl_->shade.image(), p.width, p.height, taps, result.pixels, passes, readback);

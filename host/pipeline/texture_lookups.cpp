@@ -42,7 +42,7 @@ TextureLookups::Kernels& TextureLookups::kernels_for(const SamplerParams& sample
       program_options(format_, sampler) + (traverse_early_out_ ? "" : " -DSEAMCL_TRAVERSE_EARLY_OUT=0");
   auto it = kernels_.find(options);
   if (it == kernels_.end()) {
-    const cl::Program& program = runtime_.program(options);
+    const cl::Program& program = runtime_.program(KernelProgram::Sampling, options);
     it = kernels_.emplace(options, Kernels{cl::Kernel(program, "texture_lookup_batch"),
                                            cl::Kernel(program, "texture_filter_batch")}).first;
   }
@@ -57,7 +57,7 @@ TextureLookups::GroupedKernels& TextureLookups::grouped_kernels_for(const Sample
   const std::string options = program_options(format_, sampler) + " -DSEAMCL_ANISO_GROUPED=1";
   auto it = grouped_kernels_.find(options);
   if (it == grouped_kernels_.end()) {
-    const cl::Program& program = runtime_.program(options);
+    const cl::Program& program = runtime_.program(KernelProgram::Sampling, options);
     GroupedKernels k{cl::Kernel(program, "aniso_plan_batch"), {}};
     for (int n = 1; n <= SEAMCL_MAX_PROBES; ++n) {
       k.groups.emplace_back(program, ("aniso_group_batch_" + std::to_string(n)).c_str());

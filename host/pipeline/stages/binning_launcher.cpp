@@ -8,14 +8,12 @@
 
 namespace seamcl {
 
-void BinningLauncher::use_program(const std::string& program_options) {
-  auto it = kernels_.find(program_options);
-  if (it == kernels_.end()) {
-    const cl::Program& program = runtime_.program(program_options);
-    Kernels kernels{cl::Kernel(program, "bin_count"), cl::Kernel(program, "bin_scan"), cl::Kernel(program, "bin_fill")};
-    it = kernels_.emplace(program_options, std::move(kernels)).first;
+BinningLauncher::Kernels& BinningLauncher::kernels() {
+  if (kernel_.count() == nullptr) {
+    const cl::Program& program = runtime_.program(KernelProgram::Geometry);
+    kernel_ = Kernels{cl::Kernel(program, "bin_count"), cl::Kernel(program, "bin_scan"), cl::Kernel(program, "bin_fill")};
   }
-  kernel_ = it->second;
+  return kernel_;
 }
 
 void BinningLauncher::reserve(const FrameParams& p) {
@@ -42,31 +40,32 @@ void BinningLauncher::enqueue(const cl::Buffer& frame_params, const cl::Buffer& 
   const size_t tiles = static_cast<size_t>(p.tiles_x) * p.tiles_y;
   const BinChunks chunks = bin_chunks(static_cast<size_t>(p.input_triangles), tiles);
   const cl_int chunk_triangles = static_cast<cl_int>(chunks.chunk_triangles);
+  Kernels& kernel = kernels();
   if (chunks.chunks > 0) {
-    kernel_.count.setArg(0, frame_params);
-    kernel_.count.setArg(1, setups);
-    kernel_.count.setArg(2, slot_counts);
-    kernel_.count.setArg(3, chunk_counts_);
-    kernel_.count.setArg(4, chunk_triangles);
-    queue.enqueueNDRangeKernel(kernel_.count, cl::NullRange, cl::NDRange(chunks.chunks), cl::NDRange(1), nullptr,
+    kernel.count.setArg(0, frame_params);
+    kernel.count.setArg(1, setups);
+    kernel.count.setArg(2, slot_counts);
+    kernel.count.setArg(3, chunk_counts_);
+    kernel.count.setArg(4, chunk_triangles);
+    queue.enqueueNDRangeKernel(kernel.count, cl::NullRange, cl::NDRange(chunks.chunks), cl::NDRange(1), nullptr,
                                &events.emplace_back());
   }
-  kernel_.scan.setArg(0, frame_params);
-  kernel_.scan.setArg(1, chunk_counts_);
-  kernel_.scan.setArg(2, static_cast<cl_int>(chunks.chunks));
-  kernel_.scan.setArg(3, tile_counts_);
-  kernel_.scan.setArg(4, tile_offsets_);
-  kernel_.scan.setArg(5, stats);
-  queue.enqueueNDRangeKernel(kernel_.scan, cl::NullRange, cl::NDRange(1), cl::NDRange(1), nullptr, &events.emplace_back());
+  kernel.scan.setArg(0, frame_params);
+  kernel.scan.setArg(1, chunk_counts_);
+  kernel.scan.setArg(2, static_cast<cl_int>(chunks.chunks));
+  kernel.scan.setArg(3, tile_counts_);
+  kernel.scan.setArg(4, tile_offsets_);
+  kernel.scan.setArg(5, stats);
+  queue.enqueueNDRangeKernel(kernel.scan, cl::NullRange, cl::NDRange(1), cl::NDRange(1), nullptr, &events.emplace_back());
   if (chunks.chunks > 0) {
-    kernel_.fill.setArg(0, frame_params);
-    kernel_.fill.setArg(1, setups);
-    kernel_.fill.setArg(2, slot_counts);
-    kernel_.fill.setArg(3, chunk_counts_);
-    kernel_.fill.setArg(4, chunk_triangles);
-    kernel_.fill.setArg(5, tile_lists_);
-    kernel_.fill.setArg(6, tile_entry_rows_);
-    queue.enqueueNDRangeKernel(kernel_.fill, cl::NullRange, cl::NDRange(chunks.chunks), cl::NDRange(1), nullptr,
+    kernel.fill.setArg(0, frame_params);
+    kernel.fill.setArg(1, setups);
+    kernel.fill.setArg(2, slot_counts);
+    kernel.fill.setArg(3, chunk_counts_);
+    kernel.fill.setArg(4, chunk_triangles);
+    kernel.fill.setArg(5, tile_lists_);
+    kernel.fill.setArg(6, tile_entry_rows_);
+    queue.enqueueNDRangeKernel(kernel.fill, cl::NullRange, cl::NDRange(chunks.chunks), cl::NDRange(1), nullptr,
                                &events.emplace_back());
   }
 }

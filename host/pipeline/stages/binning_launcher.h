@@ -16,8 +16,6 @@ class BinningLauncher {
  public:
   explicit BinningLauncher(ClRuntime& runtime) : runtime_(runtime) {}
 
-  // Makes the kernels of the program built with `program_options` the ones enqueue runs.
-  void use_program(const std::string& program_options);
   // Sizes the per-tile counters for the frame's tiles and input triangles, and the tile lists for
   // p.bin_capacity entries.
   void reserve(const FrameParams& p);
@@ -49,7 +47,7 @@ class BinningLauncher {
     cl::Kernel count, scan, fill;
   };
   ClRuntime& runtime_;
-  std::map<std::string, Kernels> kernels_;  // by program options
+  Kernels& kernels();  // built on first use: the geometry program has no variants
   Kernels kernel_;
   cl::Buffer tile_counts_, tile_offsets_, chunk_counts_, tile_lists_, tile_entry_rows_;
   size_t tiles_capacity_ = 0, chunk_counts_capacity_ = 0;

@@ -6,15 +6,11 @@
 
 namespace seamcl {
 
-void DownsampleLauncher::use_program(const std::string& program_options) {
-  auto it = kernels_.find(program_options);
-  if (it == kernels_.end()) {
-    const cl::Program& program = runtime_.program(program_options);
-    it = kernels_.emplace(program_options, std::make_pair(cl::Kernel(program, "downsample_rows"),
-                                                          cl::Kernel(program, "downsample_columns"))).first;
-  }
-  rows_ = it->second.first;
-  columns_ = it->second.second;
+void DownsampleLauncher::build_kernels() {
+  if (rows_() != nullptr) return;
+  const cl::Program& program = runtime_.program(KernelProgram::Downsample);
+  rows_ = cl::Kernel(program, "downsample_rows");
+  columns_ = cl::Kernel(program, "downsample_columns");
 }
 
 void DownsampleLauncher::enqueue(const cl::Buffer& image, int width, int height, const DownsampleTaps& taps,
@@ -26,6 +22,7 @@ void DownsampleLauncher::enqueue(const cl::Buffer& image, int width, int height,
     throw std::invalid_argument("downsample: " + std::to_string(width) + "x" + std::to_string(height) +
                                 " is not a multiple of " + std::to_string(f));
   }
+  build_kernels();
   const int out_w = width / f, out_h = height / f;
   cl::CommandQueue& queue = runtime_.queue();
   weights_ = cl::Buffer(runtime_.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, taps.weights.size() * sizeof(float),

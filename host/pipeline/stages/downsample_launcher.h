@@ -17,8 +17,6 @@ class DownsampleLauncher {
  public:
   explicit DownsampleLauncher(ClRuntime& runtime) : runtime_(runtime) {}
 
-  // Makes the kernels of the program built with `program_options` the ones enqueue runs.
-  void use_program(const std::string& program_options);
   // Queues both passes over `image` (width x height RGBA floats) and the read of the result into
   // `out` (resized here); the events of the passes go to `passes`, the read's to `readback`.
   // std::invalid_argument for sizes that are not multiples of the factor.
@@ -30,7 +28,7 @@ class DownsampleLauncher {
 
  private:
   ClRuntime& runtime_;
-  std::map<std::string, std::pair<cl::Kernel, cl::Kernel>> kernels_;  // by program options
+  void build_kernels();  // on first use
   cl::Kernel rows_, columns_;
   cl::Buffer weights_, mid_, out_;
   size_t mid_capacity_ = 0, out_capacity_ = 0;

@@ -21,7 +21,7 @@ cl::Buffer upload(ClRuntime& runtime, const std::vector<T>& data, size_t& bytes_
 }  // namespace
 
 PtexFilterLauncher::PtexFilterLauncher(ClRuntime& runtime)
-    : runtime_(runtime), kernel_(runtime.program(), "ptex_filter_lookups") {}
+    : runtime_(runtime), kernel_(runtime.program(KernelProgram::PtexFilter), "ptex_filter_lookups") {}
 
 void PtexFilterLauncher::load(const PtexFilterData& data) {
   device_bytes_ = 0;

@@ -5,12 +5,9 @@
 
 namespace seamcl {
 
-void RasterLauncher::use_program(const std::string& program_options) {
-  auto it = kernels_.find(program_options);
-  if (it == kernels_.end()) {
-    it = kernels_.emplace(program_options, cl::Kernel(runtime_.program(program_options), "raster")).first;
-  }
-  kernel_ = it->second;
+cl::Kernel& RasterLauncher::kernel() {
+  if (kernel_() == nullptr) kernel_ = cl::Kernel(runtime_.program(KernelProgram::Geometry), "raster");
+  return kernel_;
 }
 
 void RasterLauncher::reserve(const FrameParams& p) {
@@ -20,15 +17,16 @@ void RasterLauncher::reserve(const FrameParams& p) {
 
 void RasterLauncher::enqueue(const cl::Buffer& frame_params, const cl::Buffer& setups, const BinningLauncher& binning,
                              const FrameParams& p, std::vector<cl::Event>& events) {
-  kernel_.setArg(0, frame_params);
-  kernel_.setArg(1, setups);
-  kernel_.setArg(2, binning.tile_counts());
-  kernel_.setArg(3, binning.tile_offsets());
-  kernel_.setArg(4, binning.tile_lists());
-  kernel_.setArg(5, binning.tile_entry_rows());
-  kernel_.setArg(6, sample_triangle_);
+  cl::Kernel& kernel = this->kernel();
+  kernel.setArg(0, frame_params);
+  kernel.setArg(1, setups);
+  kernel.setArg(2, binning.tile_counts());
+  kernel.setArg(3, binning.tile_offsets());
+  kernel.setArg(4, binning.tile_lists());
+  kernel.setArg(5, binning.tile_entry_rows());
+  kernel.setArg(6, sample_triangle_);
   // One work-item per tile (kernels/raster.cl walks a tile's list once, a row in a 16-wide vector).
-  runtime_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange,
+  runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange,
                                         cl::NDRange(static_cast<size_t>(p.tiles_x), static_cast<size_t>(p.tiles_y)),
                                         cl::NDRange(1, 1), nullptr, &events.emplace_back());
 }

@@ -17,8 +17,6 @@ class RasterLauncher {
  public:
   explicit RasterLauncher(ClRuntime& runtime) : runtime_(runtime) {}
 
-  // Makes the kernel of the program built with `program_options` the one enqueue runs.
-  void use_program(const std::string& program_options);
   // Sizes the per-sample slots for the frame's pixels and samples.
   void reserve(const FrameParams& p);
   // Queues raster of the frame's tiles from the setup records and binning's lists; its event is
@@ -36,7 +34,7 @@ class RasterLauncher {
 
  private:
   ClRuntime& runtime_;
-  std::map<std::string, cl::Kernel> kernels_;  // by program options
+  cl::Kernel& kernel();  // built on first use: the geometry program has no variants
   cl::Kernel kernel_;
   cl::Buffer sample_triangle_;
   size_t samples_capacity_ = 0;

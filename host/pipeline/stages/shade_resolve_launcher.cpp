@@ -7,7 +7,7 @@ namespace seamcl {
 void ShadeResolveLauncher::use_program(const std::string& program_options) {
   auto it = kernels_.find(program_options);
   if (it == kernels_.end()) {
-    it = kernels_.emplace(program_options, cl::Kernel(runtime_.program(program_options), "shade_resolve")).first;
+    it = kernels_.emplace(program_options, cl::Kernel(runtime_.program(KernelProgram::Shading, program_options), "shade_resolve")).first;
   }
   kernel_ = it->second;
 }

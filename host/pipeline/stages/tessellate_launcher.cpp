@@ -37,13 +37,12 @@ void TessellateLauncher::release() {
   params_ = patches_ = samples_ = positions_ = normals_ = vertices_ = cl::Buffer();
 }
 
-TessellateLauncher::Kernels& TessellateLauncher::kernels(const std::string& program_options) {
-  auto it = kernels_.find(program_options);
-  if (it == kernels_.end()) {
-    const cl::Program& program = runtime_.program(program_options);
-    it = kernels_.emplace(program_options, Kernels{cl::Kernel(program, "tessellate"), cl::Kernel(program, "tessellated_setup")}).first;
+TessellateLauncher::Kernels& TessellateLauncher::kernels() {
+  if (!kernels_) {
+    const cl::Program& program = runtime_.program(KernelProgram::Geometry);
+    kernels_ = Kernels{cl::Kernel(program, "tessellate"), cl::Kernel(program, "tessellated_setup")};
   }
-  return it->second;
+  return *kernels_;
 }
 
 void TessellateLauncher::enqueue_tessellate(Kernels& k, std::vector<cl::Event>* events) {
@@ -61,10 +60,10 @@ void TessellateLauncher::enqueue_tessellate(Kernels& k, std::vector<cl::Event>* 
                                         nullptr, event);
 }
 
-void TessellateLauncher::enqueue(const std::string& program_options, const cl::Buffer& frame_params, const cl::Buffer& setups,
+void TessellateLauncher::enqueue(const cl::Buffer& frame_params, const cl::Buffer& setups,
                                 const cl::Buffer& slot_counts, const cl::Buffer& stats, int input_triangles, std::vector<cl::Event>& tessellate_events,
                                 std::vector<cl::Event>& setup_events) {
-  Kernels& k = kernels(program_options);
+  Kernels& k = kernels();
   enqueue_tessellate(k, &tessellate_events);
   if (input_triangles <= 0) return;
   k.setup.setArg(0, frame_params);
@@ -78,8 +77,8 @@ void TessellateLauncher::enqueue(const std::string& program_options, const cl::B
                                         cl::NDRange(SEAMCL_SETUP_GROUP), nullptr, &setup_events.emplace_back());
 }
 
-std::vector<TessVertex> TessellateLauncher::tessellate(const std::string& program_options) {
-  enqueue_tessellate(kernels(program_options), nullptr);
+std::vector<TessVertex> TessellateLauncher::tessellate() {
+  enqueue_tessellate(kernels(), nullptr);
   return read_vertices();
 }
 

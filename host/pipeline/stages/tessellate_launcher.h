@@ -2,7 +2,7 @@
 // queues, in place of triangle setup, the tessellation of every patch and the setup of every
 // micro-triangle, so binning, raster and shading run on the displaced surface unchanged.
 #pragma once
-#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,15 +21,15 @@ class TessellateLauncher {
   bool loaded() const { return loaded_; }
   void release();
 
-  // Queues tessellate and tessellated_setup (kernels of the program built with `options`),
+  // Queues tessellate and tessellated_setup (kernels of the geometry program),
   // writing each micro-triangle's fan of records into `setups` and its size into `slot_counts`
   // (as triangle_setup does); one event each is appended to `tessellate_events` and `setup_events`.
-  void enqueue(const std::string& program_options, const cl::Buffer& frame_params, const cl::Buffer& setups,
+  void enqueue(const cl::Buffer& frame_params, const cl::Buffer& setups,
                const cl::Buffer& slot_counts, const cl::Buffer& stats, int input_triangles, std::vector<cl::Event>& tessellate_events,
                std::vector<cl::Event>& setup_events);
 
   // Only tessellates (for the gap metric and the kernel tests), then reads the vertices back.
-  std::vector<TessVertex> tessellate(const std::string& program_options);
+  std::vector<TessVertex> tessellate();
   // The vertices of the last enqueue or tessellate.
   std::vector<TessVertex> read_vertices();
 
@@ -39,11 +39,11 @@ class TessellateLauncher {
   struct Kernels {
     cl::Kernel tessellate, setup;
   };
-  Kernels& kernels(const std::string& program_options);
+  Kernels& kernels();  // built on first use
   void enqueue_tessellate(Kernels& k, std::vector<cl::Event>* events);
 
   ClRuntime& runtime_;
-  std::map<std::string, Kernels> kernels_;
+  std::optional<Kernels> kernels_;
   PackedDisplacement packed_;
   bool loaded_ = false;
   cl::Buffer params_, patches_, samples_, positions_, normals_, vertices_;

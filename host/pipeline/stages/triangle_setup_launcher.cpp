@@ -6,12 +6,9 @@
 
 namespace seamcl {
 
-void TriangleSetupLauncher::use_program(const std::string& program_options) {
-  auto it = kernels_.find(program_options);
-  if (it == kernels_.end()) {
-    it = kernels_.emplace(program_options, cl::Kernel(runtime_.program(program_options), "triangle_setup")).first;
-  }
-  kernel_ = it->second;
+cl::Kernel& TriangleSetupLauncher::kernel() {
+  if (kernel_() == nullptr) kernel_ = cl::Kernel(runtime_.program(KernelProgram::Geometry), "triangle_setup");
+  return kernel_;
 }
 
 void TriangleSetupLauncher::reserve(size_t input_triangles) {
@@ -23,14 +20,15 @@ void TriangleSetupLauncher::reserve(size_t input_triangles) {
 void TriangleSetupLauncher::enqueue(const cl::Buffer& frame_params, const cl::Buffer& positions, const cl::Buffer& faces,
                                     const cl::Buffer& stats, int input_triangles, std::vector<cl::Event>& events) {
   if (input_triangles <= 0) return;
-  kernel_.setArg(0, frame_params);
-  kernel_.setArg(1, positions);
-  kernel_.setArg(2, faces);
-  kernel_.setArg(3, setups_);
-  kernel_.setArg(4, slot_counts_);
-  kernel_.setArg(5, stats);
+  cl::Kernel& kernel = this->kernel();
+  kernel.setArg(0, frame_params);
+  kernel.setArg(1, positions);
+  kernel.setArg(2, faces);
+  kernel.setArg(3, setups_);
+  kernel.setArg(4, slot_counts_);
+  kernel.setArg(5, stats);
   const size_t setup_items = (static_cast<size_t>(input_triangles) + SEAMCL_SETUP_LANES - 1) / SEAMCL_SETUP_LANES;
-  runtime_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(round_up(setup_items, SEAMCL_SETUP_GROUP)),
+  runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(round_up(setup_items, SEAMCL_SETUP_GROUP)),
                                         cl::NDRange(SEAMCL_SETUP_GROUP), nullptr, &events.emplace_back());
 }
 

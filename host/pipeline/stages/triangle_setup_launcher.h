@@ -24,8 +24,6 @@ class TriangleSetupLauncher {
  public:
   explicit TriangleSetupLauncher(ClRuntime& runtime) : runtime_(runtime) {}
 
-  // Makes the kernel of the program built with `program_options` the one enqueue runs.
-  void use_program(const std::string& program_options);
   // Sizes the records and counts for `input_triangles`; the tessellation stage writes them too.
   void reserve(size_t input_triangles);
   // Queues setup of `input_triangles` triangles (none: nothing is queued); its event is appended.
@@ -44,7 +42,7 @@ class TriangleSetupLauncher {
 
  private:
   ClRuntime& runtime_;
-  std::map<std::string, cl::Kernel> kernels_;  // by program options
+  cl::Kernel& kernel();  // built on first use: the geometry program has no variants
   cl::Kernel kernel_;
   cl::Buffer setups_, slot_counts_;
   size_t setups_capacity_ = 0, slot_counts_capacity_ = 0;
