@@ -15,7 +15,9 @@
 //   ptex_1_thread/...   PtexFilter::eval over the queries on this thread.
 //   ptex_all_cores/...  the queries split in contiguous slices over hardware_concurrency threads,
 //                       from the threads' start to their join.
-// Face data is read into memory before timing on every side (Ptex reads faces lazily).
+// Face data is read into memory before timing on every side (Ptex reads faces lazily). Each row
+// also gives the process's CPU seconds over the same loop: lookups_per_cpu_s, and cpu_per_wall (the
+// cores in use: on a machine shared with other jobs, lookups_per_s drops with the share it gets).
 //
 // Equal work: device values are checked against the twin's (max_abs_diff_vs_twin) and, with Ptex,
 // against the Ptex library's on every query (max_abs_diff_vs_device, on the ptex_* rows); a
@@ -33,6 +35,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <functional>
 #include <map>
 #include <memory>
@@ -193,6 +196,37 @@ void set_rate(benchmark::State& state, double lookups, double seconds, const cha
   state.counters[key] = seconds > 0.0 ? lookups / seconds : 0.0;
 }
 
+// CPU seconds of every thread of the process (PoCL's workers included).
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+// Wall and process CPU time of the timed loop: cpu_per_wall is the cores the side kept busy (2 on
+// 2 idle cores; less when other jobs share the machine), lookups_per_cpu_s its work per core.
+struct Clocks {
+  double wall = 0.0, cpu = 0.0;
+  double cpu_start = 0.0;
+  std::chrono::steady_clock::time_point start;
+  void begin() {
+    cpu_start = process_cpu_seconds();
+    start = std::chrono::steady_clock::now();
+  }
+  double end() {
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    cpu += process_cpu_seconds() - cpu_start;
+    wall += s;
+    return s;
+  }
+  void report(benchmark::State& state, double lookups_per_iteration) const {
+    const double lookups = lookups_per_iteration * static_cast<double>(state.iterations());
+    set_rate(state, lookups, wall);
+    set_rate(state, lookups, cpu, "lookups_per_cpu_s");
+    state.counters["cpu_per_wall"] = wall > 0.0 ? cpu / wall : 0.0;
+  }
+};
+
 void device_lookups(benchmark::State& state, std::string file, FilterKind filter) {
   const std::vector<PtexFilterQuery>& q = queries(file, filter);
   seamcl::PtexFilterLauncher& l = launcher(file);
@@ -209,16 +243,14 @@ void device_lookups(benchmark::State& state, std::string file, FilterKind filter
     state.SkipWithError("device values differ from the twin's by more than 1e-4");
     return;
   }
-  double seconds = 0.0;
+  Clocks clocks;
   for (auto _ : state) {
-    const auto start = std::chrono::steady_clock::now();
+    clocks.begin();
     std::vector<float> out = l.run(q);
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     benchmark::DoNotOptimize(out.data());
-    state.SetIterationTime(s);
-    seconds += s;
+    state.SetIterationTime(clocks.end());
   }
-  set_rate(state, static_cast<double>(q.size()) * static_cast<double>(state.iterations()), seconds);
+  clocks.report(state, static_cast<double>(q.size()));
   std::vector<double> kernel_ms = l.time(q, 3);
   std::sort(kernel_ms.begin(), kernel_ms.end());
   set_rate(state, static_cast<double>(q.size()), kernel_ms[1] * 1e-3, "kernel_lookups_per_s");
@@ -230,16 +262,14 @@ void twin_lookups(benchmark::State& state, std::string file, FilterKind filter) 
   const std::vector<PtexFilterQuery>& all = queries(file, filter);
   const std::vector<PtexFilterQuery> q(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(all.size() / 16));
   float sink = 0.0f;
-  double seconds = 0.0;
+  Clocks clocks;
   for (auto _ : state) {
-    const auto start = std::chrono::steady_clock::now();
+    clocks.begin();
     for (const PtexFilterQuery& one : q) sink += seamcl::ptex_filter_twin(data, one)[0];
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    state.SetIterationTime(s);
-    seconds += s;
+    state.SetIterationTime(clocks.end());
   }
   benchmark::DoNotOptimize(sink);
-  set_rate(state, static_cast<double>(q.size()) * static_cast<double>(state.iterations()), seconds);
+  clocks.report(state, static_cast<double>(q.size()));
 }
 
 #ifdef SEAMCL_WITH_PTEX
@@ -278,9 +308,9 @@ void ptex_lookups(benchmark::State& state, std::string file, FilterKind filter, 
     state.SkipWithError("the Ptex library's values differ from the device's by more than 1e-4");
     return;
   }
-  double seconds = 0.0;
+  Clocks clocks;
   for (auto _ : state) {
-    const auto start = std::chrono::steady_clock::now();
+    clocks.begin();
     if (threads == 1) {
       ptex_eval(filters[0], q, 0, q.size(), channels, values.data());
     } else {
@@ -290,13 +320,11 @@ void ptex_lookups(benchmark::State& state, std::string file, FilterKind filter, 
                           q.size() * static_cast<size_t>(t + 1) / static_cast<size_t>(threads), channels, values.data());
       for (std::thread& t : pool) t.join();
     }
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    state.SetIterationTime(s);
-    seconds += s;
+    state.SetIterationTime(clocks.end());
   }
   benchmark::DoNotOptimize(values.data());
   for (PtexFilter* f : filters) f->release();
-  set_rate(state, static_cast<double>(q.size()) * static_cast<double>(state.iterations()), seconds);
+  clocks.report(state, static_cast<double>(q.size()));
   state.counters["threads"] = threads;
 }
 

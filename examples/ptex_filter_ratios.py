@@ -9,7 +9,9 @@
 Prints, per file and filter, the median lookups/s (millions) of the device (upload, kernel and
 readback), of the kernel alone, of the scalar twin on one thread and, when the runs were built
 against the Ptex library, of PtexFilter on one thread and on every core, with device / Ptex all
-cores (issue 42's goal: at least 2) and the largest difference between the two sides' values.
+cores (issue 42's goal: at least 2) and the largest difference between the two sides' values; then
+the same per CPU second of the process, with the cores each side kept busy (CPU s / wall s), which
+tell a side's own speed from the share of a machine that other jobs left it.
 Exits 1 when a run holds a benchmark that stopped with an error (values that disagree).
 """
 import json
@@ -24,10 +26,14 @@ def load(paths):
     """{(side, file, filter): {counter: [value per run]}}, errors, the runs' context."""
     rows, errors, context = {}, [], {}
     for path in paths:
-        with open(path) as f:
-            data = json.load(f)
+        try:
+            with open(path) as f:
+                data = json.load(f)
+            benchmarks = data["benchmarks"]
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            raise SystemExit("ptex_filter_ratios: %s: not a Google Benchmark JSON file (%s)" % (path, e))
         context = data.get("context", {})
-        for b in data["benchmarks"]:
+        for b in benchmarks:
             if b.get("run_type", "iteration") != "iteration":
                 continue
             name = b["name"].split("/iterations:")[0].split("/manual_time")[0]
@@ -38,7 +44,8 @@ def load(paths):
                 errors.append("%s: %s: %s" % (path, name, b.get("error_message", "")))
                 continue
             slot = rows.setdefault(tuple(parts), {})
-            for key in ("lookups_per_s", "kernel_lookups_per_s", "max_abs_diff_vs_device", "max_abs_diff_vs_twin"):
+            for key in ("lookups_per_s", "kernel_lookups_per_s", "lookups_per_cpu_s", "cpu_per_wall",
+                        "max_abs_diff_vs_device", "max_abs_diff_vs_twin"):
                 if key in b:
                     slot.setdefault(key, []).append(float(b[key]))
     return rows, errors, context
@@ -91,6 +98,20 @@ def main(argv):
                 bad_rates.append("%s/%s: a rate that is not a positive number: %r" % (file, filt, x))
         print("| %s.ptx | %s | %s | %s | %s | %s | %s | %s | %s |" % (file, filt, m(device), m(kernel), m(twin), m(one),
                                                                     m(every), ratio, diff))
+    print()
+    print("Per CPU second of the process (millions of lookups), and the cores in use (CPU s / wall s):")
+    print()
+    print("| file | filter | seamcl device | Ptex, 1 thread | Ptex, %s threads | device / Ptex all cores "
+          "| cores: device | cores: Ptex all |" % cores)
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for file, filt in keys:
+        device = median(rows, "device", file, filt, "lookups_per_cpu_s")
+        one = median(rows, "ptex_1_thread", file, filt, "lookups_per_cpu_s")
+        every = median(rows, "ptex_all_cores", file, filt, "lookups_per_cpu_s")
+        ratio = "%.2f" % (device / every) if device and every else "n/a"
+        busy = [median(rows, side, file, filt, "cpu_per_wall") for side in ("device", "ptex_all_cores")]
+        print("| %s.ptx | %s | %s | %s | %s | %s | %s | %s |" % (file, filt, m(device), m(one), m(every), ratio,
+                                                              *("%.2f" % b if b is not None else "n/a" for b in busy)))
     for e in bad_rates:
         print("ERROR:", e, file=sys.stderr)
     return 1 if errors or bad_rates else 0

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """build/seamcl_bench_ptex_filter at a tiny size (issue 42, item 5), with or without the Ptex
 library: every file and filter has a device and a twin row with finite positive rates, the
-device's values within 1e-4 of the twin's; the ptex_* rows, when the build has Ptex, within 1e-4
+device's values within 1e-4 of the twin's, rates per CPU second and cores in use too; the ptex_* rows, when the build has Ptex, within 1e-4
 of the device's; a bad --queries exits 2 naming the flag; and examples/ptex_filter_ratios.py makes
 the table from two such runs (medians, ratios), and from hand-written runs with known figures.
 
@@ -48,7 +48,8 @@ def check_run(check, path):
                 if not check(b is not None, name + " is in the run"):
                     continue
                 check(not b.get("error_occurred"), "%s ran without error: %s" % (name, b.get("error_message")))
-                check(positive(b.get("lookups_per_s")), "%s: lookups_per_s finite and positive: %r" % (name, b.get("lookups_per_s")))
+                for key in ("lookups_per_s", "lookups_per_cpu_s", "cpu_per_wall"):
+                    check(positive(b.get(key)), "%s: %s finite and positive: %r" % (name, key, b.get(key)))
             device = rows.get("device/%s/%s" % (file, filt), {})
             check(positive(device.get("kernel_lookups_per_s")), "device/%s/%s: kernel_lookups_per_s positive" % (file, filt))
             check(device.get("queries") == 256, "device/%s/%s: 256 queries" % (file, filt))
@@ -71,11 +72,13 @@ def check_ratios_by_hand(check, d):
     for i, (device, every) in enumerate(((10e6, 2e6), (14e6, 4e6))):
         data = {"context": {"ptex_library": "yes", "hardware_threads": "2"}, "benchmarks": [
             {"name": "device/cube_text/box/manual_time", "run_type": "iteration", "lookups_per_s": device,
-             "kernel_lookups_per_s": 2 * device, "max_abs_diff_vs_twin": 1e-7},
+             "kernel_lookups_per_s": 2 * device, "max_abs_diff_vs_twin": 1e-7, "lookups_per_cpu_s": device / 2,
+             "cpu_per_wall": 2.0 - i},
             {"name": "twin/cube_text/box/manual_time", "run_type": "iteration", "lookups_per_s": 1e6},
             {"name": "ptex_1_thread/cube_text/box/manual_time", "run_type": "iteration", "lookups_per_s": every / 2,
              "max_abs_diff_vs_device": 3e-6 * (i + 1)},
-            {"name": "ptex_all_cores/cube_text/box/manual_time", "run_type": "iteration", "lookups_per_s": every},
+            {"name": "ptex_all_cores/cube_text/box/manual_time", "run_type": "iteration", "lookups_per_s": every,
+             "lookups_per_cpu_s": every / 4, "cpu_per_wall": 1.5},
             {"name": "device/cube_text/box/manual_time_median", "run_type": "aggregate", "lookups_per_s": 1e15}]}
         paths.append(os.path.join(d, "hand%d.json" % i))
         with open(paths[-1], "w") as f:
@@ -85,6 +88,9 @@ def check_ratios_by_hand(check, d):
     check("| cube_text.ptx | box | 12.00 | 24.00 | 1.00 | 1.50 | 3.00 | 4.00 | 6.0e-06 |" in r.stdout,
           "medians, ratio 4.00 and the largest difference of hand-written runs: " + r.stdout)
     check("Ptex, 2 threads" in r.stdout, "the header names the thread count: " + r.stdout)
+    # Per CPU second: device 6 / Ptex all cores 0.75 = 8.00; cores in use: median of 2 and 1, and 1.5.
+    check("| cube_text.ptx | box | 6.00 | n/a | 0.75 | 8.00 | 1.50 | 1.50 |" in r.stdout,
+          "per CPU second and cores in use of hand-written runs: " + r.stdout)
     # A run whose benchmark stopped with an error fails the table.
     bad = {"context": {}, "benchmarks": [{"name": "device/cellnoise/box/manual_time", "run_type": "iteration",
                                           "error_occurred": True, "error_message": "differ"}]}
@@ -111,8 +117,10 @@ def main():
         if all(os.path.exists(p) for p in outs):
             r = subprocess.run([sys.executable, RATIOS, *outs], capture_output=True, text=True)
             check(r.returncode == 0, "ratios of the two runs exit 0: %s" % r.stderr)
-            lines = [l for l in r.stdout.splitlines() if l.startswith("| ") and ".ptx |" in l]
-            check(len(lines) == len(FILES) * len(FILTERS), "one table row per file and filter: %d" % len(lines))
+            wall, _, cpu = r.stdout.partition("Per CPU second")
+            for table, text in (("wall", wall), ("CPU", cpu)):
+                lines = [l for l in text.splitlines() if l.startswith("| ") and ".ptx |" in l]
+                check(len(lines) == len(FILES) * len(FILTERS), "one %s table row per file and filter: %d" % (table, len(lines)))
             check("over 2 run(s)" in r.stdout, "the table counts its runs: " + r.stdout[:200])
         check_ratios_by_hand(check, d)
         r = run_bench(args.bench, os.path.join(d, "never.json"), ["--queries=12x"])
