@@ -66,7 +66,9 @@ def main(argv):
         print(__doc__)
         return 2
     rows, errors, context = load(argv[1:])
-    keys = sorted({(f, k) for (_, f, k) in rows}, key=lambda fk: fk[0])
+    # Files in name order, each file's filters in the benchmark's own order (rows keep it).
+    seen = list(dict.fromkeys((f, k) for (_, f, k) in rows))
+    keys = sorted(seen, key=lambda fk: (fk[0], seen.index(fk)))
     for e in errors:
         print("ERROR:", e, file=sys.stderr)
     if not keys:
