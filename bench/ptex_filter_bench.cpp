@@ -19,9 +19,10 @@
 // also gives the process's CPU seconds over the same loop: lookups_per_cpu_s, and cpu_per_wall (the
 // cores in use: on a machine shared with other jobs, lookups_per_s drops with the share it gets).
 //
-// Equal work: device values are checked against the twin's (max_abs_diff_vs_twin) and, with Ptex,
-// against the Ptex library's on every query (max_abs_diff_vs_device, on the ptex_* rows); a
-// difference above 1e-4 ends the benchmark with an error instead of a rate.
+// Equal work: device values are checked against the twin's on the first sixteenth of the queries
+// (max_abs_diff_vs_twin) and, with Ptex, against the Ptex library's on every query
+// (max_abs_diff_vs_device, on the ptex_* rows); a difference above 1e-4 ends the benchmark with an
+// error instead of a rate.
 //
 // Run: build/seamcl_bench_ptex_filter [--queries=N] [Google Benchmark flags]
 //      (N lookups per benchmark, default 262144; docs/benchmarks.md has the table's commands)
