@@ -99,44 +99,82 @@ bool is_closed_mesh(const Scene& scene) {
   return true;
 }
 
-Scene with_flag_shell(const Scene& scene, float shrink) {
-  Scene out = scene;
-  glm::vec3 center(0.0f);
-  for (const glm::vec3& p : scene.positions) center += p;
-  if (!scene.positions.empty()) center /= static_cast<float>(scene.positions.size());
-  const auto base = static_cast<uint32_t>(out.positions.size());
-  for (const glm::vec3& p : scene.positions) out.positions.push_back(center + (p - center) * shrink);
-  TextureLevel flag;
-  flag.width = flag.height = 1;
-  flag.texels = {glm::vec4(kFlagColor, 1.0f)};
-  const MipChain flag_texture = build_mip_chain(flag);
-  for (const Face& f : scene.faces) {
-    const auto& v = f.vertices;
-    out.faces.push_back({{base + v[0], base + v[3], base + v[2], base + v[1]}, flag_texture});
+Scene with_back_faces_flagged(const Scene& scene, const std::vector<TessVertex>& vertices, int tessellation) {
+  const auto t = static_cast<size_t>(tessellation);
+  const size_t per_patch = (t + 1) * (t + 1);
+  if (tessellation < 1 || vertices.size() % per_patch != 0) {
+    throw std::invalid_argument("with_back_faces_flagged: vertices are not whole patches at this tessellation");
   }
-  if (scene.displacement) {
-    auto displacement = std::make_shared<Displacement>(*scene.displacement);
-    displacement->maps.resize(out.faces.size());  // the flag's maps are empty: not displaced
-    out.displacement = displacement;
-  }
-  if (scene.albedo) {
-    const size_t scene_faces = scene.faces.size();
-    out.albedo = [albedo = scene.albedo, scene_faces](size_t face, glm::vec3 p) {
-      return face < scene_faces ? albedo(face, p) : glm::vec4(kFlagColor, 1.0f);
-    };
+  const size_t patches = vertices.size() / per_patch;
+  Scene out;
+  out.name = scene.name;
+  out.camera = scene.camera;
+  out.orbit = scene.orbit;
+  out.light = scene.light;
+  out.background = scene.background;
+  // One set of vertices for both: the flag must project exactly where the surface does (a flag
+  // edge one subpixel past the surface's silhouette would show with nothing in front of it).
+  out.positions.reserve(vertices.size());
+  for (const TessVertex& v : vertices) out.positions.emplace_back(v.position[0], v.position[1], v.position[2]);
+  auto solid = [](glm::vec3 colour) {
+    TextureLevel level;
+    level.width = level.height = 1;
+    level.texels = {glm::vec4(colour, 1.0f)};
+    return build_mip_chain(level);
+  };
+  const MipChain flag = solid(kFlagColor);
+  out.faces.reserve(2 * patches * t * t);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (size_t p = 0; p < patches; ++p) {
+      // Light tints that differ between neighbours, never near the flag's magenta.
+      const float k = static_cast<float>(p % 7) / 7.0f;
+      const MipChain tint = pass == 0 ? solid(glm::vec3(0.55f + 0.3f * k, 0.75f - 0.2f * k, 0.6f)) : flag;
+      for (size_t j = 0; j < t; ++j) {
+        for (size_t i = 0; i < t; ++i) {
+          auto at = [&](size_t di, size_t dj) {
+            return static_cast<uint32_t>(p * per_patch + (j + dj) * (t + 1) + i + di);
+          };
+          // The tessellator splits a cell (00, 10, 11) + (00, 11, 01); a face (a, b, c, d)
+          // renders as (a, b, c) + (a, c, d): the same triangles from corner 00. The reverse,
+          // (00, 01, 11, 10), keeps that diagonal and turns both triangles over.
+          const std::array<uint32_t, 4> quad = pass == 0 ? std::array<uint32_t, 4>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)}
+                                                         : std::array<uint32_t, 4>{at(0, 0), at(0, 1), at(1, 1), at(1, 0)};
+          out.faces.push_back({quad, tint});
+        }
+      }
+    }
   }
   return out;
 }
 
+std::vector<TessVertex> tessellate_displacement(ClRuntime& runtime, const Scene& scene, const RenderOptions& options) {
+  if (!options.displacement) throw InputError("displacement_method", "is needed to tessellate a displaced surface");
+  TessellateLauncher stage(runtime);
+  stage.load(pack_displacement(scene, {*options.displacement, options.tessellation, options.displacement_level}));
+  std::vector<TessVertex> vertices = stage.tessellate(program_options(options.texels, sampler_params(options), false));
+  stage.release();
+  return vertices;
+}
+
+RenderOptions crack_render_options(const RenderOptions& options) {
+  RenderOptions out;
+  out.scene = options.scene;
+  out.width = options.width;
+  out.height = options.height;
+  out.msaa = options.msaa;
+  out.method = Method::Clamp;
+  out.filter = Filter::Bilinear;
+  return out;
+}
+
 size_t count_flag_pixels(const std::vector<uint32_t>& sample_triangles, int width, int height, int sample_count,
-                         int tessellation, size_t first_flag_patch) {
-  const size_t per_patch = 2 * static_cast<size_t>(tessellation) * tessellation;
+                         size_t first_flag_face) {
   size_t flagged = 0;
   const size_t pixels = static_cast<size_t>(width) * height;
   for (size_t pixel = 0; pixel < pixels && (pixel + 1) * sample_count <= sample_triangles.size(); ++pixel) {
     for (int s = 0; s < sample_count; ++s) {
       const uint32_t slot = sample_triangles[pixel * sample_count + s];
-      if (slot != SEAMCL_NO_TRIANGLE && slot / SEAMCL_CLIP_SLOTS / per_patch >= first_flag_patch) {
+      if (slot != SEAMCL_NO_TRIANGLE && slot / SEAMCL_CLIP_SLOTS / 2 >= first_flag_face) {
         ++flagged;
         break;
       }
@@ -168,7 +206,7 @@ nlohmann::json DisplacementReport::to_json() const {
 }
 
 void check_tessellation_levels(const Scene& scene, const std::vector<int>& levels) {
-  // A closed mesh is also rendered with its flag shell (with_flag_shell: twice the faces).
+  // A closed mesh's crack renders hold its micro-quads twice (with_back_faces_flagged).
   const size_t patches = (is_closed_mesh(scene) ? 2 : 1) * scene.faces.size();
   for (int t : levels) check_tessellation(patches, t);
 }
@@ -186,7 +224,7 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   report.tessellation = settings.tessellation;
   report.level = settings.level;
 
-  // 1. The gap, from the device's own tessellation.
+  // 1. The gap, from the device's own tessellation (whose vertices the crack renders draw).
   PackedDisplacement packed = pack_displacement(scene, settings);
   report.extra_bytes = packed.method_bytes();
   report.matched_samples = packed.matched_samples;
@@ -194,7 +232,7 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   report.triangles = packed.triangle_count();
   TessellateLauncher stage(runtime);
   stage.load(std::move(packed));
-  const std::vector<TessVertex> vertices =
+  std::vector<TessVertex> vertices =
       stage.tessellate(program_options(options.texels, sampler_params(options), false));
   report.gap = measure_gap(stage.packed(), vertices);
   report.vertices = vertices.size();
@@ -227,17 +265,20 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
     report.tessellate_ms = median(tessellate);
   }
 
-  // 3. Crack pixels, on a closed mesh with its flag inside.
+  // 3. Crack pixels, on a closed mesh with its back faces flagged. The tessellation does not
+  //    depend on the camera, so one copy of the displaced surface serves every frame.
   if (is_closed_mesh(scene)) {
-    const Scene flagged = with_flag_shell(scene);
+    const size_t first_flag_face = scene.faces.size() * static_cast<size_t>(settings.tessellation) * settings.tessellation;
+    const RenderOptions crack_options = crack_render_options(options);
     Renderer renderer(runtime);
     renderer.set_device_byte_limit(device_byte_limit);
-    renderer.load_scene(flagged, options.texels);
+    renderer.load_scene(with_back_faces_flagged(scene, vertices, settings.tessellation), crack_options.texels);
+    vertices = {};
     size_t cracks = 0;
     for (const Camera& c : cameras) {
-      renderer.render(c, options);
-      cracks += count_flag_pixels(renderer.read_sample_triangles(), options.width, options.height, options.msaa,
-                                  options.tessellation, scene.faces.size());
+      renderer.render(c, crack_options);
+      cracks += count_flag_pixels(renderer.read_sample_triangles(), crack_options.width, crack_options.height,
+                                  crack_options.msaa, first_flag_face);
     }
     report.crack_pixels = cracks;
     report.crack_frames = static_cast<int>(cameras.size());

@@ -1,5 +1,5 @@
 // What a displacement method costs and whether it is watertight: the exact position gap between
-// vertices that two patches share, crack pixels on a closed mesh whose inside is a flag, and the
+// vertices that two patches share, crack pixels on a closed mesh whose back faces are a flag, and the
 // samples and bytes each method spends.
 #pragma once
 #include <cstddef>
@@ -34,17 +34,35 @@ DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<
 // be counted on it).
 bool is_closed_mesh(const Scene& scene);
 
-// The scene plus its flag: a copy of the mesh shrunk by `shrink` about the mean of its
-// positions, with reversed faces (so their inside faces the camera) in a constant flag colour and
-// without displacement. Seen from outside, the flag is hidden by any watertight surface around it;
-// every sample that shows it looks through a crack. The flag's faces come after the scene's.
-Scene with_flag_shell(const Scene& scene, float shrink = 0.5f);
+// The displaced surface as plain faces, for counting cracks on any closed mesh: every micro-quad
+// of `vertices` (the tessellator's output, patch-major, (T+1)^2 a patch) as a face split on the
+// tessellator's own diagonal, so it rasterises as the displaced render does, the patches'
+// vertices not merged, so every gap stays open; then the same quads reversed, in the flag colour.
+// Of a quad and its reverse exactly one faces the camera: the render is the surface with its back
+// faces drawn as the flag. Along a ray from outside, the nearest surface of a closed watertight
+// mesh is a front face whatever its shape (the ray must enter the solid before it can see its
+// inside), so a sample whose winner is a flag face looks through a crack. No centre or inside
+// point is assumed. Faces [0, patches * T^2) are the surface. Front faces are tinted per patch
+// (the patches' borders show in an image); no displacement, albedo or environment is kept.
+// What it cannot tell from a crack: a back face that wins a sample without one, where the
+// displaced surface intersects itself, or where a fold's back face meets a front face on a
+// silhouette edge (equal depths there, decided by the 1/w planes' rounding).
+Scene with_back_faces_flagged(const Scene& scene, const std::vector<TessVertex>& vertices, int tessellation);
 inline const glm::vec3 kFlagColor{1.0f, 0.0f, 1.0f};
 
-// Pixels (of width x height, sample_count samples each) where some sample's winning slot belongs
-// to a patch >= first_flag_patch, with T the render's tessellation.
+// The device's tessellation of `scene` with options.displacement (required), T and level: the
+// vertices every render of those options displaces to (patch-major, (T+1)^2 a patch).
+std::vector<TessVertex> tessellate_displacement(ClRuntime& runtime, const Scene& scene, const RenderOptions& options);
+
+// The options of the crack renders of `options`: its size and samples (the coverage counted),
+// no displacement (the scene is already displaced), and the plainest colour lookup, which reads
+// no adjacency (the micro-quads have none worth building).
+RenderOptions crack_render_options(const RenderOptions& options);
+
+// Pixels (of width x height, sample_count samples each) where some sample's winner (read back in
+// input order, 2 triangles a face) belongs to a face >= first_flag_face.
 size_t count_flag_pixels(const std::vector<uint32_t>& sample_triangles, int width, int height, int sample_count,
-                         int tessellation, size_t first_flag_patch);
+                         size_t first_flag_face);
 
 struct DisplacementReport {
   std::string method;
@@ -66,12 +84,12 @@ struct DisplacementReport {
 
 // Every level of a run checked before its first render: InputError("tessellation") for a T outside
 // 1..64 or one whose micro-triangles (patches * 2 * T^2, the patches doubled for a closed mesh,
-// whose crack renders add the flag shell) exceed the renderer's bound.
+// whose crack renders add the reversed copy: with_back_faces_flagged) exceed the renderer's bound.
 void check_tessellation_levels(const Scene& scene, const std::vector<int>& levels);
 
 // Measures options.displacement (required) on `scene` at `camera`, or over `frames` frames of
 // its orbit when frames > 0: the gap from the device's tessellation, crack pixels from renders
-// of with_flag_shell(scene) (closed meshes only), time per frame from `repeat` renders of the
+// of with_back_faces_flagged on those same vertices (closed meshes only), time per frame from `repeat` renders of the
 // scene itself (median; repeat 0 leaves the times 0 for a caller that times its own renders).
 // Its Renderers are held to `device_byte_limit` (Renderer::set_device_byte_limit; 0: none).
 DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, const Camera& camera,
