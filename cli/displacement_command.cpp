@@ -34,13 +34,13 @@ void print_table(const json& out) {
   std::printf("%s %s msaa %d, crack pixels over %d orbit frames%s\n", out["scene"].get<std::string>().c_str(),
               out["size"].get<std::string>().c_str(), out["msaa"].get<int>(), out["frames"].get<int>(),
               out["closed_mesh"].get<bool>() ? "" : " (open mesh: not counted)");
-  std::printf("| method | T | max gap | differing pairs | crack pixels | samples | extra bytes | tessellate ms | frame ms |\n"
-              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
+  std::printf("| method | T | max gap | differing pairs | normal gap | crack pixels | samples | extra bytes | tessellate ms | frame ms |\n"
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
   for (const json& r : out["results"]) {
     const std::string cracks = r["crack_pixels"].is_null() ? "n/a" : std::to_string(r["crack_pixels"].get<size_t>());
-    std::printf("| %s | %d | %.4g | %zu | %s | %zu | %zu | %.2f | %.2f |\n", r["method"].get<std::string>().c_str(),
+    std::printf("| %s | %d | %.4g | %zu | %.4g | %s | %zu | %zu | %.2f | %.2f |\n", r["method"].get<std::string>().c_str(),
                 r["tessellation"].get<int>(), r["max_gap"].get<double>(), r["differing_pairs"].get<size_t>(),
-                cracks.c_str(), r["samples"].get<size_t>(), r["extra_bytes"].get<size_t>(),
+                r["max_normal_gap"].get<double>(), cracks.c_str(), r["samples"].get<size_t>(), r["extra_bytes"].get<size_t>(),
                 r["tessellate_ms"].get<double>(), r["frame_ms"].get<double>());
   }
 }

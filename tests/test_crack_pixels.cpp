@@ -14,6 +14,7 @@
 #include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene_generators.h>
+#include "pipeline/displacement_packing.h"
 #include "scene/displaced_scene.h"
 #include "scene/displacement_map.h"
 #include "test_support.h"
@@ -142,6 +143,51 @@ TEST(CrackPixels, TorusCracksOnlyWhereTheGapIsOpen) {
   const Scene torus = make_torus(16, 8);
   EXPECT_EQ(torus.faces.size(), 128u);
   expect_cracks_only_where_the_gap_is_open(torus, 240, 270);
+}
+
+// The displaced surface's normals (displaced_normal), computed by each patch at its own copy of a
+// boundary point: bit for bit the same on both sides of every edge and at every mesh vertex for
+// the watertight methods, different for naive, whose positions differ.
+TEST(DisplacedNormals, AgreeBitForBitAcrossEveryEdgeForTheWatertightMethods) {
+  Scene plane = load_scene_source(kAssets + "plane.obj");
+  attach_ptex_displacement(plane, kAssets + "rand_lo.ptx");
+  for (const Scene& scene : {generate_scene("displaced", {}), cube_obj(), make_torus(16, 8), plane}) {
+    for (int t : {3, 8}) {
+      for (DisplacementMethod m : kWatertight) {
+        const DisplacementReport r =
+            measure_displacement(shared_runtime(), scene, scene.camera, crack_options(m, t, 32, 32, 1), 0, 0);
+        EXPECT_EQ(r.gap.max_normal_gap, 0.0) << scene.name << " " << to_string(m) << " T=" << t;
+        EXPECT_EQ(r.gap.differing_normals, 0u) << scene.name << " " << to_string(m) << " T=" << t;
+      }
+      const DisplacementReport naive = measure_displacement(shared_runtime(), scene, scene.camera,
+                                                            crack_options(DisplacementMethod::Naive, t, 32, 32, 1), 0, 0);
+      EXPECT_GT(naive.gap.max_normal_gap, 0.0) << scene.name << " T=" << t;
+      EXPECT_GT(naive.gap.differing_normals, 0u) << scene.name << " T=" << t;
+      EXPECT_LE(naive.gap.max_normal_gap, 2.0) << "unit normals differ by at most 2 a coordinate";
+    }
+  }
+}
+
+TEST(DisplacedNormals, PointOutOfTheUndisplacedSphereEverywhere) {
+  // With no displacement the `displaced` scene is a closed polyhedron around the origin: every
+  // normal, inside a patch, on its edges and at its corners, points away from the origin.
+  Scene scene = generate_scene("displaced", {});
+  auto flat = std::make_shared<Displacement>(*scene.displacement);
+  flat->scale = 0.0f;
+  scene.displacement = flat;
+  const RenderOptions options = crack_options(DisplacementMethod::Fixed, 4, 32, 32, 1);
+  const PackedDisplacement packed = pack_displacement(scene, {DisplacementMethod::Fixed, 4, 0});
+  const std::vector<TessVertex> vertices = tessellate_displacement(shared_runtime(), scene, options);
+  for (int p = 0; p < static_cast<int>(scene.faces.size()); ++p) {
+    for (int j = 0; j <= 4; ++j) {
+      for (int i = 0; i <= 4; ++i) {
+        const std::array<float, 3> n = displaced_normal(packed, vertices, p, i, j);
+        const float* at = vertices[(static_cast<size_t>(p) * 5 + j) * 5 + i].position;
+        EXPECT_NEAR(n[0] * n[0] + n[1] * n[1] + n[2] * n[2], 1.0f, 1e-5f);
+        EXPECT_GT(n[0] * at[0] + n[1] * at[1] + n[2] * at[2], 0.5f) << "patch " << p << " (" << i << ", " << j << ")";
+      }
+    }
+  }
 }
 
 }  // namespace

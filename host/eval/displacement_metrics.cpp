@@ -42,6 +42,49 @@ double compare(const TessVertex& a, const TessVertex& b, DisplacementGap& gap) {
   return largest;
 }
 
+// A copy of one surface point: grid point (i, j) of a patch.
+struct GridPoint {
+  int patch, i, j;
+  bool operator<(const GridPoint& o) const {
+    return patch != o.patch ? patch < o.patch : (j != o.j ? j < o.j : i < o.i);
+  }
+};
+
+// Every copy of grid point (i, j) of patch p, itself included, sorted: inside the patch only
+// itself; on a shared edge the neighbour's point at the same step; at a corner the corner of
+// every patch at that mesh vertex.
+std::vector<GridPoint> copies_of(const PackedDisplacement& packed, int p, int i, int j) {
+  const int t = packed.params.tessellation;
+  std::vector<GridPoint> out{{p, i, j}};
+  const DisplacementPatch& patch = packed.patches[static_cast<size_t>(p)];
+  const bool corner = (i == 0 || i == t) && (j == 0 || j == t);
+  if (corner) {
+    const int c = j == 0 ? (i == 0 ? 0 : 1) : (i == t ? 2 : 3);
+    const uint32_t vertex = patch.vertex[c];
+    out.clear();
+    for (int q = 0; q < static_cast<int>(packed.patches.size()); ++q) {
+      for (int qc = 0; qc < 4; ++qc) {
+        if (packed.patches[static_cast<size_t>(q)].vertex[qc] != vertex) continue;
+        out.push_back({q, (qc == 1 || qc == 2) ? t : 0, qc >= 2 ? t : 0});
+      }
+    }
+  } else {
+    for (int e = 0; e < 4; ++e) {
+      int k = -1;
+      if (e == 0 && j == 0) k = i;
+      if (e == 1 && i == t) k = j;
+      if (e == 2 && j == t) k = t - i;
+      if (e == 3 && i == 0) k = t - j;
+      if (k < 0 || patch.neighbor[e] < 0) continue;
+      int qi = 0, qj = 0;
+      edge_grid(patch.neighbor_edge[e], patch.neighbor_same_way[e] ? k : t - k, t, &qi, &qj);
+      out.push_back({patch.neighbor[e], qi, qj});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 double median(std::vector<double> values) {
   if (values.empty()) return 0.0;
   std::sort(values.begin(), values.end());
@@ -81,7 +124,66 @@ DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<
       if (!inserted) gap.max_corner_gap = std::max(gap.max_corner_gap, compare(vertices[it->second], vertices[index], gap));
     }
   }
+  // Normals at every boundary point with more than one copy, once per point (from its
+  // lowest-numbered copy).
+  for (int p = 0; p < static_cast<int>(packed.patches.size()); ++p) {
+    for (int j = 0; j <= t; ++j) {
+      for (int i = 0; i <= t; i += (j == 0 || j == t) ? 1 : t) {
+        const std::vector<GridPoint> copies = copies_of(packed, p, i, j);
+        if (copies.size() < 2 || copies.front().patch != p || copies.front().i != i || copies.front().j != j) continue;
+        const std::array<float, 3> first = displaced_normal(packed, vertices, p, i, j);
+        bool differ = false;
+        for (size_t c = 1; c < copies.size(); ++c) {
+          const std::array<float, 3> other = displaced_normal(packed, vertices, copies[c].patch, copies[c].i, copies[c].j);
+          for (int k = 0; k < 3; ++k) {
+            gap.max_normal_gap =
+                std::max(gap.max_normal_gap, std::fabs(static_cast<double>(first[k]) - static_cast<double>(other[k])));
+            differ = differ || first[k] != other[k];
+          }
+        }
+        gap.differing_normals += differ;
+      }
+    }
+  }
   return gap;
+}
+
+std::array<float, 3> displaced_normal(const PackedDisplacement& packed, const std::vector<TessVertex>& vertices,
+                                      int patch, int i, int j) {
+  const int t = packed.params.tessellation;
+  const TessVertex& own = vertices[vertex_index(patch, i, j, t)];
+  float nx = 0.0f, ny = 0.0f, nz = 0.0f;
+  for (const GridPoint& copy : copies_of(packed, patch, i, j)) {
+    // Each cell of the copy's patch around the point, both triangles as the tessellator splits
+    // them, (00, 10, 11) and (00, 11, 01), in one order.
+    for (int cj = copy.j - 1; cj <= copy.j; ++cj) {
+      for (int ci = copy.i - 1; ci <= copy.i; ++ci) {
+        if (ci < 0 || cj < 0 || ci >= t || cj >= t) continue;
+        const int corners[2][3][2] = {{{0, 0}, {1, 0}, {1, 1}}, {{0, 0}, {1, 1}, {0, 1}}};
+        for (const auto& triangle : corners) {
+          const TessVertex* v[3];
+          bool touches = false;
+          for (int k = 0; k < 3; ++k) {
+            const int gi = ci + triangle[k][0], gj = cj + triangle[k][1];
+            const bool centre = gi == copy.i && gj == copy.j;
+            touches = touches || centre;
+            v[k] = centre ? &own : &vertices[vertex_index(copy.patch, gi, gj, t)];
+          }
+          if (!touches) continue;
+          const float ax = v[1]->position[0] - v[0]->position[0], ay = v[1]->position[1] - v[0]->position[1],
+                      az = v[1]->position[2] - v[0]->position[2];
+          const float bx = v[2]->position[0] - v[0]->position[0], by = v[2]->position[1] - v[0]->position[1],
+                      bz = v[2]->position[2] - v[0]->position[2];
+          nx += ay * bz - az * by;
+          ny += az * bx - ax * bz;
+          nz += ax * by - ay * bx;
+        }
+      }
+    }
+  }
+  const float length = std::sqrt(nx * nx + ny * ny + nz * nz);
+  if (!(length > 0.0f) || !std::isfinite(length)) return {0.0f, 0.0f, 0.0f};
+  return {nx / length, ny / length, nz / length};
 }
 
 bool is_closed_mesh(const Scene& scene) {
@@ -190,6 +292,8 @@ nlohmann::json DisplacementReport::to_json() const {
                         {"max_gap", gap.max_gap},
                         {"max_edge_gap", gap.max_edge_gap},
                         {"max_corner_gap", gap.max_corner_gap},
+                        {"max_normal_gap", gap.max_normal_gap},
+                        {"differing_normals", gap.differing_normals},
                         {"compared_pairs", gap.compared_pairs},
                         {"differing_pairs", gap.differing_pairs},
                         {"crack_frames", crack_frames},

@@ -2,6 +2,7 @@
 // vertices that two patches share, crack pixels on a closed mesh whose back faces are a flag, and the
 // samples and bytes each method spends.
 #pragma once
+#include <array>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -27,8 +28,24 @@ struct DisplacementGap {
   size_t differing_pairs = 0;  // pairs whose positions are not equal coordinate by coordinate
   double max_edge_gap = 0.0;   // max_gap over the pairs inside shared edges (not at their ends)
   double max_corner_gap = 0.0; // max_gap over the pairs at mesh vertices
+  // The displaced surface's normal at each copy of a point on a patch boundary
+  // (displaced_normal), each copy's against the first's (lowest patch): the largest coordinate
+  // difference of the unit normals, and the points where any differs.
+  double max_normal_gap = 0.0;
+  size_t differing_normals = 0;
 };
 DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<TessVertex>& vertices);
+
+// The unit normal of the displaced surface at grid point (i, j) of `patch`, as that patch computes
+// it: the area-weighted sum of the micro-triangles around the point, its own and, for a point on
+// a shared edge or at a mesh vertex, those of the patches that hold a copy of it (found by
+// topology, as measure_gap pairs them), each at its own vertices except the point itself, which is
+// this patch's copy. The triangles are summed in one order whichever patch asks (by patch, then
+// cell), so two patches whose copies of the point and of its ring agree bit for bit get the same
+// bits: a watertight method's normals agree across every edge exactly, and where the positions
+// differ (naive) the normals differ with them. Float arithmetic, as a kernel would do it.
+std::array<float, 3> displaced_normal(const PackedDisplacement& packed, const std::vector<TessVertex>& vertices,
+                                      int patch, int i, int j);
 
 // Whether every edge of the mesh is shared by exactly two faces (a closed mesh: crack pixels can
 // be counted on it).
