@@ -96,6 +96,11 @@ TEST(DisplacementCracks, BackFacesAreTheFlagHiddenByAClosedSurfaceAndSeenWithout
   const size_t inside = covered_pixels(renderer.read_sample_triangles());
   EXPECT_GT(inside, 1000u);
   EXPECT_EQ(inside, covered_pixels(both)) << "the back faces alone cover the same silhouette";
+  // The coverage balance: with the front faces gone every back face is open, every pixel a crack.
+  EXPECT_EQ(count_crack_pixels(back, renderer.last_frame_params(), renderer.read_sample_triangles(), 0), inside);
+  renderer.load_scene(flagged);
+  renderer.render(scene.camera, crack_options);
+  EXPECT_EQ(count_crack_pixels(flagged, renderer.last_frame_params(), renderer.read_sample_triangles(), surface_faces), 0u);
   EXPECT_FALSE(is_closed_mesh(generate_scene("quad2", {})));
   EXPECT_TRUE(is_closed_mesh(scene));
   // An orbit to count over is needed.

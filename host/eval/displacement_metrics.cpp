@@ -7,6 +7,9 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/pipeline/renderer.h>
 #include "pipeline/displacement_packing.h"
+#include "pipeline/packed_scene.h"
+#include "pipeline/stages/sample_pattern.h"
+#include "pipeline/stages/triangle_setup_twin.h"
 #include "pipeline/stages/tessellate_launcher.h"
 #include "scene/displacement_map.h"
 
@@ -285,6 +288,99 @@ size_t count_flag_pixels(const std::vector<uint32_t>& sample_triangles, int widt
   return flagged;
 }
 
+size_t count_crack_pixels(const Scene& flagged, const FrameParams& frame, const std::vector<uint32_t>& sample_triangles,
+                          size_t first_flag_face) {
+  const int width = frame.width, height = frame.height, samples = frame.sample_count;
+  const size_t pixels = static_cast<size_t>(width) * height;
+  if (sample_triangles.size() < pixels * samples) throw std::invalid_argument("count_crack_pixels: too few samples");
+  // The samples a flag face won, and their pixels.
+  std::vector<char> candidate(pixels * samples, 0), candidate_pixel(pixels, 0);
+  bool any = false;
+  for (size_t i = 0; i < pixels * samples; ++i) {
+    const uint32_t slot = sample_triangles[i];
+    if (slot != SEAMCL_NO_TRIANGLE && slot / SEAMCL_CLIP_SLOTS / 2 >= first_flag_face) {
+      candidate[i] = candidate_pixel[i / samples] = 1;
+      any = true;
+    }
+  }
+  if (!any) return 0;
+  // The faces that may cover one of them: projected with the frame's matrix, boxes padded by two
+  // pixels (setup's snapping moves a vertex by less); a face reaching behind the near plane is
+  // kept whole. The rest cannot change a candidate's balance.
+  glm::mat4 view_proj;
+  for (int k = 0; k < 16; ++k) view_proj[k / 4][k % 4] = frame.view_proj[k];
+  std::vector<int> per_row_prefix(pixels + static_cast<size_t>(height), 0);  // candidates per row, prefix sums
+  const int stride = width + 1;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      per_row_prefix[static_cast<size_t>(y) * stride + x + 1] =
+          per_row_prefix[static_cast<size_t>(y) * stride + x] + candidate_pixel[static_cast<size_t>(y) * width + x];
+    }
+  }
+  Scene near;
+  near.positions = flagged.positions;
+  std::vector<size_t> original;  // near's face f is flagged's face original[f]
+  TextureLevel texel;
+  texel.width = texel.height = 1;
+  texel.texels = {glm::vec4(1.0f)};
+  const MipChain plain = build_mip_chain(texel);
+  for (size_t f = 0; f < flagged.faces.size(); ++f) {
+    float x0 = 1e30f, x1 = -1e30f, y0 = 1e30f, y1 = -1e30f;
+    bool behind = false;
+    for (uint32_t v : flagged.faces[f].vertices) {
+      const glm::vec4 c = view_proj * glm::vec4(flagged.positions[v], 1.0f);
+      if (!(c.w > frame.near_w)) {
+        behind = true;
+        break;
+      }
+      const float sx = (c.x / c.w * 0.5f + 0.5f) * static_cast<float>(width);
+      const float sy = (0.5f - c.y / c.w * 0.5f) * static_cast<float>(height);
+      x0 = std::min(x0, sx), x1 = std::max(x1, sx), y0 = std::min(y0, sy), y1 = std::max(y1, sy);
+    }
+    bool keep = behind;
+    if (!behind && x1 >= -2.0f && y1 >= -2.0f && x0 <= static_cast<float>(width) + 2.0f && y0 <= static_cast<float>(height) + 2.0f) {
+      const int px0 = std::max(0, static_cast<int>(std::floor(x0)) - 2), px1 = std::min(width - 1, static_cast<int>(x1) + 2);
+      const int py0 = std::max(0, static_cast<int>(std::floor(y0)) - 2), py1 = std::min(height - 1, static_cast<int>(y1) + 2);
+      for (int y = py0; y <= py1 && !keep && px0 <= px1; ++y) {
+        keep = per_row_prefix[static_cast<size_t>(y) * stride + px1 + 1] != per_row_prefix[static_cast<size_t>(y) * stride + px0];
+      }
+    }
+    if (!keep) continue;
+    near.faces.push_back({flagged.faces[f].vertices, plain});
+    original.push_back(f);
+  }
+  FrameParams near_frame = frame;
+  near_frame.input_triangles = static_cast<cl_int>(2 * near.faces.size());
+  const std::vector<TriangleSetup> setups = setup_triangles_reference(pack_scene(near), near_frame);
+  // Front faces +1, flag faces -1, at each candidate sample.
+  std::vector<int> balance(pixels * samples, 0);
+  const std::vector<SampleOffset>& pattern = sample_pattern(samples);
+  for (size_t r = 0; r < setups.size(); ++r) {
+    const TriangleSetup& s = setups[r];
+    if (setup_is_empty(s)) continue;
+    const int sign = original[r / SEAMCL_CLIP_SLOTS / 2] >= first_flag_face ? -1 : 1;
+    for (int y = std::max(0, s.bbox_min_y); y <= std::min(height - 1, s.bbox_max_y); ++y) {
+      for (int x = std::max(0, s.bbox_min_x); x <= std::min(width - 1, s.bbox_max_x); ++x) {
+        const size_t pixel = static_cast<size_t>(y) * width + x;
+        if (!candidate_pixel[pixel]) continue;
+        for (int k = 0; k < samples; ++k) {
+          if (candidate[pixel * samples + k] && setup_covers(s, sample_fixed_x(x, pattern[static_cast<size_t>(k)]),
+                                                              sample_fixed_y(y, pattern[static_cast<size_t>(k)]))) {
+            balance[pixel * samples + k] += sign;
+          }
+        }
+      }
+    }
+  }
+  size_t cracks = 0;
+  for (size_t pixel = 0; pixel < pixels; ++pixel) {
+    bool open = false;
+    for (int k = 0; k < samples && !open; ++k) open = candidate[pixel * samples + k] && balance[pixel * samples + k] != 0;
+    cracks += open;
+  }
+  return cracks;
+}
+
 nlohmann::json DisplacementReport::to_json() const {
   nlohmann::json out = {{"method", method},
                         {"tessellation", tessellation},
@@ -376,13 +472,13 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
     const RenderOptions crack_options = crack_render_options(options);
     Renderer renderer(runtime);
     renderer.set_device_byte_limit(device_byte_limit);
-    renderer.load_scene(with_back_faces_flagged(scene, vertices, settings.tessellation), crack_options.texels);
+    const Scene flagged = with_back_faces_flagged(scene, vertices, settings.tessellation);
     vertices = {};
+    renderer.load_scene(flagged, crack_options.texels);
     size_t cracks = 0;
     for (const Camera& c : cameras) {
       renderer.render(c, crack_options);
-      cracks += count_flag_pixels(renderer.read_sample_triangles(), crack_options.width, crack_options.height,
-                                  crack_options.msaa, first_flag_face);
+      cracks += count_crack_pixels(flagged, renderer.last_frame_params(), renderer.read_sample_triangles(), first_flag_face);
     }
     report.crack_pixels = cracks;
     report.crack_frames = static_cast<int>(cameras.size());

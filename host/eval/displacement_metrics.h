@@ -61,9 +61,9 @@ bool is_closed_mesh(const Scene& scene);
 // inside), so a sample whose winner is a flag face looks through a crack. No centre or inside
 // point is assumed. Faces [0, patches * T^2) are the surface. Front faces are tinted per patch
 // (the patches' borders show in an image); no displacement, albedo or environment is kept.
-// What it cannot tell from a crack: a back face that wins a sample without one, where the
-// displaced surface intersects itself, or where a fold's back face meets a front face on a
-// silhouette edge (equal depths there, decided by the 1/w planes' rounding).
+// A back face can also win a sample without a crack, where the displaced surface intersects
+// itself or a fold's back face meets a front face on a silhouette edge (equal depths there,
+// decided by the 1/w planes' rounding): count_crack_pixels tells those apart.
 Scene with_back_faces_flagged(const Scene& scene, const std::vector<TessVertex>& vertices, int tessellation);
 inline const glm::vec3 kFlagColor{1.0f, 0.0f, 1.0f};
 
@@ -80,6 +80,17 @@ RenderOptions crack_render_options(const RenderOptions& options);
 // input order, 2 triangles a face) belongs to a face >= first_flag_face.
 size_t count_flag_pixels(const std::vector<uint32_t>& sample_triangles, int width, int height, int sample_count,
                          size_t first_flag_face);
+
+// Of the pixels count_flag_pixels finds in a render of `flagged` (with_back_faces_flagged) at
+// `frame` (Renderer::last_frame_params), those where the surface is open: some flag-won sample
+// is covered by a different number of front faces than of flag (back) faces. Along any ray from
+// outside, a closed surface is entered as often as it is left, even where it folds or intersects
+// itself (where a back face can win a sample without a crack); with shared edges rasterised from
+// the same snapped vertices the top-left rule keeps that balance sample by sample, so only a gap
+// breaks it. Coverage from the setup twin (setup_triangles_reference) of the faces near those
+// pixels, the same records the device made.
+size_t count_crack_pixels(const Scene& flagged, const FrameParams& frame, const std::vector<uint32_t>& sample_triangles,
+                          size_t first_flag_face);
 
 struct DisplacementReport {
   std::string method;
@@ -106,7 +117,7 @@ void check_tessellation_levels(const Scene& scene, const std::vector<int>& level
 
 // Measures options.displacement (required) on `scene` at `camera`, or over `frames` frames of
 // its orbit when frames > 0: the gap from the device's tessellation, crack pixels from renders
-// of with_back_faces_flagged on those same vertices (closed meshes only), time per frame from `repeat` renders of the
+// of with_back_faces_flagged on those same vertices (closed meshes only; count_crack_pixels), time per frame from `repeat` renders of the
 // scene itself (median; repeat 0 leaves the times 0 for a caller that times its own renders).
 // Its Renderers are held to `device_byte_limit` (Renderer::set_device_byte_limit; 0: none).
 DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, const Camera& camera,
