@@ -84,7 +84,7 @@ Command add_displacement_command(CLI::App& app) {
       "Measure every displacement method at every tessellation level: exact gap, crack pixels over an orbit, time, extra bytes");
   args->options = std::make_unique<OptionFlags>(command, displacement_metrics_option_table());
   command->add_option("--displacement-map", args->displacement_map, "A .ptx of displacement for an .obj --scene (face i takes face i)");
-  command->add_option("--images", args->images, "Write frame 0 of each entry as PNG (flag shell inside: cracks magenta)");
+  command->add_option("--images", args->images, "Write frame 0 of each entry as PNG (closed meshes: back faces, seen through cracks, magenta)");
   command->add_flag("--json", args->json_out, "Print one JSON object");
   command->add_flag("--no-progress", args->no_progress, "Do not print progress lines on stderr");
   return {command, [args](const GlobalOptions& global) { return run(*args, global); }};

@@ -117,8 +117,9 @@ void check_tessellation_levels(const Scene& scene, const std::vector<int>& level
 
 // Measures options.displacement (required) on `scene` at `camera`, or over `frames` frames of
 // its orbit when frames > 0: the gap from the device's tessellation, crack pixels from renders
-// of with_back_faces_flagged on those same vertices (closed meshes only; count_crack_pixels), time per frame from `repeat` renders of the
-// scene itself (median; repeat 0 leaves the times 0 for a caller that times its own renders).
+// of with_back_faces_flagged on those same vertices (closed meshes only; count_crack_pixels),
+// time per frame from `repeat` renders of the scene itself (median; repeat 0 leaves the times 0
+// for a caller that times its own renders).
 // Its Renderers are held to `device_byte_limit` (Renderer::set_device_byte_limit; 0: none).
 DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, const Camera& camera,
                                         const RenderOptions& options, int orbit_frames = 0, int repeat = 1,

@@ -46,7 +46,7 @@ const OptionTable& displacement_metrics_option_table() {
     level.default_value = 0;
     OptionSpec size = *find_option(render_option_table(), "size");
     OptionSpec msaa = *find_option(render_option_table(), "msaa");
-    msaa.help = "Samples per pixel (crack pixels count a pixel when any sample sees the flag)";
+    msaa.help = "Samples per pixel (crack pixels count a pixel when any sample sees through a crack)";
     msaa.default_value = 4;
     OptionSpec frames = make_option("frames", OptionType::Integer,
                                     "Orbit frames to count crack pixels over; 0: the scene's camera only");
