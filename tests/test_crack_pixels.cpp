@@ -139,9 +139,10 @@ TEST(CrackPixels, PtexCubeWithTunnelsCracksOnlyWhereTheGapIsOpen) {
   expect_cracks_only_where_the_gap_is_open(cube_obj(), 240, 270);
 }
 
-// Issue 39's command (480x540, 4x MSAA, 8 frames, T = 4 and 16), which charged the watertight
-// methods with 111 / 77 / 79 crack pixels at T = 4. At T = 16 a fold of the text's steps lets a
-// back face win one sample with no crack under it: the coverage balance must not count it.
+// Issue 39's command (480x540, 4x MSAA, 8 frames, T = 4 and 16), where the half-size shell
+// charged the watertight methods with cracks. At T = 16 a fold of the text's steps lets a back
+// face win a sample with no crack under it (docs/displacement.md): the coverage balance must not
+// count it.
 TEST(CrackPixels, TheIssuesCubeCommandCountsNoneForTheWatertightMethods) {
   const Scene scene = cube_obj();
   for (int t : {4, 16}) {
