@@ -78,6 +78,7 @@ int run_bench(BenchArgs& args, const GlobalOptions& global) {
   ClRuntime runtime(global.device);
   SceneSourceOptions source;
   source.generator = job.generator_options();
+  source.displacement_map = job.frame().displacement_map;
   const Scene scene = load_scene_source(job.frame().scene, job.frame().texture, source);
   // An estimate, so --check makes it too: a batch's pre-check (scripts/farm) must not pass a part
   // that would then be refused.

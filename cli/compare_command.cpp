@@ -67,6 +67,7 @@ int run_compare(CompareArgs& args, const GlobalOptions& global) {
   ClRuntime runtime(global.device);  // a --device that matches none: refused before any work
   SceneSourceOptions source;
   source.generator = job.generator_options();
+  source.displacement_map = job.frame().displacement_map;
   const Scene scene = load_scene_source(job.frame().scene, job.frame().texture, source);
   // A compare this machine cannot hold is refused before it allocates, as render refuses one.
   const JobPlan plan = job.plan(scene);

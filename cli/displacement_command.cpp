@@ -34,13 +34,13 @@ void print_table(const json& out) {
   std::printf("%s %s msaa %d, crack pixels over %d orbit frames%s\n", out["scene"].get<std::string>().c_str(),
               out["size"].get<std::string>().c_str(), out["msaa"].get<int>(), out["frames"].get<int>(),
               out["closed_mesh"].get<bool>() ? "" : " (open mesh: not counted)");
-  std::printf("| method | T | max gap | differing pairs | crack pixels | samples | extra bytes | tessellate ms | frame ms |\n"
-              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
+  std::printf("| method | T | max gap | differing pairs | normal gap | crack pixels | samples | extra bytes | tessellate ms | frame ms |\n"
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
   for (const json& r : out["results"]) {
     const std::string cracks = r["crack_pixels"].is_null() ? "n/a" : std::to_string(r["crack_pixels"].get<size_t>());
-    std::printf("| %s | %d | %.4g | %zu | %s | %zu | %zu | %.2f | %.2f |\n", r["method"].get<std::string>().c_str(),
+    std::printf("| %s | %d | %.4g | %zu | %.4g | %s | %zu | %zu | %.2f | %.2f |\n", r["method"].get<std::string>().c_str(),
                 r["tessellation"].get<int>(), r["max_gap"].get<double>(), r["differing_pairs"].get<size_t>(),
-                cracks.c_str(), r["samples"].get<size_t>(), r["extra_bytes"].get<size_t>(),
+                r["max_normal_gap"].get<double>(), cracks.c_str(), r["samples"].get<size_t>(), r["extra_bytes"].get<size_t>(),
                 r["tessellate_ms"].get<double>(), r["frame_ms"].get<double>());
   }
 }
@@ -84,7 +84,7 @@ Command add_displacement_command(CLI::App& app) {
       "Measure every displacement method at every tessellation level: exact gap, crack pixels over an orbit, time, extra bytes");
   args->options = std::make_unique<OptionFlags>(command, displacement_metrics_option_table());
   command->add_option("--displacement-map", args->displacement_map, "A .ptx of displacement for an .obj --scene (face i takes face i)");
-  command->add_option("--images", args->images, "Write frame 0 of each entry as PNG (flag shell inside: cracks magenta)");
+  command->add_option("--images", args->images, "Write frame 0 of each entry as PNG (closed meshes: back faces, seen through cracks, magenta)");
   command->add_flag("--json", args->json_out, "Print one JSON object");
   command->add_flag("--no-progress", args->no_progress, "Do not print progress lines on stderr");
   return {command, [args](const GlobalOptions& global) { return run(*args, global); }};

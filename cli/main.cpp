@@ -33,7 +33,6 @@ using namespace seamcl;
 
 struct RenderArgs {
   std::unique_ptr<cli::OptionFlags> options;
-  std::optional<std::string> displacement_map;  // a .ptx of displacement for an .obj scene (a local file)
   std::optional<std::string> output;
   bool json_out = false;
 };
@@ -41,8 +40,6 @@ struct RenderArgs {
 int run_render(const RenderArgs& args, const std::string& device) {
   // Validate everything before any work, so bad input changes nothing.
   const std::string output = cli::given_value(args.output, "output", "leave out -o to render and time only");
-  const std::string displacement_map = cli::given_value(args.displacement_map, "displacement_map",
-                                                        "leave out --displacement-map to use the scene's own maps");
   const RenderJob job(args.options->request());
   const RenderOptions& options = job.options();
   if (!output.empty()) {
@@ -51,15 +48,13 @@ int run_render(const RenderArgs& args, const std::string& device) {
   }
   if (args.options->given("crack_orbit") && !args.json_out)
     throw InputError("crack_orbit", "counts the cracks of a displaced render in --json's displacement block: give --json too");
-  if (!displacement_map.empty() && !options.displacement)
-    throw InputError("displacement_map", "displaces only a render with --displacement-method");
 
   ClRuntime runtime(device);  // a --device that matches none is bad input too: refused before any work
   const auto scene_start = std::chrono::steady_clock::now();
   SceneSourceOptions source;
   source.generator = job.generator_options();
+  source.displacement_map = options.displacement_map;
   Scene scene = load_scene_source(options.scene, options.texture, source);
-  if (!displacement_map.empty()) attach_ptex_displacement(scene, displacement_map);
   const double scene_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - scene_start).count();
 
   // A render this machine cannot hold is refused before it allocates.
@@ -138,8 +133,6 @@ int main(int argc, char** argv) {
   RenderArgs render_args;
   CLI::App* render = app.add_subcommand("render", "Render one frame of a scene to PNG (sRGB 8-bit) or EXR (linear)");
   render_args.options = std::make_unique<cli::OptionFlags>(render, render_job_option_table());
-  render->add_option("--displacement-map", render_args.displacement_map,
-                     "Displacement: a 1-channel .ptx for an .obj scene, face i displacing face i");
   render->add_option("-o,--output", render_args.output, "Output image, .png or .exr (none: render and time only)");
   render->add_flag("--json", render_args.json_out,
                    "Print one JSON object: device, options, ms per stage, triangles, fragments, plan, memory");

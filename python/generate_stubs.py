@@ -100,7 +100,7 @@ def stubs() -> str:
     # The built package (PYTHONPATH), not the sources beside this script, which lack the module.
     sys.path[:] = [p for p in sys.path if pathlib.Path(p or ".").resolve() != HERE]
     from seamcl import _options
-    render = function("render", "render", ["device: Optional[str] = ...", "displacement_map: Optional[str] = ...",
+    render = function("render", "render", ["device: Optional[str] = ...",
                                            "progress: Optional[Callable[[str], None]] = ..."], "RenderResult",
                       _options.table)
     compare = function("compare", "compare", ["device: Optional[str] = ...", "images: bool = ...",

@@ -104,6 +104,7 @@ std::shared_ptr<const Scene> SceneResolver::asset_scene(const RenderOptions& opt
   // refused by the reader before they are decoded; a deferred file never holds them all as floats.
   // A smaller asset is measured against the budgets like any scene.
   source.ptex_limits.max_texels = std::min<uint64_t>(source.ptex_limits.max_texels, max_request_host_bytes_ / sizeof(uint32_t));
+  source.displacement_map = options.displacement_map;
   return assets_->load(options.scene, options.texture, source);
 }
 
@@ -113,12 +114,16 @@ std::shared_ptr<const Scene> SceneResolver::resolve(const json& inline_scene, Re
   const bool builtin = inline_scene.is_null() && is_builtin_scene(options.scene);
   if (!options.texture.empty() && (builtin || !inline_scene.is_null()))
     throw HttpError{400, "texture", "goes with an .obj scene of the asset directory"};
+  if (!options.displacement_map.empty() && (builtin || !inline_scene.is_null()))
+    throw HttpError{400, "displacement_map", "goes with a scene of the asset directory"};
   if (inline_scene.is_null() && !builtin && assets_) {
     std::shared_ptr<const Scene> scene = asset_scene(options);
     options.scene = scene->name;
     return scene;
   }
   if (!options.texture.empty()) throw HttpError{400, "texture", "this server has no asset directory (seamcl serve --assets DIR)"};
+  if (!options.displacement_map.empty())
+    throw HttpError{400, "displacement_map", "this server has no asset directory (seamcl serve --assets DIR)"};
   if (!inline_scene.is_null()) {
     std::shared_ptr<const Scene> scene = parse_inline_scene(inline_scene, options.tint);
     options.scene = scene->name;

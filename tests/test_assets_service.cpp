@@ -243,3 +243,90 @@ TEST(AssetsService, ADeferredPtexsKeptBytesCountAgainstTheHostBudget) {
     }
   }
 }
+
+// The displacement map of a render over HTTP: an asset of the server's directory, resolved and
+// refused like the texture (every refusal a 400 naming displacement_map), and part of the asset
+// cache's key (two maps on the same mesh are two scenes, not one served twice).
+TEST(AssetsService, DisplacementMapIsAnAssetNamedByItsField) {
+  Workspace w;
+  fs::copy_file(sample("plane.obj"), w.path("assets/plane.obj"));
+  fs::copy_file(sample("rand_lo.ptx"), w.path("assets/maps/rand_lo.ptx"));
+  fs::copy_file(sample("wave_lo.ptx"), w.path("assets/maps/wave_lo.ptx"));
+  fs::copy_file(sample("cellnoise.ptx"), w.path("assets/cellnoise.ptx"));
+  fs::copy_file(sample("rand_lo.ptx"), w.path("outside/secret.ptx"));
+  fs::create_symlink(w.path("outside/secret.ptx"), w.path("assets/escape.ptx"));
+
+  seamcl::server::ServerOptions options;
+  options.threads = 1;
+  options.assets_dir = w.path("assets").string();
+  LiveServer server(options);
+  httplib::Client client("127.0.0.1", server.port());
+  client.set_read_timeout(120, 0);
+
+  const json base = {{"scene", "plane.obj"}, {"displacement_method", "fixed"}, {"tessellation", 4}, {"size", "48x36"}};
+  auto render = [&](const std::string& map) {
+    json body = base;
+    body["displacement_map"] = map;
+    const auto answer = client.Post("/v1/render", body.dump(), "application/json");
+    EXPECT_TRUE(answer);
+    if (!answer) return std::string();
+    EXPECT_EQ(answer->status, 200) << answer->body;
+    EXPECT_EQ(answer->get_header_value("Content-Type"), "image/png");
+    return answer->body;
+  };
+  const std::string rand_lo = render("maps/rand_lo.ptx");
+  const std::string wave_lo = render("maps/wave_lo.ptx");
+  EXPECT_NE(rand_lo, wave_lo) << "each map displaces the mesh its own way";
+  EXPECT_EQ(render("maps/rand_lo.ptx"), rand_lo) << "the same map again: the same image";
+  const auto get =
+      client.Get("/v1/render?scene=plane.obj&displacement_method=zipper&tessellation=3&size=16x16&displacement_map=maps/wave_lo.ptx");
+  ASSERT_TRUE(get);
+  EXPECT_EQ(get->status, 200) << get->body;
+
+  struct Refusal {
+    json body;
+    std::string field, text;
+  };
+  auto with = [&](json extra) {
+    json body = base;
+    for (const auto& [key, value] : extra.items()) body[key] = value;
+    return body;
+  };
+  for (const Refusal& r : {
+           Refusal{with({{"displacement_map", "maps/../../outside/secret.ptx"}}), "displacement_map", "'..'"},
+           Refusal{with({{"displacement_map", w.path("outside/secret.ptx").string()}}), "displacement_map", "absolute"},
+           Refusal{with({{"displacement_map", "escape.ptx"}}), "displacement_map", "leads out of the asset directory"},
+           Refusal{with({{"displacement_map", "nothing.ptx"}}), "displacement_map", "no asset"},
+           Refusal{with({{"displacement_map", "cellnoise.ptx"}}), "displacement_map", "channel"},
+           Refusal{with({{"displacement_map", ""}}), "displacement_map", ""},
+           Refusal{with({{"displacement_map", 7}}), "displacement_map", ""},
+           Refusal{with({{"scene", "displaced"}, {"displacement_map", "maps/rand_lo.ptx"}}), "displacement_map",
+                   "goes with a scene of the asset directory"},
+           Refusal{{{"scene", "plane.obj"}, {"displacement_map", "maps/rand_lo.ptx"}}, "displacement_map",
+                   "displacement_method"},
+       }) {
+    SCOPED_TRACE(r.body.dump());
+    const auto answer = client.Post("/v1/render", r.body.dump(), "application/json");
+    ASSERT_TRUE(answer);
+    EXPECT_GE(answer->status, 400) << answer->body;
+    EXPECT_LT(answer->status, 500) << answer->body;
+    const json error = json::parse(answer->body);
+    EXPECT_EQ(error.at("field"), r.field);
+    EXPECT_NE(error.at("error").get<std::string>().find(r.text), std::string::npos) << answer->body;
+  }
+  // The OpenAPI document derives the field from the option table.
+  const json doc = json::parse(seamcl::server::openapi_json());
+  EXPECT_NE(doc.dump().find("displacement_map"), std::string::npos);
+
+  // Without an asset directory no map is reachable.
+  seamcl::server::ServerOptions bare;
+  bare.threads = 1;
+  LiveServer plain(bare);
+  httplib::Client plain_client("127.0.0.1", plain.port());
+  const auto answer = plain_client.Post(
+      "/v1/render", json{{"scene", "displaced"}, {"displacement_method", "fixed"}, {"displacement_map", "rand_lo.ptx"}}.dump(),
+      "application/json");
+  ASSERT_TRUE(answer);
+  EXPECT_EQ(answer->status, 400) << answer->body;
+  EXPECT_EQ(json::parse(answer->body).at("field"), "displacement_map");
+}

@@ -62,26 +62,47 @@ TEST(DisplacementCracks, FlagShowsOnlyThroughCracksOverASixtyFrameOrbit) {
   }
 }
 
-TEST(DisplacementCracks, TheFlagIsHiddenByTheUndisplacedMeshAndSeenWithoutIt) {
-  // The flag test can fail both ways: with the outer surface gone every covered pixel is flag;
-  // with it in place and no displacement at all nothing is.
+TEST(DisplacementCracks, BackFacesAreTheFlagHiddenByAClosedSurfaceAndSeenWithoutIt) {
+  // The flag test can fail both ways: with the front faces gone every covered pixel is flag; with
+  // them in place on a watertight surface (fixed, no displacement: the base points alone) none is,
+  // and the image covers exactly the pixels the front faces alone cover.
   const Scene scene = generate_scene("displaced", {});
-  Scene flagged = with_flag_shell(scene);
-  RenderOptions options = small_options(DisplacementMethod::Naive, 4);
-  Renderer renderer(shared_runtime());
-  Scene flat = flagged;
+  RenderOptions options = small_options(DisplacementMethod::Fixed, 4);
+  Scene flat = scene;
   auto zero = std::make_shared<Displacement>(*scene.displacement);
   zero->scale = 0.0f;
-  zero->maps.resize(flat.faces.size());
   flat.displacement = zero;
-  renderer.load_scene(flat);
-  renderer.render(scene.camera, options);
-  EXPECT_EQ(count_flag_pixels(renderer.read_sample_triangles(), 96, 96, 1, 4, scene.faces.size()), 0u);
-  // Only the flag: shift its patch range to 0 so every covered pixel counts.
-  const size_t covered = count_flag_pixels(renderer.read_sample_triangles(), 96, 96, 1, 4, 0);
-  EXPECT_GT(covered, 1000u);
+  const Scene flagged = with_back_faces_flagged(flat, tessellate_displacement(shared_runtime(), flat, options), 4);
+  const size_t surface_faces = scene.faces.size() * 4 * 4;
+  ASSERT_EQ(flagged.faces.size(), 2 * surface_faces);
+  const RenderOptions crack_options = crack_render_options(options);
+  EXPECT_FALSE(crack_options.displacement.has_value());
+  auto covered_pixels = [](const std::vector<uint32_t>& winners) {
+    return count_flag_pixels(winners, 96, 96, 1, 0);  // every face counts
+  };
+  Renderer renderer(shared_runtime());
+  renderer.load_scene(flagged);
+  renderer.render(scene.camera, crack_options);
+  const std::vector<uint32_t> both = renderer.read_sample_triangles();
+  EXPECT_EQ(count_flag_pixels(both, 96, 96, 1, surface_faces), 0u);
+  Scene front = flagged, back = flagged;
+  front.faces.resize(surface_faces);
+  back.faces.erase(back.faces.begin(), back.faces.begin() + static_cast<std::ptrdiff_t>(surface_faces));
+  renderer.load_scene(front);
+  renderer.render(scene.camera, crack_options);
+  EXPECT_EQ(covered_pixels(renderer.read_sample_triangles()), covered_pixels(both));
+  renderer.load_scene(back);
+  renderer.render(scene.camera, crack_options);
+  const size_t inside = covered_pixels(renderer.read_sample_triangles());
+  EXPECT_GT(inside, 1000u);
+  EXPECT_EQ(inside, covered_pixels(both)) << "the back faces alone cover the same silhouette";
+  // The coverage balance: with the front faces gone every back face is open, every pixel a crack.
+  EXPECT_EQ(count_crack_pixels(back, renderer.last_frame_params(), renderer.read_sample_triangles(), 0), inside);
+  renderer.load_scene(flagged);
+  renderer.render(scene.camera, crack_options);
+  EXPECT_EQ(count_crack_pixels(flagged, renderer.last_frame_params(), renderer.read_sample_triangles(), surface_faces), 0u);
   EXPECT_FALSE(is_closed_mesh(generate_scene("quad2", {})));
-  EXPECT_TRUE(is_closed_mesh(flagged));
+  EXPECT_TRUE(is_closed_mesh(scene));
   // An orbit to count over is needed.
   Scene still = scene;
   still.orbit.reset();

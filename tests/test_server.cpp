@@ -495,7 +495,7 @@ TEST_F(Server, MethodsListsOptionsRangesAndTextureMemory) {
   EXPECT_THROW(parse_render_options({{"aniso", aniso.at("minimum").get<int>() - 1}}), InputError);
   for (const json& msaa : body.at("options").at("msaa").at("enum")) EXPECT_NO_THROW(parse_render_options({{"msaa", msaa}}));
   // Every option the parser takes is listed (the displacement ones and texture too), with its bounds.
-  for (const char* key : {"texture", "displacement_method", "tessellation", "displacement_level"}) {
+  for (const char* key : {"texture", "displacement_method", "tessellation", "displacement_level", "displacement_map"}) {
     EXPECT_TRUE(body.at("options").contains(key)) << key;
   }
   EXPECT_EQ(body.at("options").at("displacement_method").at("enum").get<std::vector<std::string>>(),

@@ -244,6 +244,11 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
     const std::string texture_path = resolve(texture, "", "texture");
     key << texture_path << "|" << stamp_text(stamp_(texture_path));
   }
+  key << "|";
+  if (!options.displacement_map.empty()) {
+    const std::string map_path = resolve(options.displacement_map, "", "displacement_map");
+    key << map_path << "|" << stamp_text(stamp_(map_path));
+  }
   // Deferred or baked is part of the key: a caller that reads the stored texels must not be handed
   // a deferred scene, nor one that packs face by face a baked one (its float copy of every face).
   key << "|" << options.generator.tint << "|" << options.generator.defer_textures << "|" << options.mesh_texture_size

@@ -67,9 +67,9 @@ class AssetDirectory {
   std::string resolve(const std::string& name, const std::string& relative_to, const std::string& field) const;
 
   // load_scene_source with every name resolved here; from the cache when the same names with the
-  // same options were loaded before and every file the load resolved (the scene and texture, and
-  // the files a scene file names: meshes, .ptx, face and environment images) still has the size
-  // and modification time it had when it was resolved; otherwise loaded again. (A deferred image
+  // same options were loaded before and every file the load resolved (the scene, the texture,
+  // options.displacement_map, and the files a scene file names: meshes, .ptx, face and
+  // environment images) still has the size and modification time it had when it was resolved; otherwise loaded again. (A deferred image
   // face reads its file when packed: a cached scene must not name a file changed since.) The
   // files are stamped outside the cache's lock.
   std::shared_ptr<const Scene> load(const std::string& scene, const std::string& texture, SceneSourceOptions options);

@@ -11,6 +11,7 @@
 #include "assets/environment_file.h"
 #include <seamcl/assets/face_image.h>
 #include <seamcl/assets/obj_mesh.h>
+#include <seamcl/assets/ptex_displacement.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/regular_file.h>
 #include <seamcl/core/json_document.h>
@@ -179,8 +180,10 @@ std::string resolve_any_path(const std::string& name, const std::string& relativ
   return (fs::path(relative_to) / path).string();
 }
 
-Scene load_scene_source(const std::string& scene, const std::string& texture, const SceneSourceOptions& options) {
-  const Loader loader{options, options.resolve ? options.resolve : AssetPathResolver(resolve_any_path)};
+namespace {
+
+Scene load_scene_itself(const Loader& loader, const std::string& scene, const std::string& texture,
+                        const SceneSourceOptions& options) {
   if (is_builtin_scene(scene)) {
     if (!texture.empty()) throw InputError("texture", "goes with an .obj scene, not the built-in scene '" + scene + "'");
     Scene out = generate_scene(scene, options.generator);
@@ -201,6 +204,17 @@ Scene load_scene_source(const std::string& scene, const std::string& texture, co
     return loader.scene_file(path);  // applies the generator options itself
   }
   apply_generator_options(out, options.generator);
+  return out;
+}
+
+}  // namespace
+
+Scene load_scene_source(const std::string& scene, const std::string& texture, const SceneSourceOptions& options) {
+  const Loader loader{options, options.resolve ? options.resolve : AssetPathResolver(resolve_any_path)};
+  Scene out = load_scene_itself(loader, scene, texture, options);
+  if (!options.displacement_map.empty()) {
+    attach_ptex_displacement(out, loader.resolve(options.displacement_map, "", "displacement_map"), options.ptex_limits);
+  }
   return out;
 }
 

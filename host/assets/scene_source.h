@@ -38,6 +38,9 @@ struct SceneSourceOptions {
   PtexLimits ptex_limits;      // what a .ptx may make the reader allocate
   int mesh_texture_size = 64;  // texels per side of each face of a mesh without a .ptx
   AssetPathResolver resolve;   // empty: resolve_any_path
+  // A 1-channel .ptx (resolved like the scene's files, field "displacement_map") whose faces
+  // become the scene's displacement maps (attach_ptex_displacement); empty: none.
+  std::string displacement_map;
 };
 
 // `scene`: a built-in name, a .json scene file, an .obj mesh or a .ptx holding its mesh.

@@ -7,6 +7,9 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/pipeline/renderer.h>
 #include "pipeline/displacement_packing.h"
+#include "pipeline/packed_scene.h"
+#include "pipeline/stages/sample_pattern.h"
+#include "pipeline/stages/triangle_setup_twin.h"
 #include "pipeline/stages/tessellate_launcher.h"
 #include "scene/displacement_map.h"
 
@@ -40,6 +43,49 @@ double compare(const TessVertex& a, const TessVertex& b, DisplacementGap& gap) {
   gap.max_gap = std::max(gap.max_gap, largest);
   gap.differing_pairs += differ;
   return largest;
+}
+
+// A copy of one surface point: grid point (i, j) of a patch.
+struct GridPoint {
+  int patch, i, j;
+  bool operator<(const GridPoint& o) const {
+    return patch != o.patch ? patch < o.patch : (j != o.j ? j < o.j : i < o.i);
+  }
+};
+
+// Every copy of grid point (i, j) of patch p, itself included, sorted: inside the patch only
+// itself; on a shared edge the neighbour's point at the same step; at a corner the corner of
+// every patch at that mesh vertex.
+std::vector<GridPoint> copies_of(const PackedDisplacement& packed, int p, int i, int j) {
+  const int t = packed.params.tessellation;
+  std::vector<GridPoint> out{{p, i, j}};
+  const DisplacementPatch& patch = packed.patches[static_cast<size_t>(p)];
+  const bool corner = (i == 0 || i == t) && (j == 0 || j == t);
+  if (corner) {
+    const int c = j == 0 ? (i == 0 ? 0 : 1) : (i == t ? 2 : 3);
+    const uint32_t vertex = patch.vertex[c];
+    out.clear();
+    for (int q = 0; q < static_cast<int>(packed.patches.size()); ++q) {
+      for (int qc = 0; qc < 4; ++qc) {
+        if (packed.patches[static_cast<size_t>(q)].vertex[qc] != vertex) continue;
+        out.push_back({q, (qc == 1 || qc == 2) ? t : 0, qc >= 2 ? t : 0});
+      }
+    }
+  } else {
+    for (int e = 0; e < 4; ++e) {
+      int k = -1;
+      if (e == 0 && j == 0) k = i;
+      if (e == 1 && i == t) k = j;
+      if (e == 2 && j == t) k = t - i;
+      if (e == 3 && i == 0) k = t - j;
+      if (k < 0 || patch.neighbor[e] < 0) continue;
+      int qi = 0, qj = 0;
+      edge_grid(patch.neighbor_edge[e], patch.neighbor_same_way[e] ? k : t - k, t, &qi, &qj);
+      out.push_back({patch.neighbor[e], qi, qj});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 double median(std::vector<double> values) {
@@ -81,7 +127,66 @@ DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<
       if (!inserted) gap.max_corner_gap = std::max(gap.max_corner_gap, compare(vertices[it->second], vertices[index], gap));
     }
   }
+  // Normals at every boundary point with more than one copy, once per point (from its
+  // lowest-numbered copy).
+  for (int p = 0; p < static_cast<int>(packed.patches.size()); ++p) {
+    for (int j = 0; j <= t; ++j) {
+      for (int i = 0; i <= t; i += (j == 0 || j == t) ? 1 : t) {
+        const std::vector<GridPoint> copies = copies_of(packed, p, i, j);
+        if (copies.size() < 2 || copies.front().patch != p || copies.front().i != i || copies.front().j != j) continue;
+        const std::array<float, 3> first = displaced_normal(packed, vertices, p, i, j);
+        bool differ = false;
+        for (size_t c = 1; c < copies.size(); ++c) {
+          const std::array<float, 3> other = displaced_normal(packed, vertices, copies[c].patch, copies[c].i, copies[c].j);
+          for (int k = 0; k < 3; ++k) {
+            gap.max_normal_gap =
+                std::max(gap.max_normal_gap, std::fabs(static_cast<double>(first[k]) - static_cast<double>(other[k])));
+            differ = differ || first[k] != other[k];
+          }
+        }
+        gap.differing_normals += differ;
+      }
+    }
+  }
   return gap;
+}
+
+std::array<float, 3> displaced_normal(const PackedDisplacement& packed, const std::vector<TessVertex>& vertices,
+                                      int patch, int i, int j) {
+  const int t = packed.params.tessellation;
+  const TessVertex& own = vertices[vertex_index(patch, i, j, t)];
+  float nx = 0.0f, ny = 0.0f, nz = 0.0f;
+  for (const GridPoint& copy : copies_of(packed, patch, i, j)) {
+    // Each cell of the copy's patch around the point, both triangles as the tessellator splits
+    // them, (00, 10, 11) and (00, 11, 01), in one order.
+    for (int cj = copy.j - 1; cj <= copy.j; ++cj) {
+      for (int ci = copy.i - 1; ci <= copy.i; ++ci) {
+        if (ci < 0 || cj < 0 || ci >= t || cj >= t) continue;
+        const int corners[2][3][2] = {{{0, 0}, {1, 0}, {1, 1}}, {{0, 0}, {1, 1}, {0, 1}}};
+        for (const auto& triangle : corners) {
+          const TessVertex* v[3];
+          bool touches = false;
+          for (int k = 0; k < 3; ++k) {
+            const int gi = ci + triangle[k][0], gj = cj + triangle[k][1];
+            const bool centre = gi == copy.i && gj == copy.j;
+            touches = touches || centre;
+            v[k] = centre ? &own : &vertices[vertex_index(copy.patch, gi, gj, t)];
+          }
+          if (!touches) continue;
+          const float ax = v[1]->position[0] - v[0]->position[0], ay = v[1]->position[1] - v[0]->position[1],
+                      az = v[1]->position[2] - v[0]->position[2];
+          const float bx = v[2]->position[0] - v[0]->position[0], by = v[2]->position[1] - v[0]->position[1],
+                      bz = v[2]->position[2] - v[0]->position[2];
+          nx += ay * bz - az * by;
+          ny += az * bx - ax * bz;
+          nz += ax * by - ay * bx;
+        }
+      }
+    }
+  }
+  const float length = std::sqrt(nx * nx + ny * ny + nz * nz);
+  if (!(length > 0.0f) || !std::isfinite(length)) return {0.0f, 0.0f, 0.0f};
+  return {nx / length, ny / length, nz / length};
 }
 
 bool is_closed_mesh(const Scene& scene) {
@@ -99,50 +204,181 @@ bool is_closed_mesh(const Scene& scene) {
   return true;
 }
 
-Scene with_flag_shell(const Scene& scene, float shrink) {
-  Scene out = scene;
-  glm::vec3 center(0.0f);
-  for (const glm::vec3& p : scene.positions) center += p;
-  if (!scene.positions.empty()) center /= static_cast<float>(scene.positions.size());
-  const auto base = static_cast<uint32_t>(out.positions.size());
-  for (const glm::vec3& p : scene.positions) out.positions.push_back(center + (p - center) * shrink);
-  TextureLevel flag;
-  flag.width = flag.height = 1;
-  flag.texels = {glm::vec4(kFlagColor, 1.0f)};
-  const MipChain flag_texture = build_mip_chain(flag);
-  for (const Face& f : scene.faces) {
-    const auto& v = f.vertices;
-    out.faces.push_back({{base + v[0], base + v[3], base + v[2], base + v[1]}, flag_texture});
+Scene with_back_faces_flagged(const Scene& scene, const std::vector<TessVertex>& vertices, int tessellation) {
+  const auto t = static_cast<size_t>(tessellation);
+  const size_t per_patch = (t + 1) * (t + 1);
+  if (tessellation < 1 || vertices.size() % per_patch != 0) {
+    throw std::invalid_argument("with_back_faces_flagged: vertices are not whole patches at this tessellation");
   }
-  if (scene.displacement) {
-    auto displacement = std::make_shared<Displacement>(*scene.displacement);
-    displacement->maps.resize(out.faces.size());  // the flag's maps are empty: not displaced
-    out.displacement = displacement;
-  }
-  if (scene.albedo) {
-    const size_t scene_faces = scene.faces.size();
-    out.albedo = [albedo = scene.albedo, scene_faces](size_t face, glm::vec3 p) {
-      return face < scene_faces ? albedo(face, p) : glm::vec4(kFlagColor, 1.0f);
-    };
+  const size_t patches = vertices.size() / per_patch;
+  Scene out;
+  out.name = scene.name;
+  out.camera = scene.camera;
+  out.orbit = scene.orbit;
+  out.light = scene.light;
+  out.background = scene.background;
+  // One set of vertices for both: the flag must project exactly where the surface does (a flag
+  // edge one subpixel past the surface's silhouette would show with nothing in front of it).
+  out.positions.reserve(vertices.size());
+  for (const TessVertex& v : vertices) out.positions.emplace_back(v.position[0], v.position[1], v.position[2]);
+  auto solid = [](glm::vec3 colour) {
+    TextureLevel level;
+    level.width = level.height = 1;
+    level.texels = {glm::vec4(colour, 1.0f)};
+    return build_mip_chain(level);
+  };
+  const MipChain flag = solid(kFlagColor);
+  out.faces.reserve(2 * patches * t * t);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (size_t p = 0; p < patches; ++p) {
+      // Light tints that differ between neighbours, never near the flag's magenta.
+      const float k = static_cast<float>(p % 7) / 7.0f;
+      const MipChain tint = pass == 0 ? solid(glm::vec3(0.55f + 0.3f * k, 0.75f - 0.2f * k, 0.6f)) : flag;
+      for (size_t j = 0; j < t; ++j) {
+        for (size_t i = 0; i < t; ++i) {
+          auto at = [&](size_t di, size_t dj) {
+            return static_cast<uint32_t>(p * per_patch + (j + dj) * (t + 1) + i + di);
+          };
+          // The tessellator splits a cell (00, 10, 11) + (00, 11, 01); a face (a, b, c, d)
+          // renders as (a, b, c) + (a, c, d): the same triangles from corner 00. The reverse,
+          // (00, 01, 11, 10), keeps that diagonal and turns both triangles over.
+          const std::array<uint32_t, 4> quad = pass == 0 ? std::array<uint32_t, 4>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)}
+                                                         : std::array<uint32_t, 4>{at(0, 0), at(0, 1), at(1, 1), at(1, 0)};
+          out.faces.push_back({quad, tint});
+        }
+      }
+    }
   }
   return out;
 }
 
+std::vector<TessVertex> tessellate_displacement(ClRuntime& runtime, const Scene& scene, const RenderOptions& options) {
+  if (!options.displacement) throw InputError("displacement_method", "is needed to tessellate a displaced surface");
+  TessellateLauncher stage(runtime);
+  stage.load(pack_displacement(scene, {*options.displacement, options.tessellation, options.displacement_level}));
+  std::vector<TessVertex> vertices = stage.tessellate(program_options(options.texels, sampler_params(options), false));
+  stage.release();
+  return vertices;
+}
+
+RenderOptions crack_render_options(const RenderOptions& options) {
+  RenderOptions out;
+  out.scene = options.scene;
+  out.width = options.width;
+  out.height = options.height;
+  out.msaa = options.msaa;
+  out.method = Method::Clamp;
+  out.filter = Filter::Bilinear;
+  return out;
+}
+
 size_t count_flag_pixels(const std::vector<uint32_t>& sample_triangles, int width, int height, int sample_count,
-                         int tessellation, size_t first_flag_patch) {
-  const size_t per_patch = 2 * static_cast<size_t>(tessellation) * tessellation;
+                         size_t first_flag_face) {
   size_t flagged = 0;
   const size_t pixels = static_cast<size_t>(width) * height;
   for (size_t pixel = 0; pixel < pixels && (pixel + 1) * sample_count <= sample_triangles.size(); ++pixel) {
     for (int s = 0; s < sample_count; ++s) {
       const uint32_t slot = sample_triangles[pixel * sample_count + s];
-      if (slot != SEAMCL_NO_TRIANGLE && slot / SEAMCL_CLIP_SLOTS / per_patch >= first_flag_patch) {
+      if (slot != SEAMCL_NO_TRIANGLE && slot / SEAMCL_CLIP_SLOTS / 2 >= first_flag_face) {
         ++flagged;
         break;
       }
     }
   }
   return flagged;
+}
+
+size_t count_crack_pixels(const Scene& flagged, const FrameParams& frame, const std::vector<uint32_t>& sample_triangles,
+                          size_t first_flag_face) {
+  const int width = frame.width, height = frame.height, samples = frame.sample_count;
+  const size_t pixels = static_cast<size_t>(width) * height;
+  if (sample_triangles.size() < pixels * samples) throw std::invalid_argument("count_crack_pixels: too few samples");
+  // The samples a flag face won, and their pixels.
+  std::vector<char> candidate(pixels * samples, 0), candidate_pixel(pixels, 0);
+  bool any = false;
+  for (size_t i = 0; i < pixels * samples; ++i) {
+    const uint32_t slot = sample_triangles[i];
+    if (slot != SEAMCL_NO_TRIANGLE && slot / SEAMCL_CLIP_SLOTS / 2 >= first_flag_face) {
+      candidate[i] = candidate_pixel[i / samples] = 1;
+      any = true;
+    }
+  }
+  if (!any) return 0;
+  // The faces that may cover one of them: projected with the frame's matrix, boxes padded by two
+  // pixels (setup's snapping moves a vertex by less); a face reaching behind the near plane is
+  // kept whole. The rest cannot change a candidate's balance.
+  glm::mat4 view_proj;
+  for (int k = 0; k < 16; ++k) view_proj[k / 4][k % 4] = frame.view_proj[k];
+  std::vector<int> per_row_prefix(pixels + static_cast<size_t>(height), 0);  // candidates per row, prefix sums
+  const int stride = width + 1;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      per_row_prefix[static_cast<size_t>(y) * stride + x + 1] =
+          per_row_prefix[static_cast<size_t>(y) * stride + x] + candidate_pixel[static_cast<size_t>(y) * width + x];
+    }
+  }
+  Scene near;
+  near.positions = flagged.positions;
+  std::vector<size_t> original;  // near's face f is flagged's face original[f]
+  TextureLevel texel;
+  texel.width = texel.height = 1;
+  texel.texels = {glm::vec4(1.0f)};
+  const MipChain plain = build_mip_chain(texel);
+  for (size_t f = 0; f < flagged.faces.size(); ++f) {
+    float x0 = 1e30f, x1 = -1e30f, y0 = 1e30f, y1 = -1e30f;
+    bool behind = false;
+    for (uint32_t v : flagged.faces[f].vertices) {
+      const glm::vec4 c = view_proj * glm::vec4(flagged.positions[v], 1.0f);
+      if (!(c.w > frame.near_w)) {
+        behind = true;
+        break;
+      }
+      const float sx = (c.x / c.w * 0.5f + 0.5f) * static_cast<float>(width);
+      const float sy = (0.5f - c.y / c.w * 0.5f) * static_cast<float>(height);
+      x0 = std::min(x0, sx), x1 = std::max(x1, sx), y0 = std::min(y0, sy), y1 = std::max(y1, sy);
+    }
+    bool keep = behind;
+    if (!behind && x1 >= -2.0f && y1 >= -2.0f && x0 <= static_cast<float>(width) + 2.0f && y0 <= static_cast<float>(height) + 2.0f) {
+      const int px0 = std::max(0, static_cast<int>(std::floor(x0)) - 2), px1 = std::min(width - 1, static_cast<int>(x1) + 2);
+      const int py0 = std::max(0, static_cast<int>(std::floor(y0)) - 2), py1 = std::min(height - 1, static_cast<int>(y1) + 2);
+      for (int y = py0; y <= py1 && !keep && px0 <= px1; ++y) {
+        keep = per_row_prefix[static_cast<size_t>(y) * stride + px1 + 1] != per_row_prefix[static_cast<size_t>(y) * stride + px0];
+      }
+    }
+    if (!keep) continue;
+    near.faces.push_back({flagged.faces[f].vertices, plain});
+    original.push_back(f);
+  }
+  FrameParams near_frame = frame;
+  near_frame.input_triangles = static_cast<cl_int>(2 * near.faces.size());
+  const std::vector<TriangleSetup> setups = setup_triangles_reference(pack_scene(near), near_frame);
+  // Front faces +1, flag faces -1, at each candidate sample.
+  std::vector<int> balance(pixels * samples, 0);
+  const std::vector<SampleOffset>& pattern = sample_pattern(samples);
+  for (size_t r = 0; r < setups.size(); ++r) {
+    const TriangleSetup& s = setups[r];
+    if (setup_is_empty(s)) continue;
+    const int sign = original[r / SEAMCL_CLIP_SLOTS / 2] >= first_flag_face ? -1 : 1;
+    for (int y = std::max(0, s.bbox_min_y); y <= std::min(height - 1, s.bbox_max_y); ++y) {
+      for (int x = std::max(0, s.bbox_min_x); x <= std::min(width - 1, s.bbox_max_x); ++x) {
+        const size_t pixel = static_cast<size_t>(y) * width + x;
+        if (!candidate_pixel[pixel]) continue;
+        for (int k = 0; k < samples; ++k) {
+          if (candidate[pixel * samples + k] && setup_covers(s, sample_fixed_x(x, pattern[static_cast<size_t>(k)]),
+                                                              sample_fixed_y(y, pattern[static_cast<size_t>(k)]))) {
+            balance[pixel * samples + k] += sign;
+          }
+        }
+      }
+    }
+  }
+  size_t cracks = 0;
+  for (size_t pixel = 0; pixel < pixels; ++pixel) {
+    bool open = false;
+    for (int k = 0; k < samples && !open; ++k) open = candidate[pixel * samples + k] && balance[pixel * samples + k] != 0;
+    cracks += open;
+  }
+  return cracks;
 }
 
 nlohmann::json DisplacementReport::to_json() const {
@@ -152,6 +388,8 @@ nlohmann::json DisplacementReport::to_json() const {
                         {"max_gap", gap.max_gap},
                         {"max_edge_gap", gap.max_edge_gap},
                         {"max_corner_gap", gap.max_corner_gap},
+                        {"max_normal_gap", gap.max_normal_gap},
+                        {"differing_normals", gap.differing_normals},
                         {"compared_pairs", gap.compared_pairs},
                         {"differing_pairs", gap.differing_pairs},
                         {"crack_frames", crack_frames},
@@ -168,7 +406,7 @@ nlohmann::json DisplacementReport::to_json() const {
 }
 
 void check_tessellation_levels(const Scene& scene, const std::vector<int>& levels) {
-  // A closed mesh is also rendered with its flag shell (with_flag_shell: twice the faces).
+  // A closed mesh's crack renders hold its micro-quads twice (with_back_faces_flagged).
   const size_t patches = (is_closed_mesh(scene) ? 2 : 1) * scene.faces.size();
   for (int t : levels) check_tessellation(patches, t);
 }
@@ -186,7 +424,7 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   report.tessellation = settings.tessellation;
   report.level = settings.level;
 
-  // 1. The gap, from the device's own tessellation.
+  // 1. The gap, from the device's own tessellation (whose vertices the crack renders draw).
   PackedDisplacement packed = pack_displacement(scene, settings);
   report.extra_bytes = packed.method_bytes();
   report.matched_samples = packed.matched_samples;
@@ -194,7 +432,7 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   report.triangles = packed.triangle_count();
   TessellateLauncher stage(runtime);
   stage.load(std::move(packed));
-  const std::vector<TessVertex> vertices = stage.tessellate();
+  std::vector<TessVertex> vertices = stage.tessellate();
   report.gap = measure_gap(stage.packed(), vertices);
   report.vertices = vertices.size();
   for (const TessVertex& v : vertices) report.samples += v.samples;
@@ -226,17 +464,20 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
     report.tessellate_ms = median(tessellate);
   }
 
-  // 3. Crack pixels, on a closed mesh with its flag inside.
+  // 3. Crack pixels, on a closed mesh with its back faces flagged. The tessellation does not
+  //    depend on the camera, so one copy of the displaced surface serves every frame.
   if (is_closed_mesh(scene)) {
-    const Scene flagged = with_flag_shell(scene);
+    const size_t first_flag_face = scene.faces.size() * static_cast<size_t>(settings.tessellation) * settings.tessellation;
+    const RenderOptions crack_options = crack_render_options(options);
     Renderer renderer(runtime);
     renderer.set_device_byte_limit(device_byte_limit);
-    renderer.load_scene(flagged, options.texels);
+    const Scene flagged = with_back_faces_flagged(scene, vertices, settings.tessellation);
+    vertices = {};
+    renderer.load_scene(flagged, crack_options.texels);
     size_t cracks = 0;
     for (const Camera& c : cameras) {
-      renderer.render(c, options);
-      cracks += count_flag_pixels(renderer.read_sample_triangles(), options.width, options.height, options.msaa,
-                                  options.tessellation, scene.faces.size());
+      renderer.render(c, crack_options);
+      cracks += count_crack_pixels(flagged, renderer.last_frame_params(), renderer.read_sample_triangles(), first_flag_face);
     }
     report.crack_pixels = cracks;
     report.crack_frames = static_cast<int>(cameras.size());

@@ -284,6 +284,7 @@ SweepSettings BenchJob::sweep_settings() const {
   settings.make_scene = [base = frame_](const GeneratorOptions& generator) {
     SceneSourceOptions source;
     source.generator = generator;
+    source.displacement_map = base.displacement_map;
     return load_scene_source(base.scene, base.texture, source);
   };
   return settings;

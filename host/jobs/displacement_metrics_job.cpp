@@ -17,6 +17,16 @@ using nlohmann::json;
 
 constexpr int kMaxCrackFrames = 3600;
 
+// What with_back_faces_flagged makes for `patches` patches at T, before any vertex exists:
+// (T+1)^2 vertices and 2 T^2 faces (1x1 textures) a patch.
+SceneSizes back_faces_flagged_sizes(size_t patches, int tessellation) {
+  const auto t = static_cast<size_t>(std::max(tessellation, 1));
+  SceneSizes sizes;
+  sizes.vertices = patches * (t + 1) * (t + 1);
+  sizes.faces.assign(2 * patches * t * t, {1, 1});
+  return sizes;
+}
+
 }  // namespace
 
 const OptionTable& displacement_metrics_option_table() {
@@ -36,7 +46,7 @@ const OptionTable& displacement_metrics_option_table() {
     level.default_value = 0;
     OptionSpec size = *find_option(render_option_table(), "size");
     OptionSpec msaa = *find_option(render_option_table(), "msaa");
-    msaa.help = "Samples per pixel (crack pixels count a pixel when any sample sees the flag)";
+    msaa.help = "Samples per pixel (crack pixels count a pixel when any sample sees through a crack)";
     msaa.default_value = 4;
     OptionSpec frames = make_option("frames", OptionType::Integer,
                                     "Orbit frames to count crack pixels over; 0: the scene's camera only");
@@ -82,9 +92,15 @@ JobPlan DisplacementMetricsJob::plan(const Scene& scene) const {
   check_tessellation_levels(scene, levels_);  // the triangle bound of every level, before any render
   RenderOptions densest = frame_;
   densest.tessellation = *std::max_element(levels_.begin(), levels_.end());
-  const RenderMemory memory = render_memory(is_closed_mesh(scene) ? with_flag_shell(scene) : scene, densest);
-  return JobPlan{"this displacement-metrics run", memory.device_shares(frame_buffers_field(densest.msaa)),
-                 memory.host_shares()};
+  // The timed renders hold the scene tessellated; a closed mesh's crack renders, after them, its
+  // displaced micro-quads twice as plain faces: the run needs the larger.
+  const std::string field = frame_buffers_field(densest.msaa);
+  const RenderMemory timed = render_memory(scene, densest);
+  if (!is_closed_mesh(scene)) return JobPlan{"this displacement-metrics run", timed.device_shares(field), timed.host_shares(), {}};
+  const RenderMemory cracks =
+      render_memory(back_faces_flagged_sizes(scene.faces.size(), densest.tessellation), crack_render_options(densest));
+  return JobPlan{"this displacement-metrics run", larger(timed.device_shares(field), cracks.device_shares(field)),
+                 larger(timed.host_shares(), cracks.host_shares()), {}};
 }
 
 json DisplacementMetricsJob::run(ClRuntime& runtime, const Scene& scene, const JobControl& control,
@@ -104,12 +120,21 @@ json DisplacementMetricsJob::run(ClRuntime& runtime, const Scene& scene, const J
       json item = measure_displacement(runtime, scene, scene.camera, options, frames_, repeat_, control.device_byte_limit)
                       .to_json();
       if (!images_dir.empty()) {
-        // Frame 0 of the orbit with the flag shell inside (closed meshes): cracks show as magenta.
+        // Frame 0 of the orbit; a closed mesh's as the crack renders count it: back faces (seen
+        // only through cracks) in the flag's magenta, front faces tinted per patch.
         const Camera camera = scene.orbit ? orbit_camera(scene, 0, std::max(frames_, 1)) : scene.camera;
         Renderer renderer(runtime);
         renderer.set_device_byte_limit(control.device_byte_limit);
-        renderer.load_scene(closed ? with_flag_shell(scene) : scene, options.texels);
-        const RenderResult image = renderer.render(camera, options);
+        RenderResult image;
+        if (closed) {
+          const RenderOptions crack_options = crack_render_options(options);
+          renderer.load_scene(with_back_faces_flagged(scene, tessellate_displacement(runtime, scene, options), t),
+                              crack_options.texels);
+          image = renderer.render(camera, crack_options);
+        } else {
+          renderer.load_scene(scene, options.texels);
+          image = renderer.render(camera, options);
+        }
         const std::filesystem::path path =
             std::filesystem::path(images_dir) / (to_string(method) + "_T" + std::to_string(t) + ".png");
         write_image(path.string(), image.width, image.height, image.pixels);

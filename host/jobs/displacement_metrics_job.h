@@ -1,6 +1,6 @@
 // The displacement-metrics job: every displacement method at every tessellation level, measured on
 // one scene (host/eval/displacement_metrics.h): the exact gap between vertices two patches share,
-// crack pixels over an orbit (closed meshes: a flag shell inside shows through every crack), time
+// crack pixels over an orbit (closed meshes: back faces drawn as a flag, seen only through cracks), time
 // per frame and the extra data each method keeps. What `seamcl displacement-metrics` runs; its
 // JSON is examples/displacement_chart.py's input.
 #pragma once
@@ -30,7 +30,7 @@ class DisplacementMetricsJob {
 
   // InputError for a scene the run cannot measure ("scene" without displacement maps, "frames"
   // without an orbit, "tessellation" past the triangle bound); else the memory at most: a render
-  // at the highest level, its flag shell included on a closed mesh.
+  // at the highest level, or of a closed mesh's crack renders (its micro-quads twice) if larger.
   JobPlan plan(const Scene& scene) const;
 
   // Measures every method at every level (the scene's displacement maps attached by the caller

@@ -195,6 +195,12 @@ const std::vector<RenderField>& render_fields() {
                       "none"),
          [](RenderOptions& o, const json& v) { o.texture = v.get<std::string>(); },
          [](const RenderOptions& o) { return o.texture.empty() ? json() : json(o.texture); }},
+        {absent_means(of_type("displacement_map", OptionType::String,
+                              "Displacement: a 1-channel .ptx whose faces displace the mesh's (face i takes face i), "
+                              "in place of the scene's own maps; needs displacement_method"),
+                      "the scene's own maps"),
+         [](RenderOptions& o, const json& v) { o.displacement_map = v.get<std::string>(); },
+         [](const RenderOptions& o) { return o.displacement_map.empty() ? json() : json(o.displacement_map); }},
         {choice("method", method_names(), "Seam method"),
          [](RenderOptions& o, const json& v) { o.method = enum_value(v, kMethods); },
          [](const RenderOptions& o) { return json(to_string(o.method)); }},
@@ -306,6 +312,9 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
   if (centroid) {
     if (options.shading == ShadingMode::Sample) throw InputError("centroid", "cannot be combined with shading=sample");
     options.shading = ShadingMode::Centroid;
+  }
+  if (!options.displacement_map.empty() && !options.displacement) {
+    throw InputError("displacement_map", "displaces only a render with displacement_method");
   }
   if (options.frame && *options.frame >= options.frames) {
     throw InputError("frame", "must be less than frames (" + std::to_string(options.frames) + "), got " +

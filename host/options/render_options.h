@@ -94,6 +94,9 @@ inline constexpr float kMaxLodBias = 4.0f;                    // lod_bias's boun
 struct RenderOptions {
   std::string scene = "paper";  // built-in name or scene file (.json, .obj mesh, .ptx with its mesh)
   std::string texture;          // a .ptx for an .obj scene; empty: none
+  // A 1-channel .ptx whose faces displace the scene's (face i takes face i), replacing its own
+  // maps; empty: the scene's own, if any. Needs `displacement`.
+  std::string displacement_map;
   Method method = Method::Discard;
   Filter filter = Filter::Aniso;
   ZeroCoverage zero_coverage = ZeroCoverage::Clamp;

@@ -117,15 +117,11 @@ def _request(job: str, options: dict) -> str:
     return json.dumps(request, allow_nan=False)
 
 
-def render(*, device: Optional[str] = None, displacement_map: Optional[str] = None,
-           progress: Optional[Callable[[str], None]] = None, **options) -> RenderResult:
+def render(*, device: Optional[str] = None, progress: Optional[Callable[[str], None]] = None,
+           **options) -> RenderResult:
     """Renders one frame: the render job of `seamcl render --json`. Raises InputError (a
     ValueError) naming the option at fault; KeyboardInterrupt (Ctrl-C) stops it between renders."""
-    if displacement_map is not None and (not isinstance(displacement_map, str) or not displacement_map):
-        raise InputError("displacement_map: must not be empty (leave it out to use the scene's own maps)",
-                         "displacement_map")
-    info, image, address = _seamcl.render(_request("render", options), _device(device), displacement_map or "",
-                                          progress)
+    info, image, address = _seamcl.render(_request("render", options), _device(device), progress)
     return RenderResult(image=image, info=json.loads(info), _buffer_address=address)
 
 
@@ -167,7 +163,6 @@ def _describe(function, job: str, own: list, summary: str):
 
 _K = inspect.Parameter.KEYWORD_ONLY
 _describe(render, "render", [inspect.Parameter("device", _K, default=None),
-                             inspect.Parameter("displacement_map", _K, default=None),
                              inspect.Parameter("progress", _K, default=None)], render.__doc__)
 _describe(compare, "compare", [inspect.Parameter("device", _K, default=None),
                                inspect.Parameter("images", _K, default=False),

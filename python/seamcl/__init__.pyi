@@ -51,6 +51,7 @@ def render(
     *,
     scene: Union[str, PathLike, Scene] = ...,  # Built-in scene name, a scene JSON file, an .obj mesh or a .ptx that holds its mesh
     texture: Optional[str] = ...,  # A .ptx file of per-face textures for an .obj scene (face i of the mesh takes face i of the file)
+    displacement_map: Optional[str] = ...,  # Displacement: a 1-channel .ptx whose faces displace the mesh's (face i takes face i), in place of the scene's own maps; needs displacement_method
     method: Literal['clamp', 'black', 'discard', 'traverse', 'traverse-edges', 'guardband'] = ...,  # Seam method
     filter: Literal['bilinear', 'trilinear', 'aniso', 'ewa'] = ...,  # Texture filter
     zero_coverage: Literal['clamp', 'nan'] = ...,  # discard with every tap outside the face: a clamped lookup, or the raw 0/0
@@ -73,7 +74,6 @@ def render(
     crack_orbit: int = ...,  # Displacement: count crack pixels over N frames of the scene's orbit instead of this frame
     export_mesh: Optional[str] = ...,  # Displacement: write the frame's tessellated patches, not merged, to a .obj or .ply file
     device: Optional[str] = ...,
-    displacement_map: Optional[str] = ...,
     progress: Optional[Callable[[str], None]] = ...,
 ) -> RenderResult: ...
 
@@ -81,6 +81,7 @@ def compare(
     *,
     scene: Union[str, PathLike, Scene] = ...,  # Built-in scene name, a scene JSON file, an .obj mesh or a .ptx that holds its mesh
     texture: Optional[str] = ...,  # A .ptx file of per-face textures for an .obj scene (face i of the mesh takes face i of the file)
+    displacement_map: Optional[str] = ...,  # Displacement: a 1-channel .ptx whose faces displace the mesh's (face i takes face i), in place of the scene's own maps; needs displacement_method
     filter: Literal['bilinear', 'trilinear', 'aniso', 'ewa'] = ...,  # Texture filter
     zero_coverage: Literal['clamp', 'nan'] = ...,  # discard with every tap outside the face: a clamped lookup, or the raw 0/0
     texels: Literal['rgba8', 'rgba32f'] = ...,  # Texel storage

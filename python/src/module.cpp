@@ -105,8 +105,7 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 
 // `seamcl render --json` and its image: (info JSON text, float32 (H, W, 4) image, the address of
 // the image's C++ buffer, which the array views).
-nb::tuple render(const std::string& request_text, const std::string& device, const std::string& displacement_map,
-                 nb::object progress) {
+nb::tuple render(const std::string& request_text, const std::string& device, nb::object progress) {
   const json request = json::parse(request_text);
   PythonControl python_control(std::move(progress));
   RenderRun run;
@@ -116,14 +115,12 @@ nb::tuple render(const std::string& request_text, const std::string& device, con
     nb::gil_scoped_release release;
     const RenderJob job(request);
     const RenderOptions& options = job.options();
-    if (!displacement_map.empty() && !options.displacement)
-      throw InputError("displacement_map", "displaces only a render with displacement_method");
     ClRuntime& runtime = runtime_for(device);
     const auto scene_start = std::chrono::steady_clock::now();
     SceneSourceOptions source;
     source.generator = job.generator_options();
+    source.displacement_map = options.displacement_map;
     Scene scene = load_scene_source(options.scene, options.texture, source);
-    if (!displacement_map.empty()) attach_ptex_displacement(scene, displacement_map);
     const double scene_ms = ms_since(scene_start);
     // Refused before it allocates, as the command line refuses it.
     const JobPlan plan = job.plan(scene);
@@ -173,6 +170,7 @@ nb::tuple compare(const std::string& request_text, const std::string& device, co
     ClRuntime& runtime = runtime_for(device);
     SceneSourceOptions source;
     source.generator = job.generator_options();
+    source.displacement_map = job.frame().displacement_map;
     const Scene scene = load_scene_source(job.frame().scene, job.frame().texture, source);
     const JobPlan plan = job.plan(scene);
     refuse_beyond_machine(plan, runtime.info());
@@ -300,7 +298,7 @@ NB_MODULE(_seamcl, m) {
   });
   nb::register_exception_translator(translate);
   m.def("option_table", &table_json, nb::arg("job"));
-  m.def("render", &render, nb::arg("request"), nb::arg("device"), nb::arg("displacement_map"), nb::arg("progress").none());
+  m.def("render", &render, nb::arg("request"), nb::arg("device"), nb::arg("progress").none());
   m.def("compare", &compare, nb::arg("request"), nb::arg("device"), nb::arg("cache_dir"), nb::arg("use_cache"),
         nb::arg("progress").none(), nb::arg("images"));
   m.def("describe_scene", &describe_scene, nb::arg("scene"), nb::arg("texture"));

@@ -79,7 +79,7 @@ def test_every_render_option_is_a_keyword_with_the_tables_default(cli):
     table = {spec["key"]: spec for spec in seamcl._options.table("render")}
     params = inspect.signature(seamcl.render).parameters
     assert set(table) <= set(params)
-    assert set(params) - set(table) == {"device", "displacement_map", "progress"}
+    assert set(params) - set(table) == {"device", "progress"}
     help_text = cli("render", "--help").stdout
     for key, spec in table.items():
         # The command line's flags come from the same table.
