@@ -256,7 +256,7 @@ std::vector<TessVertex> tessellate_displacement(ClRuntime& runtime, const Scene&
   if (!options.displacement) throw InputError("displacement_method", "is needed to tessellate a displaced surface");
   TessellateLauncher stage(runtime);
   stage.load(pack_displacement(scene, {*options.displacement, options.tessellation, options.displacement_level}));
-  std::vector<TessVertex> vertices = stage.tessellate(program_options(options.texels, sampler_params(options), false));
+  std::vector<TessVertex> vertices = stage.tessellate();
   stage.release();
   return vertices;
 }
