@@ -11,6 +11,10 @@
 
 namespace seamcl {
 
+// The domains' names, as the table's rows and scene_option_domains (jobs/scene_domains.h) give them.
+inline constexpr const char* kCubeDomain = "cube";
+inline constexpr const char* kDisplacementDomain = "displacement";
+
 // Domain name -> the render options of that domain, in the table's order; options of no domain
 // are left out.
 const std::map<std::string, std::vector<std::string>>& render_option_domains();

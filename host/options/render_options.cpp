@@ -241,16 +241,16 @@ const std::vector<RenderField>& render_fields() {
          [](const RenderOptions& o) { return json(o.tint); }},
         {choice("cube_method", cube_method_names(), "Cube-map seam method of scenes with an environment (envmap)", "cube method"),
          [](RenderOptions& o, const json& v) { o.cube_method = enum_value(v, kCubeMethods); },
-         [](const RenderOptions& o) { return json(to_string(o.cube_method)); }, "cube"},
+         [](const RenderOptions& o) { return json(to_string(o.cube_method)); }, kCubeDomain},
         {absent_means(choice("displacement_method", displacement_method_names(),
                              "Tessellate every patch and displace it by the scene's maps with this seam method", "displacement method"),
                       "no displacement"),
          [](RenderOptions& o, const json& v) { o.displacement = parse_displacement_method(v.get<std::string>()); },
-         [](const RenderOptions& o) { return o.displacement ? json(to_string(*o.displacement)) : json(); }, "displacement"},
+         [](const RenderOptions& o) { return o.displacement ? json(to_string(*o.displacement)) : json(); }, kDisplacementDomain},
         {integer("tessellation", 1, SEAMCL_MAX_TESSELLATION, "Displacement: each patch a (T+1)^2 grid"),
-         [](RenderOptions& o, const json& v) { o.tessellation = v.get<int>(); }, displaced_only(json()), "displacement"},
+         [](RenderOptions& o, const json& v) { o.tessellation = v.get<int>(); }, displaced_only(json()), kDisplacementDomain},
         {integer("displacement_level", 0, kMaxDisplacementLevel, "Displacement: the maps' level every patch samples"),
-         [](RenderOptions& o, const json& v) { o.displacement_level = v.get<int>(); }, displaced_only(json()), "displacement"},
+         [](RenderOptions& o, const json& v) { o.displacement_level = v.get<int>(); }, displaced_only(json()), kDisplacementDomain},
     };
     // Defaults are RenderOptions' own initialisers, read through the same accessors; the two
     // displacement settings are written only with a method, so their defaults are read directly.

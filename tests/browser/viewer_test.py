@@ -362,6 +362,31 @@ def run(base, chromium, profile, shots, t, deadline):
                 elif spec.get("type") == "integer":
                     t.check((control["min"], control["max"]) == (str(spec["minimum"]), str(spec["maximum"])),
                             "the %s control has the option's bounds" % key, str(control))
+        # A domain's controls are shown for the scenes it acts on (GET /v1/scenes "domains") and
+        # its options sent for those only. Switched and back in one script turn: the page's
+        # render waits for the controls to settle, so nothing is rendered for the switch.
+        for domain, keys in domains.items():
+            acting = [sc["name"] for sc in scenes if domain in sc.get("domains", [])]
+            other = next((sc["name"] for sc in scenes if domain not in sc.get("domains", [])), None)
+            if not t.check(acting and other, "some scenes have the %s domain and some not" % domain, str(scenes)):
+                continue
+            key = next(k for k in keys if "enum" in options[k])
+            pick = str(options[key]["enum"][-1])
+            seen = page.eval("""(() => {
+                const scene = document.getElementById('scene'), control = document.getElementById('option_%s');
+                const was = [scene.value, control.value], out = {};
+                for (const name of [%s, %s]) {
+                  scene.value = name; scene.dispatchEvent(new Event('change'));
+                  control.value = %s; control.dispatchEvent(new Event('change'));
+                  out[name] = [document.getElementById('domain_%s').hidden, renderParams('x').get('%s')];
+                }
+                control.value = was[1]; control.dispatchEvent(new Event('change'));
+                scene.value = was[0]; scene.dispatchEvent(new Event('change'));
+                return out; })()""" % (key, json.dumps(acting[0]), json.dumps(other), json.dumps(pick), domain, key))
+            t.check(seen[acting[0]] == [False, pick] and seen[other] == [True, None],
+                    "the %s controls show, and %s is sent, for %s only" % (domain, key, acting[0]), str(seen))
+        wait_idle(page, min(RENDER_WAIT_S, left()), "the render after the domain checks")
+
         # The assets of --assets: the scene list is the built-in scenes then every asset; the
         # texture list (for a mesh) every .ptx.
         scene_values = page.eval("[...document.getElementById('scene').options].map((o) => o.value)")
