@@ -378,7 +378,8 @@ def run(base, chromium, profile, shots, t, deadline):
                 for (const name of [%s, %s]) {
                   scene.value = name; scene.dispatchEvent(new Event('change'));
                   control.value = %s; control.dispatchEvent(new Event('change'));
-                  out[name] = [document.getElementById('domain_%s').hidden, renderParams('x').get('%s')];
+                  out[name] = [getComputedStyle(document.getElementById('domain_%s')).display === 'none',
+                               renderParams('x').get('%s')];
                 }
                 control.value = was[1]; control.dispatchEvent(new Event('change'));
                 scene.value = was[0]; scene.dispatchEvent(new Event('change'));
@@ -386,6 +387,35 @@ def run(base, chromium, profile, shots, t, deadline):
             t.check(seen[acting[0]] == [False, pick] and seen[other] == [True, None],
                     "the %s controls show, and %s is sent, for %s only" % (domain, key, acting[0]), str(seen))
         wait_idle(page, min(RENDER_WAIT_S, left()), "the render after the domain checks")
+
+        # The environment of the cube domain's scenes: a control per property of the OpenAPI
+        # document's Environment schema; a value set renders the scene as an inline generator
+        # scene, POSTed, and the page shows the server's render of exactly that request.
+        doc = json.loads(get(base + "/openapi.json")[1])
+        env_schema = doc["components"]["schemas"]["Environment"]["properties"]
+        env_controls = page.eval("[...document.querySelectorAll('#domain_cube #environment_controls input')].map((e) => e.id)")
+        t.check(env_controls == ["env_" + k for k in env_schema], "an environment control per property of the Environment schema",
+                "%r vs %r" % (env_controls, list(env_schema)))
+        env_scene = next((sc["name"] for sc in scenes if "cube" in sc.get("domains", [])), None)
+        if env_scene and "sun_radius" in env_schema:
+            radius = env_schema["sun_radius"]["default"] * 4
+            set_controls(page, {"scene": env_scene, "size": COMPARE_SIZE, "env_sun_radius": str(radius)})
+            wait_idle(page, min(RENDER_WAIT_S, left()), "the render with an environment set")
+            key = page.eval("document.getElementById('image_a').dataset.src")
+            sent = json.loads(key.split(" ", 2)[2]) if key.startswith("POST /v1/render ") else {}
+            t.check(sent.get("scene") == {"generator": env_scene, "options": {"environment": {"sun_radius": radius}}},
+                    "an environment value sends the scene as an inline generator scene", key)
+            if sent:
+                shown_a = page.eval("Array.from(shown.A.image.rgba)")
+                mine, _, _ = decode_png_rgb(get(base + "/v1/render", sent)[1])
+                plain, _, _ = decode_png_rgb(get(base + "/v1/render?" + urllib.parse.urlencode(
+                    {k: str(v).lower() if isinstance(v, bool) else v for k, v in sent.items() if k != "scene"}
+                    | {"scene": env_scene}))[1])
+                t.check([tuple(shown_a[4 * i:4 * i + 3]) for i in range(len(mine))] == mine and mine != plain,
+                        "the page shows the server's render with that environment (not the scene's own)")
+            shot(page, "0-environment.png")
+            set_controls(page, {"scene": options["scene"]["default"], "size": SIZE, "env_sun_radius": str(env_schema["sun_radius"]["default"])})
+            wait_idle(page, min(RENDER_WAIT_S, left()), "the render after the environment check")
 
         # The assets of --assets: the scene list is the built-in scenes then every asset; the
         # texture list (for a mesh) every .ptx.
