@@ -29,6 +29,8 @@
 #include <unistd.h>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/jobs/scene_domains.h>
+#include <seamcl/options/option_domains.h>
 #include <seamcl/memory/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
@@ -471,6 +473,11 @@ TEST_F(Server, ScenesListsTheBuiltInScenes) {
   ASSERT_EQ(scenes.size(), scene_generators().size());
   for (size_t i = 0; i < scenes.size(); ++i) EXPECT_EQ(scenes[i].at("name"), scene_generators()[i].name);
   EXPECT_EQ(generate_scene("quad2", {}).faces.size(), scenes[1].at("faces").get<size_t>());
+  // The option domains that act on each scene, as the library says (envmap: cube; displaced: displacement).
+  for (const json& scene : scenes) {
+    EXPECT_EQ(scene.at("domains"), json(scene_option_domains(generate_scene(scene.at("name").get<std::string>(), {}))))
+        << scene.at("name");
+  }
 }
 
 TEST_F(Server, MethodsListsOptionsRangesAndTextureMemory) {
@@ -486,6 +493,7 @@ TEST_F(Server, MethodsListsOptionsRangesAndTextureMemory) {
   EXPECT_EQ(body.at("options").at("method").at("enum").get<std::vector<std::string>>(), method_names());
   EXPECT_EQ(body.at("options").at("filter").at("enum").get<std::vector<std::string>>(), filter_names());
   EXPECT_EQ(body.at("options").at("size").at("default"), to_json(RenderOptions{}).at("size"));
+  EXPECT_EQ(body.at("domains"), json(render_option_domains()));
   const Scene paper = generate_scene(RenderOptions{}.scene, {});
   EXPECT_EQ(body.at("methods")[0].at("texture_bytes").at("rgba8").get<size_t>(), pack_scene(paper).texture_bytes());
   // The ranges are the parser's: the bounds pass, one past them fails.
