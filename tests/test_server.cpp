@@ -403,7 +403,7 @@ TEST(ServerSchema, OpenApiDocumentsEveryEndpoint) {
   EXPECT_TRUE(doc.at("openapi").get<std::string>().starts_with("3."));
   for (const auto& [path, method] : std::vector<std::pair<std::string, std::string>>{
            {"/", "get"}, {"/health", "get"}, {"/v1/scenes", "get"}, {"/v1/methods", "get"}, {"/v1/render", "get"},
-           {"/v1/render", "post"}, {"/v1/compare", "post"}, {"/openapi.json", "get"}}) {
+           {"/v1/render", "post"}, {"/v1/compare", "post"}, {"/v1/progress", "get"}, {"/openapi.json", "get"}}) {
     EXPECT_TRUE(doc.at("paths").contains(path) && doc.at("paths").at(path).contains(method)) << method << " " << path;
   }
   // Every $ref resolves.
@@ -745,6 +745,43 @@ TEST_F(Server, CompareMatchesTheLibrary) {
   EXPECT_EQ(cached.at("reference").at("ms"), 0.0);
   expect_close(cached.at("results"), expected, "cached results");
   EXPECT_FALSE(fs::is_empty(cache_dir()));
+}
+
+// A compare posted with X-Seamcl-Job is shown by GET /v1/progress under that name: the job's last
+// line and its entries done of the total (a client polls it while the compare runs; here, after).
+TEST_F(Server, CompareProgressIsShownUnderItsJobName) {
+  httplib::Client c = client();
+  const json request = {{"scene", "quad2"}, {"size", "32x32"}, {"methods", "discard"}, {"msaa", "1,4"}, {"repeat", 1}};
+  auto res = c.Post("/v1/compare", httplib::Headers{{"X-Seamcl-Job", "progress-test.1"}}, request.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  // The compare's own split of its time, as the command line's.
+  const json timing = json::parse(res->body).at("timing");
+  for (const char* key : {"setup_ms", "targets_ms", "entries_ms"}) EXPECT_LE(timing.at(key).get<double>(), timing.at("total_ms").get<double>()) << key;
+  auto progress = c.Get("/v1/progress?job=progress-test.1");
+  ASSERT_TRUE(progress);
+  ASSERT_EQ(progress->status, 200) << progress->body;
+  expect_documented("get", "/v1/progress", progress);
+  const json p = json::parse(progress->body);
+  EXPECT_EQ(p.at("id"), "progress-test.1");
+  EXPECT_FALSE(p.at("running").get<bool>());
+  EXPECT_EQ(p.at("done"), 2);
+  EXPECT_EQ(p.at("total"), 2);
+  EXPECT_EQ(p.at("line"), "entry 2/2: discard at msaa 4");
+  EXPECT_GT(p.at("elapsed_ms").get<double>(), 0);
+
+  auto unknown = c.Get("/v1/progress?job=never-posted");
+  ASSERT_TRUE(unknown);
+  EXPECT_EQ(unknown->status, 404);
+  EXPECT_EQ(json::parse(unknown->body).at("field"), "job");
+  auto bad = c.Get("/v1/progress?job=a%20b");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_EQ(json::parse(bad->body).at("field"), "job");
+  auto bad_header = c.Post("/v1/compare", httplib::Headers{{"X-Seamcl-Job", "a/b"}}, request.dump(), "application/json");
+  ASSERT_TRUE(bad_header);
+  EXPECT_EQ(bad_header->status, 400);
+  EXPECT_EQ(json::parse(bad_header->body).at("field"), "X-Seamcl-Job");
 }
 
 // One malformed request and what it must get.

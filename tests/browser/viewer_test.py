@@ -541,10 +541,11 @@ def run(base, chromium, profile, shots, t, deadline):
 
         if orbit_scene:
             # The orbit scrubber: after frame 3 the next frames were fetched ahead; moving the
-            # slider to 4 shows frame 4 (the server's render of frame 4, not 3's image again). On
-            # the default scene: one whose every frame shows something.
-            set_controls(page, {"scene": options["scene"]["default"], "texels": options["texels"]["default"]})
-            wait_idle(page, min(RENDER_WAIT_S, left()), "frame 3 of the default scene")
+            # slider to 4 shows frame 4 (the server's render of frame 4, not 3's image again). On a
+            # closed object, which every frame of its orbit shows, and a small one (cube).
+            scrub_scene = next((sc["name"] for sc in scenes if sc["name"] == "cube"), options["scene"]["default"])
+            set_controls(page, {"scene": scrub_scene, "texels": options["texels"]["default"]})
+            wait_idle(page, min(RENDER_WAIT_S, left()), "frame 3 of " + scrub_scene)
             src3 = image_info(page, "image_a")["src"]
             page.wait("document.getElementById('scrubber').dataset.ahead === '4,5'", timeout=min(RENDER_WAIT_S, left()),
                       what="frames 4 and 5 fetched ahead")
@@ -598,7 +599,7 @@ def run(base, chromium, profile, shots, t, deadline):
             if state[0] != "running":
                 break
             if state[1].get("state") == "running":
-                seen.append((int(state[1]["done"]), int(state[1]["total"]), float(state[1]["elapsed"])))
+                seen.append((int(state[1]["done"]), int(state[1]["total"]), float(state[1]["elapsed"]), state[1].get("detail", "")))
             time.sleep(0.2)
         page.wait("['done', 'error'].includes(document.getElementById('compare').dataset.state)", timeout=5,
                   what="the compare answer")
@@ -618,9 +619,12 @@ def run(base, chromium, profile, shots, t, deadline):
             t.check(page.eval("document.getElementById('pareto').dataset.points") == str(methods * rates),
                     "the speed/error canvas drew every point")
         entries = methods * rates
-        t.check(len(seen) >= 2 and all(x[1] == entries for x in seen) and seen[-1][0] > seen[0][0]
-                and seen[-1][2] > seen[0][2], "the compare's progress counts its entries and its elapsed time grows",
-                str(seen[:3] + seen[-2:]))
+        # The entries done and the job's line come from the server (GET /v1/progress, polled).
+        done = [x[0] for x in seen]
+        t.check(len(seen) >= 2 and all(x[1] == entries for x in seen) and done == sorted(done)
+                and seen[-1][2] > seen[0][2] and any(x[3] for x in seen),
+                "the compare's progress shows the server's entries done and line, and its elapsed time grows",
+                str(seen[:2] + [x for x in seen if x[3]][:3] + seen[-2:]))
         t.check(page.eval("document.getElementById('progress').textContent").startswith("compared %d entries in " % entries),
                 "the compare's time is shown when it ends", page.eval("document.getElementById('progress').textContent"))
 
@@ -674,8 +678,10 @@ def run(base, chromium, profile, shots, t, deadline):
                 "the permalink restores the compare table and its charts from the browser's copy",
                 page5.eval("document.getElementById('compare_status').textContent"))
         page5.close()
-        # Another compare (the chosen rate only) that this browser never ran: run again, said so.
-        page5 = browser.open(href.replace("rates=all", "rates=chosen"))
+        # Another compare (the chosen rate only) that this browser never ran, pasted into the same
+        # tab (its images are at hand): run again, said so.
+        page5 = page
+        page5.eval("location.hash = %s" % json.dumps(href.split("#", 1)[1].replace("rates=all", "rates=chosen")))
         page5.wait("document.getElementById('compare_status').dataset.source === 'rerun'", timeout=min(RENDER_WAIT_S, left()),
                    what="the permalink's compare run again")
         notice = page5.eval("document.getElementById('compare_status').textContent")
@@ -688,7 +694,6 @@ def run(base, chromium, profile, shots, t, deadline):
                 "a permalink to a compare the browser has not kept runs it again with a notice, and the same errors",
                 "%s: %r vs %r" % (notice, again, same))
         shot(page5, "11-permalink-compare.png")
-        page5.close()
         scene2 = next((s["name"] for s in scenes if s["name"] != options["scene"]["default"]), None)
         if scene2:
             set_control(page, "scene", scene2)
