@@ -1186,7 +1186,7 @@ TEST_F(Server, UnroutedMethodsAre405WithAllow) {
   const std::map<std::string, std::string> allowed = {{"/", "GET"},           {"/health", "GET"},
                                                       {"/v1/scenes", "GET"}, {"/v1/methods", "GET"},
                                                       {"/openapi.json", "GET"}, {"/v1/render", "GET, POST"},
-                                                      {"/v1/compare", "POST"}};
+                                                      {"/v1/compare", "POST"}, {"/v1/progress", "GET"}};
   for (const auto& [path, allow] : allowed) {
     for (const std::string method : {"HEAD", "PUT", "DELETE", "PATCH", "OPTIONS", "GET", "POST"}) {
       if (allow.find(method) != std::string::npos) continue;
