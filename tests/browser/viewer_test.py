@@ -359,6 +359,9 @@ def run(base, chromium, profile, shots, t, deadline):
                         want = [""] + want
                     t.check(control["values"] == want, "the %s control lists exactly the option table's values" % key,
                             "%r vs %r" % (control["values"], want))
+                    if key.endswith("_method"):  # a domain's method: a control for B too
+                        b_values = page.eval("[...document.getElementById('option_%s_b').options].map((o) => o.value)" % key)
+                        t.check(b_values == want, "the %s control of B lists the same values" % key, str(b_values))
                 elif spec.get("type") == "integer":
                     t.check((control["min"], control["max"]) == (str(spec["minimum"]), str(spec["maximum"])),
                             "the %s control has the option's bounds" % key, str(control))
@@ -397,14 +400,24 @@ def run(base, chromium, profile, shots, t, deadline):
         t.check(env_controls == ["env_" + k for k in env_schema], "an environment control per property of the Environment schema",
                 "%r vs %r" % (env_controls, list(env_schema)))
         env_scene = next((sc["name"] for sc in scenes if "cube" in sc.get("domains", [])), None)
-        if env_scene and "sun_radius" in env_schema:
+        cube_key = next((k for k in domains.get("cube", []) if k.endswith("_method")), None)
+        if env_scene and "sun_radius" in env_schema and cube_key:
+            # B with another cube method than A's (the default): A and B differ on this scene.
             radius = env_schema["sun_radius"]["default"] * 4
-            set_controls(page, {"scene": env_scene, "size": COMPARE_SIZE, "env_sun_radius": str(radius)})
+            cube_b = next(v for v in options[cube_key]["enum"] if v != options[cube_key]["default"])
+            set_controls(page, {"scene": env_scene, "size": COMPARE_SIZE, "env_sun_radius": str(radius),
+                                "option_%s_b" % cube_key: cube_b})
             wait_idle(page, min(RENDER_WAIT_S, left()), "the render with an environment set")
             key = page.eval("document.getElementById('image_a').dataset.src")
             sent = json.loads(key.split(" ", 2)[2]) if key.startswith("POST /v1/render ") else {}
             t.check(sent.get("scene") == {"generator": env_scene, "options": {"environment": {"sun_radius": radius}}},
                     "an environment value sends the scene as an inline generator scene", key)
+            key_b = page.eval("document.getElementById('image_b').dataset.src")
+            sent_b = json.loads(key_b.split(" ", 2)[2]) if key_b.startswith("POST /v1/render ") else {}
+            differ = page.eval("shown.A.image.rgba.some((v, i) => v !== shown.B.image.rgba[i])")
+            t.check(cube_key not in sent and sent_b.get(cube_key) == cube_b and differ
+                    and cube_b in page.eval("document.getElementById('label_b').textContent"),
+                    "B renders with its own cube method, A with the default, and their images differ", key_b)
             if sent:
                 shown_a = page.eval("Array.from(shown.A.image.rgba)")
                 mine, _, _ = decode_png_rgb(get(base + "/v1/render", sent)[1])
@@ -414,7 +427,9 @@ def run(base, chromium, profile, shots, t, deadline):
                 t.check([tuple(shown_a[4 * i:4 * i + 3]) for i in range(len(mine))] == mine and mine != plain,
                         "the page shows the server's render with that environment (not the scene's own)")
             shot(page, "0-environment.png")
-            set_controls(page, {"scene": options["scene"]["default"], "size": SIZE, "env_sun_radius": str(env_schema["sun_radius"]["default"])})
+            set_controls(page, {"scene": options["scene"]["default"], "size": SIZE,
+                                "env_sun_radius": str(env_schema["sun_radius"]["default"]),
+                                "option_%s_b" % cube_key: options[cube_key]["default"]})
             wait_idle(page, min(RENDER_WAIT_S, left()), "the render after the environment check")
 
         # The assets of --assets: the scene list is the built-in scenes then every asset; the
