@@ -7,15 +7,18 @@ works it through the DOM after the page's scripts ran:
   the same PNGs (decoded in Python); each image's time is shown split into queue, build, render
   and encode as the server reported it;
 - every domain's controls (cube map, displacement) come from the methods document: each in its
-  domain's fieldset, a choice listing exactly the option table's values, bounds as the table's;
-  the scene and texture controls list the files of --assets;
+  domain's fieldset, a choice listing exactly the option table's values (a domain's method for A
+  and for B), bounds as the table's, shown and sent for the scenes the domain acts on only; the
+  environment's controls are the OpenAPI document's Environment schema, and a value set renders
+  the scene inline (the page shows the server's render of that request); B with another cube
+  method than A renders another image; the scene and texture controls list the files of --assets;
 - the orbit scrubber: the next frames are fetched ahead, moving the slider shows the server's
   render of that frame;
 - changing method A (twice, quickly) while B is shown changes A's image URL to the last choice;
 - a permalink opened in a new tab restores every control and the same images;
 - dragging the wipe divider and moving the magnifier follow the pointer;
-- a compare fills the Figure 5 and speed/error chart data, counting its entries and its elapsed
-  time as it runs; Figure 5 has log axes (tick labels powers of ten) and its legend outside the
+- a compare fills the Figure 5 and speed/error chart data, showing the entries done (polled from
+  GET /v1/progress) and its elapsed time as it runs; Figure 5 has log axes (tick labels powers of ten) and its legend outside the
   plot; the speed/error chart is log-log with a min..max bar per point and the Pareto front of
   examples/charts.py; changing the scene clears it; a size over the server's compare limit is
   refused on the page, not compared at another size;
