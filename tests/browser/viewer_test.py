@@ -429,6 +429,9 @@ def run(base, chromium, profile, shots, t, deadline):
                     | {"scene": env_scene}))[1])
                 t.check([tuple(shown_a[4 * i:4 * i + 3]) for i in range(len(mine))] == mine and mine != plain,
                         "the page shows the server's render with that environment (not the scene's own)")
+            # The magnifier was at (32, 32) of the 64x64 image: at 32x32 it is back at the centre.
+            loupe_text = page.eval("document.getElementById('loupe_text').textContent")
+            t.check("(16, 16)" in loupe_text, "the magnifier goes back to the centre when the size changes", loupe_text)
             shot(page, "0-environment.png")
             set_controls(page, {"scene": options["scene"]["default"], "size": SIZE,
                                 "env_sun_radius": str(env_schema["sun_radius"]["default"]),
