@@ -790,7 +790,7 @@ def run(base, chromium, profile, shots, t, deadline):
             proxy.deadline_compares, proxy.compares = True, 0
             page3.eval("document.getElementById('compare').click()")
             page3.wait("document.getElementById('compare').dataset.state === 'error'", timeout=10, what="the deadline answer")
-            time.sleep(2.5)  # longer than the first backoff
+            time.sleep(1.5)  # longer than the first backoff (Retry-After: 1)
             text = page3.eval("document.getElementById('compare_status').textContent")
             t.check(proxy.compares == 1 and "deadline" in text and "not retried" in text,
                     "a compare past the deadline is not retried", "%d requests: %s" % (proxy.compares, text))
