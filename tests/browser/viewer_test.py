@@ -25,7 +25,7 @@ works it through the DOM after the page's scripts ran:
 - a permalink restores the compare table and charts from the browser's copy, or runs the compare
   again with a notice (the same errors);
 - through a proxy: a 503 overload is retried with a growing backoff and a notice; a 503 past the
-  deadline is not retried;
+  deadline is not retried; cancel stops a long compare on the page at once;
 - an error answer ({"error", "field"}) is shown; the reference is used, or said to be unavailable.
 - the inspect view fetches the renders as f32: its pixel readout is the f32 answer's floats at that
   pixel; a wheel zoom keeps the pixel under the cursor and zooms A, B and the difference together,
@@ -172,7 +172,7 @@ class Proxy(http.server.ThreadingHTTPServer):
     def __init__(self, upstream):
         self.upstream, self.slow_method, self.fake_reference = upstream, None, False
         self.busy_method, self.busy_left, self.busy_times = None, 0, []
-        self.deadline_compares, self.compares = False, 0
+        self.deadline_compares, self.compares, self.hold_compares = False, 0, False
         super().__init__(("127.0.0.1", 0), ProxyHandler)
         threading.Thread(target=self.serve_forever, daemon=True).start()
 
@@ -203,7 +203,9 @@ class ProxyHandler(http.server.BaseHTTPRequestHandler):
                 return self.refuse(503, "queue", "queue: this server's render queue is full; retry later")
         if method == "POST" and path == "/v1/compare":
             self.server.compares += 1
-            if self.server.deadline_compares:
+            if self.server.hold_compares:  # a compare that takes long: never reaches seamcl
+                time.sleep(3.0)
+            if self.server.deadline_compares or self.server.hold_compares:
                 return self.refuse(503, "deadline", "deadline: the compare ran past this server's deadline of 1000 ms")
         request = urllib.request.Request(self.server.upstream + path, data=body, method=method,
                                          headers={"Content-Type": self.headers.get("Content-Type", "application/json")})
@@ -796,6 +798,20 @@ def run(base, chromium, profile, shots, t, deadline):
                     "a compare past the deadline is not retried", "%d requests: %s" % (proxy.compares, text))
             proxy.deadline_compares = False
             shot(page3, "12-deadline.png")
+
+            # Cancel: the page stops waiting for a long compare at once and says so.
+            proxy.hold_compares = True
+            page3.eval("document.getElementById('compare').click()")
+            page3.wait("document.getElementById('compare').dataset.state === 'running' && "
+                       "!document.getElementById('compare_cancel').hidden", timeout=5, what="the compare running")
+            clicked = time.monotonic()
+            page3.eval("document.getElementById('compare_cancel').click()")
+            page3.wait("document.getElementById('compare').dataset.state === 'cancelled'", timeout=2, what="the cancel")
+            text = page3.eval("document.getElementById('compare_status').textContent")
+            t.check(time.monotonic() - clicked < 1 and "cancelled" in text
+                    and page3.eval("document.getElementById('compare_cancel').hidden"),
+                    "cancel stops the compare on the page at once", text)
+            proxy.hold_compares = False
             t.check(not page3.errors(), "no script errors through the proxy", str(page3.errors()))
         finally:
             proxy.shutdown()
