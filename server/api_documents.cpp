@@ -7,6 +7,7 @@
 #include <seamcl/io/image_encoding.h>
 #include <seamcl/jobs/compare_job.h>
 #include <seamcl/jobs/render_job.h>
+#include <seamcl/options/option_domains.h>
 #include <seamcl/options/render_options.h>
 #include <seamcl/memory/render_memory.h>
 #include <seamcl/scene/scene.h>
@@ -176,6 +177,7 @@ json methods_document(const Scene& default_scene, const ServerOptions& limits) {
       {"methods", methods},
       {"options", options_document(scene_names, limits)},
       {"compare_options", compare_options_document(limits)},
+      {"domains", render_option_domains()},
       {"limits",
        {{"max_body_bytes", limits.max_body_bytes},
         {"max_samples", limits.max_samples},

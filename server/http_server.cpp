@@ -297,8 +297,14 @@ void HttpServer::install_routes() {
               jobs_->reference(parse_json_body(req, options_.max_json_depth), res);
             }));
   http.Post("/v1/compare", guarded([this](const httplib::Request& req, httplib::Response& res) {
-              jobs_->compare(parse_json_body(req, options_.max_json_depth), res);
+              const std::string job = req.has_header("X-Seamcl-Job")
+                                          ? checked_job_id(req.get_header_value("X-Seamcl-Job"), "X-Seamcl-Job")
+                                          : std::string();
+              jobs_->compare(parse_json_body(req, options_.max_json_depth), res, job);
             }));
+  http.Get("/v1/progress", guarded([this](const httplib::Request& req, httplib::Response& res) {
+             jobs_->progress(checked_job_id(req.get_param_value("job"), "job"), res);
+           }));
   // Last, for every other path and method cpp-httplib routes: a known path is reached here only
   // with a body, which cpp-httplib has read by now.
   http.Get(".*", answer_not_routed);

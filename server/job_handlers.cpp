@@ -247,7 +247,7 @@ void JobHandlers::render(const json& request, httplib::Response& res) {
 // POST /v1/compare: the compare job (host/jobs/compare_job.h) on one frame, admitted as one
 // request, answered as the JSON of `seamcl compare --json` (without server paths: no cache_path,
 // no images).
-void JobHandlers::compare(const json& request, httplib::Response& res) {
+void JobHandlers::compare(const json& request, httplib::Response& res, const std::string& job_id) {
   const Clock::time_point start = Clock::now();
   if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
   json rest = request;
@@ -296,6 +296,18 @@ void JobHandlers::compare(const json& request, httplib::Response& res) {
   JobControl control;
   control.should_stop = [deadline] { return GuardedHttpServer::client_gone() || Clock::now() > deadline; };
   control.device_byte_limit = options_.max_request_device_bytes;
+  // A client that named the job (X-Seamcl-Job) polls GET /v1/progress for its lines and steps.
+  struct Finish {
+    JobProgressBoard& board;
+    const std::string& id;
+    ~Finish() {
+      if (!id.empty()) board.finish(id);
+    }
+  } finish{progress_, job_id};
+  if (!job_id.empty()) {
+    progress_.start(job_id, control);
+    control.report("waiting for a render slot");
+  }
 
   // One admitted request for the whole compare, with a Renderer of its own (the job's): the 8x
   // reference's buffers are freed with it, and the slot's warm Renderers keep their scenes.
@@ -308,6 +320,7 @@ void JobHandlers::compare(const json& request, httplib::Response& res) {
     if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
     const size_t planned = plan.unified.total() > 0 ? plan.unified.total() : plan.device.total() + plan.host.total();
     const std::unique_ptr<MemoryReservation> reserved = reserve(lease->slot(), planned, plan.what);
+    control.report("building kernels and packing the scene");
     // Two compares of the same reference at once render it once: the second reads the first's.
     const ReferenceLock lock_reference = [this](const std::string& cache_key) {
       return std::unique_lock<std::mutex>(reference_lock(cache_key));
@@ -324,6 +337,20 @@ void JobHandlers::compare(const json& request, httplib::Response& res) {
   out["queue_ms"] = queue_ms;
   out["server_ms"] = ms_since(start);
   res.set_content(json_text(out), "application/json");
+}
+
+std::string checked_job_id(const std::string& text, const std::string& field) {
+  const bool ok = !text.empty() && text.size() <= 64 && std::all_of(text.begin(), text.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
+  });
+  if (!ok) throw HttpError{400, field, "must be 1 to 64 letters, digits, '-', '_' or '.', got '" + echo(text) + "'"};
+  return text;
+}
+
+void JobHandlers::progress(const std::string& job_id, httplib::Response& res) const {
+  const std::optional<json> state = progress_.get(job_id);
+  if (!state) throw HttpError{404, "job", "no job '" + echo(job_id) + "' on this server (never started here, or long gone)"};
+  res.set_content(json_text(*state), "application/json");
 }
 
 ReferenceSettings JobHandlers::take_reference_settings(json& rest, bool& explicit_msaa) const {

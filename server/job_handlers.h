@@ -14,6 +14,7 @@
 
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/eval/reference.h>
+#include <seamcl/jobs/job_progress.h>
 #include <seamcl/options/render_options.h>
 
 #include "http_server.h"
@@ -24,6 +25,10 @@
 
 namespace seamcl::server {
 
+// A job id a client gives (X-Seamcl-Job on POST /v1/compare, job on GET /v1/progress): 1 to 64
+// letters, digits, '-', '_' or '.'; anything else is a 400 naming `field`.
+std::string checked_job_id(const std::string& text, const std::string& field);
+
 class JobHandlers {
  public:
   // Every reference outlives the handlers (the HttpServer owns them all).
@@ -31,8 +36,11 @@ class JobHandlers {
               MemoryBound& memory);
 
   void render(const nlohmann::json& request, httplib::Response& res);
-  void compare(const nlohmann::json& request, httplib::Response& res);
+  // job_id: empty, or the client's name for this compare, under which GET /v1/progress shows it.
+  void compare(const nlohmann::json& request, httplib::Response& res, const std::string& job_id = "");
   void reference(const nlohmann::json& request, httplib::Response& res);
+  // GET /v1/progress?job=ID: what the job named ID has reported (JobProgressBoard::get).
+  void progress(const std::string& job_id, httplib::Response& res) const;
 
  private:
   // reference_method and reference_msaa taken out of a reference request.
@@ -58,6 +66,7 @@ class JobHandlers {
   // Two requests for the same reference at once would both render it and write the same cache
   // file: one lock per hash stripe of the cache key.
   std::array<std::mutex, 16> reference_locks_;
+  JobProgressBoard progress_;
 };
 
 }  // namespace seamcl::server

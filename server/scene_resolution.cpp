@@ -4,6 +4,7 @@
 #include <utility>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/jobs/scene_domains.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
 #include <seamcl/scene/scene_json.h>
@@ -74,6 +75,7 @@ json SceneResolver::scenes_json() const {
                     {"triangles", scene.triangle_count()},
                     {"texels", scene.texel_count()},
                     {"orbit", scene.orbit.has_value()},
+                    {"domains", scene_option_domains(scene)},
                     {"default", g.name == default_scene}});
   }
   return {{"scenes", list}};

@@ -4,17 +4,22 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/jobs/compare_job.h>
 #include <seamcl/jobs/render_job.h>
+#include <seamcl/jobs/scene_domains.h>
+#include <seamcl/options/option_domains.h>
 #include <seamcl/options/option_table.h>
 #include <seamcl/options/render_options.h>
+#include <seamcl/scene/scene_generators.h>
 #include "api_documents.h"
 #include "http_server.h"
 
@@ -163,4 +168,20 @@ TEST(OptionTable, DocumentsAreTheTable) {
     EXPECT_TRUE(compare.contains(spec.key)) << spec.key;
   }
   EXPECT_EQ(render.size(), render_option_table().size() + 1) << "RenderRequest has options the table does not declare";
+}
+
+// The option domains are declared in the table's rows: the cube and displacement options, each a
+// key of the table, and the methods document lists them as the table does; the built-in scenes
+// name the domains that act on them (the viewer shows and sends those options there only).
+TEST(OptionTable, DomainsAreTheTablesAndScenesNameTheirs) {
+  using Domains = std::map<std::string, std::vector<std::string>>;
+  EXPECT_EQ(render_option_domains(),
+            (Domains{{"cube", {"cube_method"}}, {"displacement", {"displacement_method", "tessellation", "displacement_level"}}}));
+  for (const auto& [domain, keys] : render_option_domains())
+    for (const std::string& key : keys) EXPECT_NE(find_option(render_option_table(), key), nullptr) << key;
+  const json methods = server::methods_document(generate_scene("quad2", {}), server::ServerOptions{});
+  EXPECT_EQ(methods.at("domains"), json(render_option_domains()));
+  EXPECT_EQ(scene_option_domains(generate_scene("envmap", {})), std::vector<std::string>{"cube"});
+  EXPECT_EQ(scene_option_domains(generate_scene("displaced", {})), std::vector<std::string>{"displacement"});
+  EXPECT_TRUE(scene_option_domains(generate_scene("quad2", {})).empty());
 }

@@ -29,6 +29,8 @@
 #include <unistd.h>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/jobs/scene_domains.h>
+#include <seamcl/options/option_domains.h>
 #include <seamcl/memory/compare_memory.h>
 #include <seamcl/eval/comparison.h>
 #include <seamcl/eval/metrics.h>
@@ -401,7 +403,7 @@ TEST(ServerSchema, OpenApiDocumentsEveryEndpoint) {
   EXPECT_TRUE(doc.at("openapi").get<std::string>().starts_with("3."));
   for (const auto& [path, method] : std::vector<std::pair<std::string, std::string>>{
            {"/", "get"}, {"/health", "get"}, {"/v1/scenes", "get"}, {"/v1/methods", "get"}, {"/v1/render", "get"},
-           {"/v1/render", "post"}, {"/v1/compare", "post"}, {"/openapi.json", "get"}}) {
+           {"/v1/render", "post"}, {"/v1/compare", "post"}, {"/v1/progress", "get"}, {"/openapi.json", "get"}}) {
     EXPECT_TRUE(doc.at("paths").contains(path) && doc.at("paths").at(path).contains(method)) << method << " " << path;
   }
   // Every $ref resolves.
@@ -471,6 +473,11 @@ TEST_F(Server, ScenesListsTheBuiltInScenes) {
   ASSERT_EQ(scenes.size(), scene_generators().size());
   for (size_t i = 0; i < scenes.size(); ++i) EXPECT_EQ(scenes[i].at("name"), scene_generators()[i].name);
   EXPECT_EQ(generate_scene("quad2", {}).faces.size(), scenes[1].at("faces").get<size_t>());
+  // The option domains that act on each scene, as the library says (envmap: cube; displaced: displacement).
+  for (const json& scene : scenes) {
+    EXPECT_EQ(scene.at("domains"), json(scene_option_domains(generate_scene(scene.at("name").get<std::string>(), {}))))
+        << scene.at("name");
+  }
 }
 
 TEST_F(Server, MethodsListsOptionsRangesAndTextureMemory) {
@@ -486,6 +493,7 @@ TEST_F(Server, MethodsListsOptionsRangesAndTextureMemory) {
   EXPECT_EQ(body.at("options").at("method").at("enum").get<std::vector<std::string>>(), method_names());
   EXPECT_EQ(body.at("options").at("filter").at("enum").get<std::vector<std::string>>(), filter_names());
   EXPECT_EQ(body.at("options").at("size").at("default"), to_json(RenderOptions{}).at("size"));
+  EXPECT_EQ(body.at("domains"), json(render_option_domains()));
   const Scene paper = generate_scene(RenderOptions{}.scene, {});
   EXPECT_EQ(body.at("methods")[0].at("texture_bytes").at("rgba8").get<size_t>(), pack_scene(paper).texture_bytes());
   // The ranges are the parser's: the bounds pass, one past them fails.
@@ -737,6 +745,43 @@ TEST_F(Server, CompareMatchesTheLibrary) {
   EXPECT_EQ(cached.at("reference").at("ms"), 0.0);
   expect_close(cached.at("results"), expected, "cached results");
   EXPECT_FALSE(fs::is_empty(cache_dir()));
+}
+
+// A compare posted with X-Seamcl-Job is shown by GET /v1/progress under that name: the job's last
+// line and its entries done of the total (a client polls it while the compare runs; here, after).
+TEST_F(Server, CompareProgressIsShownUnderItsJobName) {
+  httplib::Client c = client();
+  const json request = {{"scene", "quad2"}, {"size", "32x32"}, {"methods", "discard"}, {"msaa", "1,4"}, {"repeat", 1}};
+  auto res = c.Post("/v1/compare", httplib::Headers{{"X-Seamcl-Job", "progress-test.1"}}, request.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  // The compare's own split of its time, as the command line's.
+  const json timing = json::parse(res->body).at("timing");
+  for (const char* key : {"setup_ms", "targets_ms", "entries_ms"}) EXPECT_LE(timing.at(key).get<double>(), timing.at("total_ms").get<double>()) << key;
+  auto progress = c.Get("/v1/progress?job=progress-test.1");
+  ASSERT_TRUE(progress);
+  ASSERT_EQ(progress->status, 200) << progress->body;
+  expect_documented("get", "/v1/progress", progress);
+  const json p = json::parse(progress->body);
+  EXPECT_EQ(p.at("id"), "progress-test.1");
+  EXPECT_FALSE(p.at("running").get<bool>());
+  EXPECT_EQ(p.at("done"), 2);
+  EXPECT_EQ(p.at("total"), 2);
+  EXPECT_EQ(p.at("line"), "entry 2/2: discard at msaa 4");
+  EXPECT_GT(p.at("elapsed_ms").get<double>(), 0);
+
+  auto unknown = c.Get("/v1/progress?job=never-posted");
+  ASSERT_TRUE(unknown);
+  EXPECT_EQ(unknown->status, 404);
+  EXPECT_EQ(json::parse(unknown->body).at("field"), "job");
+  auto bad = c.Get("/v1/progress?job=a%20b");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_EQ(json::parse(bad->body).at("field"), "job");
+  auto bad_header = c.Post("/v1/compare", httplib::Headers{{"X-Seamcl-Job", "a/b"}}, request.dump(), "application/json");
+  ASSERT_TRUE(bad_header);
+  EXPECT_EQ(bad_header->status, 400);
+  EXPECT_EQ(json::parse(bad_header->body).at("field"), "X-Seamcl-Job");
 }
 
 // One malformed request and what it must get.
@@ -1141,7 +1186,7 @@ TEST_F(Server, UnroutedMethodsAre405WithAllow) {
   const std::map<std::string, std::string> allowed = {{"/", "GET"},           {"/health", "GET"},
                                                       {"/v1/scenes", "GET"}, {"/v1/methods", "GET"},
                                                       {"/openapi.json", "GET"}, {"/v1/render", "GET, POST"},
-                                                      {"/v1/compare", "POST"}};
+                                                      {"/v1/compare", "POST"}, {"/v1/progress", "GET"}};
   for (const auto& [path, allow] : allowed) {
     for (const std::string method : {"HEAD", "PUT", "DELETE", "PATCH", "OPTIONS", "GET", "POST"}) {
       if (allow.find(method) != std::string::npos) continue;

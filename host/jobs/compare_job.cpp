@@ -165,6 +165,8 @@ CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobCont
   renderer.set_device_byte_limit(control.device_byte_limit);
   renderer.load_scene(scene, frame_.texels);
   CompareRun run;
+  const int total = static_cast<int>(entries_.size());
+  control.step(0, total);
   run.timing.setup_ms = ms_since(start);
   const Clock::time_point targets_start = Clock::now();
   {
@@ -176,7 +178,14 @@ CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobCont
   throw_if_stopped(control.should_stop, "before the entries");
   const TargetsFor targets_for = [&](const MethodEntry& entry) { return run.targets.for_entry(entry); };
   const Clock::time_point entries_start = Clock::now();
-  run.measured = compare_methods(renderer, scene, view, entries_, targets_for, repeat_, control.should_stop, control.progress);
+  // Each entry's line comes before it: the entries before it are done.
+  int started = 0;
+  const Progress entry_progress = [&](const std::string& line) {
+    control.report(line);
+    control.step(started++, total);
+  };
+  run.measured = compare_methods(renderer, scene, view, entries_, targets_for, repeat_, control.should_stop, entry_progress);
+  control.step(total, total);
   run.timing.entries_ms = ms_since(entries_start);
   // Watertightness of the displaced surface at this camera (docs/displacement.md), at the first rate.
   if (frame_.displacement) {
@@ -204,12 +213,10 @@ json CompareJob::result_json(const CompareRun& run, const Scene& scene, const st
     out["frames"] = frame_.frames;
   }
   if (!run.displacement.is_null()) out["displacement"] = run.displacement;
-  if (with_cache_path) {
-    out["timing"] = {{"setup_ms", run.timing.setup_ms},
-                     {"targets_ms", run.timing.targets_ms},
-                     {"entries_ms", run.timing.entries_ms},
-                     {"total_ms", run.timing.total_ms}};
-  }
+  out["timing"] = {{"setup_ms", run.timing.setup_ms},
+                   {"targets_ms", run.timing.targets_ms},
+                   {"entries_ms", run.timing.entries_ms},
+                   {"total_ms", run.timing.total_ms}};
   return out;
 }
 

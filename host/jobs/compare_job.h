@@ -76,8 +76,8 @@ class CompareJob {
 
   // The documented answer: scene, size, device, repeat, options, results, the references'
   // summary (reference, references, seam_pixels, seam_mask), frame and frames with an orbit frame,
-  // displacement for a displaced frame. with_cache_path: where a cached reference lies, and the
-  // run's timing {setup_ms, targets_ms, entries_ms, total_ms} (the command line's; a service
+  // displacement for a displaced frame, the run's timing {setup_ms, targets_ms, entries_ms,
+  // total_ms}. with_cache_path: where a cached reference lies (the command line's; a service
   // keeps its paths to itself).
   nlohmann::json result_json(const CompareRun& run, const Scene& scene, const std::string& device,
                              bool with_cache_path) const;

@@ -32,8 +32,15 @@ struct JobControl {
   // frame's tile lists grow past any plan, and the limit refuses that growth (OverBudget).
   size_t device_byte_limit = 0;
 
+  // The units of work done of the total (a compare's entries), once before the first (0 of the
+  // total) and after each; empty: silent. A progress bar's figures, where `progress` gives words.
+  std::function<void(int done, int total)> steps;
+
   void report(const std::string& line) const {
     if (progress) progress(line);
+  }
+  void step(int done, int total) const {
+    if (steps) steps(done, total);
   }
 };
 

@@ -1,5 +1,7 @@
 #include <seamcl/options/render_options.h>
 
+#include <seamcl/options/option_domains.h>
+
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -129,11 +131,12 @@ using nlohmann::json;
 
 // One row of the table: the option's spec and how it reads from and writes to RenderOptions.
 // `write` takes a value checked_option has already checked; `read` gives the value to_json writes,
-// null where to_json leaves the key out (an option not in effect).
+// null where to_json leaves the key out (an option not in effect). `domain`: see option_domains.h.
 struct RenderField {
   OptionSpec spec;
   std::function<void(RenderOptions&, const json&)> write;
   std::function<json(const RenderOptions&)> read;
+  std::string domain;
 };
 
 template <typename Enum, size_t N>
@@ -244,16 +247,16 @@ const std::vector<RenderField>& render_fields() {
          [](const RenderOptions& o) { return json(o.tint); }},
         {choice("cube_method", cube_method_names(), "Cube-map seam method of scenes with an environment (envmap)", "cube method"),
          [](RenderOptions& o, const json& v) { o.cube_method = enum_value(v, kCubeMethods); },
-         [](const RenderOptions& o) { return json(to_string(o.cube_method)); }},
+         [](const RenderOptions& o) { return json(to_string(o.cube_method)); }, kCubeDomain},
         {absent_means(choice("displacement_method", displacement_method_names(),
                              "Tessellate every patch and displace it by the scene's maps with this seam method", "displacement method"),
                       "no displacement"),
          [](RenderOptions& o, const json& v) { o.displacement = parse_displacement_method(v.get<std::string>()); },
-         [](const RenderOptions& o) { return o.displacement ? json(to_string(*o.displacement)) : json(); }},
+         [](const RenderOptions& o) { return o.displacement ? json(to_string(*o.displacement)) : json(); }, kDisplacementDomain},
         {integer("tessellation", 1, SEAMCL_MAX_TESSELLATION, "Displacement: each patch a (T+1)^2 grid"),
-         [](RenderOptions& o, const json& v) { o.tessellation = v.get<int>(); }, displaced_only(json())},
+         [](RenderOptions& o, const json& v) { o.tessellation = v.get<int>(); }, displaced_only(json()), kDisplacementDomain},
         {integer("displacement_level", 0, kMaxDisplacementLevel, "Displacement: the maps' level every patch samples"),
-         [](RenderOptions& o, const json& v) { o.displacement_level = v.get<int>(); }, displaced_only(json())},
+         [](RenderOptions& o, const json& v) { o.displacement_level = v.get<int>(); }, displaced_only(json()), kDisplacementDomain},
     };
     // Defaults are RenderOptions' own initialisers, read through the same accessors; the two
     // displacement settings are written only with a method, so their defaults are read directly.
@@ -294,6 +297,16 @@ const OptionTable& render_option_table() {
     return specs;
   }();
   return table;
+}
+
+const std::map<std::string, std::vector<std::string>>& render_option_domains() {
+  static const std::map<std::string, std::vector<std::string>> domains = [] {
+    std::map<std::string, std::vector<std::string>> out;
+    for (const RenderField& field : render_fields())
+      if (!field.domain.empty()) out[field.domain].push_back(field.spec.key);
+    return out;
+  }();
+  return domains;
 }
 
 RenderOptions parse_render_options(const nlohmann::json& request) {

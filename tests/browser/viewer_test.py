@@ -4,12 +4,28 @@
 works it through the DOM after the page's scripts ran:
 
 - both images decode as PNGs of the chosen size; the page's heat map equals one computed here from
-  the same PNGs (decoded in Python);
+  the same PNGs (decoded in Python); each image's time is shown split into queue, build, render
+  and encode as the server reported it;
+- every domain's controls (cube map, displacement) come from the methods document: each in its
+  domain's fieldset, a choice listing exactly the option table's values (a domain's method for A
+  and for B), bounds as the table's, shown and sent for the scenes the domain acts on only; the
+  environment's controls are the OpenAPI document's Environment schema, and a value set renders
+  the scene inline (the page shows the server's render of that request); B with another cube
+  method than A renders another image; the scene and texture controls list the files of --assets;
+- the orbit scrubber: the next frames are fetched ahead, moving the slider shows the server's
+  render of that frame;
 - changing method A (twice, quickly) while B is shown changes A's image URL to the last choice;
 - a permalink opened in a new tab restores every control and the same images;
 - dragging the wipe divider and moving the magnifier follow the pointer;
-- a compare fills the Figure 5 and speed/error chart data; changing the scene clears it; a size
-  over the server's compare limit is refused on the page, not compared at another size;
+- a compare fills the Figure 5 and speed/error chart data, showing the entries done (polled from
+  GET /v1/progress) and its elapsed time as it runs; Figure 5 has log axes (tick labels powers of ten) and its legend outside the
+  plot; the speed/error chart is log-log with a min..max bar per point and the Pareto front of
+  examples/charts.py; changing the scene clears it; a size over the server's compare limit is
+  refused on the page, not compared at another size;
+- a permalink restores the compare table and charts from the browser's copy, or runs the compare
+  again with a notice (the same errors);
+- through a proxy: a 503 overload is retried with a growing backoff and a notice; a 503 past the
+  deadline is not retried; cancel stops a long compare on the page at once;
 - an error answer ({"error", "field"}) is shown; the reference is used, or said to be unavailable.
 - the inspect view fetches the renders as f32: its pixel readout is the f32 answer's floats at that
   pixel; a wheel zoom keeps the pixel under the cursor and zooms A, B and the difference together,
@@ -146,13 +162,17 @@ def mean_distance(p, q):
 
 class Proxy(http.server.ThreadingHTTPServer):
     """In front of seamcl for what the server cannot do on demand: it delays renders of one method
-    (answers that arrive late and out of order), and, where seamcl has no POST /v1/reference yet,
-    answers it with a stand-in (a traverse render of the same frame) so the page's reference path
-    runs too."""
+    (answers that arrive late and out of order); refuses renders of one method as an overloaded
+    server does (503, field queue, Retry-After: 1) a given number of times, noting when each
+    request came; answers every compare as one past the server's deadline (503, field deadline);
+    and, where seamcl has no POST /v1/reference yet, answers it with a stand-in (a traverse render
+    of the same frame) so the page's reference path runs too."""
     daemon_threads = True
 
     def __init__(self, upstream):
         self.upstream, self.slow_method, self.fake_reference = upstream, None, False
+        self.busy_method, self.busy_left, self.busy_times = None, 0, []
+        self.deadline_compares, self.compares, self.hold_compares = False, 0, False
         super().__init__(("127.0.0.1", 0), ProxyHandler)
         threading.Thread(target=self.serve_forever, daemon=True).start()
 
@@ -176,6 +196,17 @@ class ProxyHandler(http.server.BaseHTTPRequestHandler):
         query = urllib.parse.parse_qs(urllib.parse.urlparse(path).query)
         if self.server.slow_method and query.get("method") == [self.server.slow_method]:
             time.sleep(2.0)
+        if self.server.busy_method and query.get("method") == [self.server.busy_method] and path.startswith("/v1/render"):
+            self.server.busy_times.append(time.monotonic())
+            if self.server.busy_left > 0:
+                self.server.busy_left -= 1
+                return self.refuse(503, "queue", "queue: this server's render queue is full; retry later")
+        if method == "POST" and path == "/v1/compare":
+            self.server.compares += 1
+            if self.server.hold_compares:  # a compare that takes long: never reaches seamcl
+                time.sleep(3.0)
+            if self.server.deadline_compares or self.server.hold_compares:
+                return self.refuse(503, "deadline", "deadline: the compare ran past this server's deadline of 1000 ms")
         request = urllib.request.Request(self.server.upstream + path, data=body, method=method,
                                          headers={"Content-Type": self.headers.get("Content-Type", "application/json")})
         try:
@@ -195,6 +226,15 @@ class ProxyHandler(http.server.BaseHTTPRequestHandler):
             self.wfile.write(data)
         except OSError:  # the page aborted this request
             pass
+
+    def refuse(self, status, field, error):
+        data = json.dumps({"error": error, "field": field}).encode()
+        self.send_response(status)
+        self.send_header("Content-Type", "application/json")
+        self.send_header("Retry-After", "1")
+        self.send_header("Content-Length", str(len(data)))
+        self.end_headers()
+        self.wfile.write(data)
 
     def do_GET(self):
         self.relay("GET")
@@ -263,6 +303,7 @@ def run(base, chromium, profile, shots, t, deadline):
     b0 = others[0]
     _, scenes_body = get(base + "/v1/scenes")
     scenes = json.loads(scenes_body)["scenes"]
+    assets = json.loads(get(base + "/v1/assets")[1])["assets"]
 
     def left():
         return max(1.0, deadline - time.monotonic())
@@ -291,6 +332,122 @@ def run(base, chromium, profile, shots, t, deadline):
         status_text = page.eval("document.getElementById('status').textContent")
         t.check("error" not in page.eval("document.getElementById('status').className"), "no error after render",
                 status_text)
+        # The server's split of each answer's time, shown as it reported it (device time inside
+        # the server's wall time).
+        for which in ("A", "B"):
+            timing = json.loads(page.eval("document.getElementById('status').dataset.timings%s || '{}'" % which))
+            parts = ("queue", "build", "render", "encode")
+            t.check(set(timing) == set(parts + ("server",)) and all(timing[k] >= 0 for k in timing)
+                    and sum(timing[k] for k in parts) <= timing["server"] + 0.01,
+                    which + "'s timings split into queue, build, render and encode within the server's time", str(timing))
+        t.check(all(k in status_text for k in ("queue ", "build ", "render ", "encode ")), "the status names the timings",
+                status_text)
+
+        # Every domain's controls, from the methods document's domains and options (never listed
+        # here): each option of a domain in the domain's fieldset, a choice with exactly the
+        # table's values (and "none" where leaving it out means something), bounds as the table's.
+        domains = info.get("domains", {})
+        t.check("cube_method" in domains.get("cube", []) and "displacement_method" in domains.get("displacement", []),
+                "the methods document names the cube and displacement domains", str(domains))
+        for domain, keys in domains.items():
+            for key in keys:
+                spec = options[key]
+                control = page.eval("(() => { const e = document.getElementById('option_%s'); if (!e) return null; "
+                                    "return {fieldset: e.closest('fieldset').id, tag: e.tagName, min: e.min, max: e.max, "
+                                    "values: e.tagName === 'SELECT' ? [...e.options].map((o) => o.value) : null}; })()" % key)
+                if not t.check(control is not None and control["fieldset"] == "domain_" + domain,
+                               "option %s has a control in the %s fieldset" % (key, domain), str(control)):
+                    continue
+                if "enum" in spec:
+                    want = [str(v) for v in spec["enum"]]
+                    if "default" not in spec:
+                        want = [""] + want
+                    t.check(control["values"] == want, "the %s control lists exactly the option table's values" % key,
+                            "%r vs %r" % (control["values"], want))
+                    if key.endswith("_method"):  # a domain's method: a control for B too
+                        b_values = page.eval("[...document.getElementById('option_%s_b').options].map((o) => o.value)" % key)
+                        t.check(b_values == want, "the %s control of B lists the same values" % key, str(b_values))
+                elif spec.get("type") == "integer":
+                    t.check((control["min"], control["max"]) == (str(spec["minimum"]), str(spec["maximum"])),
+                            "the %s control has the option's bounds" % key, str(control))
+        # A domain's controls are shown for the scenes it acts on (GET /v1/scenes "domains") and
+        # its options sent for those only. Switched and back in one script turn: the page's
+        # render waits for the controls to settle, so nothing is rendered for the switch.
+        for domain, keys in domains.items():
+            acting = [sc["name"] for sc in scenes if domain in sc.get("domains", [])]
+            other = next((sc["name"] for sc in scenes if domain not in sc.get("domains", [])), None)
+            if not t.check(acting and other, "some scenes have the %s domain and some not" % domain, str(scenes)):
+                continue
+            key = next(k for k in keys if "enum" in options[k])
+            pick = str(options[key]["enum"][-1])
+            seen = page.eval("""(() => {
+                const scene = document.getElementById('scene'), control = document.getElementById('option_%s');
+                const was = [scene.value, control.value], out = {};
+                for (const name of [%s, %s]) {
+                  scene.value = name; scene.dispatchEvent(new Event('change'));
+                  control.value = %s; control.dispatchEvent(new Event('change'));
+                  out[name] = [getComputedStyle(document.getElementById('domain_%s')).display === 'none',
+                               renderParams('x').get('%s')];
+                }
+                control.value = was[1]; control.dispatchEvent(new Event('change'));
+                scene.value = was[0]; scene.dispatchEvent(new Event('change'));
+                return out; })()""" % (key, json.dumps(acting[0]), json.dumps(other), json.dumps(pick), domain, key))
+            t.check(seen[acting[0]] == [False, pick] and seen[other] == [True, None],
+                    "the %s controls show, and %s is sent, for %s only" % (domain, key, acting[0]), str(seen))
+        wait_idle(page, min(RENDER_WAIT_S, left()), "the render after the domain checks")
+
+        # The environment of the cube domain's scenes: a control per property of the OpenAPI
+        # document's Environment schema; a value set renders the scene as an inline generator
+        # scene, POSTed, and the page shows the server's render of exactly that request.
+        doc = json.loads(get(base + "/openapi.json")[1])
+        env_schema = doc["components"]["schemas"]["Environment"]["properties"]
+        env_controls = page.eval("[...document.querySelectorAll('#domain_cube #environment_controls input')].map((e) => e.id)")
+        t.check(env_controls == ["env_" + k for k in env_schema], "an environment control per property of the Environment schema",
+                "%r vs %r" % (env_controls, list(env_schema)))
+        env_scene = next((sc["name"] for sc in scenes if "cube" in sc.get("domains", [])), None)
+        cube_key = next((k for k in domains.get("cube", []) if k.endswith("_method")), None)
+        if env_scene and "sun_radius" in env_schema and cube_key:
+            # B with another cube method than A's (the default): A and B differ on this scene.
+            radius = env_schema["sun_radius"]["default"] * 4
+            cube_b = next(v for v in options[cube_key]["enum"] if v != options[cube_key]["default"])
+            set_controls(page, {"scene": env_scene, "size": COMPARE_SIZE, "env_sun_radius": str(radius),
+                                "option_%s_b" % cube_key: cube_b})
+            wait_idle(page, min(RENDER_WAIT_S, left()), "the render with an environment set")
+            key = page.eval("document.getElementById('image_a').dataset.src")
+            sent = json.loads(key.split(" ", 2)[2]) if key.startswith("POST /v1/render ") else {}
+            t.check(sent.get("scene") == {"generator": env_scene, "options": {"environment": {"sun_radius": radius}}},
+                    "an environment value sends the scene as an inline generator scene", key)
+            key_b = page.eval("document.getElementById('image_b').dataset.src")
+            sent_b = json.loads(key_b.split(" ", 2)[2]) if key_b.startswith("POST /v1/render ") else {}
+            differ = page.eval("shown.A.image.rgba.some((v, i) => v !== shown.B.image.rgba[i])")
+            t.check(cube_key not in sent and sent_b.get(cube_key) == cube_b and differ
+                    and cube_b in page.eval("document.getElementById('label_b').textContent"),
+                    "B renders with its own cube method, A with the default, and their images differ", key_b)
+            if sent:
+                shown_a = page.eval("Array.from(shown.A.image.rgba)")
+                mine, _, _ = decode_png_rgb(get(base + "/v1/render", sent)[1])
+                plain, _, _ = decode_png_rgb(get(base + "/v1/render?" + urllib.parse.urlencode(
+                    {k: str(v).lower() if isinstance(v, bool) else v for k, v in sent.items() if k != "scene"}
+                    | {"scene": env_scene}))[1])
+                t.check([tuple(shown_a[4 * i:4 * i + 3]) for i in range(len(mine))] == mine and mine != plain,
+                        "the page shows the server's render with that environment (not the scene's own)")
+            # The magnifier was at (32, 32) of the 64x64 image: at 32x32 it is back at the centre.
+            loupe_text = page.eval("document.getElementById('loupe_text').textContent")
+            t.check("(16, 16)" in loupe_text, "the magnifier goes back to the centre when the size changes", loupe_text)
+            shot(page, "0-environment.png")
+            set_controls(page, {"scene": options["scene"]["default"], "size": SIZE,
+                                "env_sun_radius": str(env_schema["sun_radius"]["default"]),
+                                "option_%s_b" % cube_key: options[cube_key]["default"]})
+            wait_idle(page, min(RENDER_WAIT_S, left()), "the render after the environment check")
+
+        # The assets of --assets: the scene list is the built-in scenes then every asset; the
+        # texture list (for a mesh) every .ptx.
+        scene_values = page.eval("[...document.getElementById('scene').options].map((o) => o.value)")
+        t.check(scene_values == options["scene"]["enum"] + [a["name"] for a in assets] and len(assets) >= 2,
+                "the scene control lists the built-in scenes and the --assets files", "%r vs %r" % (scene_values, assets))
+        texture_values = page.eval("[...document.getElementById('texture').options].map((o) => o.value)")
+        t.check(texture_values == [""] + [a["name"] for a in assets if a["kind"] == "ptex"],
+                "the texture control lists the .ptx assets", str(texture_values))
 
         step(2)
         # 2. The heat map equals the one computed here from the server's own PNGs.
@@ -405,6 +562,35 @@ def run(base, chromium, profile, shots, t, deadline):
         t.check(not page2.errors(), "no script errors in the permalink's page", str(page2.errors()))
         page2.close()
 
+        if orbit_scene:
+            # The orbit scrubber: after frame 3 the next frames were fetched ahead; moving the
+            # slider to 4 shows frame 4 (the server's render of frame 4, not 3's image again). On a
+            # closed object, which every frame of its orbit shows, and a small one (cube).
+            scrub_scene = next((sc["name"] for sc in scenes if sc["name"] == "cube"), options["scene"]["default"])
+            set_controls(page, {"scene": scrub_scene, "texels": options["texels"]["default"]})
+            wait_idle(page, min(RENDER_WAIT_S, left()), "frame 3 of " + scrub_scene)
+            src3 = image_info(page, "image_a")["src"]
+            page.wait("document.getElementById('scrubber').dataset.ahead === '4,5'", timeout=min(RENDER_WAIT_S, left()),
+                      what="frames 4 and 5 fetched ahead")
+            scrub = page.eval("(() => { const e = document.getElementById('scrubber'); return [e.min, e.max, e.value, "
+                              "document.getElementById('scrub_label').hidden]; })()")
+            t.check(scrub == ["0", "11", "3", False], "the scrubber spans the orbit's frames at frame 3", str(scrub))
+            page.eval("(() => { const e = document.getElementById('scrubber'); e.value = '4'; "
+                      "e.dispatchEvent(new Event('input')); })()")
+            page.wait("new URLSearchParams(document.getElementById('image_a').dataset.src.split('?')[1]).get('frame') === '4'",
+                      timeout=min(RENDER_WAIT_S, left()), what="frame 4 shown")
+            wait_idle(page, min(RENDER_WAIT_S, left()), "the scrubbed frame")
+            src4 = image_info(page, "image_a")["src"]
+            t.check(page.eval("document.getElementById('frame').value") == "4" and "frame=4" in page.eval("location.hash"),
+                    "the scrubber sets the frame and the permalink")
+            t.check(page.eval("document.getElementById('status').dataset.aheadA") == "1",
+                    "the scrubbed frame was the one fetched ahead")
+            p3, _, _ = decode_png_rgb(get(base + src3)[1])
+            p4, _, _ = decode_png_rgb(get(base + src4)[1])
+            shown4 = page.eval("Array.from(shown.A.image.rgba)")
+            t.check("frame=3" in src3 and p3 != p4 and [tuple(shown4[4 * i:4 * i + 3]) for i in range(len(p4))] == p4,
+                    "the page shows the server's render of the scrubbed frame, another image than frame 3's", src4)
+
         step(8)
         # 8. The reference: used if the server offers POST /v1/reference, else said unavailable.
         set_control(page, "view", "heat")
@@ -428,8 +614,18 @@ def run(base, chromium, profile, shots, t, deadline):
                             "size": COMPARE_SIZE})
         wait_idle(page, min(RENDER_WAIT_S, left()), 'a render')
         page.eval("document.getElementById('compare').click()")
-        page.wait("['done', 'error'].includes(document.getElementById('compare').dataset.state)",
-                  timeout=min(RENDER_WAIT_S, left()), what="the compare answer")
+        # While it runs: the elapsed time and the entries done, as the page shows them.
+        seen, until = [], time.monotonic() + min(RENDER_WAIT_S, left())
+        while time.monotonic() < until:
+            state = page.eval("[document.getElementById('compare').dataset.state, "
+                              "{...document.getElementById('progress').dataset}]")
+            if state[0] != "running":
+                break
+            if state[1].get("state") == "running":
+                seen.append((int(state[1]["done"]), int(state[1]["total"]), float(state[1]["elapsed"]), state[1].get("detail", "")))
+            time.sleep(0.2)
+        page.wait("['done', 'error'].includes(document.getElementById('compare').dataset.state)", timeout=5,
+                  what="the compare answer")
         data = json.loads(page.eval("document.getElementById('chart_data').textContent"))
         status_text = page.eval("document.getElementById('compare_status').textContent")
         rates = len(options["msaa"]["enum"])
@@ -445,7 +641,82 @@ def run(base, chromium, profile, shots, t, deadline):
                     and len(data["curves"]) == methods * rates, "Figure 5 curves of 41 points", str(data["curves"]))
             t.check(page.eval("document.getElementById('pareto').dataset.points") == str(methods * rates),
                     "the speed/error canvas drew every point")
+        entries = methods * rates
+        # The entries done and the job's line come from the server (GET /v1/progress, polled).
+        done = [x[0] for x in seen]
+        t.check(len(seen) >= 2 and all(x[1] == entries for x in seen) and done == sorted(done)
+                and seen[-1][2] > seen[0][2] and any(x[3] for x in seen),
+                "the compare's progress shows the server's entries done and line, and its elapsed time grows",
+                str(seen[:2] + [x for x in seen if x[3]][:3] + seen[-2:]))
+        t.check(page.eval("document.getElementById('progress').textContent").startswith("compared %d entries in " % entries),
+                "the compare's time is shown when it ends", page.eval("document.getElementById('progress').textContent"))
+
+        # The charts as the Python ones: Figure 5 with both axes logarithmic (every tick label a
+        # power of ten) and the legend right of the plot, not over it; the speed/error chart
+        # log-log with a min..max bar per point (the compare answer's), the Pareto front circled.
+        def canvas(id_):
+            return page.eval("({...document.getElementById(%s).dataset})" % json.dumps(id_))
+
+        def power_of_ten(label):
+            return label == "1" or (label.startswith("1e") and label[2:].lstrip("-").isdigit())
+        for id_ in ("curve_all", "curve_seam", "pareto"):
+            c = canvas(id_)
+            plot, legend = json.loads(c.get("plot", "null")), json.loads(c.get("legend", "null"))
+            t.check(c.get("xscale") == "log" and c.get("yscale") == "log", id_ + " has log axes", str(c))
+            t.check(plot and legend and legend[0] >= plot[2], id_ + "'s legend is outside the plot", "%r %r" % (plot, legend))
+        for id_ in ("curve_all", "curve_seam"):
+            c = canvas(id_)
+            yticks, xticks = json.loads(c["yticks"]), json.loads(c["xticks"])
+            t.check(len(yticks) >= 4 and all(map(power_of_ten, yticks)) and yticks[0] == "1e-5" and yticks[-1] == "1",
+                    id_ + "'s y axis is logarithmic from 1e-5 (its tick labels powers of ten)", str(yticks))
+            t.check(xticks == ["1e-4", "1e-3", "1e-2", "1e-1", "1"], id_ + "'s x axis is logarithmic from 1e-4 to 1", str(xticks))
+        if data:
+            c = canvas("pareto")
+            bars = json.loads(c["bars"])
+            want = [[p["method"], p["msaa"], p["ms_min"], p["ms_max"]] for p in data["pareto"]]
+            t.check(bars == want and all(b[2] <= p["ms"] <= b[3] for b, p in zip(bars, data["pareto"])),
+                    "the speed/error chart has a min..max bar per point", "%r vs %r" % (bars, want))
+            pts = [(p["ms"], p["seam_mean"]) for p in data["pareto"]]
+            front = sorted((i for i, (x, y) in enumerate(pts) if not any(
+                x2 <= x and y2 <= y and (x2 < x or y2 < y) for j, (x2, y2) in enumerate(pts) if j != i)), key=lambda i: pts[i][0])
+            want_front = ["%s %dx" % (data["pareto"][i]["method"], data["pareto"][i]["msaa"]) for i in front]
+            t.check(json.loads(c["front"]) == want_front, "the chart's Pareto front is examples/charts.py's",
+                    "%s vs %r" % (c["front"], want_front))
         shot(page, "5-compare.png")
+
+        # The permalink restores the compare too: from this browser's copy in a new tab (the same
+        # rows, not run again), and run again, with a notice, where the browser has no copy.
+        def table(p):
+            return p.eval("[...document.querySelectorAll('#compare_table tbody tr')].map((r) => "
+                          "[...r.cells].map((c) => c.textContent))")
+        rows = table(page)
+        href = page.eval("location.href")
+        t.check("cmp=1" in href and len(rows) == entries, "the permalink says compare results are shown", href)
+        page5 = browser.open(href)
+        page5.wait("document.getElementById('compare').dataset.state === 'done'", timeout=min(RENDER_WAIT_S, left()),
+                   what="the permalink's compare")
+        t.check(page5.eval("document.getElementById('compare_status').dataset.source") == "saved" and table(page5) == rows
+                and page5.eval("document.getElementById('chart_data').textContent")
+                == page.eval("document.getElementById('chart_data').textContent"),
+                "the permalink restores the compare table and its charts from the browser's copy",
+                page5.eval("document.getElementById('compare_status').textContent"))
+        page5.close()
+        # Another compare (the chosen rate only) that this browser never ran, pasted into the same
+        # tab (its images are at hand): run again, said so.
+        page5 = page
+        page5.eval("location.hash = %s" % json.dumps(href.split("#", 1)[1].replace("rates=all", "rates=chosen")))
+        page5.wait("document.getElementById('compare_status').dataset.source === 'rerun'", timeout=min(RENDER_WAIT_S, left()),
+                   what="the permalink's compare run again")
+        notice = page5.eval("document.getElementById('compare_status').textContent")
+        page5.wait("document.getElementById('compare').dataset.state === 'done'", timeout=min(RENDER_WAIT_S, left()),
+                   what="the permalink's compare run again")
+        again = table(page5)
+        msaa0 = str(options["msaa"]["default"])
+        same = [r for r in rows if r[1] == msaa0]
+        t.check("running it again" in notice and [r[:6] for r in again] == [r[:6] for r in same],
+                "a permalink to a compare the browser has not kept runs it again with a notice, and the same errors",
+                "%s: %r vs %r" % (notice, again, same))
+        shot(page5, "11-permalink-compare.png")
         scene2 = next((s["name"] for s in scenes if s["name"] != options["scene"]["default"]), None)
         if scene2:
             set_control(page, "scene", scene2)
@@ -498,6 +769,49 @@ def run(base, chromium, profile, shots, t, deadline):
             time.sleep(2.2)  # the slow answer for a1 has come (or was aborted) by now
             src = image_info(page3, "image_a")["src"]
             t.check(method_of(src) == a2, "a late answer for the previous A is not shown", src)
+            proxy.slow_method = None
+
+            # An overloaded server (503, field queue): A's render is retried after Retry-After,
+            # then twice that, with a notice; it then shows.
+            proxy.busy_method, proxy.busy_left = a2, 2
+            retries_before = int(page3.eval("document.getElementById('retry_notice').dataset.retries || '0'"))
+            set_control(page3, "aniso", str(max(options["aniso"]["minimum"], options["aniso"]["default"] // 4)))
+            page3.wait("document.getElementById('retry_notice').textContent.includes('retry 1 of')", timeout=10,
+                       what="the retry notice")
+            wait_idle(page3, min(RENDER_WAIT_S, left()), "the render retried")
+            notice = page3.eval("document.getElementById('retry_notice').textContent")
+            gaps = [b - a for a, b in zip(proxy.busy_times, proxy.busy_times[1:])]
+            t.check(int(page3.eval("document.getElementById('retry_notice').dataset.retries")) - retries_before == 2
+                    and "answered after 2 retries" in notice and len(gaps) == 2 and 0.9 <= gaps[0] < 1.9 and gaps[1] >= 1.9,
+                    "a 503 overload is retried with a growing backoff and a notice", "%s; gaps %r" % (notice, gaps))
+            proxy.busy_method = None
+
+            # A compare past the server's deadline (503, field deadline) is not retried.
+            set_control(page3, "size", COMPARE_SIZE)
+            wait_idle(page3, min(RENDER_WAIT_S, left()), "a render")
+            proxy.deadline_compares, proxy.compares = True, 0
+            page3.eval("document.getElementById('compare').click()")
+            page3.wait("document.getElementById('compare').dataset.state === 'error'", timeout=10, what="the deadline answer")
+            time.sleep(1.5)  # longer than the first backoff (Retry-After: 1)
+            text = page3.eval("document.getElementById('compare_status').textContent")
+            t.check(proxy.compares == 1 and "deadline" in text and "not retried" in text,
+                    "a compare past the deadline is not retried", "%d requests: %s" % (proxy.compares, text))
+            proxy.deadline_compares = False
+            shot(page3, "12-deadline.png")
+
+            # Cancel: the page stops waiting for a long compare at once and says so.
+            proxy.hold_compares = True
+            page3.eval("document.getElementById('compare').click()")
+            page3.wait("document.getElementById('compare').dataset.state === 'running' && "
+                       "!document.getElementById('compare_cancel').hidden", timeout=5, what="the compare running")
+            clicked = time.monotonic()
+            page3.eval("document.getElementById('compare_cancel').click()")
+            page3.wait("document.getElementById('compare').dataset.state === 'cancelled'", timeout=2, what="the cancel")
+            text = page3.eval("document.getElementById('compare_status').textContent")
+            t.check(time.monotonic() - clicked < 1 and "cancelled" in text
+                    and page3.eval("document.getElementById('compare_cancel').hidden"),
+                    "cancel stops the compare on the page at once", text)
+            proxy.hold_compares = False
             t.check(not page3.errors(), "no script errors through the proxy", str(page3.errors()))
         finally:
             proxy.shutdown()
@@ -673,7 +987,11 @@ def main():
     port = free_port()
     base = "http://127.0.0.1:%d" % port
     cache = tempfile.mkdtemp(prefix="seamcl-viewer-cache-")
-    server = subprocess.Popen([args.seamcl, "serve", "--port", str(port), "--quick-start", "--threads", "1"],
+    # A few small assets: the page lists them (scene and texture controls).
+    assets = tempfile.mkdtemp(prefix="seamcl-viewer-assets-")
+    for name in ("cube.obj", "black.ptx"):
+        shutil.copy(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "assets", "ptex", name), assets)
+    server = subprocess.Popen([args.seamcl, "serve", "--port", str(port), "--quick-start", "--threads", "1", "--assets", assets],
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                               env=dict(os.environ, SEAMCL_CACHE_DIR=cache))
     profile = tempfile.mkdtemp(prefix="seamcl-chromium-")
@@ -692,6 +1010,7 @@ def main():
             server.kill()
         shutil.rmtree(profile, ignore_errors=True)
         shutil.rmtree(cache, ignore_errors=True)
+        shutil.rmtree(assets, ignore_errors=True)
     print("%d passed, %d failed in %.1f s" % (t.passed, len(t.failed), time.monotonic() - start))
     return 1 if t.failed else 0
 
