@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <tuple>
+#include <utility>
 
 #include <seamcl/core/input_error.h>
 
@@ -133,6 +134,9 @@ using nlohmann::json;
 // `write` takes a value checked_option has already checked; `read` gives the value to_json writes,
 // null where to_json leaves the key out (an option not in effect). `domain`: see option_domains.h.
 struct RenderField {
+  RenderField(OptionSpec spec_, std::function<void(RenderOptions&, const json&)> write_,
+              std::function<json(const RenderOptions&)> read_, std::string domain_ = "")
+      : spec(std::move(spec_)), write(std::move(write_)), read(std::move(read_)), domain(std::move(domain_)) {}
   OptionSpec spec;
   std::function<void(RenderOptions&, const json&)> write;
   std::function<json(const RenderOptions&)> read;
@@ -203,7 +207,8 @@ const std::vector<RenderField>& render_fields() {
                               "in place of the scene's own maps; needs displacement_method"),
                       "the scene's own maps"),
          [](RenderOptions& o, const json& v) { o.displacement_map = v.get<std::string>(); },
-         [](const RenderOptions& o) { return o.displacement_map.empty() ? json() : json(o.displacement_map); }},
+         [](const RenderOptions& o) { return o.displacement_map.empty() ? json() : json(o.displacement_map); },
+         kDisplacementDomain},
         {choice("method", method_names(), "Seam method"),
          [](RenderOptions& o, const json& v) { o.method = enum_value(v, kMethods); },
          [](const RenderOptions& o) { return json(to_string(o.method)); }},
