@@ -5,9 +5,9 @@
 #include <map>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/pipeline/packed_scene.h>
 #include <seamcl/pipeline/renderer.h>
 #include "pipeline/displacement_packing.h"
-#include "pipeline/packed_scene.h"
 #include "pipeline/stages/sample_pattern.h"
 #include "pipeline/stages/triangle_setup_twin.h"
 #include "pipeline/stages/tessellate_launcher.h"
