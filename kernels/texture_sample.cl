@@ -3,7 +3,7 @@
  * Inputs: a FaceGpu (level-0 size, level count, index of its level table), level_offsets (first
  * texel of each level), the texels, and SamplerParams. Texels are RGBA8 with sRGB-encoded RGB
  * (packed r | g << 8 | b << 16 | a << 24, decoded through the host's 256-entry table) or, when
- * the program is built with -DSEAMCL_TEXELS_F32=1, linear RGBA32F. Filtering is in linear RGB.
+ * the shading or sampling program is built with -DSEAMCL_TEXELS_F32=1, linear RGBA32F. Filtering is in linear RGB.
  * Coordinates: uv in face space; texel (i, j) of a W x H level is centred at ((i+.5)/W, (j+.5)/H);
  * derivatives are d(uv)/d(pixel).
  * Result: a FilterSum, the filtered colour and the summed weight of the taps that read inside the

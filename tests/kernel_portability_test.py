@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """The kernels as standard OpenCL C, not as what PoCL happens to accept.
 
-Every program variant (`seamcl warmup --list`, plus the texel, cube and zero-coverage switches
-that list leaves at their defaults) is compiled by clang for the spir64 target as OpenCL C 1.2 and
+The text of every kernel file in build order (one program holding the five that seamcl builds,
+host/cl/kernel_sources.cpp), with the build options of every shading variant (`seamcl warmup
+--list`, plus the texel, cube and zero-coverage switches that list leaves at their defaults), is
+compiled by clang for the spir64 target as OpenCL C 1.2 and
 as OpenCL C 3.0 with every optional 3.0 feature and every extension off (-cl-ext=-all: what any
 conformant device must take), warnings as errors. A set of variants that together take every
 value of every build switch is then compiled to LLVM IR, translated to SPIR-V (llvm-spirv) and
@@ -10,7 +12,7 @@ validated (spirv-val): an intrinsic or construct another vendor's compiler would
 there. Full translation of every variant would take minutes; the switches only select code paths,
 so covering each value once keeps the check to seconds while each path is translated.
 
-Usage: kernel_portability_test.py SEAMCL_BINARY KERNEL_FILE...  (the files in program order)
+Usage: kernel_portability_test.py SEAMCL_BINARY KERNEL_FILE...  (every kernel file, in build order)
 Exit 77 (skipped, with the reason) when clang, llvm-spirv or spirv-val is not installed;
 scripts/install-deps installs them (clang-14, llvm-spirv-14, spirv-tools).
 """

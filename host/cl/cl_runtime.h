@@ -1,4 +1,5 @@
-// The OpenCL runtime: device choice, one context, one in-order profiling queue, the program.
+// The OpenCL runtime: device choice, one context, one in-order profiling queue, the programs
+// (host/cl/kernel_program.h).
 // Errors carry the failing call, the CL error name and, for builds, each device's build log.
 #pragma once
 #include <map>

@@ -99,9 +99,9 @@ EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environme
     const std::vector<glm::vec4> values = lookups.sample(batch, sampler);
     double sum = 0, worst = 0;
     for (size_t i = 0; i < values.size(); i += 2) {
-      const double step = rgb_norm(values[i] - values[i + 1]);
-      sum += step;
-      worst = std::max(worst, step);
+      const double jump = rgb_norm(values[i] - values[i + 1]);
+      sum += jump;
+      worst = std::max(worst, jump);
     }
     if (step < cube.level_count()) {
       out.seam_step_mean.push_back(sum / static_cast<double>(values.size() / 2));

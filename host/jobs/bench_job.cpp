@@ -301,7 +301,7 @@ JobPlan BenchJob::plan(const Scene& scene) const {
   const BenchMemory memory =
       bench_memory(scene_sizes(scene), frame_, entries_, reference_,
                    {with_errors_, error_frame_count(), discard_traverse_pairs(entries_).size(), range_.size()});
-  return JobPlan{"this bench", memory.device, memory.host};
+  return JobPlan{"this bench", memory.device, memory.host, {}};
 }
 
 void BenchJob::refuse_beyond_machine(const Scene& scene, const DeviceInfo& device) const {

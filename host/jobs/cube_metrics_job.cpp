@@ -87,7 +87,7 @@ JobPlan CubeMetricsJob::plan(const Scene& scene) const {
   }
   device.add("scene", largest_cube);
   host.add("scene", largest_cube);
-  return JobPlan{"this cube-metrics run", device, host};
+  return JobPlan{"this cube-metrics run", device, host, {}};
 }
 
 json CubeMetricsJob::run(ClRuntime& runtime, const Scene& source, const JobControl& control,

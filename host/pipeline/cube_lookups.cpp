@@ -7,8 +7,8 @@
 namespace seamcl {
 
 CubeLookups::CubeLookups(ClRuntime& runtime, const CubeMap& cube, bool border) : runtime_(runtime), size_(cube.size) {
-  // The batch kernel does not depend on the patch sampler's build options: the default render
-  // variant's program serves (and is usually built already).
+  // The batch kernel does not depend on the patch sampler's build options: the sampling program
+  // of the default render's options serves.
   const RenderOptions defaults;
   kernel_ = cl::Kernel(runtime.program(KernelProgram::Sampling, program_options(defaults.texels, sampler_params(defaults))), "cube_lookup_batch");
   std::vector<float> texels = pack_cube_texels(cube, border);

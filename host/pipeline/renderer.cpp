@@ -65,11 +65,14 @@ struct Renderer::Impl {
     stats = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, sizeof(FrameStats));
   }
 
-  // Makes the shading kernel of the program variant for this texel format and sampler current
-  // (the other stages' programs have no variants).
+  // Makes the shading kernel of the program variant for this texel format and sampler current,
+  // and builds the option-free programs the frame's other stages take their kernels from: here,
+  // before the frame queues anything, so a build that fails or is slow does so before the frame.
   void use_kernels(TexelFormat format, const SamplerParams& sampler, bool with_seam_mask) {
     const std::string options = program_options(format, sampler, with_seam_mask, scene->environment.has_value());
     program_key = options;
+    runtime.program(KernelProgram::Geometry);
+    if (downsample_taps) runtime.program(KernelProgram::Downsample);
     shade.use_program(options);
   }
 
@@ -407,11 +410,16 @@ std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, c
     if (std::find(variants.begin(), variants.end(), options) == variants.end()) variants.push_back(options);
   }
   return std::async(std::launch::async, [&runtime, variants = std::move(variants)] {
-    try {
-      runtime.program(KernelProgram::Geometry);  // every render's first stages
-      for (const std::string& options : variants) runtime.program(KernelProgram::Shading, options);
-    } catch (...) {  // the render that uses it builds it again and reports the error
-    }
+    // A build that fails is left to the render that uses it, which builds it again and reports
+    // the error; the builds after it still run.
+    auto build = [&runtime](KernelProgram program, const std::string& options) {
+      try {
+        runtime.program(program, options);
+      } catch (...) {
+      }
+    };
+    build(KernelProgram::Geometry, "");  // every render's first stages
+    for (const std::string& options : variants) build(KernelProgram::Shading, options);
   });
 }
 
