@@ -24,6 +24,10 @@ for f in "$prefix/bin/seamcl" "$libdir/cmake/seamcl/seamclConfig.cmake" "$libdir
   [ -e "$f" ] || fail "not installed: $f"
 done
 ls "$libdir"/libseamcl.* >/dev/null 2>&1 || fail "no libseamcl in $libdir"
+[ -f "$libdir/seamcl/libseamcl_oiio.so" ] || fail "no OpenImageIO module in $libdir/seamcl"
+# The consumer writes PNGs through the installed module: a prefix other than the configured one
+# names it (host/io/image_codec.h).
+export SEAMCL_OIIO_MODULE="$libdir/seamcl/libseamcl_oiio.so"
 for private in pipeline/stages/raster_twin.h cl/kernel_sources.h pipeline/adjacency.h core/srgb.h io/texture_file.h; do
   [ ! -e "$prefix/include/seamcl/$private" ] || fail "private header installed: $private"
 done

@@ -4,7 +4,8 @@
 
 - a file in host/F/ (or a folder inside it, such as host/pipeline/stages/) includes only host/F/
   and the folders F may depend on (ALLOWED);
-- OpenCL headers only in host/cl/, OpenImageIO only in .cpp files of host/io/ and host/eval/;
+- OpenCL headers only in host/cl/, OpenImageIO only in host/io/oiio/ (the module the library loads
+  on its first image file), and that module includes nothing of the library but host/io/image_codec.h;
 - a public header (listed in CMakeLists.txt) includes no private one;
 - outside host/, a public header is included as <seamcl/F/NAME.h>, never by a relative path,
   and cli/, server/, python/ and examples/ include no private header at all.
@@ -75,8 +76,12 @@ def main():
             where = f"host/{rel}: #include {kind}{name}{closing}"
             if name.startswith("CL/") and folder != "cl":
                 problems.append(f"{where}: OpenCL headers belong to host/cl/ only")
-            if name.startswith("OpenImageIO/") and not (folder in ("io", "eval") and path.suffix == ".cpp"):
-                problems.append(f"{where}: OpenImageIO only in .cpp files of host/io/ and host/eval/")
+            in_module = rel.startswith("io/oiio/")
+            if name.startswith("OpenImageIO/") and not in_module:
+                problems.append(f"{where}: OpenImageIO only in host/io/oiio/, the module the library loads")
+            if in_module and kind == '"' and name != "io/image_codec.h":
+                problems.append(f"{where}: the OpenImageIO module links nothing of the library: "
+                                "it includes host/io/image_codec.h alone")
             target = host_target(kind, name)
             if target is None:
                 continue

@@ -1,9 +1,16 @@
 // Image files: in-memory encoding gives the same bytes as writing a file, formats by extension,
-// and a failed write leaves nothing behind.
+// a failed write leaves nothing behind, and OpenImageIO is loaded (as a module) with the first
+// image only.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <string>
+
+#include <unistd.h>
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/io/image_io.h>
@@ -88,4 +95,80 @@ TEST(ImageIo, FailedWriteLeavesNoFile) {
   std::filesystem::remove_all(dir);
   EXPECT_THROW(write_image((dir / "sub" / "x.png").string(), 4, 4, gradient(4, 4)), std::runtime_error);
   EXPECT_FALSE(std::filesystem::exists(dir));
+}
+
+namespace {
+
+// A temporary path the same in the test and in its death-test child, which re-runs the test from its
+// start in a process of another id.
+std::filesystem::path shared_temporary(const std::string& stem) {
+  const std::string variable = "SEAMCL_TEST_TEMPORARY_" + stem;
+  if (const char* given = std::getenv(variable.c_str()); given != nullptr) return given;
+  const auto path = std::filesystem::temp_directory_path() / ("seamcl-image-io-" + stem + "-" + std::to_string(::getpid()));
+  ::setenv(variable.c_str(), path.c_str(), 1);
+  return path;
+}
+
+bool open_image_io_is_mapped() {
+  std::ifstream maps("/proc/self/maps");
+  std::string line;
+  while (std::getline(maps, line))
+    if (line.find("libOpenImageIO") != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+// OpenImageIO's ~260 shared libraries are loaded with the first image, not at start: the tests and
+// the seamcl command do not link them (host/io/image_codec.h).
+TEST(ImageIo, OpenImageIoIsLoadedWithTheFirstImageOnly) {
+  // A fresh process ("threadsafe" death tests re-run this binary for this test alone).
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const std::string path = shared_temporary("lazy").string() + ".png";
+  EXPECT_EXIT(
+      {
+        const bool before = open_image_io_is_mapped();
+        write_image(path, 4, 4, gradient(4, 4));
+        std::exit(!before && open_image_io_is_mapped() ? 0 : 1);
+      },
+      testing::ExitedWithCode(0), "");
+  EXPECT_TRUE(std::filesystem::is_regular_file(path));
+  std::filesystem::remove(path);
+
+  FILE* ldd = ::popen(("ldd " + std::string(SEAMCL_BINARY)).c_str(), "r");
+  ASSERT_NE(ldd, nullptr);
+  std::string libraries;
+  char buffer[4096];
+  for (size_t n; (n = std::fread(buffer, 1, sizeof buffer, ldd)) > 0;) libraries.append(buffer, n);
+  EXPECT_EQ(::pclose(ldd), 0);
+  EXPECT_NE(libraries.find("libOpenCL"), std::string::npos) << libraries;
+  EXPECT_EQ(libraries.find("libOpenImageIO"), std::string::npos) << "seamcl links OpenImageIO:\n" << libraries;
+}
+
+TEST(ImageIo, AModuleThatDoesNotLoadIsAnErrorNamingWhereItLooked) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const auto dir = shared_temporary("nomodule");
+  std::filesystem::create_directories(dir);
+  const std::string bogus = (dir / "libseamcl_oiio.so").string();
+  { std::ofstream(bogus) << "not a shared object"; }
+  for (const std::string& module : {(dir / "absent.so").string(), bogus}) {
+    SCOPED_TRACE(module);
+    // In a fresh process: this one may have loaded the module already.
+    EXPECT_EXIT(
+        {
+          ::setenv("SEAMCL_OIIO_MODULE", module.c_str(), 1);
+          try {
+            write_image((dir / "x.png").string(), 4, 4, gradient(4, 4));
+          } catch (const std::runtime_error& e) {
+            const std::string what = e.what();
+            std::cerr << what;
+            const bool named = what.find("SEAMCL_OIIO_MODULE") != std::string::npos &&
+                               what.find(module + ": ") != std::string::npos;
+            std::exit(named && !std::filesystem::exists(dir / "x.png") ? 0 : 2);
+          }
+          std::exit(3);
+        },
+        testing::ExitedWithCode(0), module == bogus ? "not a shared object|invalid ELF|too short" : "no such file");
+  }
+  std::filesystem::remove_all(dir);
 }

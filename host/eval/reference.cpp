@@ -21,13 +21,11 @@
 #include <system_error>
 #include <unistd.h>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/version.h>
+#include "io/image_codec.h"
 #include "cl/kernel_sources.h"
 #include "pipeline/stages/downsample_twin.h"
 
@@ -98,19 +96,17 @@ std::optional<std::vector<glm::vec4>> read_cached(const std::string& path, const
                                                   int height) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) return std::nullopt;
-  auto input = OIIO::ImageInput::open(path);
-  if (!input) {
-    (void)OIIO::geterror();  // clear the global error
-    return std::nullopt;
-  }
-  const OIIO::ImageSpec& spec = input->spec();
-  if (spec.width != width || spec.height != height || spec.nchannels != 4 ||
-      spec.get_string_attribute("seamcl:reference_key") != key) {
-    return std::nullopt;
-  }
-  std::vector<glm::vec4> pixels(static_cast<size_t>(width) * static_cast<size_t>(height));
-  if (!input->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, pixels.data())) {
-    (void)input->geterror();
+  std::unique_ptr<ImageSource> input;
+  std::vector<glm::vec4> pixels;
+  try {
+    input = image_codec().open(path);
+    if (input->width() != width || input->height() != height || input->channels() != 4 ||
+        input->attribute("seamcl:reference_key") != key) {
+      return std::nullopt;
+    }
+    pixels.resize(static_cast<size_t>(width) * static_cast<size_t>(height));
+    input->read(pixels.data(), false);
+  } catch (const std::runtime_error&) {
     return std::nullopt;
   }
   return pixels;
@@ -125,16 +121,15 @@ bool write_cached(const std::string& path, const std::string& key, int width, in
   // Unique per process and thread, so concurrent writers of one entry never share a temp file.
   const std::string temp = path + ".tmp" + std::to_string(::getpid()) + "-" +
                            std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id())) + ".exr";
-  {
-    auto output = OIIO::ImageOutput::create(temp);
-    if (!output) return false;
-    OIIO::ImageSpec spec(width, height, 4, OIIO::TypeDesc::FLOAT);
-    spec.attribute("seamcl:reference_key", key);
-    spec.attribute("compression", "zip");
-    if (!output->open(temp, spec) || !output->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !output->close()) {
-      fs::remove(temp, ec);
-      return false;
-    }
+  try {
+    ImageLevel level{width, height, StoredPixels::Float, pixels.data()};
+    ImageWriteOptions options;
+    options.compression = "zip";
+    options.text_attributes = {{"seamcl:reference_key", key}};
+    image_codec().write(temp, "", {level}, options, nullptr);
+  } catch (const std::runtime_error&) {
+    fs::remove(temp, ec);
+    return false;
   }
   fs::rename(temp, path, ec);
   if (ec) {
@@ -270,18 +265,7 @@ std::vector<glm::vec4> downsample_mitchell(const std::vector<glm::vec4>& pixels,
                                 " is not a multiple of " + std::to_string(factor));
   }
   const int out_w = width / factor, out_h = height / factor;
-  // Wraps the caller's pixels without copying (ImageBuf only reads them here).
-  const OIIO::ImageSpec src_spec(width, height, 4, OIIO::TypeDesc::FLOAT);
-  const OIIO::ImageBuf src(src_spec, const_cast<glm::vec4*>(pixels.data()));
-  OIIO::ImageBuf dst(OIIO::ImageSpec(out_w, out_h, 4, OIIO::TypeDesc::FLOAT));
-  if (!OIIO::ImageBufAlgo::resize(dst, src, "mitchell", kMitchellWidth)) {
-    throw std::runtime_error("Mitchell downsample failed: " + dst.geterror());
-  }
-  std::vector<glm::vec4> out(static_cast<size_t>(out_w) * static_cast<size_t>(out_h));
-  if (!dst.get_pixels(OIIO::ROI(0, out_w, 0, out_h, 0, 1, 0, 4), OIIO::TypeDesc::FLOAT, out.data())) {
-    throw std::runtime_error("Mitchell downsample: " + dst.geterror());
-  }
-  return out;
+  return image_codec().resize(pixels, width, height, out_w, out_h, "mitchell", kMitchellWidth);
 }
 
 std::string default_reference_method() { return parse_method("traverse") ? "traverse" : "discard"; }

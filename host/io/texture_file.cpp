@@ -1,11 +1,11 @@
 #include "io/texture_file.h"
 
 #include "core/srgb.h"
+#include "io/image_codec.h"
 
 #include <algorithm>
 #include <stdexcept>
 
-#include <OpenImageIO/imageio.h>
 
 namespace seamcl {
 
@@ -30,24 +30,20 @@ std::vector<float> packed_level_linear(const PackedScene& packed, uint32_t face,
 }
 
 void write_face_mip_exr(const PackedScene& packed, uint32_t face, const std::string& path) {
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw std::runtime_error("no writer for " + path + ": " + OIIO::geterror());
-  if (!out->supports("mipmap") || !out->supports("tiles")) throw std::runtime_error(path + ": format lacks MIP-mapped tiles");
-  const int levels = packed.faces.at(face).level_count;
-  for (int l = 0; l < levels; ++l) {
-    int w = 0, h = 0;
-    const std::vector<float> pixels = packed_level_linear(packed, face, l, w, h);
-    OIIO::ImageSpec spec(w, h, 4, OIIO::TypeDesc::FLOAT);
-    spec.tile_width = 64;
-    spec.tile_height = 64;
-    spec.attribute("textureformat", "Plain Texture");
-    spec.attribute("compression", "zip");
-    const auto mode = l == 0 ? OIIO::ImageOutput::Create : OIIO::ImageOutput::AppendMIPLevel;
-    if (!out->open(path, spec, mode) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels.data())) {
-      throw std::runtime_error("writing " + path + ": " + out->geterror());
-    }
+  const int level_count = packed.faces.at(face).level_count;
+  std::vector<std::vector<float>> pixels(static_cast<size_t>(level_count));
+  std::vector<ImageLevel> levels(static_cast<size_t>(level_count));
+  for (int l = 0; l < level_count; ++l) {
+    ImageLevel& level = levels[static_cast<size_t>(l)];
+    pixels[static_cast<size_t>(l)] = packed_level_linear(packed, face, l, level.width, level.height);
+    level.stored = StoredPixels::Float;
+    level.pixels = pixels[static_cast<size_t>(l)].data();
   }
-  if (!out->close()) throw std::runtime_error("closing " + path + ": " + out->geterror());
+  ImageWriteOptions options;
+  options.tile_size = 64;
+  options.mip_texture = true;
+  options.compression = "zip";
+  image_codec().write(path, "", levels, options, nullptr);
 }
 
 }  // namespace seamcl
