@@ -6,6 +6,7 @@
 # `OCL_ICD_VENDORS=/nonexistent ctest -LE device` shows that they pass with no OpenCL driver to be
 # found.
 set(SEAMCL_HOST_ONLY_TESTS
+  AdaptiveFactors.*
   Adjacency.Quad2HasOneLinkEachWay
   Adjacency.CollapsedEdgesLinkNothing
   Adjacency.ClosedMeshesLinkEveryEdge

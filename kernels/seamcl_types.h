@@ -300,12 +300,13 @@ typedef struct {
   DisplacementTexcoord texcoord[4][4]; /* ownership: corner k; 0 own, 1 edge k's owner, 2 edge (k+3)%4's, 3 the corner's */
   cl_uint map_offset;             /* first sample in the samples buffer */
   cl_int columns, rows;
-  cl_int pad0;
+  cl_int inner_factor;            /* 0: uniform, every edge and the inside at T; else the inside's factor */
+  cl_int edge_factor[4];          /* adaptive: edge k's factor 1..T, the same in both patches of the edge */
 } DisplacementPatch;
 
 /* Per tessellation, read-only. */
 typedef struct {
-  cl_int tessellation;   /* T: every patch is a (T+1)^2 grid, 1..SEAMCL_MAX_TESSELLATION */
+  cl_int tessellation;   /* T: every patch is a (T+1)^2 grid of slots, 1..SEAMCL_MAX_TESSELLATION */
   cl_int method;         /* SEAMCL_DISPLACEMENT_* */
   cl_int patches;        /* patches in the buffer */
   cl_float scale;        /* world units per unit of displacement (samples / 65535) */

@@ -5,7 +5,13 @@
  *   1. Domain point (u, v). naive: i/T, j/T in float. The other methods: fixed point
  *      (SEAMCL_DOMAIN_ONE = 1); a point on edge e is computed from the edge's end with the lower
  *      mesh vertex index and mirrored at the other end, so both patches on the edge make the same
- *      point (the D3D11 tessellator's rule). An edge's level is T on both sides.
+ *      point (the D3D11 tessellator's rule). Uniform (inner_factor 0): every edge at T.
+ *      Adaptive (inner_factor > 0): the (T+1)^2 slots stay, T the largest factor; slot k of edge e
+ *      (counted from the lower end) is step tess_step(k, edge_factor[e], T) of that edge, a step
+ *      0 or F being the corner itself; slot (i, j) inside is point (a, b) / F_in of the inner
+ *      grid, a = tess_step(i, F_in, T) clamped to 1..F_in-1. Slots that land on one point make
+ *      degenerate micro-triangles (setup culls them); the ring of cells along the edges is the
+ *      transition strip from each edge's factor to the inside's.
  *   2. Base surface: bilinear in the patch's corner positions and vertex normals.
  *   3. Displacement h in [0, 1] by the method (SEAMCL_DISPLACEMENT_*): naive and fixed sample the
  *      patch's own map (float bilinear / exact integer bilinear), zipper averages both sides'
@@ -18,7 +24,10 @@
  *
  * tessellated_setup: triangle setup (kernels/triangle_setup.cl's clipping, snapping, culling and
  * planes, whose helpers it calls) of micro-triangle t: patch t / (2 T^2), cell c = (t / 2) % T^2
- * at (c % T, c / T), split as the quads are: (00, 10, 11) for even t and (00, 11, 01) for odd t.
+ * at (c % T, c / T), split as the quads are: (00, 10, 11) for even t and (00, 11, 01) for odd t;
+ * adaptive, the cells (T-1, 0) and (0, T-1) split the other way, (00, 10, 01) and (10, 11, 01): there
+ * the inner grid's corner point may lie on the patch corner's side of the 00-11 diagonal, which
+ * would turn a triangle over, while 10-01 passes through that point.
  * Every record's face is the patch, so shading reads the patch's colour texture and seam method.
  * Twin: host/pipeline/stages/tessellate_twin.cpp (tessellate); tessellated_setup at T = 1
  * without displacement equals triangle_setup exactly (tests/test_displacement.cpp). */
@@ -56,6 +65,29 @@ SEAMCL_INLINE float disp_sample_exact(__global const ushort* s, int columns, int
   const long top = (long)s[j1 * columns + i0] * (one - fx) + (long)s[j1 * columns + i1] * fx;
   const long numerator = bottom * (one - fy) + top * fy;
   return (float)numerator * (1.0f / 4294967296.0f) * (1.0f / 65535.0f);
+}
+
+/* Adaptive factors: slot k of T slots at factor f (1..T) is step k * f / T, rounded half up, so
+ * slots 0 and T are steps 0 and f and neighbouring slots differ by at most one step. */
+SEAMCL_INLINE int tess_step(int k, int f, int t) { return (2 * k * f + t) / (2 * t); }
+
+/* Adaptive: a slot on edge e whose step is 0 or the edge's factor is that corner's slot. */
+SEAMCL_INLINE void tess_collapse_to_corner(__global const DisplacementPatch* p, int t, int* i, int* j) {
+  int e = -1, step = 0;
+  if ((*i == 0 || *i == t) && (*j == 0 || *j == t)) return;
+  if (*j == 0) { e = 0; step = *i; }
+  else if (*i == t) { e = 1; step = *j; }
+  else if (*j == t) { e = 2; step = t - *i; }
+  else if (*i == 0) { e = 3; step = t - *j; }
+  if (e < 0) return;
+  const int f = p->edge_factor[e];
+  const int lower_first = p->vertex[e] < p->vertex[(e + 1) % 4];
+  const int m = tess_step(lower_first ? step : t - step, f, t);
+  const int from_e = lower_first ? m : f - m;
+  if (from_e != 0 && from_e != f) return;
+  const int c = from_e == 0 ? e : (e + 1) % 4;
+  *i = (c == 1 || c == 2) ? t : 0;
+  *j = c >= 2 ? t : 0;
 }
 
 SEAMCL_INLINE void disp_edge_uv(int e, long s, long* u, long* v) {
@@ -118,13 +150,15 @@ __kernel void tessellate(__constant TessellationParams* params, __global const D
   const int id = (int)get_global_id(0);
   if (id >= params->patches * side * side) return;
   const int patch = id / (side * side);
-  const int i = (id % (side * side)) % side, j = (id % (side * side)) / side;
+  int i = (id % (side * side)) % side, j = (id % (side * side)) / side;
   __global const DisplacementPatch* p = &patches[patch];
   const long one = SEAMCL_DOMAIN_ONE;
   const float inv_one = 1.0f / (float)SEAMCL_DOMAIN_ONE;
   const int method = params->method;
+  const int adaptive = p->inner_factor > 0;
 
   /* 1. Domain point */
+  if (adaptive) tess_collapse_to_corner(p, t, &i, &j);
   int edge = -1, step = 0;
   const int corner = (i == 0 || i == t) && (j == 0 || j == t);
   if (!corner) {
@@ -134,14 +168,32 @@ __kernel void tessellate(__constant TessellationParams* params, __global const D
     else if (i == 0) { edge = 3; step = t - j; }
   }
   long uf = (long)i * one / t, vf = (long)j * one / t;
+  float naive_u = (float)i / (float)t, naive_v = (float)j / (float)t;
   long s = 0;
   if (edge >= 0) {
-    s = p->vertex[edge] < p->vertex[(edge + 1) % 4] ? (long)step * one / t : one - (long)(t - step) * one / t;
+    const int lower_first = p->vertex[edge] < p->vertex[(edge + 1) % 4];
+    if (adaptive) {
+      const int f = p->edge_factor[edge];
+      const int m = tess_step(lower_first ? step : t - step, f, t);
+      s = lower_first ? (long)m * one / f : one - (long)m * one / f;
+      const float ns = (float)(lower_first ? m : f - m) / (float)f;
+      naive_u = edge == 0 ? ns : edge == 1 ? 1.0f : edge == 2 ? 1.0f - ns : 0.0f;
+      naive_v = edge == 0 ? 0.0f : edge == 1 ? ns : edge == 2 ? 1.0f : 1.0f - ns;
+    } else {
+      s = lower_first ? (long)step * one / t : one - (long)(t - step) * one / t;
+    }
     disp_edge_uv(edge, s, &uf, &vf);
+  } else if (adaptive && !corner) {
+    const int f = p->inner_factor;
+    const int a = clamp(tess_step(i, f, t), 1, f - 1), b = clamp(tess_step(j, f, t), 1, f - 1);
+    uf = (long)a * one / f;
+    vf = (long)b * one / f;
+    naive_u = (float)a / (float)f;
+    naive_v = (float)b / (float)f;
   }
   const int naive = method == SEAMCL_DISPLACEMENT_NAIVE;
-  const float u = naive ? (float)i / (float)t : (float)uf * inv_one;
-  const float v = naive ? (float)j / (float)t : (float)vf * inv_one;
+  const float u = naive ? naive_u : (float)uf * inv_one;
+  const float v = naive ? naive_v : (float)vf * inv_one;
 
   /* 2. Base surface */
   float w[4];
@@ -239,7 +291,7 @@ __kernel void tessellate(__constant TessellationParams* params, __global const D
 __kernel __attribute__((reqd_work_group_size(SEAMCL_SETUP_GROUP, 1, 1)))
 void tessellated_setup(__constant FrameParams* frame, __constant TessellationParams* params,
                        __global const TessVertex* vertices, __global TriangleSetup* out,
-                       __global uint* slot_counts, __global FrameStats* stats) {
+                       __global uint* slot_counts, __global FrameStats* stats, int adaptive) {
   __local uint group_visible[SEAMCL_SETUP_GROUP];
   const int triangles = frame->input_triangles; /* > 0: the host runs no setup without triangles */
   const int t = params->tessellation;
@@ -255,9 +307,12 @@ void tessellated_setup(__constant FrameParams* frame, __constant TessellationPar
   const int16 patch = read_tri / (2 * t * t);
   const int16 cell = (read_tri / 2) % (t * t);
   const int16 odd = (read_tri & 1) != 0;
-  const int16 vertex0 = patch * (side * side) + (cell / t) * side + cell % t;
-  const int16 vertex1 = vertex0 + select((int16)(1), (int16)(side + 1), odd);
-  const int16 vertex2 = vertex0 + select((int16)(side + 1), (int16)(side), odd);
+  const int16 base = patch * (side * side) + (cell / t) * side + cell % t;
+  const int16 cx = cell % t, cy = cell / t;
+  const int16 flip = (((cx == t - 1) & (cy == 0)) | ((cx == 0) & (cy == t - 1))) & (int16)(adaptive && t >= 2 ? -1 : 0);
+  const int16 vertex0 = base + select((int16)(0), (int16)(1), odd & flip);
+  const int16 vertex1 = base + select((int16)(1), (int16)(side + 1), odd);
+  const int16 vertex2 = select(base + select((int16)(side + 1), (int16)(side), odd), base + side, flip);
 #define TESS_X0(i) vertices[vertex0[i]].position[0]
 #define TESS_Y0(i) vertices[vertex0[i]].position[1]
 #define TESS_Z0(i) vertices[vertex0[i]].position[2]

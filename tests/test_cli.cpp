@@ -159,6 +159,7 @@ TEST_F(Cli, DisplacementOptionsWithoutDisplacementAreInputErrors) {
   expect_input_error("render --scene displaced --displacement-method zipper --size 16x16 --crack-orbit 4 -o x.png",
                      "crack_orbit");
   expect_input_error("render --scene quad2 --size 16x16 --displacement-map d.ptx -o x.png", "displacement_map");
+  expect_input_error("render --scene quad2 --size 16x16 --tessellation-pixels 4 -o x.png", "tessellation_pixels");
 }
 
 TEST_F(Cli, DeviceThatMatchesNoneIsInputError) {

@@ -11,6 +11,7 @@
 #include "pipeline/stages/sample_pattern.h"
 #include "pipeline/stages/triangle_setup_twin.h"
 #include "pipeline/stages/tessellate_launcher.h"
+#include "pipeline/tessellation_factors.h"
 #include "scene/displacement_map.h"
 
 namespace seamcl {
@@ -88,6 +89,13 @@ std::vector<GridPoint> copies_of(const PackedDisplacement& packed, int p, int i,
   return out;
 }
 
+// Adaptive tessellation splits cells (T-1, 0) and (0, T-1) on their other diagonal
+// (kernels/tessellate.cl, tessellated_setup).
+bool cell_is_flipped(const PackedDisplacement& packed, int ci, int cj) {
+  const int t = packed.params.tessellation;
+  return packed.adaptive() && t >= 2 && ((ci == t - 1 && cj == 0) || (ci == 0 && cj == t - 1));
+}
+
 double median(std::vector<double> values) {
   if (values.empty()) return 0.0;
   std::sort(values.begin(), values.end());
@@ -158,12 +166,16 @@ std::array<float, 3> displaced_normal(const PackedDisplacement& packed, const st
   float nx = 0.0f, ny = 0.0f, nz = 0.0f;
   for (const GridPoint& copy : copies_of(packed, patch, i, j)) {
     // Each cell of the copy's patch around the point, both triangles as the tessellator splits
-    // them, (00, 10, 11) and (00, 11, 01), in one order.
+    // them, (00, 10, 11) and (00, 11, 01), in one order (adaptive: the two flipped corner cells
+    // (00, 10, 01) and (10, 11, 01)). Adaptive slots that share a point make degenerate
+    // triangles, whose cross products are exactly 0.
     for (int cj = copy.j - 1; cj <= copy.j; ++cj) {
       for (int ci = copy.i - 1; ci <= copy.i; ++ci) {
         if (ci < 0 || cj < 0 || ci >= t || cj >= t) continue;
-        const int corners[2][3][2] = {{{0, 0}, {1, 0}, {1, 1}}, {{0, 0}, {1, 1}, {0, 1}}};
-        for (const auto& triangle : corners) {
+        const bool flip = cell_is_flipped(packed, ci, cj);
+        const int plain[2][3][2] = {{{0, 0}, {1, 0}, {1, 1}}, {{0, 0}, {1, 1}, {0, 1}}};
+        const int flipped[2][3][2] = {{{0, 0}, {1, 0}, {0, 1}}, {{1, 0}, {1, 1}, {0, 1}}};
+        for (const auto& triangle : flip ? flipped : plain) {
           const TessVertex* v[3];
           bool touches = false;
           for (int k = 0; k < 3; ++k) {
@@ -204,7 +216,8 @@ bool is_closed_mesh(const Scene& scene) {
   return true;
 }
 
-Scene with_back_faces_flagged(const Scene& scene, const std::vector<TessVertex>& vertices, int tessellation) {
+Scene with_back_faces_flagged(const Scene& scene, const std::vector<TessVertex>& vertices, int tessellation,
+                              bool adaptive) {
   const auto t = static_cast<size_t>(tessellation);
   const size_t per_patch = (t + 1) * (t + 1);
   if (tessellation < 1 || vertices.size() % per_patch != 0) {
@@ -241,9 +254,19 @@ Scene with_back_faces_flagged(const Scene& scene, const std::vector<TessVertex>&
           };
           // The tessellator splits a cell (00, 10, 11) + (00, 11, 01); a face (a, b, c, d)
           // renders as (a, b, c) + (a, c, d): the same triangles from corner 00. The reverse,
-          // (00, 01, 11, 10), keeps that diagonal and turns both triangles over.
-          const std::array<uint32_t, 4> quad = pass == 0 ? std::array<uint32_t, 4>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)}
-                                                         : std::array<uint32_t, 4>{at(0, 0), at(0, 1), at(1, 1), at(1, 0)};
+          // (00, 01, 11, 10), keeps that diagonal and turns both triangles over. Adaptive, the
+          // cells (T-1, 0) and (0, T-1) split on 10-01: the same from corner 10.
+          const bool flip = adaptive && t >= 2 && ((i == t - 1 && j == 0) || (i == 0 && j == t - 1));
+          // Adaptive slots that share a point can make a cell without area (both its triangles
+          // degenerate, nothing to draw), which a scene may not hold: left out of both passes.
+          const glm::vec3 p0 = out.positions[at(0, 0)], p1 = out.positions[at(1, 0)], p2 = out.positions[at(1, 1)],
+                          p3 = out.positions[at(0, 1)];
+          if (!(glm::length(glm::cross(p2 - p0, p3 - p1)) > 0.0f)) continue;
+          const std::array<uint32_t, 4> quad =
+              flip ? (pass == 0 ? std::array<uint32_t, 4>{at(1, 0), at(1, 1), at(0, 1), at(0, 0)}
+                                : std::array<uint32_t, 4>{at(1, 0), at(0, 0), at(0, 1), at(1, 1)})
+                   : (pass == 0 ? std::array<uint32_t, 4>{at(0, 0), at(1, 0), at(1, 1), at(0, 1)}
+                                : std::array<uint32_t, 4>{at(0, 0), at(0, 1), at(1, 1), at(1, 0)});
           out.faces.push_back({quad, tint});
         }
       }
@@ -252,10 +275,11 @@ Scene with_back_faces_flagged(const Scene& scene, const std::vector<TessVertex>&
   return out;
 }
 
-std::vector<TessVertex> tessellate_displacement(ClRuntime& runtime, const Scene& scene, const RenderOptions& options) {
+std::vector<TessVertex> tessellate_displacement(ClRuntime& runtime, const Scene& scene, const RenderOptions& options,
+                                                const Camera* camera) {
   if (!options.displacement) throw InputError("displacement_method", "is needed to tessellate a displaced surface");
   TessellateLauncher stage(runtime);
-  stage.load(pack_displacement(scene, {*options.displacement, options.tessellation, options.displacement_level}));
+  stage.load(pack_displacement(scene, displacement_settings(scene, options, camera ? *camera : scene.camera)));
   std::vector<TessVertex> vertices = stage.tessellate();
   stage.release();
   return vertices;
@@ -396,6 +420,9 @@ nlohmann::json DisplacementReport::to_json() const {
                         {"samples", samples},
                         {"vertices", vertices},
                         {"triangles", triangles},
+                        {"surface_triangles", surface_triangles},
+                        {"slots", slots},
+                        {"tessellation_pixels", tessellation_pixels ? nlohmann::json(*tessellation_pixels) : nlohmann::json(nullptr)},
                         {"extra_bytes", extra_bytes},
                         {"matched_samples", matched_samples},
                         {"unmatched_edges", unmatched_edges},
@@ -418,11 +445,14 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   if (orbit_frames > 0 && !scene.orbit) {
     throw InputError("crack_orbit", "scene '" + scene.name + "' has no orbit to count crack pixels over");
   }
-  const DisplacementSettings settings{*options.displacement, options.tessellation, options.displacement_level};
+  // Screen-space factors from `camera`, kept for every orbit frame: the crack renders draw one
+  // tessellation, mixed factors included.
+  const DisplacementSettings settings = displacement_settings(scene, options, camera);
   DisplacementReport report;
   report.method = to_string(settings.method);
   report.tessellation = settings.tessellation;
   report.level = settings.level;
+  report.tessellation_pixels = options.tessellation_pixels;
 
   // 1. The gap, from the device's own tessellation (whose vertices the crack renders draw).
   PackedDisplacement packed = pack_displacement(scene, settings);
@@ -430,6 +460,9 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   report.matched_samples = packed.matched_samples;
   report.unmatched_edges = packed.unmatched_edges;
   report.triangles = packed.triangle_count();
+  report.surface_triangles = packed.surface_triangle_count();
+  report.slots = packed.params.tessellation;
+  const bool adaptive = packed.adaptive();
   TessellateLauncher stage(runtime);
   stage.load(std::move(packed));
   std::vector<TessVertex> vertices = stage.tessellate();
@@ -467,11 +500,11 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   // 3. Crack pixels, on a closed mesh with its back faces flagged. The tessellation does not
   //    depend on the camera, so one copy of the displaced surface serves every frame.
   if (is_closed_mesh(scene)) {
-    const size_t first_flag_face = scene.faces.size() * static_cast<size_t>(settings.tessellation) * settings.tessellation;
     const RenderOptions crack_options = crack_render_options(options);
     Renderer renderer(runtime);
     renderer.set_device_byte_limit(device_byte_limit);
-    const Scene flagged = with_back_faces_flagged(scene, vertices, settings.tessellation);
+    const Scene flagged = with_back_faces_flagged(scene, vertices, report.slots, adaptive);
+    const size_t first_flag_face = flagged.faces.size() / 2;
     vertices = {};
     renderer.load_scene(flagged, crack_options.texels);
     size_t cracks = 0;

@@ -59,17 +59,23 @@ bool is_closed_mesh(const Scene& scene);
 // faces drawn as the flag. Along a ray from outside, the nearest surface of a closed watertight
 // mesh is a front face whatever its shape (the ray must enter the solid before it can see its
 // inside), so a sample whose winner is a flag face looks through a crack. No centre or inside
-// point is assumed. Faces [0, patches * T^2) are the surface. Front faces are tinted per patch
+// point is assumed. The first half of the faces are the surface (patches * T^2 of them, fewer
+// when adaptive slots leave cells without area, which are left out of both halves). Front faces are tinted per patch
 // (the patches' borders show in an image); no displacement, albedo or environment is kept.
 // A back face can also win a sample without a crack, where the displaced surface intersects
 // itself or a fold's back face meets a front face on a silhouette edge (equal depths there,
 // decided by the 1/w planes' rounding): count_crack_pixels tells those apart.
-Scene with_back_faces_flagged(const Scene& scene, const std::vector<TessVertex>& vertices, int tessellation);
+// `tessellation` is the slot grid's T (PackedDisplacement::params); `adaptive` splits the cells
+// the adaptive tessellator splits the other way (PackedDisplacement::adaptive).
+Scene with_back_faces_flagged(const Scene& scene, const std::vector<TessVertex>& vertices, int tessellation,
+                              bool adaptive = false);
 inline const glm::vec3 kFlagColor{1.0f, 0.0f, 1.0f};
 
 // The device's tessellation of `scene` with options.displacement (required), T and level: the
-// vertices every render of those options displaces to (patch-major, (T+1)^2 a patch).
-std::vector<TessVertex> tessellate_displacement(ClRuntime& runtime, const Scene& scene, const RenderOptions& options);
+// vertices every render of those options displaces to (patch-major, (T+1)^2 a patch). With
+// options.tessellation_pixels, the screen-space factors of `camera` (null: the scene's camera).
+std::vector<TessVertex> tessellate_displacement(ClRuntime& runtime, const Scene& scene, const RenderOptions& options,
+                                                const Camera* camera = nullptr);
 
 // The options of the crack renders of `options`: its size and samples (the coverage counted),
 // no displacement (the scene is already displaced), and the plainest colour lookup, which reads
@@ -101,7 +107,10 @@ struct DisplacementReport {
   int crack_frames = 0;
   size_t samples = 0;          // displacement samples per frame (all vertices)
   size_t vertices = 0;
-  size_t triangles = 0;
+  size_t triangles = 0;          // micro-triangles set up: patches * 2 * slots^2
+  size_t surface_triangles = 0;  // of those, not degenerate (fewer with adaptive factors)
+  int slots = 0;                 // the slot grid's T: tessellation, or adaptive the largest factor
+  std::optional<float> tessellation_pixels;  // adaptive: the target; empty: uniform
   size_t extra_bytes = 0;      // the method's per-patch data (PackedDisplacement::method_bytes)
   size_t matched_samples = 0;  // fixed: samples its edge matching changed
   size_t unmatched_edges = 0;

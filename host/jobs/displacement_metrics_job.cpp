@@ -9,6 +9,8 @@
 #include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
+#include "pipeline/displacement_packing.h"
+#include "pipeline/tessellation_factors.h"
 
 namespace seamcl {
 namespace {
@@ -57,7 +59,10 @@ const OptionTable& displacement_metrics_option_table() {
     repeat.minimum = 1;
     repeat.maximum = 100;
     repeat.default_value = 5;
-    return OptionTable{scene, methods, levels, level, size, msaa, frames, repeat};
+    OptionSpec pixels = *find_option(render_option_table(), "tessellation_pixels");
+    pixels.help = "Screen-space adaptive factors from the scene's camera, this many pixels a segment, each T the "
+                  "largest factor; absent: uniform";
+    return OptionTable{scene, methods, levels, level, size, msaa, frames, repeat, pixels};
   }();
   return table;
 }
@@ -75,11 +80,13 @@ DisplacementMetricsJob::DisplacementMetricsJob(const json& request) {
   for (const json& t : value_of("tessellation")) levels_.push_back(t.get<int>());
   frames_ = value_of("frames").get<int>();
   repeat_ = value_of("repeat").get<int>();
-  frame_ = parse_render_options({{"scene", value_of("scene")},
-                                 {"size", value_of("size")},
-                                 {"msaa", value_of("msaa")},
-                                 {"displacement_method", to_string(methods_.front())},
-                                 {"displacement_level", value_of("level")}});
+  json frame = {{"scene", value_of("scene")},
+                {"size", value_of("size")},
+                {"msaa", value_of("msaa")},
+                {"displacement_method", to_string(methods_.front())},
+                {"displacement_level", value_of("level")}};
+  if (request.contains("tessellation_pixels")) frame["tessellation_pixels"] = value_of("tessellation_pixels");
+  frame_ = parse_render_options(frame);
 }
 
 JobPlan DisplacementMetricsJob::plan(const Scene& scene) const {
@@ -128,7 +135,9 @@ json DisplacementMetricsJob::run(ClRuntime& runtime, const Scene& scene, const J
         RenderResult image;
         if (closed) {
           const RenderOptions crack_options = crack_render_options(options);
-          renderer.load_scene(with_back_faces_flagged(scene, tessellate_displacement(runtime, scene, options), t),
+          const PackedDisplacement packed = pack_displacement(scene, displacement_settings(scene, options, scene.camera));
+          renderer.load_scene(with_back_faces_flagged(scene, tessellate_displacement(runtime, scene, options),
+                                                      packed.params.tessellation, packed.adaptive()),
                               crack_options.texels);
           image = renderer.render(camera, crack_options);
         } else {
@@ -147,6 +156,7 @@ json DisplacementMetricsJob::run(ClRuntime& runtime, const Scene& scene, const J
           {"size", std::to_string(frame_.width) + "x" + std::to_string(frame_.height)},
           {"msaa", frame_.msaa},
           {"level", frame_.displacement_level},
+          {"tessellation_pixels", frame_.tessellation_pixels ? json(*frame_.tessellation_pixels) : json()},
           {"crack_frames", closed ? frames_ : 0},
           {"closed_mesh", closed},
           {"repeat", repeat_},

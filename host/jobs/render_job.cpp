@@ -10,6 +10,7 @@
 #include "io/mesh_export.h"
 #include "pipeline/displacement_packing.h"
 #include "pipeline/stages/tessellate_launcher.h"
+#include "pipeline/tessellation_factors.h"
 
 namespace seamcl {
 namespace {
@@ -136,10 +137,11 @@ RenderRun RenderJob::run(ClRuntime& runtime, Renderer& renderer, const Scene& sc
     throw_if_stopped(control.should_stop, "before the mesh export");
     control.report("export_mesh: " + export_mesh_);
     TessellateLauncher stage(runtime);
-    stage.load(pack_displacement(scene, {*options_.displacement, options_.tessellation, options_.displacement_level}));
+    stage.load(pack_displacement(scene, displacement_settings(scene, options_, view)));
     const std::vector<TessVertex> vertices = stage.tessellate();
+    const int slots = stage.packed().params.tessellation;
     stage.release();
-    write_patch_mesh(export_mesh_, vertices, options_.tessellation, "export_mesh");
+    write_patch_mesh(export_mesh_, vertices, slots, "export_mesh");
   }
   return run;
 }

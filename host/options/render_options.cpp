@@ -189,6 +189,13 @@ const std::vector<RenderField>& render_fields() {
                                   "Added to every texture lookup's mip level (positive: blurrier)");
     lod_bias.minimum = -kMaxLodBias;
     lod_bias.maximum = kMaxLodBias;
+    OptionSpec tessellation_pixels = absent_means(
+        of_type("tessellation_pixels", OptionType::Number,
+                "Displacement: screen-space adaptive factors, each patch edge's from its projected length "
+                "over this many pixels a segment, clamped to 1..tessellation"),
+        "uniform: every edge at tessellation");
+    tessellation_pixels.minimum = kMinTessellationPixels;
+    tessellation_pixels.maximum = kMaxTessellationPixels;
     auto displaced_only = [](json value) {
       return [value](const RenderOptions& o) { return o.displacement ? value : json(); };
     };
@@ -260,6 +267,10 @@ const std::vector<RenderField>& render_fields() {
          [](const RenderOptions& o) { return o.displacement ? json(to_string(*o.displacement)) : json(); }, kDisplacementDomain},
         {integer("tessellation", 1, SEAMCL_MAX_TESSELLATION, "Displacement: each patch a (T+1)^2 grid"),
          [](RenderOptions& o, const json& v) { o.tessellation = v.get<int>(); }, displaced_only(json()), kDisplacementDomain},
+        {tessellation_pixels,
+         [](RenderOptions& o, const json& v) { o.tessellation_pixels = v.get<float>(); },
+         [](const RenderOptions& o) { return o.displacement && o.tessellation_pixels ? json(*o.tessellation_pixels) : json(); },
+         kDisplacementDomain},
         {integer("displacement_level", 0, kMaxDisplacementLevel, "Displacement: the maps' level every patch samples"),
          [](RenderOptions& o, const json& v) { o.displacement_level = v.get<int>(); }, displaced_only(json()), kDisplacementDomain},
     };
@@ -333,6 +344,9 @@ RenderOptions parse_render_options(const nlohmann::json& request) {
   }
   if (!options.displacement_map.empty() && !options.displacement) {
     throw InputError("displacement_map", "displaces only a render with displacement_method");
+  }
+  if (options.tessellation_pixels && !options.displacement) {
+    throw InputError("tessellation_pixels", "tessellates only a render with displacement_method");
   }
   if (options.frame && *options.frame >= options.frames) {
     throw InputError("frame", "must be less than frames (" + std::to_string(options.frames) + "), got " +

@@ -87,6 +87,8 @@ std::vector<std::string> cube_method_names();
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr long long kMaxSamplesPerImage = 1LL << 28;  // width * height * msaa
 inline constexpr int kMaxDisplacementLevel = 16;              // displacement_level's bound
+inline constexpr double kMinTessellationPixels = 0.25;        // tessellation_pixels' bounds
+inline constexpr double kMaxTessellationPixels = 4096.0;
 inline constexpr int kMaxFrames = 1000000;                    // frames' bound (an orbit of 1..kMaxFrames)
 inline constexpr int kMaxBandTexels = 16;                     // guard_band's bound (kMaxGuardBand of packing)
 inline constexpr float kMaxLodBias = 4.0f;                    // lod_bias's bound, either sign
@@ -116,6 +118,9 @@ struct RenderOptions {
   std::optional<DisplacementMethod> displacement;
   int tessellation = 8;         // T, 1..64
   int displacement_level = 0;   // the maps' level sampled, 0..16
+  // Absent: uniform, every edge at T. Given: screen-space adaptive factors, each patch edge's
+  // from its projected length over this many pixels a segment, clamped to 1..T.
+  std::optional<float> tessellation_pixels;
   float lod_bias = 0.0f;        // added to every lookup's mip level (-kMaxLodBias..kMaxLodBias)
 };
 

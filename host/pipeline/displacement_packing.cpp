@@ -136,6 +136,51 @@ size_t PackedDisplacement::triangle_count() const {
   return patches.size() * 2 * t * t;
 }
 
+size_t PackedDisplacement::surface_triangle_count() const {
+  if (!adaptive()) return triangle_count();
+  const int t = params.tessellation;
+  const auto step = [t](int k, int f) { return (2 * k * f + t) / (2 * t); };
+  size_t count = 0;
+  for (const DisplacementPatch& p : patches) {
+    // Every slot's domain point as the kernel makes it, in units of 2^-40: two steps m / f and
+    // m' / f' (f, f' <= 64) that differ, differ by at least 2^-12, so floor keeps them apart.
+    const auto point = [&](int i, int j) -> std::array<int64_t, 2> {
+      const int64_t one = int64_t{1} << 40;
+      const bool corner = (i == 0 || i == t) && (j == 0 || j == t);
+      if (corner) return {i == 0 ? 0 : one, j == 0 ? 0 : one};
+      int e = -1, k = 0;
+      if (j == 0) { e = 0; k = i; }
+      else if (i == t) { e = 1; k = j; }
+      else if (j == t) { e = 2; k = t - i; }
+      else if (i == 0) { e = 3; k = t - j; }
+      if (e >= 0) {
+        const int f = p.edge_factor[e];
+        const bool lower_first = p.vertex[e] < p.vertex[(e + 1) % 4];
+        const int m = step(lower_first ? k : t - k, f);
+        const int64_t at = lower_first ? one * m / f : one - one * m / f;  // from corner e
+        switch (e) {
+          case 0: return {at, 0};
+          case 1: return {one, at};
+          case 2: return {one - at, one};
+          default: return {0, one - at};
+        }
+      }
+      const int f = p.inner_factor;
+      return {one * std::clamp(step(i, f), 1, f - 1) / f, one * std::clamp(step(j, f), 1, f - 1) / f};
+    };
+    for (int j = 0; j < t; ++j) {
+      for (int i = 0; i < t; ++i) {
+        const bool flip = t >= 2 && ((i == t - 1 && j == 0) || (i == 0 && j == t - 1));
+        const auto a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1), d = point(i, j + 1);
+        const std::array<std::array<int64_t, 2>, 3> tris[2] = {flip ? std::array{a, b, d} : std::array{a, b, c},
+                                                               flip ? std::array{b, c, d} : std::array{a, c, d}};
+        for (const auto& tri : tris) count += tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2];
+      }
+    }
+  }
+  return count;
+}
+
 size_t PackedDisplacement::method_bytes() const {
   switch (params.method) {
     case SEAMCL_DISPLACEMENT_ZIPPER:
@@ -175,8 +220,40 @@ PackedDisplacement pack_displacement(const Scene& scene, const DisplacementSetti
   const Displacement& source = *scene.displacement;
   validate_displacement(source, scene.faces.size());
 
+  // Adaptive: the factors checked, the slot grid sized by the largest.
+  int slots = settings.tessellation;
+  if (!settings.edge_factors.empty()) {
+    if (settings.edge_factors.size() != scene.faces.size()) {
+      throw InputError("tessellation_factors", "needs one set of 4 edge factors per face (" +
+                                                   std::to_string(scene.faces.size()) + "), got " +
+                                                   std::to_string(settings.edge_factors.size()));
+    }
+    std::map<std::pair<uint32_t, uint32_t>, int> by_edge;
+    slots = 1;
+    for (size_t f = 0; f < scene.faces.size(); ++f) {
+      for (int k = 0; k < 4; ++k) {
+        const int factor = settings.edge_factors[f][static_cast<size_t>(k)];
+        if (factor < 1 || factor > settings.tessellation) {
+          throw InputError("tessellation_factors", "face " + std::to_string(f) + " edge " + std::to_string(k) + ": " +
+                                                       std::to_string(factor) + " is outside 1.." +
+                                                       std::to_string(settings.tessellation));
+        }
+        const uint32_t a = scene.faces[f].vertices[k], b = scene.faces[f].vertices[(k + 1) % 4];
+        const auto [it, inserted] = by_edge.emplace(std::make_pair(std::min(a, b), std::max(a, b)), factor);
+        if (!inserted && it->second != factor) {
+          throw InputError("tessellation_factors", "face " + std::to_string(f) + " edge " + std::to_string(k) +
+                                                       " has factor " + std::to_string(factor) +
+                                                       ", its other face " + std::to_string(it->second) +
+                                                       ": an edge's factor must be the same on both sides");
+        }
+        slots = std::max(slots, factor);
+      }
+    }
+    check_tessellation(scene.faces.size(), slots);
+  }
+
   PackedDisplacement out;
-  out.params.tessellation = settings.tessellation;
+  out.params.tessellation = slots;
   out.params.method = displacement_method_code(settings.method);
   out.params.patches = static_cast<cl_int>(scene.faces.size());
   out.params.scale = source.scale;
@@ -210,6 +287,17 @@ PackedDisplacement pack_displacement(const Scene& scene, const DisplacementSetti
     p.columns = maps[f].columns;
     p.rows = maps[f].rows;
     out.samples.insert(out.samples.end(), maps[f].samples.begin(), maps[f].samples.end());
+    p.inner_factor = 0;
+    for (int k = 0; k < 4; ++k) p.edge_factor[k] = slots;
+    if (!settings.edge_factors.empty()) {
+      int inner = 1;
+      for (int k = 0; k < 4; ++k) {
+        p.edge_factor[k] = settings.edge_factors[f][static_cast<size_t>(k)];
+        inner = std::max(inner, p.edge_factor[k]);
+      }
+      // With interior slots (N >= 2) the inner grid needs a point strictly inside.
+      p.inner_factor = slots >= 2 ? std::max(inner, 2) : 1;
+    }
     for (int k = 0; k < 4; ++k) {
       p.vertex[k] = face.vertices[k];
       p.neighbor[k] = -1;

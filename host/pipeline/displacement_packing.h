@@ -2,6 +2,7 @@
 // DisplacementPatch per face, every map's samples in one buffer, a normal per mesh vertex, and
 // the per-method data the seam rules need (neighbours, corner values, owners' texcoords).
 #pragma once
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -12,7 +13,8 @@
 #include "scene/displacement_map.h"
 
 static_assert(sizeof(DisplacementTexcoord) == 12, "DisplacementTexcoord layout");
-static_assert(sizeof(DisplacementPatch) == 288, "DisplacementPatch layout");
+static_assert(sizeof(DisplacementPatch) == 304, "DisplacementPatch layout");
+static_assert(offsetof(DisplacementPatch, edge_factor) == 288);
 static_assert(offsetof(DisplacementPatch, corner_value) == 64);
 static_assert(offsetof(DisplacementPatch, texcoord) == 80);
 static_assert(offsetof(DisplacementPatch, map_offset) == 272);
@@ -23,8 +25,19 @@ namespace seamcl {
 
 struct DisplacementSettings {
   DisplacementMethod method = DisplacementMethod::Naive;
-  int tessellation = 8;  // T, 1..SEAMCL_MAX_TESSELLATION
+  int tessellation = 8;  // T, 1..SEAMCL_MAX_TESSELLATION; with edge_factors, the largest allowed
   int level = 0;         // the maps' level every patch samples (explicit, no lod selection)
+  // Empty: uniform, every edge and inside at T. Else one factor per face edge (edge k from corner
+  // k), 1..T, equal on both faces of a shared edge (host/pipeline/tessellation_factors.h makes
+  // them from an edge's screen length); the packing then makes every patch's (N+1)^2 slot grid
+  // with N the largest factor given and the inside at the largest of the patch's edges (at least
+  // 2 when N >= 2).
+  std::vector<std::array<int, 4>> edge_factors;
+
+  bool operator==(const DisplacementSettings& o) const {
+    return method == o.method && tessellation == o.tessellation && level == o.level && edge_factors == o.edge_factors;
+  }
+  bool operator!=(const DisplacementSettings& o) const { return !(*this == o); }
 };
 
 // Micro-triangles one render may make (patches * 2 * T^2): with SEAMCL_CLIP_SLOTS setups of 112
@@ -46,13 +59,18 @@ struct PackedDisplacement {
 
   size_t vertex_count() const;    // patches * (T+1)^2
   size_t triangle_count() const;  // patches * 2 * T^2
+  bool adaptive() const { return !patches.empty() && patches.front().inner_factor > 0; }
+  // Micro-triangles whose three slots are three different domain points: triangle_count() when
+  // uniform, fewer when adaptive (the rest are degenerate, culled by setup).
+  size_t surface_triangle_count() const;
   // Bytes the method adds to a patch's plain data (corners, map offset and size): zipper's
   // neighbours and corner values, ownership's 16 texcoords, none for naive and fixed.
   size_t method_bytes() const;
 };
 
 // Throws InputError naming the field: "tessellation" outside 1..64 or over
-// kMaxTessellatedTriangles, "displacement_level" outside 0..16, "displacement" when the scene has
+// kMaxTessellatedTriangles, "tessellation_factors" for edge factors that are not one per face
+// edge in 1..T or differ between the two faces of an edge, "displacement_level" outside 0..16, "displacement" when the scene has
 // no maps or they do not fit it (validate_displacement).
 PackedDisplacement pack_displacement(const Scene& scene, const DisplacementSettings& settings);
 

@@ -18,6 +18,7 @@
 #include "pipeline/stages/stage_buffers.h"
 #include "pipeline/stages/tessellate_launcher.h"
 #include "pipeline/stages/triangle_setup_launcher.h"
+#include "pipeline/tessellation_factors.h"
 #include <seamcl/pipeline/packed_cube.h>
 #include <seamcl/pipeline/stage_stop.h>
 
@@ -348,9 +349,10 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   throw_if_stage_stopped("the frame");
   impl_->displaced = options.displacement.has_value();
   if (impl_->displaced) {
-    const DisplacementSettings settings{*options.displacement, options.tessellation, options.displacement_level};
+    // Screen-space factors follow the camera: a frame whose factors differ loads them anew.
+    DisplacementSettings settings = displacement_settings(*impl_->scene, options, camera);
     const auto& held = impl_->tessellation_settings;
-    if (!held || held->method != settings.method || held->tessellation != settings.tessellation || held->level != settings.level) {
+    if (!held || *held != settings) {
       impl_->tessellation.load(pack_displacement(*impl_->scene, settings));
       impl_->tessellation_settings = settings;
     }
@@ -496,7 +498,8 @@ std::vector<TriangleSetup> Renderer::read_setups() {
   // (2 T^2 each).
   const size_t triangles_per_face =
       impl_->displaced && impl_->tessellation_settings
-          ? 2 * static_cast<size_t>(impl_->tessellation_settings->tessellation) * impl_->tessellation_settings->tessellation
+          ? 2 * static_cast<size_t>(impl_->tessellation.packed().params.tessellation) *
+                static_cast<size_t>(impl_->tessellation.packed().params.tessellation)
           : 2;
   return impl_->setup.read_setups(static_cast<size_t>(impl_->last_params.input_triangles), triangles_per_face);
 }

@@ -69,6 +69,7 @@ def render(
     cube_method: Literal['cube-clamp', 'cube-seamless', 'cube-stretch', 'cube-warp', 'cube-fixup', 'cube-discard', 'cube-fixup-level', 'cube-fov', 'cube-average', 'cube-border'] = ...,  # Cube-map seam method of scenes with an environment (envmap)
     displacement_method: Optional[Literal['naive', 'zipper', 'ownership', 'fixed', 'ptex-filter']] = ...,  # Tessellate every patch and displace it by the scene's maps with this seam method
     tessellation: int = ...,  # Displacement: each patch a (T+1)^2 grid
+    tessellation_pixels: Optional[float] = ...,  # Displacement: screen-space adaptive factors, each patch edge's from its projected length over this many pixels a segment, clamped to 1..tessellation
     displacement_level: int = ...,  # Displacement: the maps' level every patch samples
     repeat: int = ...,  # Render N times and report the median time per stage
     crack_orbit: int = ...,  # Displacement: count crack pixels over N frames of the scene's orbit instead of this frame
@@ -97,6 +98,7 @@ def compare(
     cube_method: Literal['cube-clamp', 'cube-seamless', 'cube-stretch', 'cube-warp', 'cube-fixup', 'cube-discard', 'cube-fixup-level', 'cube-fov', 'cube-average', 'cube-border'] = ...,  # Cube-map seam method of scenes with an environment (envmap)
     displacement_method: Optional[Literal['naive', 'zipper', 'ownership', 'fixed', 'ptex-filter']] = ...,  # Tessellate every patch and displace it by the scene's maps with this seam method
     tessellation: int = ...,  # Displacement: each patch a (T+1)^2 grid
+    tessellation_pixels: Optional[float] = ...,  # Displacement: screen-space adaptive factors, each patch edge's from its projected length over this many pixels a segment, clamped to 1..tessellation
     displacement_level: int = ...,  # Displacement: the maps' level every patch samples
     methods: Union[Sequence[Literal['clamp', 'black', 'discard', 'traverse', 'traverse-edges', 'guardband']], str] = ...,  # Comma list of seam methods
     msaa: Union[Sequence[Literal[1, 2, 4, 8, 16]], Literal[1, 2, 4, 8, 16], str] = ...,  # Comma list of MSAA rates

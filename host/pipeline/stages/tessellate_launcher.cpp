@@ -72,6 +72,7 @@ void TessellateLauncher::enqueue(const cl::Buffer& frame_params, const cl::Buffe
   k.setup.setArg(3, setups);
   k.setup.setArg(4, slot_counts);
   k.setup.setArg(5, stats);
+  k.setup.setArg(6, static_cast<cl_int>(packed_.adaptive() ? 1 : 0));
   const size_t setup_items = (static_cast<size_t>(input_triangles) + SEAMCL_SETUP_LANES - 1) / SEAMCL_SETUP_LANES;
   runtime_.queue().enqueueNDRangeKernel(k.setup, cl::NullRange, cl::NDRange(round_up(setup_items, SEAMCL_SETUP_GROUP)),
                                         cl::NDRange(SEAMCL_SETUP_GROUP), nullptr, &setup_events.emplace_back());

@@ -1,5 +1,6 @@
 #include "pipeline/stages/tessellate_twin.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -65,6 +66,28 @@ void edge_uv(int e, int64_t s, int64_t* u, int64_t* v) {
   }
 }
 
+// Adaptive factors: slot k of T slots at factor f (1..T) is step k * f / T rounded half up.
+int step_of_slot(int k, int f, int t) { return (2 * k * f + t) / (2 * t); }
+
+// Adaptive: a slot on edge e whose step is 0 or the edge's factor is that corner's slot.
+void collapse_to_corner(const DisplacementPatch& p, int t, int* i, int* j) {
+  if ((*i == 0 || *i == t) && (*j == 0 || *j == t)) return;
+  int e = -1, step = 0;
+  if (*j == 0) { e = 0; step = *i; }
+  else if (*i == t) { e = 1; step = *j; }
+  else if (*j == t) { e = 2; step = t - *i; }
+  else if (*i == 0) { e = 3; step = t - *j; }
+  if (e < 0) return;
+  const int f = p.edge_factor[e];
+  const bool lower_first = p.vertex[e] < p.vertex[(e + 1) % 4];
+  const int m = step_of_slot(lower_first ? step : t - step, f, t);
+  const int from_e = lower_first ? m : f - m;
+  if (from_e != 0 && from_e != f) return;
+  const int c = from_e == 0 ? e : (e + 1) % 4;
+  *i = (c == 1 || c == 2) ? t : 0;
+  *j = c >= 2 ? t : 0;
+}
+
 // ptex-filter: a 3x3 tent (weights 1/4, 1/2, 1/4 per axis) of taps one own sample spacing apart;
 // a tap past edge e reads the neighbour at the same distance past its side of the edge; taps past
 // a corner or a boundary are dropped; the sum is renormalised.
@@ -115,7 +138,9 @@ TessVertex tessellate_vertex_reference(const PackedDisplacement& d, int patch, i
   const DisplacementPatch& p = d.patches[static_cast<size_t>(patch)];
   const int t = params.tessellation;
   const bool naive = params.method == SEAMCL_DISPLACEMENT_NAIVE;
+  const bool adaptive = p.inner_factor > 0;
   // 1. The domain point. Which edge (if any) the vertex lies on, and its step from corner e.
+  if (adaptive) collapse_to_corner(p, t, &i, &j);
   int edge = -1, step = 0;
   const bool corner = (i == 0 || i == t) && (j == 0 || j == t);
   if (!corner) {
@@ -125,15 +150,34 @@ TessVertex tessellate_vertex_reference(const PackedDisplacement& d, int patch, i
     else if (i == 0) { edge = 3; step = t - j; }
   }
   int64_t uf = int64_t{i} * kOne / t, vf = int64_t{j} * kOne / t;
+  float naive_u = static_cast<float>(i) / static_cast<float>(t), naive_v = static_cast<float>(j) / static_cast<float>(t);
   int64_t s = 0;  // on an edge: the fixed-point parameter from corner `edge`
   if (edge >= 0) {
     // Computed from the edge's end with the lower vertex index and mirrored at the other, so the
     // two patches sharing the edge produce the same points.
-    s = p.vertex[edge] < p.vertex[(edge + 1) % 4] ? int64_t{step} * kOne / t : kOne - int64_t{t - step} * kOne / t;
+    const bool lower_first = p.vertex[edge] < p.vertex[(edge + 1) % 4];
+    if (adaptive) {
+      const int f = p.edge_factor[edge];
+      const int m = step_of_slot(lower_first ? step : t - step, f, t);
+      s = lower_first ? int64_t{m} * kOne / f : kOne - int64_t{m} * kOne / f;
+      const float ns = static_cast<float>(lower_first ? m : f - m) / static_cast<float>(f);
+      naive_u = edge == 0 ? ns : edge == 1 ? 1.0f : edge == 2 ? 1.0f - ns : 0.0f;
+      naive_v = edge == 0 ? 0.0f : edge == 1 ? ns : edge == 2 ? 1.0f : 1.0f - ns;
+    } else {
+      s = lower_first ? int64_t{step} * kOne / t : kOne - int64_t{t - step} * kOne / t;
+    }
     edge_uv(edge, s, &uf, &vf);
+  } else if (adaptive && !corner) {
+    // The inner grid at the inside's factor, one step in from every edge.
+    const int f = p.inner_factor;
+    const int a = std::clamp(step_of_slot(i, f, t), 1, f - 1), b = std::clamp(step_of_slot(j, f, t), 1, f - 1);
+    uf = int64_t{a} * kOne / f;
+    vf = int64_t{b} * kOne / f;
+    naive_u = static_cast<float>(a) / static_cast<float>(f);
+    naive_v = static_cast<float>(b) / static_cast<float>(f);
   }
-  const float u = naive ? static_cast<float>(i) / static_cast<float>(t) : static_cast<float>(uf) * kInvOne;
-  const float v = naive ? static_cast<float>(j) / static_cast<float>(t) : static_cast<float>(vf) * kInvOne;
+  const float u = naive ? naive_u : static_cast<float>(uf) * kInvOne;
+  const float v = naive ? naive_v : static_cast<float>(vf) * kInvOne;
 
   // 2. The base surface: bilinear in the corners, positions and vertex normals.
   const float w[4] = {(1.0f - u) * (1.0f - v), u * (1.0f - v), u * v, (1.0f - u) * v};

@@ -1,0 +1,20 @@
+// Closed displaced meshes that are not star-shaped, shared by the crack and adaptive
+// tessellation tests: a torus made here and the Ptex cube with tunnels.
+#pragma once
+#include <string>
+
+#include <seamcl/scene/scene.h>
+
+namespace seamcl_tests {
+
+inline const std::string kPtexAssets = std::string(SEAMCL_TEST_ASSETS_DIR) + "/ptex/";
+
+// A torus of rings x sides quads (major radius 1, minor 0.35, axis y), counter-clockwise from
+// outside, with maps of different resolutions baked face by face: the hole makes it
+// non-star-shaped, and neighbours' maps disagree between shared corners, so naive cracks.
+seamcl::Scene make_torus(int rings, int sides);
+
+// tests/assets/ptex/cube.obj (72 quads with tunnels) displaced by cube_text.ptx.
+seamcl::Scene cube_obj();
+
+}  // namespace seamcl_tests
