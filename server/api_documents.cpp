@@ -79,6 +79,8 @@ json make_openapi() {
   json& inspect = schemas.at("InspectRequest").at("properties");
   set_options(inspect, render_option_table(), {});
   set_options(inspect, inspect_job_option_table(), {});
+  json& overlays = schemas.at("OverlaysRequest").at("properties");
+  set_options(overlays, render_option_table(), {});
   json& compare = schemas.at("CompareRequest").at("properties");
   set_options(compare, compare_option_table(), {});
   compare.at("repeat")["maximum"] = limits.max_compare_repeat;

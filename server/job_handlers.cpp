@@ -15,6 +15,7 @@
 #include <seamcl/io/image_encoding.h>
 #include <seamcl/jobs/compare_job.h>
 #include <seamcl/jobs/inspect_job.h>
+#include <seamcl/jobs/overlay_job.h>
 #include <seamcl/jobs/render_job.h>
 #include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
@@ -268,6 +269,27 @@ void JobHandlers::inspect(const json& request, httplib::Response& res) {
   for (const char* key : {"repeat", "crack_orbit", "export_mesh"})
     if (rest.contains(key)) throw HttpError{400, key, "is for renders; an inspection renders one frame"};
   const InspectJob job(rest);
+  json answer;
+  const FrameJobRun times = run_frame_job(
+      start, inline_scene, job.options(), [&](const Scene& scene, size_t held) { return job.plan(scene, held); },
+      [&](Renderer& renderer, const Scene& scene, const JobControl& control) {
+        answer = job.run(renderer, scene, control);
+      });
+  res.set_header("X-Seamcl-Queue-Ms", std::to_string(times.queue_ms));
+  res.set_header("X-Seamcl-Build-Ms", std::to_string(times.build_ms));
+  res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
+  res.set_content(json_text(answer), "application/json");
+}
+
+// POST /v1/overlays: the overlay job (host/jobs/overlay_job.h) on one frame, admitted as a render,
+// answered as its JSON.
+void JobHandlers::overlays(const json& request, httplib::Response& res) {
+  const Clock::time_point start = Clock::now();
+  if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
+  json rest = request;
+  const json inline_scene = take_inline_scene(rest);
+  if (rest.contains("format")) throw HttpError{400, "format", "overlays answer JSON; format is for /v1/render"};
+  const OverlayJob job(rest);
   json answer;
   const FrameJobRun times = run_frame_job(
       start, inline_scene, job.options(), [&](const Scene& scene, size_t held) { return job.plan(scene, held); },

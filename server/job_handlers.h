@@ -1,5 +1,5 @@
 // The routes that run the library's jobs: POST /v1/render (and GET with a query), POST
-// /v1/inspect, POST /v1/compare and POST /v1/reference. Each takes the service's own keys out of the request (the
+// /v1/inspect, POST /v1/overlays, POST /v1/compare and POST /v1/reference. Each takes the service's own keys out of the request (the
 // answer's format, an inline scene), hands the rest to the job (host/jobs/), resolves the scene,
 // holds the request to this server's limits and budgets, runs the job on an admitted render slot
 // and answers what it made.
@@ -43,6 +43,8 @@ class JobHandlers {
   void render(const nlohmann::json& request, httplib::Response& res);
   // POST /v1/inspect: a render request plus the pixel (x, y, window); the inspect job's JSON.
   void inspect(const nlohmann::json& request, httplib::Response& res);
+  // POST /v1/overlays: a render request; the overlay job's JSON (seam mask and face edges).
+  void overlays(const nlohmann::json& request, httplib::Response& res);
   // job_id: empty, or the client's name for this compare, under which GET /v1/progress shows it.
   void compare(const nlohmann::json& request, httplib::Response& res, const std::string& job_id = "");
   void reference(const nlohmann::json& request, httplib::Response& res);

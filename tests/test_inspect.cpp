@@ -10,6 +10,7 @@
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/jobs/inspect_job.h>
+#include <seamcl/jobs/overlay_job.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
 #include "pipeline/stages/shade_inspect_twin.h"
@@ -210,4 +211,55 @@ TEST(InspectJob, RefusesAMissingOrOutsidePixelNamingTheField) {
                           .run(renderer, scene, JobControl{});
   EXPECT_EQ(corner.at("width"), 2);
   EXPECT_EQ(corner.at("height"), 1);
+}
+
+TEST(OverlayJob, LayersAreTheSeamMaskAndTheFaceEdgesOfTheFrame) {
+  const json request = {{"scene", "quad2"}, {"size", "64x48"}, {"msaa", 4}, {"method", "clamp"}};
+  const OverlayJob job(request);
+  const Scene scene = generate_scene("quad2", job.render_job().generator_options());
+  Renderer renderer(shared_runtime());
+  renderer.load_scene(scene);
+  const json answer = job.run(renderer, scene, JobControl{});
+  ASSERT_EQ(answer.at("width"), 64);
+  ASSERT_EQ(answer.at("height"), 48);
+  // The same frame's seam mask and winners, read here.
+  const RenderResult frame = renderer.render(scene.camera, job.options(), true);
+  const std::vector<uint32_t> winners = renderer.read_sample_triangles();
+  const std::vector<TriangleSetup> setups = renderer.read_setups();
+  const std::string text = answer.at("pixels").get<std::string>();
+  ASSERT_EQ(text.size(), (64u * 48u + 2) / 3 * 4);
+  auto digit = [](char c) -> uint32_t {
+    return c >= 'A' && c <= 'Z' ? c - 'A' : c >= 'a' && c <= 'z' ? c - 'a' + 26 : c >= '0' && c <= '9' ? c - '0' + 52 : c == '+' ? 62 : 63;
+  };
+  std::vector<uint8_t> flags;
+  for (size_t i = 0; i < text.size(); i += 4) {
+    const uint32_t n = digit(text[i]) << 18 | digit(text[i + 1]) << 12 | (text[i + 2] == '=' ? 0 : digit(text[i + 2]) << 6) |
+                       (text[i + 3] == '=' ? 0 : digit(text[i + 3]));
+    for (int k = 0; k < 3 && flags.size() < 64u * 48u; ++k) flags.push_back(static_cast<uint8_t>(n >> (16 - 8 * k)));
+  }
+  ASSERT_EQ(flags.size(), 64u * 48u);
+  size_t seam = 0, edges = 0;
+  const int samples = 4;
+  for (size_t p = 0; p < flags.size(); ++p) {
+    EXPECT_EQ((flags[p] & kOverlaySeam) != 0, frame.seam_mask[p] == SEAMCL_MASK_SEAM) << "pixel " << p;
+    EXPECT_EQ((flags[p] & kOverlayBoundary) != 0, frame.seam_mask[p] == SEAMCL_MASK_BOUNDARY) << "pixel " << p;
+    seam += (flags[p] & kOverlaySeam) != 0;
+    // A pixel whose own samples lie on two faces is a face edge.
+    uint32_t first_face = UINT32_MAX;
+    bool two_faces = false;
+    for (int s = 0; s < samples; ++s) {
+      const uint32_t slot = winners[p * samples + s];
+      if (slot == SEAMCL_NO_TRIANGLE) continue;
+      if (first_face == UINT32_MAX) first_face = setups[slot].face;
+      two_faces = two_faces || setups[slot].face != first_face;
+    }
+    if (two_faces) EXPECT_TRUE(flags[p] & kOverlayFaceEdge) << "pixel " << p;
+    edges += (flags[p] & kOverlayFaceEdge) != 0;
+  }
+  EXPECT_EQ(answer.at("counts").at("seam"), seam);
+  EXPECT_EQ(answer.at("counts").at("face_edge"), edges);
+  // quad2's shared edge runs down the frame: a line of face-edge pixels, and seam pixels along it.
+  EXPECT_GE(edges, 20u);
+  EXPECT_GT(seam, 0u);
+  EXPECT_THROW(OverlayJob({{"method", "guardband"}}), InputError);
 }

@@ -30,6 +30,7 @@
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/jobs/inspect_job.h>
+#include <seamcl/jobs/overlay_job.h>
 #include <seamcl/jobs/scene_domains.h>
 #include <seamcl/options/option_domains.h>
 #include <seamcl/memory/compare_memory.h>
@@ -405,7 +406,7 @@ TEST(ServerSchema, OpenApiDocumentsEveryEndpoint) {
   EXPECT_TRUE(doc.at("openapi").get<std::string>().starts_with("3."));
   for (const auto& [path, method] : std::vector<std::pair<std::string, std::string>>{
            {"/", "get"}, {"/health", "get"}, {"/v1/scenes", "get"}, {"/v1/methods", "get"}, {"/v1/render", "get"},
-           {"/v1/render", "post"}, {"/v1/inspect", "post"}, {"/v1/compare", "post"}, {"/v1/progress", "get"}, {"/openapi.json", "get"}}) {
+           {"/v1/render", "post"}, {"/v1/inspect", "post"}, {"/v1/overlays", "post"}, {"/v1/compare", "post"}, {"/v1/progress", "get"}, {"/openapi.json", "get"}}) {
     EXPECT_TRUE(doc.at("paths").contains(path) && doc.at("paths").at(path).contains(method)) << method << " " << path;
   }
   // Every $ref resolves.
@@ -588,6 +589,26 @@ TEST_F(Server, InspectAnswersTheLibrarysRecords) {
     EXPECT_EQ(json::parse(refused->body).value("field", ""), field) << bad.dump();
     expect_documented("post", "/v1/inspect", refused);
   }
+}
+
+// POST /v1/overlays answers the overlay job's JSON, as documented; guardband is a 400 naming method.
+TEST_F(Server, OverlaysAnswerTheLibrarysLayers) {
+  httplib::Client c = client();
+  const json request = {{"scene", "quad2"}, {"size", "64x48"}, {"msaa", 4}};
+  auto res = c.Post("/v1/overlays", request.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  expect_documented("post", "/v1/overlays", res);
+  const OverlayJob job(request);
+  const Scene scene = generate_scene("quad2", job.render_job().generator_options());
+  Renderer renderer(seamcl_tests::shared_runtime());
+  renderer.load_scene(scene);
+  EXPECT_EQ(json::parse(res->body), job.run(renderer, scene, JobControl{}));
+  auto refused = c.Post("/v1/overlays", json{{"scene", "quad2"}, {"method", "guardband"}}.dump(), "application/json");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 400);
+  EXPECT_EQ(json::parse(refused->body).value("field", ""), "method");
+  expect_documented("post", "/v1/overlays", refused);
 }
 
 TEST_F(Server, GetRenderMatchesPostAndTheLibrary) {

@@ -9,7 +9,9 @@ tests/browser/cdp.py) against a live `seamcl serve`:
   of its first covered sample equal the library's for that pixel; a row per sample, and the tap
   list names the edge neighbour;
 - a click on the same pixel of image B (clamp) shows B's record: the same face and uv, the
-  neighbour named with weight 0 (clamp reads none of it).
+  neighbour named with weight 0 (clamp reads none of it);
+- the overlays' checkboxes draw, over A and B, exactly the pixels of the library's layers
+  (POST /v1/overlays: the seam mask, then the face edges too).
 
 Loopback only, bounded in time. Exits 0 on success, 1 on failure.
 
@@ -112,6 +114,33 @@ def run(base, chromium, profile, screenshot, t, deadline):
                 data = page.send("Page.captureScreenshot", {"format": "png", "clip": clip, "captureBeyondViewport": True}, timeout=60)["data"]
                 with open(screenshot, "wb") as f:
                     f.write(base64.b64decode(data))
+        # Overlays: the seam mask, then the face edges too, over A and B, as the library's layers.
+        status, body = get(base + "/v1/overlays", {"scene": "quad2", "size": "%dx%d" % (SIZE, SIZE), "method": "traverse",
+                                                   "msaa": MSAA})
+        t.check(status == 200, "POST /v1/overlays answers", body[:200])
+        layers = json.loads(body)
+        flags = base64.b64decode(layers["pixels"])
+        bits = layers["layers"]
+        for checkbox, mask in (("ov_seam", bits["seam"] | bits["boundary"]),
+                               ("ov_edges", bits["seam"] | bits["boundary"] | bits["face_edge"])):
+            page.eval("(() => { const e = document.getElementById(%s); e.checked = true; "
+                      "e.dispatchEvent(new Event('change')); })()" % json.dumps(checkbox))
+            expected = sum(1 for f in flags if f & mask)
+            for canvas in ("ov_a", "ov_b"):
+                drawn = page.wait("(() => { const c = document.getElementById(%s); return !c.hidden && c.dataset.drawn; })()"
+                                  % json.dumps(canvas), timeout=min(RENDER_WAIT_S, max(1.0, deadline - time.monotonic())),
+                                  what=canvas + " drawn")
+                t.check(int(drawn) == expected, "%s with %s draws the library's layer pixels" % (canvas, checkbox),
+                        "%s vs %d" % (drawn, expected))
+        t.check(layers["counts"]["seam"] > 0 and layers["counts"]["face_edge"] > 0, "quad2 has seam and face-edge pixels",
+                str(layers["counts"]))
+        if screenshot:
+            clip = page.eval("(() => { const a = document.getElementById('view_side').getBoundingClientRect(); "
+                             "return {x: a.left, y: a.top, width: a.width, height: a.height, scale: 1}; })()")
+            data = page.send("Page.captureScreenshot", {"format": "png", "clip": clip, "captureBeyondViewport": True},
+                             timeout=60)["data"]
+            with open(screenshot.replace(".png", "-overlays.png"), "wb") as f:
+                f.write(base64.b64decode(data))
         t.check(page.errors() == [], "no script errors", str(page.errors()))
     finally:
         browser.close()
