@@ -13,6 +13,7 @@
 #include <seamcl/jobs/overlay_job.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
+#include "pipeline/stages/shade_inspect_launcher.h"
 #include "pipeline/stages/shade_inspect_twin.h"
 #include "test_support.h"
 
@@ -261,5 +262,5 @@ TEST(OverlayJob, LayersAreTheSeamMaskAndTheFaceEdgesOfTheFrame) {
   // quad2's shared edge runs down the frame: a line of face-edge pixels, and seam pixels along it.
   EXPECT_GE(edges, 20u);
   EXPECT_GT(seam, 0u);
-  EXPECT_THROW(OverlayJob({{"method", "guardband"}}), InputError);
+  EXPECT_THROW(OverlayJob(json{{"method", "guardband"}}), InputError);
 }

@@ -503,8 +503,12 @@ std::vector<InspectSample> Renderer::inspect_last_frame(int x, int y, int width,
                               std::to_string(y) + " (window " + std::to_string(height) + " high)");
   }
   ShadeInspectLauncher launcher(i.runtime);
-  return launcher.inspect(i.program_key, i.frame_params, i.setup.setups(), i.shade_scene_buffers(), i.raster.sample_triangle(),
-                          p, !i.packed.neighbors.empty(), PixelWindow{x, y, width, height});
+  std::vector<InspectSample> records =
+      launcher.inspect(i.program_key, i.frame_params, i.setup.setups(), i.shade_scene_buffers(), i.raster.sample_triangle(),
+                       p, !i.packed.neighbors.empty(), PixelWindow{x, y, width, height});
+  // The slots as read_setups and read_sample_triangles number them (input order).
+  for (InspectSample& r : records) r.triangle = input_order_slot(r.triangle, static_cast<uint32_t>(p.input_triangles));
+  return records;
 }
 
 FrameParams Renderer::last_frame_params() const { return impl_->last_params; }

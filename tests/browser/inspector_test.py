@@ -139,7 +139,7 @@ def run(base, chromium, profile, screenshot, t, deadline):
                              "return {x: a.left, y: a.top, width: a.width, height: a.height, scale: 1}; })()")
             data = page.send("Page.captureScreenshot", {"format": "png", "clip": clip, "captureBeyondViewport": True},
                              timeout=60)["data"]
-            with open(screenshot.replace(".png", "-overlays.png"), "wb") as f:
+            with open(os.path.join(os.path.dirname(screenshot), "viewer-overlays.png"), "wb") as f:
                 f.write(base64.b64decode(data))
         t.check(page.errors() == [], "no script errors", str(page.errors()))
     finally:
@@ -150,7 +150,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seamcl", required=True)
     parser.add_argument("--chromium", default=shutil.which("chromium") or "chromium")
-    parser.add_argument("--screenshot", help="write a screenshot of the images and the inspector here")
+    parser.add_argument("--screenshot", help="write a screenshot of the images and the inspector here, and one of the "
+                        "overlays as viewer-overlays.png beside it")
     args = parser.parse_args()
     start = time.monotonic()
     deadline = start + BUDGET_S
