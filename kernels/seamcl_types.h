@@ -271,6 +271,30 @@ typedef struct {
   cl_uint early_culled;     /* input triangles triangle_setup's early cull stopped */
 } FrameStats;
 
+/* The pixel inspector's record of one sample (kernels/shade_inspect.cl, a shading program built
+ * with -DSEAMCL_INSPECT=1): the fragment that colours the sample and its texture lookup as the
+ * frame's seam method reads it. With pixel or centroid shading the samples of one triangle share
+ * one fragment (its shading point, coverage and lookup). */
+typedef struct {
+  cl_uint triangle;         /* the sample's winning clip slot; SEAMCL_NO_TRIANGLE: background */
+  cl_int face;              /* the slot's face; -1 for the background */
+  cl_uint coverage;         /* bit s: sample s has this sample's triangle (the fragment's samples) */
+  cl_int probes;            /* aniso probes (1 for the other filters); 0 without a lookup */
+  cl_float x, y;            /* shading point, pixels */
+  cl_float u, v;            /* at the shading point */
+  cl_float dudx, dvdx, dudy, dvdy;
+  cl_float axis_x, axis_y;  /* the footprint's screen axes, level-0 texels */
+  cl_float lod;             /* the level read, bias included, clamped to the chain */
+  cl_int level0, level1;    /* the levels whose texels are read (equal for one level) */
+  cl_int reflective;        /* 1: a cube-map lookup (no patch taps; weights stay 0) */
+  cl_float own_weight;      /* summed tap weight inside the own face (the method's address mode) */
+  cl_int edge_face[4];      /* face across edge k (v = 0, u = 1, v = 1, u = 0); -1 none */
+  cl_float edge_weight[4];  /* its taps' weight as traverse reads it; 0 when the method does not */
+  cl_int corner_face[4];    /* diagonal face past corner k (valence 4); -1 none */
+  cl_float corner_weight[4];
+  cl_float color[4];        /* the fragment's shaded colour, linear RGB, alpha 1 */
+} InspectSample;
+
 /* ---- Displacement (kernels/tessellate.cl; host/pipeline/displacement_packing.h) ---- */
 /* TessellationParams.method: how a patch's vertices take their displacement */
 #define SEAMCL_DISPLACEMENT_NAIVE 0     /* float domain points, each patch samples its own map */

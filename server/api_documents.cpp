@@ -6,6 +6,7 @@
 
 #include <seamcl/io/image_encoding.h>
 #include <seamcl/jobs/compare_job.h>
+#include <seamcl/jobs/inspect_job.h>
 #include <seamcl/jobs/render_job.h>
 #include <seamcl/options/option_domains.h>
 #include <seamcl/options/render_options.h>
@@ -74,6 +75,12 @@ json make_openapi() {
   set_options(render, render_option_table(), {});
   render["format"] = format_schema();
 
+  // An inspection: the render's options (its answer is JSON: no format) and the pixel's.
+  json& inspect = schemas.at("InspectRequest").at("properties");
+  set_options(inspect, render_option_table(), {});
+  set_options(inspect, inspect_job_option_table(), {});
+  json& overlays = schemas.at("OverlaysRequest").at("properties");
+  set_options(overlays, render_option_table(), {});
   json& compare = schemas.at("CompareRequest").at("properties");
   set_options(compare, compare_option_table(), {});
   compare.at("repeat")["maximum"] = limits.max_compare_repeat;

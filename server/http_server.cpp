@@ -293,6 +293,12 @@ void HttpServer::install_routes() {
   http.Post("/v1/render", guarded([this](const httplib::Request& req, httplib::Response& res) {
               jobs_->render(parse_json_body(req, options_.max_json_depth), res);
             }));
+  http.Post("/v1/inspect", guarded([this](const httplib::Request& req, httplib::Response& res) {
+              jobs_->inspect(parse_json_body(req, options_.max_json_depth), res);
+            }));
+  http.Post("/v1/overlays", guarded([this](const httplib::Request& req, httplib::Response& res) {
+              jobs_->overlays(parse_json_body(req, options_.max_json_depth), res);
+            }));
   http.Post("/v1/reference", guarded([this](const httplib::Request& req, httplib::Response& res) {
               jobs_->reference(parse_json_body(req, options_.max_json_depth), res);
             }));

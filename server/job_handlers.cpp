@@ -14,6 +14,8 @@
 #include <seamcl/memory/compare_memory.h>
 #include <seamcl/io/image_encoding.h>
 #include <seamcl/jobs/compare_job.h>
+#include <seamcl/jobs/inspect_job.h>
+#include <seamcl/jobs/overlay_job.h>
 #include <seamcl/jobs/render_job.h>
 #include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
@@ -149,86 +151,14 @@ void JobHandlers::render(const json& request, httplib::Response& res) {
   if (rest.contains("export_mesh"))
     throw HttpError{400, "export_mesh", "is the command line's (seamcl render --export-mesh): the server writes no file a request names"};
   const RenderJob job(rest);
-  RenderOptions options = job.options();
-  std::string key;
-  const std::shared_ptr<const Scene> scene = scenes_.resolve(inline_scene, options, key);
-  const bool inline_request = key.empty();  // an inline scene or an asset: held for this request only
-  // Limits after every syntax check (a malformed request is a 400 whatever its size) and before
-  // anything is packed or put on the device (an inline scene's own size is bounded by the face
-  // and texel limits checked before it is parsed).
-  if (static_cast<long long>(options.width) * options.height * options.msaa > options_.max_samples) {
-    throw HttpError{413, "size",
-                    "width x height x msaa = " + std::to_string(static_cast<long long>(options.width) * options.height * options.msaa) +
-                        " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
-  }
-  budget_.refuse_scene_over(*scene, options, inline_scene, key);
-  // The request's own copy of an inline scene or asset is held on top of the Renderer's.
-  const JobPlan plan = job.plan(*scene, inline_request ? scene_host_bytes(scene_sizes(*scene)) : 0);
-  budget_.refuse_over(plan.device, plan.host, !inline_request, plan.what);
-
-  // Wait for a render slot (or 503), render, and give the slot back before encoding.
-  const Clock::time_point queued = Clock::now();
   RenderRun run;
-  double queue_ms = 0, build_ms = 0;
-  {
-    const std::unique_ptr<SlotLease> lease = slots_.acquire(start);
-    queue_ms = ms_since(queued);
-    // Queued for a client that has since hung up: nobody would read the image.
-    if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
-    RenderSlot& slot = lease->slot();
-    // Admitted under the memory bound: what this slot keeps goes first, least recently used.
-    const size_t planned = plan.unified.total() > 0 ? plan.unified.total() : plan.device.total() + plan.host.total();
-    // Counted again however the request ends (after its reservation is given back); the kept
-    // caches then give back what is over.
-    struct Recount {
-      JobHandlers& jobs;
-      RenderSlot& slot;
-      ~Recount() {
-        jobs.count_kept(slot);
-        while (jobs.memory_.kept_over() && jobs.evict_one(slot)) {
-        }
-      }
-    } recount{*this, slot};
-    const std::unique_ptr<MemoryReservation> reserved = reserve(slot, planned, plan.what);
-    slot.last_used[key] = ++slot.uses;
-    std::unique_ptr<Renderer>& renderer = key.empty() ? slot.scratch : slot.renderers[key];
-    try {
-      if (!renderer) {
-        renderer = std::make_unique<Renderer>(runtime_);
-        if (!key.empty()) renderer->load_scene(*scene, options.texels);
-      }
-      // Tile lists grow with what a frame holds, past any estimate: bounded here.
-      renderer->set_device_byte_limit(options_.max_request_device_bytes);
-      if (key.empty()) renderer->load_scene(*scene, options.texels);
-      JobControl control;
-      control.device_byte_limit = options_.max_request_device_bytes;
-      // A render whose client has gone stops at the next stage boundary, like a compare.
-      control.should_stop = [] { return GuardedHttpServer::client_gone(); };
-      try {
-        // What it needs before its frame, made here and timed: kernel variants the warm-up has
-        // not built yet and an environment's cube map. A render that waits for them says so
-        // (X-Seamcl-Build-Ms), never a silent stall.
-        {
-          const StageStopScope stop_between_stages(control.should_stop);
-          const Clock::time_point build_start = Clock::now();
-          renderer->warm_up(options);
-          build_ms = ms_since(build_start);
-        }
-        run = job.run(runtime_, *renderer, *scene, control);
-      } catch (const Cancelled& e) {
-        throw HttpError{503, "client", std::string("the client has gone; render ") + e.what(), 0};
-      }
-      // Hold nothing request-sized between requests: the inline scene goes, large frames too.
-      if (key.empty()) {
-        renderer->release_scene();
-      } else if (render_memory(scene_sizes(*scene), options).frame_device_bytes() > options_.keep_frame_bytes) {
-        renderer->release_frame_buffers();
-      }
-    } catch (...) {
-      renderer.reset();  // a failed Renderer is not reused: the next request gets a fresh one
-      throw;
-    }
-  }
+  const FrameJobRun times = run_frame_job(
+      start, inline_scene, job.options(), [&](const Scene& scene, size_t held) { return job.plan(scene, held); },
+      [&](Renderer& renderer, const Scene& scene, const JobControl& control) {
+        run = job.run(runtime_, renderer, scene, control);
+      });
+  const double queue_ms = times.queue_ms, build_ms = times.build_ms;
+  const RenderOptions& options = times.options;
   const RenderResult& result = run.last;
   const Clock::time_point encode_start = Clock::now();
   set_image(res, format, result.width, result.height, result.pixels);
@@ -242,6 +172,134 @@ void JobHandlers::render(const json& request, httplib::Response& res) {
   res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
   res.set_header("X-Seamcl-Options", json_text(to_json(options)));
   res.set_header("X-Seamcl-Fragments", std::to_string(result.stats.fragments));
+}
+
+JobHandlers::FrameJobRun JobHandlers::run_frame_job(
+    Clock::time_point start, const json& inline_scene, RenderOptions options,
+    const std::function<JobPlan(const Scene&, size_t)>& make_plan,
+    const std::function<void(Renderer&, const Scene&, const JobControl&)>& work) {
+  std::string key;
+  const std::shared_ptr<const Scene> scene = scenes_.resolve(inline_scene, options, key);
+  const bool inline_request = key.empty();  // an inline scene or an asset: held for this request only
+  // Limits after every syntax check (a malformed request is a 400 whatever its size) and before
+  // anything is packed or put on the device (an inline scene's own size is bounded by the face
+  // and texel limits checked before it is parsed).
+  if (static_cast<long long>(options.width) * options.height * options.msaa > options_.max_samples) {
+    throw HttpError{413, "size",
+                    "width x height x msaa = " + std::to_string(static_cast<long long>(options.width) * options.height * options.msaa) +
+                        " exceeds this server's limit of " + std::to_string(options_.max_samples) + " samples"};
+  }
+  budget_.refuse_scene_over(*scene, options, inline_scene, key);
+  // The request's own copy of an inline scene or asset is held on top of the Renderer's.
+  const JobPlan plan = make_plan(*scene, inline_request ? scene_host_bytes(scene_sizes(*scene)) : 0);
+  budget_.refuse_over(plan.device, plan.host, !inline_request, plan.what);
+
+  // Wait for a render slot (or 503), render, and give the slot back before encoding.
+  const Clock::time_point queued = Clock::now();
+  FrameJobRun times;
+  times.options = options;
+  const std::unique_ptr<SlotLease> lease = slots_.acquire(start);
+  times.queue_ms = ms_since(queued);
+  // Queued for a client that has since hung up: nobody would read the image.
+  if (GuardedHttpServer::client_gone()) throw HttpError{503, "client", "the client has gone", 0};
+  RenderSlot& slot = lease->slot();
+  // Admitted under the memory bound: what this slot keeps goes first, least recently used.
+  const size_t planned = plan.unified.total() > 0 ? plan.unified.total() : plan.device.total() + plan.host.total();
+  // Counted again however the request ends (after its reservation is given back); the kept
+  // caches then give back what is over.
+  struct Recount {
+    JobHandlers& jobs;
+    RenderSlot& slot;
+    ~Recount() {
+      jobs.count_kept(slot);
+      while (jobs.memory_.kept_over() && jobs.evict_one(slot)) {
+      }
+    }
+  } recount{*this, slot};
+  const std::unique_ptr<MemoryReservation> reserved = reserve(slot, planned, plan.what);
+  slot.last_used[key] = ++slot.uses;
+  std::unique_ptr<Renderer>& renderer = key.empty() ? slot.scratch : slot.renderers[key];
+  try {
+    if (!renderer) {
+      renderer = std::make_unique<Renderer>(runtime_);
+      if (!key.empty()) renderer->load_scene(*scene, options.texels);
+    }
+    // Tile lists grow with what a frame holds, past any estimate: bounded here.
+    renderer->set_device_byte_limit(options_.max_request_device_bytes);
+    if (key.empty()) renderer->load_scene(*scene, options.texels);
+    JobControl control;
+    control.device_byte_limit = options_.max_request_device_bytes;
+    // A render whose client has gone stops at the next stage boundary, like a compare.
+    control.should_stop = [] { return GuardedHttpServer::client_gone(); };
+    try {
+      // What it needs before its frame, made here and timed: kernel variants the warm-up has
+      // not built yet and an environment's cube map. A render that waits for them says so
+      // (X-Seamcl-Build-Ms), never a silent stall.
+      {
+        const StageStopScope stop_between_stages(control.should_stop);
+        const Clock::time_point build_start = Clock::now();
+        renderer->warm_up(options);
+        times.build_ms = ms_since(build_start);
+      }
+      work(*renderer, *scene, control);
+    } catch (const Cancelled& e) {
+      throw HttpError{503, "client", std::string("the client has gone; render ") + e.what(), 0};
+    }
+    // Hold nothing request-sized between requests: the inline scene goes, large frames too.
+    if (key.empty()) {
+      renderer->release_scene();
+    } else if (render_memory(scene_sizes(*scene), options).frame_device_bytes() > options_.keep_frame_bytes) {
+      renderer->release_frame_buffers();
+    }
+  } catch (...) {
+    renderer.reset();  // a failed Renderer is not reused: the next request gets a fresh one
+    throw;
+  }
+  return times;
+}
+
+// POST /v1/inspect: the inspect job (host/jobs/inspect_job.h) on one frame, admitted as a render,
+// answered as its JSON.
+void JobHandlers::inspect(const json& request, httplib::Response& res) {
+  const Clock::time_point start = Clock::now();
+  if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
+  json rest = request;
+  const json inline_scene = take_inline_scene(rest);
+  if (rest.contains("format")) throw HttpError{400, "format", "inspect answers JSON; format is for /v1/render"};
+  for (const char* key : {"repeat", "crack_orbit", "export_mesh"})
+    if (rest.contains(key)) throw HttpError{400, key, "is for renders; an inspection renders one frame"};
+  const InspectJob job(rest);
+  json answer;
+  const FrameJobRun times = run_frame_job(
+      start, inline_scene, job.options(), [&](const Scene& scene, size_t held) { return job.plan(scene, held); },
+      [&](Renderer& renderer, const Scene& scene, const JobControl& control) {
+        answer = job.run(renderer, scene, control);
+      });
+  res.set_header("X-Seamcl-Queue-Ms", std::to_string(times.queue_ms));
+  res.set_header("X-Seamcl-Build-Ms", std::to_string(times.build_ms));
+  res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
+  res.set_content(json_text(answer), "application/json");
+}
+
+// POST /v1/overlays: the overlay job (host/jobs/overlay_job.h) on one frame, admitted as a render,
+// answered as its JSON.
+void JobHandlers::overlays(const json& request, httplib::Response& res) {
+  const Clock::time_point start = Clock::now();
+  if (!request.is_object()) throw HttpError{400, "body", "must be a JSON object"};
+  json rest = request;
+  const json inline_scene = take_inline_scene(rest);
+  if (rest.contains("format")) throw HttpError{400, "format", "overlays answer JSON; format is for /v1/render"};
+  const OverlayJob job(rest);
+  json answer;
+  const FrameJobRun times = run_frame_job(
+      start, inline_scene, job.options(), [&](const Scene& scene, size_t held) { return job.plan(scene, held); },
+      [&](Renderer& renderer, const Scene& scene, const JobControl& control) {
+        answer = job.run(renderer, scene, control);
+      });
+  res.set_header("X-Seamcl-Queue-Ms", std::to_string(times.queue_ms));
+  res.set_header("X-Seamcl-Build-Ms", std::to_string(times.build_ms));
+  res.set_header("X-Seamcl-Server-Ms", std::to_string(ms_since(start)));
+  res.set_content(json_text(answer), "application/json");
 }
 
 // POST /v1/compare: the compare job (host/jobs/compare_job.h) on one frame, admitted as one

@@ -94,7 +94,7 @@ bool is_json_media_type(std::string_view content_type) { return media_type(conte
 const std::map<std::string, std::vector<std::string>>& known_paths() {
   static const std::map<std::string, std::vector<std::string>> paths = {
       {"/", {"GET"}},           {"/health", {"GET"}},          {"/v1/scenes", {"GET"}}, {"/v1/assets", {"GET"}},
-      {"/v1/methods", {"GET"}}, {"/v1/render", {"GET", "POST"}}, {"/v1/compare", {"POST"}}, {"/v1/reference", {"POST"}},
+      {"/v1/methods", {"GET"}}, {"/v1/render", {"GET", "POST"}}, {"/v1/compare", {"POST"}}, {"/v1/inspect", {"POST"}}, {"/v1/overlays", {"POST"}}, {"/v1/reference", {"POST"}},
       {"/openapi.json", {"GET"}}, {"/ready", {"GET"}}, {"/v1/progress", {"GET"}}};
   return paths;
 }

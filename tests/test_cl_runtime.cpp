@@ -158,7 +158,7 @@ TEST(KernelPrograms, EachBuildsAloneWithItsKernels) {
        {"",
         {"triangle_setup", "bin_count", "bin_scan", "bin_fill", "raster", "sample_pattern", "tessellate",
          "tessellated_setup"}}},
-      {KernelProgram::Shading, {"-DSEAMCL_CUBE=1 -DSEAMCL_SEAM_MASK=1", {"shade_resolve"}}},
+      {KernelProgram::Shading, {"-DSEAMCL_CUBE=1 -DSEAMCL_SEAM_MASK=1 -DSEAMCL_INSPECT=1", {"shade_resolve", "shade_inspect"}}},
       {KernelProgram::Sampling,
        {"", {"neighbor_bytes_decoded", "texture_lookup_batch", "texture_filter_batch", "cube_lookup_batch"}}},
       {KernelProgram::PtexFilter, {"", {"ptex_filter_lookups"}}},

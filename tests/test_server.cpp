@@ -29,6 +29,8 @@
 #include <unistd.h>
 
 #include <seamcl/core/input_error.h>
+#include <seamcl/jobs/inspect_job.h>
+#include <seamcl/jobs/overlay_job.h>
 #include <seamcl/jobs/scene_domains.h>
 #include <seamcl/options/option_domains.h>
 #include <seamcl/memory/compare_memory.h>
@@ -52,7 +54,7 @@ using namespace seamcl;
 namespace {
 
 // ---- A validator for the JSON-Schema subset the OpenAPI document uses: $ref (local), type,
-// properties, required, additionalProperties: false, enum, items, minimum, maximum.
+// properties, required, additionalProperties: false, enum, items, minimum, maximum, nullable.
 void validate(const json& value, const json& schema, const json& root, const std::string& path,
               std::vector<std::string>& errors) {
   if (schema.contains("$ref")) {
@@ -64,6 +66,7 @@ void validate(const json& value, const json& schema, const json& root, const std
     validate(value, root.at(json::json_pointer(ref.substr(1))), root, path, errors);
     return;
   }
+  if (value.is_null() && schema.value("nullable", false)) return;
   if (schema.contains("type")) {
     const std::string type = schema.at("type");
     const bool ok = type == "object"    ? value.is_object()
@@ -403,7 +406,7 @@ TEST(ServerSchema, OpenApiDocumentsEveryEndpoint) {
   EXPECT_TRUE(doc.at("openapi").get<std::string>().starts_with("3."));
   for (const auto& [path, method] : std::vector<std::pair<std::string, std::string>>{
            {"/", "get"}, {"/health", "get"}, {"/v1/scenes", "get"}, {"/v1/methods", "get"}, {"/v1/render", "get"},
-           {"/v1/render", "post"}, {"/v1/compare", "post"}, {"/v1/progress", "get"}, {"/openapi.json", "get"}}) {
+           {"/v1/render", "post"}, {"/v1/inspect", "post"}, {"/v1/overlays", "post"}, {"/v1/compare", "post"}, {"/v1/progress", "get"}, {"/openapi.json", "get"}}) {
     EXPECT_TRUE(doc.at("paths").contains(path) && doc.at("paths").at(path).contains(method)) << method << " " << path;
   }
   // Every $ref resolves.
@@ -555,6 +558,57 @@ TEST_F(Server, PostRenderMatchesTheLibrary) {
   EXPECT_EQ(h, 48);
   EXPECT_FALSE(all_zero(pixels));
   EXPECT_TRUE(pixels == library_image(request));
+}
+
+// POST /v1/inspect answers the inspect job's JSON for the request, as documented; a pixel outside
+// the image or none is a 400 naming the field.
+TEST_F(Server, InspectAnswersTheLibrarysRecords) {
+  httplib::Client c = client();
+  const json request = {{"scene", "quad2"}, {"size", "64x48"}, {"msaa", 4}, {"method", "traverse"}, {"x", 31}, {"y", 20},
+                        {"window", 2}};
+  auto res = c.Post("/v1/inspect", request.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  EXPECT_EQ(res->get_header_value("Content-Type"), "application/json");
+  expect_documented("post", "/v1/inspect", res);
+  const json body = json::parse(res->body);
+  const InspectJob job(request);
+  const Scene scene = generate_scene("quad2", job.render_job().generator_options());
+  Renderer renderer(seamcl_tests::shared_runtime());
+  renderer.load_scene(scene);
+  const json expected = job.run(renderer, scene, JobControl{});
+  ASSERT_EQ(body.at("pixels").size(), 4u);
+  EXPECT_EQ(body.at("pixels"), expected.at("pixels"));
+  for (const auto& [bad, field] : std::vector<std::pair<json, std::string>>{
+           {{{"scene", "quad2"}, {"size", "64x48"}, {"x", 64}, {"y", 0}}, "x"},
+           {{{"scene", "quad2"}, {"x", 1}}, "y"},
+           {{{"scene", "quad2"}, {"x", 1}, {"y", 1}, {"format", "png"}}, "format"}}) {
+    auto refused = c.Post("/v1/inspect", bad.dump(), "application/json");
+    ASSERT_TRUE(refused);
+    EXPECT_EQ(refused->status, 400) << bad.dump() << " " << refused->body;
+    EXPECT_EQ(json::parse(refused->body).value("field", ""), field) << bad.dump();
+    expect_documented("post", "/v1/inspect", refused);
+  }
+}
+
+// POST /v1/overlays answers the overlay job's JSON, as documented; guardband is a 400 naming method.
+TEST_F(Server, OverlaysAnswerTheLibrarysLayers) {
+  httplib::Client c = client();
+  const json request = {{"scene", "quad2"}, {"size", "64x48"}, {"msaa", 4}};
+  auto res = c.Post("/v1/overlays", request.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  expect_documented("post", "/v1/overlays", res);
+  const OverlayJob job(request);
+  const Scene scene = generate_scene("quad2", job.render_job().generator_options());
+  Renderer renderer(seamcl_tests::shared_runtime());
+  renderer.load_scene(scene);
+  EXPECT_EQ(json::parse(res->body), job.run(renderer, scene, JobControl{}));
+  auto refused = c.Post("/v1/overlays", json{{"scene", "quad2"}, {"method", "guardband"}}.dump(), "application/json");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 400);
+  EXPECT_EQ(json::parse(refused->body).value("field", ""), "method");
+  expect_documented("post", "/v1/overlays", refused);
 }
 
 TEST_F(Server, GetRenderMatchesPostAndTheLibrary) {

@@ -14,6 +14,7 @@
 #include "pipeline/stages/binning_launcher.h"
 #include "pipeline/stages/downsample_launcher.h"
 #include "pipeline/stages/raster_launcher.h"
+#include "pipeline/stages/shade_inspect_launcher.h"
 #include "pipeline/stages/shade_resolve_launcher.h"
 #include "pipeline/stages/stage_buffers.h"
 #include "pipeline/stages/tessellate_launcher.h"
@@ -489,6 +490,27 @@ void Renderer::warm_up(const RenderOptions& options) {
   tiny.width = SEAMCL_TILE_SIZE;
   tiny.height = SEAMCL_TILE_SIZE;
   render(scene().camera, tiny);
+}
+
+std::vector<InspectSample> Renderer::inspect_last_frame(int x, int y, int width, int height) {
+  Impl& i = *impl_;
+  const FrameParams& p = i.last_params;
+  if (p.width == 0 || i.program_key.empty() || !i.uploaded) throw std::logic_error("inspect_last_frame without a frame");
+  if (width < 1 || x < 0 || x > p.width - width) {
+    throw InputError("x", "must lie in 0.." + std::to_string(p.width - 1) + " with the window inside the image, got " +
+                              std::to_string(x) + " (window " + std::to_string(width) + " wide)");
+  }
+  if (height < 1 || y < 0 || y > p.height - height) {
+    throw InputError("y", "must lie in 0.." + std::to_string(p.height - 1) + " with the window inside the image, got " +
+                              std::to_string(y) + " (window " + std::to_string(height) + " high)");
+  }
+  ShadeInspectLauncher launcher(i.runtime);
+  std::vector<InspectSample> records =
+      launcher.inspect(i.program_key, i.frame_params, i.setup.setups(), i.shade_scene_buffers(), i.raster.sample_triangle(),
+                       p, !i.packed.neighbors.empty(), PixelWindow{x, y, width, height});
+  // The slots as read_setups and read_sample_triangles number them (input order).
+  for (InspectSample& r : records) r.triangle = input_order_slot(r.triangle, static_cast<uint32_t>(p.input_triangles));
+  return records;
 }
 
 FrameParams Renderer::last_frame_params() const { return impl_->last_params; }

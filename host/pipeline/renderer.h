@@ -150,6 +150,13 @@ class Renderer {
   // (slow on a cold cache) rather than inside the first timed frame.
   void warm_up(const RenderOptions& options);
 
+  // The pixel inspector: per pixel of the window [x, x + width) x [y, y + height) of the last
+  // frame, its sample_count records (kernels/shade_inspect.cl: each sample's triangle, face,
+  // coverage, shading point, uv, levels, footprint and the taps' faces and weights), pixel-major,
+  // from the buffers that frame's shading read. InputError("x" or "y") for a window outside the
+  // image; std::logic_error without a frame.
+  std::vector<InspectSample> inspect_last_frame(int x, int y, int width, int height);
+
   // The intermediate buffers of the last frame, for the kernel tests.
   FrameParams last_frame_params() const;
   std::vector<TriangleSetup> read_setups();
