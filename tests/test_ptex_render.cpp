@@ -95,7 +95,7 @@ TEST(PtexRender, ShadeKernelMatchesTwinForEveryFilterAndSeamRule) {
           // gaussian's exp differs by a few ulps. A width at a power of two can pick another level.
           EXPECT_LE(apart, static_cast<int>(twin.pixels.size() / 200)) << "worst " << worst;
           EXPECT_LT(worst, 0.05f);
-          EXPECT_GT(lit, 200) << "the mesh fills much of the frame";
+          EXPECT_GT(lit, 100) << "the mesh covers part of the frame (cellnoise's object: about 180 of 3072 pixels)";
           EXPECT_EQ(twin.fragments, result.stats.fragments);
         }
       }
