@@ -1,4 +1,5 @@
-/* Ptex's own separable filters: ptex_filter_lookups, one work-item per lookup.
+/* Ptex's own separable filters: ptexf_lookup, run by ptex_filter_lookups (ptex_lookup_batch.cl)
+ * and by the Ptex variant of the shading stage (shade_resolve.cl).
  *
  * Contract: query q (face, filter, u, v, uw, vw, sharpness) gives what the Ptex library's
  * PtexFilter::eval gives on the same quad-mesh texture (uw1 = uw, vw2 = vw, uw2 = vw1 = 0, width 1,
@@ -9,10 +10,17 @@
  * dropped, the weight taken back), boundary edges merged by the file's border mode, the sum
  * divided by the kernel's weight and the type's one value. Writes 4 floats per lookup (channels
  * beyond the texture's are 0); a face out of range gives zeros (the host refuses it first).
+ * tex.seams other than SEAMCL_PTEX_SEAMS_PTEX (renders with a seam method that reads no neighbour)
+ * walks no neighbour: every edge is a boundary of that rule (seamcl_types.h), and with DISCARD the
+ * sum is divided by the weight of the taps inside the face instead.
  * Host guarantees (host/ptexfilter/ptex_filter_texture.cpp): every resolution 2^i x 2^j of every
  * face at texels + level_offsets[face.level_base + i * (vlog2 + 1) + j] (texel index; channels
  * interleaved; the element count fits a uint); no subfaces.
+ * The shading program compiles this file into its Ptex variant only (SEAMCL_SAMPLER_FILTER =
+ * SEAMCL_FILTER_PTEX); the others skip it.
  * Twin: host/pipeline/stages/ptex_filter_twin.cpp. */
+
+#if !defined(SEAMCL_SAMPLER_FILTER) || SEAMCL_SAMPLER_FILTER == SEAMCL_FILTER_PTEX
 
 #define PTEXF_BOTTOM 0
 #define PTEXF_RIGHT 1
@@ -35,6 +43,7 @@ typedef struct {
   __global const uchar* texels;
   PtexFilterTexture tex;
   float weight;
+  float applied;  /* SEAMCL_PTEX_SEAMS_DISCARD: the weight of the taps read */
   float result[4];
 } PtexfState;
 
@@ -402,6 +411,7 @@ SEAMCL_INLINE void ptexf_apply(PtexfState* s, PtexfKernel* k, int face) {
   if (k->u + k->uw > (1 << k->ulog2)) k->uw = max(0, (1 << k->ulog2) - k->u);
   if (k->v + k->vw > (1 << k->vlog2)) k->vw = max(0, (1 << k->vlog2) - k->v);
   if (k->uw <= 0 || k->vw <= 0) return;
+  if (s->tex.seams == SEAMCL_PTEX_SEAMS_DISCARD) s->applied += ptexf_weight(k);
   while (k->ulog2 > f.ulog2) ptexf_downres_u(k);
   while (k->vlog2 > f.vlog2) ptexf_downres_v(k);
   float acc[4] = {0.0f, 0.0f, 0.0f, 0.0f};
@@ -471,21 +481,28 @@ SEAMCL_INLINE void ptexf_corner(PtexfState* s, PtexfKernel* k, int faceid, PtexF
   }
 }
 
+/* Whether edge e leads to a neighbour the filter walks to. */
+SEAMCL_INLINE bool ptexf_walks(const PtexfState* s, PtexFilterFace f, int e) {
+  return s->tex.seams == SEAMCL_PTEX_SEAMS_PTEX && ptexf_adj_face(f, e) >= 0;
+}
+
 SEAMCL_INLINE void ptexf_split_and_apply(PtexfState* s, PtexfKernel* k, int faceid) {
   const PtexFilterFace f = s->faces[faceid];
   const bool split_r = k->u + k->uw > (1 << k->ulog2), split_l = k->u < 0;
   const bool split_t = k->v + k->vw > (1 << k->vlog2), split_b = k->v < 0;
-  const int umode = s->tex.u_border_mode, vmode = s->tex.v_border_mode;
+  const int seams = s->tex.seams;
+  const int umode = seams == SEAMCL_PTEX_SEAMS_PTEX ? s->tex.u_border_mode : seams == SEAMCL_PTEX_SEAMS_CLAMP ? 0 : PTEXF_BLACK;
+  const int vmode = seams == SEAMCL_PTEX_SEAMS_PTEX ? s->tex.v_border_mode : seams == SEAMCL_PTEX_SEAMS_CLAMP ? 0 : PTEXF_BLACK;
   PtexfKernel ka, kc;
   if (split_r) {
-    if (ptexf_adj_face(f, PTEXF_RIGHT) >= 0) {
+    if (ptexf_walks(s, f, PTEXF_RIGHT)) {
       ptexf_split_right(k, &ka);
       if (split_t) {
-        if (ptexf_adj_face(f, PTEXF_TOP) >= 0) { ptexf_split_top(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_TOP); }
+        if (ptexf_walks(s, f, PTEXF_TOP)) { ptexf_split_top(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_TOP); }
         else ptexf_merge_top(&ka, vmode);
       }
       if (split_b) {
-        if (ptexf_adj_face(f, PTEXF_BOTTOM) >= 0) { ptexf_split_bottom(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_RIGHT); }
+        if (ptexf_walks(s, f, PTEXF_BOTTOM)) { ptexf_split_bottom(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_RIGHT); }
         else ptexf_merge_bottom(&ka, vmode);
       }
       ptexf_across_edge(s, &ka, f, PTEXF_RIGHT);
@@ -494,14 +511,14 @@ SEAMCL_INLINE void ptexf_split_and_apply(PtexfState* s, PtexfKernel* k, int face
     }
   }
   if (split_l) {
-    if (ptexf_adj_face(f, PTEXF_LEFT) >= 0) {
+    if (ptexf_walks(s, f, PTEXF_LEFT)) {
       ptexf_split_left(k, &ka);
       if (split_t) {
-        if (ptexf_adj_face(f, PTEXF_TOP) >= 0) { ptexf_split_top(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_LEFT); }
+        if (ptexf_walks(s, f, PTEXF_TOP)) { ptexf_split_top(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_LEFT); }
         else ptexf_merge_top(&ka, vmode);
       }
       if (split_b) {
-        if (ptexf_adj_face(f, PTEXF_BOTTOM) >= 0) { ptexf_split_bottom(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_BOTTOM); }
+        if (ptexf_walks(s, f, PTEXF_BOTTOM)) { ptexf_split_bottom(&ka, &kc); ptexf_corner(s, &kc, faceid, f, PTEXF_BOTTOM); }
         else ptexf_merge_bottom(&ka, vmode);
       }
       ptexf_across_edge(s, &ka, f, PTEXF_LEFT);
@@ -510,65 +527,61 @@ SEAMCL_INLINE void ptexf_split_and_apply(PtexfState* s, PtexfKernel* k, int face
     }
   }
   if (split_t) {
-    if (ptexf_adj_face(f, PTEXF_TOP) >= 0) { ptexf_split_top(k, &ka); ptexf_across_edge(s, &ka, f, PTEXF_TOP); }
+    if (ptexf_walks(s, f, PTEXF_TOP)) { ptexf_split_top(k, &ka); ptexf_across_edge(s, &ka, f, PTEXF_TOP); }
     else ptexf_merge_top(k, vmode);
   }
   if (split_b) {
-    if (ptexf_adj_face(f, PTEXF_BOTTOM) >= 0) { ptexf_split_bottom(k, &ka); ptexf_across_edge(s, &ka, f, PTEXF_BOTTOM); }
+    if (ptexf_walks(s, f, PTEXF_BOTTOM)) { ptexf_split_bottom(k, &ka); ptexf_across_edge(s, &ka, f, PTEXF_BOTTOM); }
     else ptexf_merge_bottom(k, vmode);
   }
   ptexf_apply(s, k, faceid);
 }
 
-__kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilterFace* faces,
-                                  __global const uint* level_offsets, __global const uchar* texels,
-                                  __global const PtexFilterQuery* queries, int count, __global float* out) {
-  const int id = (int)get_global_id(0);
-  if (id >= count) return;
-  const PtexFilterQuery q = queries[id];
-  __global float* dst = out + 4 * id;
-  for (int c = 0; c < 4; ++c) dst[c] = 0.0f;
-  if (q.face < 0 || q.face >= tex.face_count) return;
-  PtexfState s;
-  s.faces = faces;
-  s.level_offsets = level_offsets;
-  s.texels = texels;
-  s.tex = tex;
-  s.weight = 0.0f;
-  for (int c = 0; c < 4; ++c) s.result[c] = 0.0f;
-  const PtexFilterFace f = faces[q.face];
-  const int nchan = tex.channels;
+/* Lookup q on the texture s reads (s->tex, faces, level_offsets, texels): 4 floats into out,
+ * channels beyond the texture's 0. */
+SEAMCL_INLINE void ptexf_lookup(PtexfState* s, const PtexFilterQuery* q, float* out) {
+  for (int c = 0; c < 4; ++c) out[c] = 0.0f;
+  if (q->face < 0 || q->face >= s->tex.face_count) return;
+  s->weight = 0.0f;
+  s->applied = 0.0f;
+  for (int c = 0; c < 4; ++c) s->result[c] = 0.0f;
+  const PtexFilterFace f = s->faces[q->face];
+  const int nchan = s->tex.channels;
   if ((f.flags & SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT) != 0u) {
-    const uint base = ptexf_level(&s, f, 0, 0) * (uint)nchan;
-    for (int c = 0; c < nchan; ++c) dst[c] = ptexf_texel(&s, base + (uint)c) / tex.one_value;
+    const uint base = ptexf_level(s, f, 0, 0) * (uint)nchan;
+    for (int c = 0; c < nchan; ++c) out[c] = ptexf_texel(s, base + (uint)c) / s->tex.one_value;
     return;
   }
-  float u = q.u, v = q.v;
-  if (q.filter == SEAMCL_PTEX_POINT) {
+  float u = q->u, v = q->v;
+  if (q->filter == SEAMCL_PTEX_POINT) {
     const int resu = 1 << f.ulog2, resv = 1 << f.vlog2;
     const int ui = clamp((int)(u * (float)resu), 0, resu - 1);
     const int vi = clamp((int)(v * (float)resv), 0, resv - 1);
-    const uint base = (ptexf_level(&s, f, f.ulog2, f.vlog2) + (uint)(vi * resu + ui)) * (uint)nchan;
-    for (int c = 0; c < nchan; ++c) dst[c] = ptexf_texel(&s, base + (uint)c) / tex.one_value;
+    const uint base = (ptexf_level(s, f, f.ulog2, f.vlog2) + (uint)(vi * resu + ui)) * (uint)nchan;
+    for (int c = 0; c < nchan; ++c) out[c] = ptexf_texel(s, base + (uint)c) / s->tex.one_value;
     return;
   }
+  const int umode = s->tex.seams == SEAMCL_PTEX_SEAMS_PTEX ? s->tex.u_border_mode : 0;
+  const int vmode = s->tex.seams == SEAMCL_PTEX_SEAMS_PTEX ? s->tex.v_border_mode : 0;
   bool black = false;
-  if (tex.u_border_mode == PTEXF_PERIODIC) u = u - floor(u);
-  else if (tex.u_border_mode == PTEXF_BLACK) black = u <= -1.0f || u >= 2.0f;
+  if (umode == PTEXF_PERIODIC) u = u - floor(u);
+  else if (umode == PTEXF_BLACK) black = u <= -1.0f || u >= 2.0f;
   else u = clamp(u, 0.0f, 1.0f);
-  if (tex.v_border_mode == PTEXF_PERIODIC) v = v - floor(v);
-  else if (tex.v_border_mode == PTEXF_BLACK) black = black || v <= -1.0f || v >= 2.0f;
+  if (vmode == PTEXF_PERIODIC) v = v - floor(v);
+  else if (vmode == PTEXF_BLACK) black = black || v <= -1.0f || v >= 2.0f;
   else v = clamp(v, 0.0f, 1.0f);
   if (black) return;
   PtexfKernel k;
   k.rot = 0;
-  ptexf_build(&k, &q, u, v, fabs(q.uw), fabs(q.vw), f.ulog2, f.vlog2);
+  ptexf_build(&k, q, u, v, fabs(q->uw), fabs(q->vw), f.ulog2, f.vlog2);
   ptexf_strip_zeros(&k);
   if (k.uw <= 0 || k.vw <= 0) return;
-  s.weight = ptexf_weight(&k);
-  ptexf_split_and_apply(&s, &k, q.face);
-  const float w = s.weight * tex.one_value;
+  s->weight = ptexf_weight(&k);
+  ptexf_split_and_apply(s, &k, q->face);
+  const float w = (s->tex.seams == SEAMCL_PTEX_SEAMS_DISCARD ? s->applied : s->weight) * s->tex.one_value;
   if (!(w != 0.0f) || isinf(w) || isnan(w)) return;
   const float scale = 1.0f / w;
-  for (int c = 0; c < nchan; ++c) dst[c] = s.result[c] * scale;
+  for (int c = 0; c < nchan; ++c) out[c] = s->result[c] * scale;
 }
+
+#endif

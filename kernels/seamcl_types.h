@@ -73,6 +73,7 @@ typedef float cl_float;
 #define SEAMCL_FILTER_TRILINEAR 1 /* two levels around log2 of the longer screen axis */
 #define SEAMCL_FILTER_ANISO 2     /* up to max_aniso trilinear probes along the major axis */
 #define SEAMCL_FILTER_EWA 3       /* elliptical Gaussian over the texels of two levels */
+#define SEAMCL_FILTER_PTEX 4      /* Ptex's own filters (ptex_filter.cl, PtexShading): the shading program only */
 /* SamplerParams.address: where taps outside the level read */
 #define SEAMCL_ADDRESS_CLAMP 0    /* the nearest edge texel */
 #define SEAMCL_ADDRESS_WRAP 1     /* the texture repeats */
@@ -376,8 +377,28 @@ typedef struct {
   cl_int edge_filter_mode; /* 0 none, 1 tanvec */
   cl_int face_count;
   cl_float one_value;      /* 255, 65535 or 1: a texel's value for 1.0 */
-  cl_int pad0;
+  cl_int seams;            /* SEAMCL_PTEX_SEAMS_*: 0 (Ptex's own) for lookups; a render's seam method */
 } PtexFilterTexture;
+
+/* How a Ptex filter treats face edges. PTEX: the library's rules (neighbours, corners, the file's
+ * border modes). The others walk no neighbour: every face edge is a boundary whose taps are merged
+ * onto the edge texels (CLAMP), dropped (BLACK: the edge darkens) or dropped with the rest
+ * renormalised (DISCARD), and a point outside the face is clamped into it. */
+#define SEAMCL_PTEX_SEAMS_PTEX 0
+#define SEAMCL_PTEX_SEAMS_CLAMP 1
+#define SEAMCL_PTEX_SEAMS_BLACK 2
+#define SEAMCL_PTEX_SEAMS_DISCARD 3
+
+/* A render's Ptex filter (shade_resolve.cl built with SEAMCL_SAMPLER_FILTER = SEAMCL_FILTER_PTEX):
+ * every fragment looks up (face, u, v, uw, vw) with uw = (|du/dx| + |du/dy|) * width_scale and
+ * vw = (|dv/dx| + |dv/dy|) * width_scale, as PtexFilter::eval sums a renderer's derivatives. */
+typedef struct {
+  PtexFilterTexture texture; /* with seams: the render's seam method */
+  cl_int filter;             /* SEAMCL_PTEX_* */
+  cl_float sharpness;        /* SEAMCL_PTEX_BICUBIC only */
+  cl_float width_scale;      /* Ptex's `width` option: 2^lod_bias */
+  cl_int rgb_source[3];      /* the file's channel shown as red, green, blue; -1: 0 */
+} PtexShading;
 
 typedef struct {
   cl_int face;

@@ -25,8 +25,15 @@
  * past a corner only); else SEAMCL_MASK_BOUNDARY: some footprint crosses a mesh boundary edge
  * only; else SEAMCL_MASK_NONE, and there every seam method returns the same colour.
  * Without guard bands only (GUARD 0): a band would count as inside.
+ * Ptex variant (SEAMCL_SAMPLER_FILTER = SEAMCL_FILTER_PTEX): the lookup is Ptex's own filter
+ * (ptexf_lookup of ptex_filter.cl) on the .ptx's faces: (face, u, v, uw, vw) with uw = (|du/dx| +
+ * |du/dy|) * width_scale, vw = (|dv/dx| + |dv/dy|) * width_scale (PtexFilter::eval's sums of a
+ * renderer's derivatives), the seam rule in ptex.texture.seams; its channels shown through
+ * ptex.rgb_source. A non-finite point shades black, a non-finite width reads a whole face.
  * Host guarantees: sample_triangle from raster of this frame; seam_mask holds width * height
- * bytes when SEAMCL_SEAM_MASK is 1 (unused otherwise).
+ * bytes when SEAMCL_SEAM_MASK is 1 (unused otherwise); in the Ptex variant, face i of the scene is
+ * face i of ptex_faces (the other variants never read the ptex arguments; they may be null) and
+ * no seam mask.
  * Twin: host/pipeline/stages/shade_resolve_twin.cpp (reflections:
  * host/pipeline/stages/shade_resolve_reflection_twin.cpp). */
 
@@ -36,6 +43,17 @@
 
 #ifndef SEAMCL_SEAM_MASK
 #define SEAMCL_SEAM_MASK 0
+#endif
+
+#if defined(SEAMCL_SAMPLER_FILTER) && SEAMCL_SAMPLER_FILTER == SEAMCL_FILTER_PTEX
+#define SEAMCL_SHADE_PTEX 1
+typedef struct {
+  PtexfState state;     /* the .ptx's buffers and texture record (seams: the render's rule) */
+  PtexShading shading;
+} PtexSource;
+#else
+#define SEAMCL_SHADE_PTEX 0
+typedef int PtexSource; /* unused */
 #endif
 
 typedef struct {
@@ -197,18 +215,48 @@ SEAMCL_INLINE uint lanes_equal(uint16 v, uint value) {
 /* The index of the lowest set bit of x != 0. */
 SEAMCL_INLINE int lowest_bit(uint x) { return (int)popcount((x & (0u - x)) - 1u); }
 
+#if SEAMCL_SHADE_PTEX
+/* Not inlined: the lookup is large, and the kernel calls shade_fragment twice (per sample, per
+ * triangle); one copy keeps the variant's build short, as environment_lookup does. */
+__attribute__((noinline)) float4 ptex_albedo(const PtexSource* ptex, int face, SurfaceUv s) {
+  const PtexShading* p = &ptex->shading;
+  PtexFilterQuery q;
+  q.face = isfinite(s.u) && isfinite(s.v) ? face : -1;
+  q.filter = p->filter;
+  q.u = s.u;
+  q.v = s.v;
+  const float uw = (fabs(s.dudx) + fabs(s.dudy)) * p->width_scale;
+  const float vw = (fabs(s.dvdx) + fabs(s.dvdy)) * p->width_scale;
+  q.uw = isfinite(uw) ? uw : 1.0f;
+  q.vw = isfinite(vw) ? vw : 1.0f;
+  q.sharpness = p->sharpness;
+  q.pad0 = 0;
+  PtexfState state = ptex->state;
+  float value[4];
+  ptexf_lookup(&state, &q, value);
+  float rgb[3];
+  for (int o = 0; o < 3; ++o) rgb[o] = p->rgb_source[o] >= 0 ? value[p->rgb_source[o]] : 0.0f;
+  return (float4)(rgb[0], rgb[1], rgb[2], 1.0f);
+}
+#endif
+
 SEAMCL_INLINE float3 shade_fragment(__constant FrameParams* frame, __global const TriangleSetup* t,
                              __global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
                              __global const uint* level_offsets, TEXEL_BUFFER texels,
                              __global const float* srgb_to_linear, __global const ReflectiveFace* reflective_faces,
-                             __global const float* cube_texels, float x, float y) {
+                             __global const float* cube_texels, const PtexSource* ptex, float x, float y) {
   const SurfaceUv s = interpolate_uv(t, x, y);
 #if SEAMCL_CUBE
   const int reflective = faces[t->face].reflective;
   if (reflective >= 0) return shade_reflection(frame, reflective_faces + reflective, cube_texels, s);
 #endif
+#if SEAMCL_SHADE_PTEX
+  const float4 albedo = ptex_albedo(ptex, t->face, s);
+#else
+  (void)ptex;
   const float4 albedo = sample_texture(faces, neighbors, t->face, level_offsets, texels, srgb_to_linear, frame->sampler,
                                        s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
+#endif
   __global const FaceGpu* face = faces + t->face;
   const float n_dot_l = face->normal[0] * frame->light_dir[0] + face->normal[1] * frame->light_dir[1] +
                         face->normal[2] * frame->light_dir[2];
@@ -300,13 +348,29 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
                    __global const uint* level_offsets, TEXEL_BUFFER texels,
                    __global const float* srgb_to_linear, __global const uint* sample_triangle, __global float4* image,
                    __global FrameStats* stats, __global uchar* seam_mask,
-                   __global const ReflectiveFace* reflective_faces, __global const float* cube_texels) {
+                   __global const ReflectiveFace* reflective_faces, __global const float* cube_texels,
+                   PtexShading ptex, __global const PtexFilterFace* ptex_faces, __global const uint* ptex_level_offsets,
+                   __global const uchar* ptex_texels) {
   /* Fragments are summed per work-group without atomics: a locked add per pixel waits for the
    * pixel's image store to drain (docs/performance.md, "faces" rows). */
   __local uint group_fragments[SEAMCL_TILE_SIZE * SEAMCL_TILE_SIZE];
   const int x = (int)get_global_id(0);
   const int y = (int)get_global_id(1);
   uint fragments = 0;
+#if SEAMCL_SHADE_PTEX
+  PtexSource ptex_source;
+  ptex_source.state.faces = ptex_faces;
+  ptex_source.state.level_offsets = ptex_level_offsets;
+  ptex_source.state.texels = ptex_texels;
+  ptex_source.state.tex = ptex.texture;
+  ptex_source.shading = ptex;
+#else
+  const PtexSource ptex_source = 0;
+  (void)ptex;
+  (void)ptex_faces;
+  (void)ptex_level_offsets;
+  (void)ptex_texels;
+#endif
   if (x < frame->width && y < frame->height) {
     const int samples = frame->sample_count;
     const int row = sample_pattern_row(samples);
@@ -325,7 +389,7 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
         }
         const float sample_x = (float)sample_fixed_x(x, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
         const float sample_y = (float)sample_fixed_y(y, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
-        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, sample_x, sample_y);
+        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, &ptex_source, sample_x, sample_y);
 #if SEAMCL_SEAM_MASK
         crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,
                                                       srgb_to_linear, sample_x, sample_y));
@@ -364,7 +428,7 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
           shade_x = centroid_x / (float)covered;
           shade_y = centroid_y / (float)covered;
         }
-        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, shade_x, shade_y) *
+        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, &ptex_source, shade_x, shade_y) *
                (float)covered;
 #if SEAMCL_SEAM_MASK
         crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,

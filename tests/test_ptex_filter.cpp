@@ -108,6 +108,49 @@ TEST(PtexFilter, MatchesThePtexLibraryOnEveryFilterNearEdgesCornersAndResolution
   }
 }
 
+// The seam rules of renders whose method reads no neighbour (PtexFilterTexture::seams), against a
+// model: a bilinear lookup on a face's left edge at the centre of texel row j weighs the edge texel
+// and one tap past the edge, half each. Clamp folds that tap onto the edge texel (the edge texel),
+// black drops it (half the edge texel), discard drops it and renormalises (the edge texel); Ptex's
+// own rule reads the neighbour there, and a lookup inside the face is the same under every rule.
+TEST(PtexFilter, SeamRulesWithoutNeighboursKeepToTheFace) {
+  const PtexFilterData data = filter_sample("cube_text");
+  ASSERT_EQ(data.texture.data_type, 0);
+  ASSERT_EQ(data.texture.channels, 1);
+  for (int face = 0; face < 6; ++face) {
+    const PtexFilterFace& f = data.faces[face];
+    const int resu = 1 << f.ulog2, resv = 1 << f.vlog2;
+    const int j = resv / 2 + face;
+    const size_t level = data.level_offsets[f.level_base + static_cast<size_t>(f.ulog2) * (f.vlog2 + 1) + f.vlog2];
+    const float edge = static_cast<float>(data.texels[level + static_cast<size_t>(j) * resu]) / 255.0f;
+    PtexFilterQuery q{};
+    q.face = face;
+    q.filter = SEAMCL_PTEX_BILINEAR;
+    q.u = 0.0f;
+    q.v = (static_cast<float>(j) + 0.5f) / static_cast<float>(resv);
+    PtexFilterTexture rule = data.texture;
+    auto with = [&](int seams, const PtexFilterQuery& query) {
+      rule.seams = seams;
+      return ptex_filter_twin(data, rule, query)[0];
+    };
+    EXPECT_FLOAT_EQ(with(SEAMCL_PTEX_SEAMS_CLAMP, q), edge) << face;
+    EXPECT_FLOAT_EQ(with(SEAMCL_PTEX_SEAMS_BLACK, q), 0.5f * edge) << face;
+    EXPECT_FLOAT_EQ(with(SEAMCL_PTEX_SEAMS_DISCARD, q), edge) << face;
+    EXPECT_EQ(with(SEAMCL_PTEX_SEAMS_PTEX, q), ptex_filter_twin(data, q)[0]) << face;
+    // A point outside the face is clamped into it: the same as on its edge.
+    PtexFilterQuery outside = q;
+    outside.u = -0.3f;
+    EXPECT_FLOAT_EQ(with(SEAMCL_PTEX_SEAMS_DISCARD, outside), edge) << face;
+    PtexFilterQuery inside = q;
+    inside.u = 0.5f + 0.5f / static_cast<float>(resu);
+    inside.filter = SEAMCL_PTEX_GAUSSIAN;
+    inside.uw = inside.vw = 2.0f / static_cast<float>(resu);
+    const float own = ptex_filter_twin(data, inside)[0];
+    for (int seams : {SEAMCL_PTEX_SEAMS_CLAMP, SEAMCL_PTEX_SEAMS_BLACK, SEAMCL_PTEX_SEAMS_DISCARD})
+      EXPECT_EQ(with(seams, inside), own) << face << " rule " << seams;
+  }
+}
+
 // The same texture with every texel (every resolution) set to one value: whatever the filter, the
 // point and the widths, near any edge or corner (cube_text: valence 3, 4, 5 and 6; cellnoise: 3, 4
 // and 9, faces of mixed resolutions), the weights Ptex applies must sum to what it divides by.

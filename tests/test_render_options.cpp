@@ -5,6 +5,8 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/options/render_options.h>
 
+#include <tuple>
+
 using nlohmann::json;
 using namespace seamcl;
 
@@ -52,9 +54,52 @@ TEST(RenderOptions, EnumNamesRoundTrip) {
   for (const std::string& name : texel_format_names()) EXPECT_EQ(to_string(*parse_texel_format(name)), name);
   EXPECT_EQ(method_names(),
             (std::vector<std::string>{"clamp", "black", "discard", "traverse", "traverse-edges", "guardband"}));
-  EXPECT_EQ(filter_names(), (std::vector<std::string>{"bilinear", "trilinear", "aniso", "ewa"}));
+  EXPECT_EQ(filter_names(),
+            (std::vector<std::string>{"bilinear", "trilinear", "aniso", "ewa", "ptex-point", "ptex-bilinear", "ptex-box",
+                                      "ptex-gaussian", "ptex-bicubic", "ptex-bspline", "ptex-catmullrom", "ptex-mitchell"}));
   EXPECT_FALSE(parse_method("Clamp").has_value());
   EXPECT_FALSE(parse_shading_mode("").has_value());
+}
+
+// Every ptex-* filter of the render options is a filter `seamcl ptx lookup` takes by the same name,
+// with the same filter code and sharpness; the patch filters are not Ptex's.
+TEST(RenderOptions, PtexFiltersAreTheLookupsFiltersByName) {
+  int ptex = 0;
+  for (const std::string& name : filter_names()) {
+    const Filter filter = *parse_filter(name);
+    EXPECT_EQ(is_ptex_filter(filter), name.rfind("ptex-", 0) == 0) << name;
+    if (!is_ptex_filter(filter)) continue;
+    ++ptex;
+    float sharpness = -1.0f;
+    const int code = ptex_filter_code(filter, sharpness);
+    EXPECT_EQ(sampler_params(Method::Traverse, filter, 16, ZeroCoverage::Clamp).filter, SEAMCL_FILTER_PTEX) << name;
+    if (name == "ptex-catmullrom") EXPECT_EQ(sharpness, 1.0f);
+    if (name == "ptex-mitchell") EXPECT_FLOAT_EQ(sharpness, 2.0f / 3.0f);
+    if (name == "ptex-bicubic" || name == "ptex-bspline") EXPECT_EQ(sharpness, 0.0f);
+    EXPECT_EQ(code, name == "ptex-point" ? SEAMCL_PTEX_POINT
+                    : name == "ptex-bilinear" ? SEAMCL_PTEX_BILINEAR
+                    : name == "ptex-box" ? SEAMCL_PTEX_BOX
+                    : name == "ptex-gaussian" ? SEAMCL_PTEX_GAUSSIAN
+                                              : SEAMCL_PTEX_BICUBIC)
+        << name;
+  }
+  EXPECT_EQ(ptex, 8);
+  // One program variant for all of them, whatever the method (the seam rule is a run-time setting).
+  const SamplerParams a = sampler_params(Method::Traverse, Filter::PtexBox, 16, ZeroCoverage::Nan);
+  const SamplerParams b = sampler_params(Method::Clamp, Filter::PtexGaussian, 4, ZeroCoverage::Clamp);
+  EXPECT_EQ(std::tie(a.address, a.renormalize, a.traverse, a.guard_band, a.zero_coverage),
+            std::tie(b.address, b.renormalize, b.traverse, b.guard_band, b.zero_coverage));
+  EXPECT_EQ(ptex_seam_rule(Method::Traverse), SEAMCL_PTEX_SEAMS_PTEX);
+  EXPECT_EQ(ptex_seam_rule(Method::Discard), SEAMCL_PTEX_SEAMS_DISCARD);
+  for (Method refused : {Method::TraverseEdges, Method::Guardband}) {
+    try {
+      ptex_seam_rule(refused);
+      ADD_FAILURE() << to_string(refused) << " is taken";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), "method");
+      EXPECT_NE(std::string(e.what()).find(to_string(refused)), std::string::npos) << e.what();
+    }
+  }
 }
 
 struct BadOption {

@@ -36,6 +36,7 @@ Scene scene_from_ptex(ObjMesh mesh, PtexFile ptex, const std::string& mesh_name,
   for (size_t f = 0; f < scene.faces.size(); ++f) scene.faces[f].texture = std::move(ptex.textures[f]);
   scene.texture_source = std::move(ptex.texture_source);  // the deferred faces' (empty when none is)
   scene.texture_source_bytes = static_cast<size_t>(ptex.texture_source_bytes);
+  scene.ptex_file = ptex_name;
   frame_camera(scene);
   validate_scene(scene);
   return scene;

@@ -11,6 +11,7 @@
 #include "pipeline/displacement_packing.h"
 #include "pipeline/stages/tessellate_launcher.h"
 #include "pipeline/tessellation_factors.h"
+#include "ptexfilter/ptex_filter_texture.h"
 
 namespace seamcl {
 namespace {
@@ -65,6 +66,7 @@ RenderJob::RenderJob(const json& request) {
   if (render_request.contains("frames") && !render_request.contains("frame"))
     throw InputError("frames", "is ignored without frame (the scene's own camera renders): leave it out");
   options_ = parse_render_options(render_request);
+  if (is_ptex_filter(options_.filter)) ptex_seam_rule(options_.method);  // refuses the methods they cannot take
   if (crack_orbit_ > 0 && !options_.displacement)
     throw InputError("crack_orbit", "counts the cracks of a displaced render: give displacement_method too");
   if (!export_mesh_.empty()) {
@@ -102,6 +104,12 @@ RenderRun RenderJob::run(ClRuntime& runtime, Renderer& renderer, const Scene& sc
   // run only (host/pipeline/stage_stop.h).
   const StageStopScope stage_stop(control.should_stop);
   throw_if_stopped(control.should_stop, "before the kernels");
+  // Ptex's own filters read the scene's .ptx again, in its own units: once per file a Renderer keeps.
+  const std::string& ptex_file = renderer.scene().ptex_file;
+  if (is_ptex_filter(options_.filter) && !ptex_file.empty() && renderer.ptex_texture_file() != ptex_file) {
+    renderer.set_ptex_texture(std::make_shared<const PtexFilterData>(build_ptex_filter_data(read_ptex_stored(ptex_file))),
+                              ptex_file);
+  }
   renderer.warm_up(options_);
   RenderRun run;
   // Each run's times, and only the last run's image: holding every frame kept `repeat` images

@@ -28,6 +28,7 @@ std::vector<WarmupVariant> warmup_variants() {
   std::vector<WarmupVariant> out;
   for (const std::string& method : method_names()) {
     for (const std::string& filter : filter_names()) {
+      if (is_ptex_filter(*parse_filter(filter))) continue;
       WarmupVariant v;
       v.name = method + " " + filter;
       v.options = parse_render_options({{"method", method}, {"filter", filter}});
@@ -35,8 +36,16 @@ std::vector<WarmupVariant> warmup_variants() {
       out.push_back(std::move(v));
     }
   }
+  // Ptex's own filters share one program whatever the filter and method (both are run-time
+  // settings of the lookup), and have no seam mask.
+  WarmupVariant ptex;
+  ptex.name = "ptex filters";
+  ptex.options = parse_render_options({{"method", "traverse"}, {"filter", "ptex-bilinear"}});
+  ptex.build_options = program_options(ptex.options.texels, sampler_params(ptex.options));
+  out.push_back(std::move(ptex));
   // The seam mask is rendered with black (footprint_seam_mask): its own build per filter.
   for (const std::string& filter : filter_names()) {
+    if (is_ptex_filter(*parse_filter(filter))) continue;
     WarmupVariant v;
     v.name = "seam mask " + filter;
     v.options = parse_render_options({{"method", "black"}, {"filter", filter}});
@@ -141,6 +150,8 @@ WarmupReport WarmupJob::run(ClRuntime& runtime, const std::vector<WarmupVariant>
     renderer.load_scene(generate_scene("quad2", GeneratorOptions{}));
     int rendered = 0;
     for (const WarmupVariant& variant : variants) {
+      // The warm-up scene has no .ptx for Ptex's filters to read: their program is built only.
+      if (is_ptex_filter(variant.options.filter)) continue;
       RenderOptions tiny = variant.options;
       tiny.width = SEAMCL_TILE_SIZE;
       tiny.height = SEAMCL_TILE_SIZE;

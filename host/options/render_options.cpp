@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <functional>
+#include <stdexcept>
 #include <tuple>
 #include <utility>
 
@@ -43,8 +44,18 @@ constexpr std::array<std::pair<Method, const char*>, 6> kMethods{{{Method::Clamp
                                                                   {Method::Traverse, "traverse"},
                                                                   {Method::TraverseEdges, "traverse-edges"},
                                                                   {Method::Guardband, "guardband"}}};
-constexpr std::array<std::pair<Filter, const char*>, 4> kFilters{
-    {{Filter::Bilinear, "bilinear"}, {Filter::Trilinear, "trilinear"}, {Filter::Aniso, "aniso"}, {Filter::Ewa, "ewa"}}};
+constexpr std::array<std::pair<Filter, const char*>, 12> kFilters{{{Filter::Bilinear, "bilinear"},
+                                                                   {Filter::Trilinear, "trilinear"},
+                                                                   {Filter::Aniso, "aniso"},
+                                                                   {Filter::Ewa, "ewa"},
+                                                                   {Filter::PtexPoint, "ptex-point"},
+                                                                   {Filter::PtexBilinear, "ptex-bilinear"},
+                                                                   {Filter::PtexBox, "ptex-box"},
+                                                                   {Filter::PtexGaussian, "ptex-gaussian"},
+                                                                   {Filter::PtexBicubic, "ptex-bicubic"},
+                                                                   {Filter::PtexBspline, "ptex-bspline"},
+                                                                   {Filter::PtexCatmullrom, "ptex-catmullrom"},
+                                                                   {Filter::PtexMitchell, "ptex-mitchell"}}};
 constexpr std::array<std::pair<ZeroCoverage, const char*>, 2> kZeroCoverage{
     {{ZeroCoverage::Clamp, "clamp"}, {ZeroCoverage::Nan, "nan"}}};
 constexpr std::array<std::pair<TexelFormat, const char*>, 2> kTexelFormats{
@@ -78,6 +89,38 @@ std::string to_string(ImageFormat format) { return enum_name(format, kFormats); 
 std::optional<Filter> parse_filter(std::string_view name) { return parse_enum(name, kFilters); }
 std::string to_string(Filter filter) { return enum_name(filter, kFilters); }
 std::vector<std::string> filter_names() { return enum_names(kFilters); }
+bool is_ptex_filter(Filter filter) { return filter >= Filter::PtexPoint; }
+
+int ptex_filter_code(Filter filter, float& sharpness) {
+  sharpness = 0.0f;
+  switch (filter) {
+    case Filter::PtexPoint: return SEAMCL_PTEX_POINT;
+    case Filter::PtexBilinear: return SEAMCL_PTEX_BILINEAR;
+    case Filter::PtexBox: return SEAMCL_PTEX_BOX;
+    case Filter::PtexGaussian: return SEAMCL_PTEX_GAUSSIAN;
+    case Filter::PtexBicubic:
+    case Filter::PtexBspline: return SEAMCL_PTEX_BICUBIC;
+    case Filter::PtexCatmullrom: sharpness = 1.0f; return SEAMCL_PTEX_BICUBIC;
+    case Filter::PtexMitchell: sharpness = 2.0f / 3.0f; return SEAMCL_PTEX_BICUBIC;
+    default: throw std::logic_error("ptex_filter_code: " + to_string(filter) + " is not a Ptex filter");
+  }
+}
+
+int ptex_seam_rule(Method method) {
+  switch (method) {
+    case Method::Traverse: return SEAMCL_PTEX_SEAMS_PTEX;
+    case Method::Clamp: return SEAMCL_PTEX_SEAMS_CLAMP;
+    case Method::Black: return SEAMCL_PTEX_SEAMS_BLACK;
+    case Method::Discard: return SEAMCL_PTEX_SEAMS_DISCARD;
+    case Method::TraverseEdges:
+      throw InputError("method", "traverse-edges leaves out the corners, which Ptex's filters always read: use traverse "
+                                 "(the Ptex library's own rules), or clamp, black or discard (no neighbour read)");
+    case Method::Guardband:
+      throw InputError("method", "guardband fills bands of the packed texture, which Ptex's filters do not read: use "
+                                 "traverse (the Ptex library's own rules), or clamp, black or discard (no neighbour read)");
+  }
+  throw std::logic_error("ptex_seam_rule: unknown method");
+}
 std::optional<ZeroCoverage> parse_zero_coverage(std::string_view name) { return parse_enum(name, kZeroCoverage); }
 std::string to_string(ZeroCoverage mode) { return enum_name(mode, kZeroCoverage); }
 std::vector<std::string> zero_coverage_names() { return enum_names(kZeroCoverage); }
@@ -94,6 +137,16 @@ bool needs_adjacency(Method method) { return reads_adjacency(method) || method =
 SamplerParams sampler_params(Method method, Filter filter, int max_aniso, ZeroCoverage zero_coverage, int guard_band,
                              float lod_bias) {
   SamplerParams p{};
+  if (is_ptex_filter(filter)) {
+    // One program variant for every Ptex filter and method: the filter, its sharpness and the seam
+    // rule are run-time settings of the lookup (PtexShading), the packed texture is never sampled.
+    p.filter = SEAMCL_FILTER_PTEX;
+    p.address = SEAMCL_ADDRESS_BORDER;
+    p.max_aniso = max_aniso;
+    p.zero_coverage = SEAMCL_ZERO_COVERAGE_CLAMP;
+    p.lod_bias = lod_bias;
+    return p;
+  }
   p.filter = filter == Filter::Bilinear    ? SEAMCL_FILTER_BILINEAR
              : filter == Filter::Trilinear ? SEAMCL_FILTER_TRILINEAR
              : filter == Filter::Aniso     ? SEAMCL_FILTER_ANISO

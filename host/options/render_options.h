@@ -29,8 +29,24 @@ namespace seamcl {
 //   guardband - clamp, on textures whose every level carries a band of guard_band texels
 //               filled from the neighbours at build time (McDonald and Burley 2011).
 enum class Method { Clamp, Black, Discard, Traverse, TraverseEdges, Guardband };
-// The filter of one lookup: bilinear (level 0), trilinear, aniso (hardware-style probes), ewa.
-enum class Filter { Bilinear, Trilinear, Aniso, Ewa };
+// The filter of one lookup: bilinear (level 0), trilinear, aniso (hardware-style probes), ewa; or
+// one of Ptex's own filters (ptex-*, docs/ptex-filters.md), which read a .ptx scene's faces as the
+// Ptex library does: ptex-point, ptex-bilinear, ptex-box, ptex-gaussian, ptex-bicubic (sharpness
+// 0, as ptex-bspline), ptex-bspline, ptex-catmullrom (sharpness 1), ptex-mitchell (2/3).
+enum class Filter {
+  Bilinear,
+  Trilinear,
+  Aniso,
+  Ewa,
+  PtexPoint,
+  PtexBilinear,
+  PtexBox,
+  PtexGaussian,
+  PtexBicubic,
+  PtexBspline,
+  PtexCatmullrom,
+  PtexMitchell
+};
 // Discard with every tap outside: a clamped lookup (the paper's fix) or the raw 0/0 (NaN).
 enum class ZeroCoverage { Clamp, Nan };
 // Where a fragment is shaded: the pixel centre, the centroid of its covered samples, or every
@@ -74,6 +90,15 @@ std::string to_string(ImageFormat format);
 std::optional<Filter> parse_filter(std::string_view name);
 std::string to_string(Filter filter);
 std::vector<std::string> filter_names();
+// Whether the filter is one of Ptex's own (ptex-*).
+bool is_ptex_filter(Filter filter);
+// A Ptex filter's SEAMCL_PTEX_* and sharpness (bicubic's B-spline to Catmull-Rom blend).
+int ptex_filter_code(Filter filter, float& sharpness);
+// The rule a Ptex filter applies at face edges under `method` (SEAMCL_PTEX_SEAMS_*): traverse, the
+// library's own (neighbours and corners); clamp, black and discard, every face edge a boundary of
+// that rule. InputError("method") for traverse-edges (Ptex's filter always takes the corners) and
+// guardband (its bands belong to the packed texture, which Ptex filters do not read).
+int ptex_seam_rule(Method method);
 std::optional<ZeroCoverage> parse_zero_coverage(std::string_view name);
 std::string to_string(ZeroCoverage mode);
 std::vector<std::string> zero_coverage_names();

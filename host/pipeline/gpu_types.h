@@ -43,4 +43,8 @@ static_assert(sizeof(PtexFilterFace) == 40, "PtexFilterFace layout");
 static_assert(offsetof(PtexFilterFace, level_base) == 32);
 static_assert(sizeof(PtexFilterTexture) == 32, "PtexFilterTexture layout");
 static_assert(sizeof(PtexFilterQuery) == 32, "PtexFilterQuery layout");
+static_assert(offsetof(PtexFilterTexture, seams) == 28);
+static_assert(sizeof(PtexShading) == 56, "PtexShading layout");
+static_assert(offsetof(PtexShading, width_scale) == 40);
+static_assert(offsetof(PtexShading, rgb_source) == 44);
 static_assert(offsetof(PtexFilterQuery, sharpness) == 24);

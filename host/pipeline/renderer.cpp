@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <optional>
 #include <cassert>
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -13,6 +14,7 @@
 #include "pipeline/frame_params.h"
 #include "pipeline/stages/binning_launcher.h"
 #include "pipeline/stages/downsample_launcher.h"
+#include "pipeline/stages/ptex_filter_twin.h"
 #include "pipeline/stages/raster_launcher.h"
 #include "pipeline/stages/shade_inspect_launcher.h"
 #include "pipeline/stages/shade_resolve_launcher.h"
@@ -58,6 +60,13 @@ struct Renderer::Impl {
   // render_downsampled: the stage that reduces the image on the device before the read-back.
   DownsampleLauncher downsampler{runtime};
   const DownsampleTaps* downsample_taps = nullptr;
+  // Ptex's own filters: the file's faces as they read them (set_ptex_texture), uploaded once, and
+  // this frame's settings (null buffers and zeros for the other filters).
+  std::shared_ptr<const PtexFilterData> ptex;
+  std::string ptex_file;
+  cl::Buffer ptex_faces, ptex_level_offsets, ptex_texels;
+  PtexShading ptex_shading{};
+  bool ptex_frame = false;
 
   explicit Impl(ClRuntime& rt) : runtime(rt) {
     const auto& table = srgb_to_linear_table();
@@ -205,7 +214,41 @@ struct Renderer::Impl {
   }
 
   ShadeSceneBuffers shade_scene_buffers() const {
-    return ShadeSceneBuffers{faces, neighbors, level_offsets, texels, srgb_table, reflective_faces, cube_texels};
+    static const cl::Buffer none;
+    return ShadeSceneBuffers{faces,        neighbors,   level_offsets, texels, srgb_table, reflective_faces, cube_texels,
+                             ptex_frame ? ptex_faces : none, ptex_frame ? ptex_level_offsets : none,
+                             ptex_frame ? ptex_texels : none, ptex_frame ? ptex_shading : PtexShading{}};
+  }
+
+  // The checks and settings of a frame with one of Ptex's own filters; InputError naming the field.
+  void prepare_ptex_frame(const RenderOptions& options, bool with_seam_mask) {
+    const std::string filter = to_string(options.filter);
+    if (with_seam_mask) {
+      throw InputError("filter", filter + ": the seam mask measures the footprints of the packed texture's filters, "
+                                          "which Ptex's filters do not read");
+    }
+    const int seams = ptex_seam_rule(options.method);
+    if (scene->ptex_file.empty()) {
+      throw InputError("filter", filter + " filters the faces of a .ptx file, and scene '" + scene->name +
+                                     "' has none: give a mesh with a .ptx texture (--scene MESH.obj --texture FILE.ptx) "
+                                     "or a .ptx that holds its mesh");
+    }
+    if (!ptex || ptex_file != scene->ptex_file) {
+      // A job that does not load the file for Ptex's filters (only render does).
+      throw InputError("filter", filter + ": '" + scene->ptex_file + "' is not loaded for Ptex's filters here; "
+                                          "`render` offers them");
+    }
+    if (ptex->faces.size() != scene->faces.size()) {
+      throw InputError("texture", "'" + ptex_file + "' has " + std::to_string(ptex->faces.size()) +
+                                      " faces but the scene has " + std::to_string(scene->faces.size()));
+    }
+    ptex_shading = PtexShading{};
+    ptex_shading.texture = ptex->texture;
+    ptex_shading.texture.seams = seams;
+    ptex_shading.filter = ptex_filter_code(options.filter, ptex_shading.sharpness);
+    ptex_shading.width_scale = std::exp2(options.lod_bias);
+    const std::array<cl_int, 3> rgb = ptex_rgb_source(ptex->texture.channels, ptex->alpha_channel);
+    for (int o = 0; o < 3; ++o) ptex_shading.rgb_source[o] = rgb[o];
   }
 
   // Queues one frame; returns the events of each stage in order.
@@ -268,6 +311,7 @@ bool Renderer::has_scene() const { return impl_->scene != nullptr; }
 void Renderer::release_frame_buffers() { impl_->release_frame_buffers(); }
 
 void Renderer::release_scene() {
+  set_ptex_texture(nullptr, "");
   impl_->release_scene_buffers();
   impl_->scene.reset();
   impl_->release_frame_buffers();
@@ -277,7 +321,8 @@ size_t Renderer::device_bytes() const {
   const Impl& i = *impl_;
   size_t bytes = 0;
   for (const cl::Buffer* buffer : {&i.positions, &i.faces, &i.neighbors, &i.level_offsets, &i.texels, &i.reflective_faces,
-                                   &i.cube_texels, &i.srgb_table, &i.frame_params, &i.stats}) {
+                                   &i.cube_texels, &i.srgb_table, &i.frame_params, &i.stats, &i.ptex_faces,
+                                   &i.ptex_level_offsets, &i.ptex_texels}) {
     bytes += buffer_bytes(*buffer);
   }
   return bytes + i.setup.device_bytes() + i.binning.device_bytes() + i.raster.device_bytes() + i.shade.device_bytes() +
@@ -293,8 +338,25 @@ const PackedScene& Renderer::packed_scene() const { return impl_->packed; }
 
 const std::vector<float>& Renderer::cube_texels() const { return impl_->cube_host; }
 
+void Renderer::set_ptex_texture(std::shared_ptr<const PtexFilterData> data, const std::string& file) {
+  Impl& i = *impl_;
+  i.drain_queue();  // queued frames may read the old buffers
+  i.ptex_faces = i.ptex_level_offsets = i.ptex_texels = cl::Buffer();
+  i.ptex = std::move(data);
+  i.ptex_file = i.ptex ? file : std::string();
+  if (!i.ptex) return;
+  i.ptex_faces = i.upload(i.ptex->faces);
+  i.ptex_level_offsets = i.upload(i.ptex->level_offsets);
+  i.ptex_texels = i.upload(i.ptex->texels);
+}
+
+const std::string& Renderer::ptex_texture_file() const { return impl_->ptex_file; }
+const PtexShading& Renderer::ptex_shading() const { return impl_->ptex_shading; }
+
 RenderResult Renderer::render(const Camera& camera, const RenderOptions& options, bool with_seam_mask) {
   if (!impl_->scene) throw std::logic_error("Renderer::render before load_scene");
+  impl_->ptex_frame = is_ptex_filter(options.filter);
+  if (impl_->ptex_frame) impl_->prepare_ptex_frame(options, with_seam_mask);
   if (with_seam_mask && options.method == Method::Guardband) {
     throw InputError("method", "the seam mask is measured on the faces' own texels; guardband's bands would count as "
                                "inside (any other method gives the same mask)");
@@ -486,6 +548,11 @@ RenderResult Renderer::downsample_last_frame(const DownsampleTaps& taps) {
 }
 
 void Renderer::warm_up(const RenderOptions& options) {
+  if (is_ptex_filter(options.filter) && (scene().ptex_file.empty() || impl_->ptex_file != scene().ptex_file)) {
+    // No .ptx to render here (a built-in scene warming every variant): the program alone.
+    impl_->use_kernels(options.texels, sampler_params(options), false);
+    return;
+  }
   RenderOptions tiny = options;
   tiny.width = SEAMCL_TILE_SIZE;
   tiny.height = SEAMCL_TILE_SIZE;

@@ -41,6 +41,8 @@ struct StageTimes {
 
 // One axis's filter of the downsample stage (host/pipeline/stages/downsample_twin.h).
 struct DownsampleTaps;
+// A .ptx as Ptex's own filters read it (host/ptexfilter/ptex_filter_texture.h).
+struct PtexFilterData;
 
 struct RenderResult {
   int width = 0;
@@ -101,6 +103,15 @@ class Renderer {
   // empty for a scene without an environment.
   const std::vector<float>& cube_texels() const;
   bool has_scene() const;
+
+  // Ptex's own filters (the ptex-* filters, docs/ptex-filters.md) read `data`: the file
+  // `file` as build_ptex_filter_data makes it, uploaded here and kept across scenes. A render with
+  // one of them needs the scene's ptex_file to be `file` (InputError("filter") for a scene without
+  // one); null drops it. RenderJob::run sets it from the scene.
+  void set_ptex_texture(std::shared_ptr<const PtexFilterData> data, const std::string& file);
+  const std::string& ptex_texture_file() const;  // empty: none set
+  // The last frame's Ptex settings (the seam rule, filter, widths' scale, channels), for the twins.
+  const PtexShading& ptex_shading() const;
 
   // Frees the buffers sized by a request (triangle setups, tiles and tile lists, the sample
   // buffer, the image) so that a kept Renderer does not hold the largest frame it ever rendered;

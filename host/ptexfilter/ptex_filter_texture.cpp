@@ -182,6 +182,7 @@ PtexFilterData build_ptex_filter_data(const PtexStored& stored, const PtexFilter
   out.texture.v_border_mode = stored.v_border_mode;
   out.texture.edge_filter_mode = stored.edge_filter_mode;
   out.texture.face_count = static_cast<cl_int>(file.faces.size());
+  out.alpha_channel = file.alpha_channel;
   out.texture.one_value = file.data_type == PtexDataType::Uint8    ? 255.0f
                           : file.data_type == PtexDataType::Uint16 ? 65535.0f
                                                                    : 1.0f;

@@ -118,6 +118,9 @@ struct Scene {
   // Per face (empty: 0 for all), what texture_source holds beside the face's level 0 while it makes
   // the face: an image face's decode buffers (texture_making_bytes counts them).
   std::vector<size_t> texture_source_decode_bytes;
+  // The .ptx file whose face i is face i's texture, as resolved (a mesh with a .ptx, or a .ptx that
+  // holds its mesh); empty for others. Ptex's own filters (ptex-*) read it again, in its own units.
+  std::string ptex_file;
 
   size_t triangle_count() const { return faces.size() * 2; }
   std::array<glm::vec3, 4> corners(const Face& f) const;

@@ -372,17 +372,21 @@ void build_kernel(Kern& k, const PtexFilterQuery& q, float u, float v, float uw,
 
 class Evaluator {
  public:
-  Evaluator(const PtexFilterData& data) : d_(data), nchan_(data.texture.channels) {}
+  Evaluator(const PtexFilterData& data, const PtexFilterTexture& texture)
+      : d_(data), tex_(texture), nchan_(texture.channels) {}
 
   float weight_ = 0.0f;
+  float applied_ = 0.0f;  // SEAMCL_PTEX_SEAMS_DISCARD: the weight of the taps read
   float result_[4] = {};
 
   int adj_face(const PtexFilterFace& f, int e) const { return f.adj_faces[e & 3]; }
+  // Whether edge e leads to a neighbour the filter walks to (seam rules other than Ptex's walk none).
+  bool walks(const PtexFilterFace& f, int e) const { return tex_.seams == SEAMCL_PTEX_SEAMS_PTEX && adj_face(f, e) >= 0; }
   int adj_edge(const PtexFilterFace& f, int e) const { return static_cast<int>((f.adj_edges >> (2 * (e & 3))) & 3u); }
 
   float texel(size_t index, int c) const {
     const size_t i = index * static_cast<size_t>(nchan_) + static_cast<size_t>(c);
-    switch (d_.texture.data_type) {
+    switch (tex_.data_type) {
       case 0: return static_cast<float>(d_.texels[i]);
       case 1: {
         uint16_t x;
@@ -430,6 +434,7 @@ class Evaluator {
     if (k.u + k.uw > k.res_u()) k.uw = std::max(0, k.res_u() - k.u);
     if (k.v + k.vw > k.res_v()) k.vw = std::max(0, k.res_v() - k.v);
     if (k.uw <= 0 || k.vw <= 0) return;
+    if (tex_.seams == SEAMCL_PTEX_SEAMS_DISCARD) applied_ += weight(k);
     while (k.ulog2 > f.ulog2) downres_u(k);
     while (k.vlog2 > f.vlog2) downres_v(k);
     float acc[4] = {};
@@ -451,7 +456,7 @@ class Evaluator {
       }
     }
     // Tangent-space vectors (edge filter mode tanvec) turn with the neighbour.
-    if (d_.texture.edge_filter_mode == 1 && nchan_ >= 2 && k.rot > 0) {
+    if (tex_.edge_filter_mode == 1 && nchan_ >= 2 && k.rot > 0) {
       switch (k.rot) {
         case 1: result_[0] -= acc[1]; result_[1] += acc[0]; break;
         case 2: result_[0] -= acc[0]; result_[1] -= acc[1]; break;
@@ -513,17 +518,21 @@ class Evaluator {
     const PtexFilterFace& f = d_.faces[faceid];
     const bool split_r = k.u + k.uw > k.res_u(), split_l = k.u < 0;
     const bool split_t = k.v + k.vw > k.res_v(), split_b = k.v < 0;
-    const int umode = d_.texture.u_border_mode, vmode = d_.texture.v_border_mode;
+    // A seam method that reads no neighbour makes every edge a boundary of its own rule.
+    const int seams = tex_.seams;
+    const int rule = seams == SEAMCL_PTEX_SEAMS_CLAMP ? kClamp : kBlack;
+    const int umode = seams == SEAMCL_PTEX_SEAMS_PTEX ? tex_.u_border_mode : rule;
+    const int vmode = seams == SEAMCL_PTEX_SEAMS_PTEX ? tex_.v_border_mode : rule;
     Kern ka, kc;
     if (split_r) {
-      if (adj_face(f, kRight) >= 0) {
+      if (walks(f, kRight)) {
         split_right(k, ka);
         if (split_t) {
-          if (adj_face(f, kTop) >= 0) { split_top(ka, kc); apply_to_corner(kc, faceid, f, kTop); }
+          if (walks(f, kTop)) { split_top(ka, kc); apply_to_corner(kc, faceid, f, kTop); }
           else merge_top(ka, vmode);
         }
         if (split_b) {
-          if (adj_face(f, kBottom) >= 0) { split_bottom(ka, kc); apply_to_corner(kc, faceid, f, kRight); }
+          if (walks(f, kBottom)) { split_bottom(ka, kc); apply_to_corner(kc, faceid, f, kRight); }
           else merge_bottom(ka, vmode);
         }
         apply_across_edge(ka, f, kRight);
@@ -532,14 +541,14 @@ class Evaluator {
       }
     }
     if (split_l) {
-      if (adj_face(f, kLeft) >= 0) {
+      if (walks(f, kLeft)) {
         split_left(k, ka);
         if (split_t) {
-          if (adj_face(f, kTop) >= 0) { split_top(ka, kc); apply_to_corner(kc, faceid, f, kLeft); }
+          if (walks(f, kTop)) { split_top(ka, kc); apply_to_corner(kc, faceid, f, kLeft); }
           else merge_top(ka, vmode);
         }
         if (split_b) {
-          if (adj_face(f, kBottom) >= 0) { split_bottom(ka, kc); apply_to_corner(kc, faceid, f, kBottom); }
+          if (walks(f, kBottom)) { split_bottom(ka, kc); apply_to_corner(kc, faceid, f, kBottom); }
           else merge_bottom(ka, vmode);
         }
         apply_across_edge(ka, f, kLeft);
@@ -548,11 +557,11 @@ class Evaluator {
       }
     }
     if (split_t) {
-      if (adj_face(f, kTop) >= 0) { split_top(k, ka); apply_across_edge(ka, f, kTop); }
+      if (walks(f, kTop)) { split_top(k, ka); apply_across_edge(ka, f, kTop); }
       else merge_top(k, vmode);
     }
     if (split_b) {
-      if (adj_face(f, kBottom) >= 0) { split_bottom(k, ka); apply_across_edge(ka, f, kBottom); }
+      if (walks(f, kBottom)) { split_bottom(k, ka); apply_across_edge(ka, f, kBottom); }
       else merge_bottom(k, vmode);
     }
     apply(k, faceid);
@@ -560,18 +569,23 @@ class Evaluator {
 
  private:
   const PtexFilterData& d_;
+  const PtexFilterTexture& tex_;  // data's, or a render's with its seam rule
   int nchan_;
 };
 
 }  // namespace
 
 std::array<float, 4> ptex_filter_twin(const PtexFilterData& data, const PtexFilterQuery& q) {
+  return ptex_filter_twin(data, data.texture, q);
+}
+
+std::array<float, 4> ptex_filter_twin(const PtexFilterData& data, const PtexFilterTexture& tex, const PtexFilterQuery& q) {
   std::array<float, 4> out{};
   if (q.face < 0 || q.face >= static_cast<int>(data.faces.size())) return out;
   const PtexFilterFace& f = data.faces[q.face];
-  Evaluator e(data);
-  const int nchan = data.texture.channels;
-  const float one = data.texture.one_value;
+  Evaluator e(data, tex);
+  const int nchan = tex.channels;
+  const float one = tex.one_value;
   if ((f.flags & SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT) != 0) {
     const size_t base = e.level_offset(f, 0, 0);
     for (int c = 0; c < nchan; ++c) out[c] = e.texel(base, c) / one;
@@ -587,13 +601,15 @@ std::array<float, 4> ptex_filter_twin(const PtexFilterData& data, const PtexFilt
     return out;
   }
   const float uw = std::fabs(q.uw), vw = std::fabs(q.vw);
+  // A point outside the face is clamped into it under a seam method that reads no neighbour.
+  const bool own = tex.seams == SEAMCL_PTEX_SEAMS_PTEX;
   bool black = false;
-  switch (data.texture.u_border_mode) {
+  switch (own ? tex.u_border_mode : kClamp) {
     case kClamp: u = std::clamp(u, 0.0f, 1.0f); break;
     case kPeriodic: u = u - std::floor(u); break;
     default: black = u <= -1.0f || u >= 2.0f; break;
   }
-  switch (data.texture.v_border_mode) {
+  switch (own ? tex.v_border_mode : kClamp) {
     case kClamp: v = std::clamp(v, 0.0f, 1.0f); break;
     case kPeriodic: v = v - std::floor(v); break;
     default: black = black || v <= -1.0f || v >= 2.0f; break;
@@ -605,11 +621,50 @@ std::array<float, 4> ptex_filter_twin(const PtexFilterData& data, const PtexFilt
   if (k.uw <= 0 || k.vw <= 0) return out;
   e.weight_ = weight(k);
   e.split_and_apply(k, q.face);
-  const float w = e.weight_ * one;
+  const float w = (tex.seams == SEAMCL_PTEX_SEAMS_DISCARD ? e.applied_ : e.weight_) * one;
   if (!(w != 0.0f) || !std::isfinite(w)) return out;
   const float scale = 1.0f / w;
   for (int c = 0; c < nchan; ++c) out[c] = e.result_[c] * scale;
   return out;
+}
+
+std::array<cl_int, 3> ptex_rgb_source(int channels, int alpha_channel) {
+  std::vector<int> colour;
+  for (int c = 0; c < channels; ++c)
+    if (c != alpha_channel) colour.push_back(c);
+  std::array<cl_int, 3> out{-1, -1, -1};
+  for (size_t o = 0; o < 3; ++o) {
+    if (colour.size() == 1) out[o] = colour[0];
+    else if (o < colour.size()) out[o] = colour[o];
+  }
+  return out;
+}
+
+PtexFilterQuery ptex_fragment_query(const PtexShading& p, int face, float u, float v, float dudx, float dvdx, float dudy,
+                                    float dvdy) {
+  PtexFilterQuery q{};
+  q.face = std::isfinite(u) && std::isfinite(v) ? face : -1;
+  q.filter = p.filter;
+  q.u = u;
+  q.v = v;
+  const float uw = (std::fabs(dudx) + std::fabs(dudy)) * p.width_scale;
+  const float vw = (std::fabs(dvdx) + std::fabs(dvdy)) * p.width_scale;
+  q.uw = std::isfinite(uw) ? uw : 1.0f;
+  q.vw = std::isfinite(vw) ? vw : 1.0f;
+  q.sharpness = p.sharpness;
+  return q;
+}
+
+glm::vec3 ptex_albedo_twin(const PtexRenderTexture& ptex, int face, float u, float v, float dudx, float dvdx, float dudy,
+                           float dvdy) {
+  const std::array<float, 4> value = ptex_filter_twin(*ptex.data, ptex.shading.texture,
+                                                     ptex_fragment_query(ptex.shading, face, u, v, dudx, dvdx, dudy, dvdy));
+  glm::vec3 rgb(0.0f);
+  for (int o = 0; o < 3; ++o) {
+    const int c = ptex.shading.rgb_source[o];
+    rgb[o] = c >= 0 ? value[c] : 0.0f;
+  }
+  return rgb;
 }
 
 }  // namespace seamcl

@@ -37,6 +37,13 @@ void ShadeResolveLauncher::enqueue(const cl::Buffer& frame_params, const cl::Buf
   }
   kernel_.setArg(11, scene.reflective_faces);
   kernel_.setArg(12, scene.cube_texels);
+  kernel_.setArg(13, scene.ptex);
+  int arg = 14;
+  for (const cl::Buffer* buffer : {&scene.ptex_faces, &scene.ptex_level_offsets, &scene.ptex_texels}) {
+    if ((*buffer)() != nullptr) kernel_.setArg(arg, *buffer);
+    else kernel_.setArg(arg, sizeof(cl_mem), nullptr);  // a variant without Ptex never reads it
+    ++arg;
+  }
   const cl::NDRange tile_grid(static_cast<size_t>(p.tiles_x) * SEAMCL_TILE_SIZE, static_cast<size_t>(p.tiles_y) * SEAMCL_TILE_SIZE);
   const cl::NDRange tile_group(SEAMCL_TILE_SIZE, SEAMCL_TILE_SIZE);
   runtime_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, tile_grid, tile_group, nullptr, &events.emplace_back());

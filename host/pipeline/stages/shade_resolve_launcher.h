@@ -24,6 +24,11 @@ struct ShadeSceneBuffers {
   const cl::Buffer& srgb_table;
   const cl::Buffer& reflective_faces;
   const cl::Buffer& cube_texels;
+  // The Ptex variant's .ptx (null buffers elsewhere) and its settings.
+  const cl::Buffer& ptex_faces;
+  const cl::Buffer& ptex_level_offsets;
+  const cl::Buffer& ptex_texels;
+  PtexShading ptex;
 };
 
 class ShadeResolveLauncher {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "pipeline/stages/ptex_filter_twin.h"
 #include "pipeline/stages/raster_twin.h"
 #include "pipeline/stages/sample_pattern.h"
 #include "pipeline/stages/shade_resolve_reflection_twin.h"
@@ -30,12 +31,13 @@ SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y) {
 }
 
 glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& f, const TriangleSetup& t, float x, float y,
-                                   const std::vector<float>* cube_texels) {
+                                   const std::vector<float>* cube_texels, const PtexRenderTexture* ptex) {
   const SurfaceUv s = interpolate_uv(t, x, y);
   const int reflective = scene.faces.at(t.face).reflective;
   if (reflective >= 0) return shade_reflection_reference(f, scene.reflective_faces.at(reflective), *cube_texels, s);
   const glm::vec4 albedo =
-      sample_texture_reference(scene.textures(), t.face, f.sampler, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
+      ptex ? glm::vec4(ptex_albedo_twin(*ptex, static_cast<int>(t.face), s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy), 1.0f)
+           : sample_texture_reference(scene.textures(), t.face, f.sampler, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
   const FaceGpu& face = scene.faces.at(t.face);
   const float n_dot_l = face.normal[0] * f.light_dir[0] + face.normal[1] * f.light_dir[1] + face.normal[2] * f.light_dir[2];
   const float lighting = f.ambient + (1.0f - f.ambient) * std::fmax(n_dot_l, 0.0f);
@@ -139,13 +141,13 @@ bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& f
 ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& f,
                                          const std::vector<TriangleSetup>& setups,
                                          const std::vector<uint32_t>& sample_triangle,
-                                         const std::vector<float>* cube_texels) {
+                                         const std::vector<float>* cube_texels, const PtexRenderTexture* ptex) {
   const int samples = f.sample_count;
   const std::vector<SampleOffset>& pattern = sample_pattern(samples);
   constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
   ResolveReference out;
   out.pixels.resize(static_cast<size_t>(f.width) * f.height);
-  const bool with_mask = !scene.neighbors.empty();
+  const bool with_mask = !scene.neighbors.empty() && ptex == nullptr;
   if (with_mask) out.seam_mask.assign(out.pixels.size(), 0);
   const glm::vec3 background(f.background[0], f.background[1], f.background[2]);
   for (int y = 0; y < f.height; ++y) {
@@ -164,14 +166,14 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
         }
         const TriangleSetup& t = setups.at(slot);
         if (f.shading_mode == SEAMCL_SHADE_SAMPLE) {
-          sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s), cube_texels);
+          sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s), cube_texels, ptex);
           if (with_mask) crosses = merge_mask(crosses, footprint_class(scene, f, t, sample_x(s), sample_y(s)));
           ++out.fragments;
           continue;
         }
         if (std::find(ids, ids + s, slot) != ids + s) continue;  // shaded at its first sample
         const PixelFragment fragment = pixel_fragment(f, t, ids, slot, x, y);
-        sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y, cube_texels) * static_cast<float>(fragment.covered);
+        sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y, cube_texels, ptex) * static_cast<float>(fragment.covered);
         if (with_mask) crosses = merge_mask(crosses, footprint_class(scene, f, t, fragment.x, fragment.y));
         ++out.fragments;
       }

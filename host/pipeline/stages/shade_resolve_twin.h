@@ -11,6 +11,8 @@
 
 namespace seamcl {
 
+struct PtexRenderTexture;  // pipeline/stages/ptex_filter_twin.h
+
 // uv and its screen derivatives at a pixel-space point, perspective-correct from the planes.
 struct SurfaceUv {
   float u, v, dudx, dvdx, dudy, dvdy;
@@ -20,8 +22,10 @@ SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y);
 // Colour of one fragment: texture lookup times the face's Lambert lighting; on a reflective face
 // the environment along the reflected ray (pipeline/stages/shade_resolve_reflection_twin.h), from
 // `cube_texels` (the renderer's Renderer::cube_texels(); needed by scenes with an environment only).
+// With `ptex` (the Ptex variant), the lookup is Ptex's own filter on its file (ptex_albedo_twin).
 glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& frame, const TriangleSetup& t, float x,
-                                   float y, const std::vector<float>* cube_texels = nullptr);
+                                   float y, const std::vector<float>* cube_texels = nullptr,
+                                   const PtexRenderTexture* ptex = nullptr);
 
 // A triangle's fragment in one pixel (pixel or centroid shading): the samples it covers and
 // where it is shaded. `ids` are the pixel's sample winners; `slot` must be among them.
@@ -55,6 +59,7 @@ struct ResolveReference {
 ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& frame,
                                          const std::vector<TriangleSetup>& setups,
                                          const std::vector<uint32_t>& sample_triangle,
-                                         const std::vector<float>* cube_texels = nullptr);
+                                         const std::vector<float>* cube_texels = nullptr,
+                                         const PtexRenderTexture* ptex = nullptr);
 
 }  // namespace seamcl

@@ -1,0 +1,24 @@
+/* Batches of lookups of Ptex's own filters (`seamcl ptx lookup`, the kernel tests and the Ptex
+ * benchmark): one work-item per query, ptexf_lookup of ptex_filter.cl.
+ * Contract: out[4 * id ..] holds query id's 4 floats (channels beyond the texture's 0; a face out of
+ * range gives zeros) for id < count. Host guarantees: tex, faces, level_offsets and texels as
+ * ptex_filter.cl states; tex.seams 0 (Ptex's own rules); out holds 4 * count floats.
+ * Twin: ptex_filter_twin in host/pipeline/stages/ptex_filter_twin.cpp. */
+
+__kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilterFace* faces,
+                                  __global const uint* level_offsets, __global const uchar* texels,
+                                  __global const PtexFilterQuery* queries, int count, __global float* out) {
+  const int id = (int)get_global_id(0);
+  if (id >= count) return;
+  const PtexFilterQuery q = queries[id];
+  PtexfState s;
+  s.faces = faces;
+  s.level_offsets = level_offsets;
+  s.texels = texels;
+  s.tex = tex;
+  float value[4];
+  ptexf_lookup(&s, &q, value);
+  __global float* dst = out + 4 * id;
+  for (int c = 0; c < 4; ++c) dst[c] = value[c];
+}
+
