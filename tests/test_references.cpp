@@ -183,3 +183,37 @@ TEST(References, ControlsStandApartFromTraverseOnTheSeamMask) {
   EXPECT_TRUE(item.at("errors").contains("paper"));
   EXPECT_EQ(item.at("error"), item.at("errors").at("seamless"));
 }
+
+TEST(References, CompareMethodsMeasureWithTheTargetsPackingNotAReload) {
+  // The targets' renderer keeps its packing (the traverse reference added the adjacency, which a
+  // reload would drop and a bake would make again); a renderer holding no scene loads it. Both
+  // measure the same: the pixels and errors match bit for bit.
+  const Scene scene = generate_scene("closeup-seam", {});
+  Renderer renderer(shared_runtime());
+  renderer.load_scene(scene);
+  const RenderOptions frame = frame_options(32, 1);
+  const std::vector<MethodEntry> entries = method_entries(to_json(frame), {"discard", "clamp"}, {frame.msaa});
+  ReferenceSettings settings = uncached();
+  settings.method = "traverse";
+  const ComparisonTargets targets =
+      prepare_targets(shared_runtime(), renderer, scene.camera, frame, entries, settings, {ReferenceKind::Paper});
+  ASSERT_EQ(renderer.packed_scene().neighbors.size(), scene.faces.size());
+  const TargetsFor targets_for = [&](const MethodEntry& entry) { return targets.for_entry(entry); };
+  const std::vector<EntryResult> kept = compare_methods(renderer, scene, scene.camera, entries, targets_for, 1, {}, {});
+  EXPECT_EQ(renderer.packed_scene().neighbors.size(), scene.faces.size()) << "the scene was loaded again";
+
+  Renderer empty(shared_runtime());
+  const std::vector<EntryResult> loaded = compare_methods(empty, scene, scene.camera, entries, targets_for, 1, {}, {});
+  ASSERT_TRUE(empty.has_scene());
+  ASSERT_EQ(kept.size(), 2u);
+  ASSERT_EQ(loaded.size(), 2u);
+  for (size_t i = 0; i < kept.size(); ++i) {
+    ASSERT_TRUE(kept[i].errors && loaded[i].errors);
+    EXPECT_TRUE(kept[i].last.pixels == loaded[i].last.pixels) << entries[i].method_name;
+    EXPECT_EQ(kept[i].errors->all.mean, loaded[i].errors->all.mean);
+    EXPECT_EQ(kept[i].errors->seam.mean, loaded[i].errors->seam.mean);
+    EXPECT_EQ(kept[i].errors->seam.pixels, loaded[i].errors->seam.pixels);
+    EXPECT_GT(kept[i].errors->seam.pixels, 0u);
+    EXPECT_EQ(kept[i].texture_bytes, loaded[i].texture_bytes);
+  }
+}

@@ -75,7 +75,8 @@ EntryResult measure_entry(Renderer& renderer, const Camera& camera, const Method
 EntryResult measure_entry(Renderer& renderer, const Camera& camera, const MethodEntry& entry, int repeat,
                           const EntryTargets& targets, const ShouldStop& should_stop = {});
 
-// seamcl compare's loop: load `scene` (once, before the first entry), then per entry warm up and
+// seamcl compare's loop: the scene the renderer holds (`scene` is loaded only into a renderer that
+// holds none; a caller loads it first, as it made the targets from it), then per entry warm up and
 // measure_entry. Entries are measured one after the other (entry-major). should_stop is asked
 // before every entry and before every timed render (so a stop waits for one render at most);
 // when it says stop, Cancelled is thrown and nothing is returned.
