@@ -18,6 +18,10 @@
 #endif
 
 #if SEAMCL_INSPECT
+#if SEAMCL_SHADE_PTEX
+/* The inspector renders with the seam mask, which a Ptex filter's render refuses. */
+#error "the pixel inspector has no Ptex variant"
+#endif
 /* The levels, probe count and axes of a lookup on `face` with the frame's filter. */
 SEAMCL_INLINE void inspect_levels(InspectSample* r, const FaceGpu* face, SamplerParams sampler, float dudx,
                                   float dvdx, float dudy, float dvdy) {
@@ -136,8 +140,9 @@ __kernel void shade_inspect(__constant FrameParams* frame, __global const Triang
       r.dvdx = uv.dvdx;
       r.dudy = uv.dudy;
       r.dvdy = uv.dvdy;
+      const PtexSource no_ptex = 0;
       const float3 c = shade_fragment(frame, t, faces, neighbors, level_offsets, texels, srgb_to_linear,
-                                      reflective_faces, cube_texels, px, py);
+                                      reflective_faces, cube_texels, &no_ptex, px, py);
       r.color[0] = c.x;
       r.color[1] = c.y;
       r.color[2] = c.z;

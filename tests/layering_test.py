@@ -29,7 +29,7 @@ ALLOWED = {
     "memory": {"core", "options", "cl", "scene", "pipeline", "io", "eval"},
     "assets": {"core", "options", "scene", "pipeline", "io", "memory"},
     "batch": {"core", "options", "cl", "scene", "pipeline", "eval", "memory"},
-    "jobs": {"core", "options", "cl", "scene", "pipeline", "io", "eval", "memory", "batch", "assets"},
+    "jobs": {"core", "options", "cl", "scene", "pipeline", "io", "eval", "memory", "batch", "assets", "ptexfilter"},
     "ptexfilter": {"core", "options", "cl", "scene", "pipeline", "io", "memory", "assets"},
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
