@@ -5,6 +5,8 @@
  * ptex_filter.cl states; tex.seams 0 (Ptex's own rules); out holds 4 * count floats.
  * Twin: ptex_filter_twin in host/pipeline/stages/ptex_filter_twin.cpp. */
 
+/* Only where ptex_filter.cl compiles: the ptex-filter program, built with no sampler variant. */
+#if !defined(SEAMCL_SAMPLER_FILTER) || SEAMCL_SAMPLER_FILTER == SEAMCL_FILTER_PTEX
 __kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilterFace* faces,
                                   __global const uint* level_offsets, __global const uchar* texels,
                                   __global const PtexFilterQuery* queries, int count, __global float* out) {
@@ -21,4 +23,4 @@ __kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilt
   __global float* dst = out + 4 * id;
   for (int c = 0; c < 4; ++c) dst[c] = value[c];
 }
-
+#endif
