@@ -53,7 +53,7 @@ def render(
     texture: Optional[str] = ...,  # A .ptx file of per-face textures for an .obj scene (face i of the mesh takes face i of the file)
     displacement_map: Optional[str] = ...,  # Displacement: a 1-channel .ptx whose faces displace the mesh's (face i takes face i), in place of the scene's own maps; needs displacement_method
     method: Literal['clamp', 'black', 'discard', 'traverse', 'traverse-edges', 'guardband'] = ...,  # Seam method
-    filter: Literal['bilinear', 'trilinear', 'aniso', 'ewa'] = ...,  # Texture filter
+    filter: Literal['bilinear', 'trilinear', 'aniso', 'ewa', 'ptex-point', 'ptex-bilinear', 'ptex-box', 'ptex-gaussian', 'ptex-bicubic', 'ptex-bspline', 'ptex-catmullrom', 'ptex-mitchell'] = ...,  # Texture filter
     zero_coverage: Literal['clamp', 'nan'] = ...,  # discard with every tap outside the face: a clamped lookup, or the raw 0/0
     texels: Literal['rgba8', 'rgba32f'] = ...,  # Texel storage
     msaa: Literal[1, 2, 4, 8, 16] = ...,  # Samples per pixel
@@ -83,7 +83,7 @@ def compare(
     scene: Union[str, PathLike, Scene] = ...,  # Built-in scene name, a scene JSON file, an .obj mesh or a .ptx that holds its mesh
     texture: Optional[str] = ...,  # A .ptx file of per-face textures for an .obj scene (face i of the mesh takes face i of the file)
     displacement_map: Optional[str] = ...,  # Displacement: a 1-channel .ptx whose faces displace the mesh's (face i takes face i), in place of the scene's own maps; needs displacement_method
-    filter: Literal['bilinear', 'trilinear', 'aniso', 'ewa'] = ...,  # Texture filter
+    filter: Literal['bilinear', 'trilinear', 'aniso', 'ewa', 'ptex-point', 'ptex-bilinear', 'ptex-box', 'ptex-gaussian', 'ptex-bicubic', 'ptex-bspline', 'ptex-catmullrom', 'ptex-mitchell'] = ...,  # Texture filter
     zero_coverage: Literal['clamp', 'nan'] = ...,  # discard with every tap outside the face: a clamped lookup, or the raw 0/0
     texels: Literal['rgba8', 'rgba32f'] = ...,  # Texel storage
     aniso: int = ...,  # Maximum anisotropy
