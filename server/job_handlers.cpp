@@ -294,7 +294,7 @@ void JobHandlers::overlays(const json& request, httplib::Response& res) {
   const FrameJobRun times = run_frame_job(
       start, inline_scene, job.options(), [&](const Scene& scene, size_t held) { return job.plan(scene, held); },
       [&](Renderer& renderer, const Scene& scene, const JobControl& control) {
-        answer = job.run(renderer, scene, control);
+        answer = job.run(runtime_, renderer, scene, control);
       });
   res.set_header("X-Seamcl-Queue-Ms", std::to_string(times.queue_ms));
   res.set_header("X-Seamcl-Build-Ms", std::to_string(times.build_ms));
