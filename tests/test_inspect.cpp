@@ -173,7 +173,7 @@ TEST(InspectJob, AnswersTheRecordsOfThePixelAsJson) {
   const Scene scene = generate_scene("quad2", job.render_job().generator_options());
   Renderer renderer(shared_runtime());
   renderer.load_scene(scene);
-  const json answer = job.run(shared_runtime(), renderer, scene, JobControl{});
+  const json answer = job.run(renderer, scene, JobControl{});
   EXPECT_EQ(answer.at("width"), 2);
   EXPECT_EQ(answer.at("height"), 2);
   EXPECT_EQ(answer.at("samples"), 4);
@@ -285,7 +285,7 @@ TEST(OverlayJob, LayersAreTheSeamMaskAndTheFaceEdgesOfTheFrame) {
 // naive on a frame where it cracks, none for a watertight method.
 TEST(OverlayJob, CrackPixelsAreThoseTheDisplacementMetricsCount) {
   const int frames = 60;
-  json request = {{"scene", "displaced"}, {"size", "96x96"}, {"msaa", 1}, {"tessellation", 8}, {"frames", frames}};
+  json request = {{"scene", "displaced"}, {"size", "96x96"}, {"msaa", 1}, {"tessellation", 8}, {"frame", 0}, {"frames", frames}};
   const Scene scene = generate_scene("displaced", OverlayJob(request).render_job().generator_options());
   ASSERT_TRUE(is_closed_mesh(scene));
   // The first orbit frame on which naive cracks, by the metrics.
