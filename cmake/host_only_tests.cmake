@@ -108,6 +108,7 @@ set(SEAMCL_HOST_ONLY_TESTS
   Metrics.HeatmapColours
   OpenApi.*
   OptionTable.*
+  OverlayCubeEdges.MarkWhereTheViewRaysCubeFaceChanges
   PaperScaling.*
   ProgramCache.TrimKeepsTheMostRecentlyUsedWithinTheBound
   Ptex.*

@@ -294,7 +294,7 @@ void JobHandlers::overlays(const json& request, httplib::Response& res) {
   const FrameJobRun times = run_frame_job(
       start, inline_scene, job.options(), [&](const Scene& scene, size_t held) { return job.plan(scene, held); },
       [&](Renderer& renderer, const Scene& scene, const JobControl& control) {
-        answer = job.run(renderer, scene, control);
+        answer = job.run(runtime_, renderer, scene, control);
       });
   res.set_header("X-Seamcl-Queue-Ms", std::to_string(times.queue_ms));
   res.set_header("X-Seamcl-Build-Ms", std::to_string(times.build_ms));
@@ -348,7 +348,7 @@ void JobHandlers::compare(const json& request, httplib::Response& res, const std
   budget_.refuse_scene_over(*scene, frame, inline_scene, key);
   const JobPlan plan = job.plan(*scene);
   budget_.refuse_over(plan.device, plan.host, !key.empty(), plan.what);
-  // Work for a client that has gone, or past the deadline, stops at the next entry or repeat.
+  // Work for a client that has gone, or past the deadline, stops at the next entry, repeat or render stage.
   const Clock::time_point deadline =
       options_.deadline_ms > 0 ? start + std::chrono::milliseconds(options_.deadline_ms) : Clock::time_point::max();
   JobControl control;

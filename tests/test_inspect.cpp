@@ -8,7 +8,11 @@
 #include <bit>
 #include <cmath>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <seamcl/core/input_error.h>
+#include <seamcl/eval/cube_metrics.h>
+#include <seamcl/eval/displacement_metrics.h>
 #include <seamcl/jobs/inspect_job.h>
 #include <seamcl/jobs/overlay_job.h>
 #include <seamcl/pipeline/renderer.h>
@@ -22,6 +26,23 @@ using nlohmann::json;
 using seamcl_tests::shared_runtime;
 
 namespace {
+
+// An overlay answer's pixels: its base64 decoded, width * height bytes.
+std::vector<uint8_t> overlay_flags(const json& answer) {
+  const std::string text = answer.at("pixels").get<std::string>();
+  const size_t size = answer.at("width").get<size_t>() * answer.at("height").get<size_t>();
+  EXPECT_EQ(text.size(), (size + 2) / 3 * 4);
+  auto digit = [](char c) -> uint32_t {
+    return c >= 'A' && c <= 'Z' ? c - 'A' : c >= 'a' && c <= 'z' ? c - 'a' + 26 : c >= '0' && c <= '9' ? c - '0' + 52 : c == '+' ? 62 : 63;
+  };
+  std::vector<uint8_t> flags;
+  for (size_t i = 0; i + 3 < text.size(); i += 4) {
+    const uint32_t n = digit(text[i]) << 18 | digit(text[i + 1]) << 12 | (text[i + 2] == '=' ? 0 : digit(text[i + 2]) << 6) |
+                       (text[i + 3] == '=' ? 0 : digit(text[i + 3]));
+    for (int k = 0; k < 3 && flags.size() < size; ++k) flags.push_back(static_cast<uint8_t>(n >> (16 - 8 * k)));
+  }
+  return flags;
+}
 
 struct Case {
   std::string name;
@@ -220,24 +241,14 @@ TEST(OverlayJob, LayersAreTheSeamMaskAndTheFaceEdgesOfTheFrame) {
   const Scene scene = generate_scene("quad2", job.render_job().generator_options());
   Renderer renderer(shared_runtime());
   renderer.load_scene(scene);
-  const json answer = job.run(renderer, scene, JobControl{});
+  const json answer = job.run(shared_runtime(), renderer, scene, JobControl{});
   ASSERT_EQ(answer.at("width"), 64);
   ASSERT_EQ(answer.at("height"), 48);
   // The same frame's seam mask and winners, read here.
   const RenderResult frame = renderer.render(scene.camera, job.options(), true);
   const std::vector<uint32_t> winners = renderer.read_sample_triangles();
   const std::vector<TriangleSetup> setups = renderer.read_setups();
-  const std::string text = answer.at("pixels").get<std::string>();
-  ASSERT_EQ(text.size(), (64u * 48u + 2) / 3 * 4);
-  auto digit = [](char c) -> uint32_t {
-    return c >= 'A' && c <= 'Z' ? c - 'A' : c >= 'a' && c <= 'z' ? c - 'a' + 26 : c >= '0' && c <= '9' ? c - '0' + 52 : c == '+' ? 62 : 63;
-  };
-  std::vector<uint8_t> flags;
-  for (size_t i = 0; i < text.size(); i += 4) {
-    const uint32_t n = digit(text[i]) << 18 | digit(text[i + 1]) << 12 | (text[i + 2] == '=' ? 0 : digit(text[i + 2]) << 6) |
-                       (text[i + 3] == '=' ? 0 : digit(text[i + 3]));
-    for (int k = 0; k < 3 && flags.size() < 64u * 48u; ++k) flags.push_back(static_cast<uint8_t>(n >> (16 - 8 * k)));
-  }
+  const std::vector<uint8_t> flags = overlay_flags(answer);
   ASSERT_EQ(flags.size(), 64u * 48u);
   size_t seam = 0, edges = 0;
   const int samples = 4;
@@ -262,5 +273,150 @@ TEST(OverlayJob, LayersAreTheSeamMaskAndTheFaceEdgesOfTheFrame) {
   // quad2's shared edge runs down the frame: a line of face-edge pixels, and seam pixels along it.
   EXPECT_GE(edges, 20u);
   EXPECT_GT(seam, 0u);
+  // The layers that do not apply to quad2 (no displacement, no environment) are there, empty.
+  EXPECT_EQ(answer.at("layers"), json({{"seam", 1}, {"boundary", 2}, {"face_edge", 4}, {"crack", 8}, {"cube_edge", 16}}));
+  EXPECT_EQ(answer.at("counts").at("crack"), 0);
+  EXPECT_EQ(answer.at("counts").at("cube_edge"), 0);
+  for (uint8_t f : flags) ASSERT_EQ(f & (kOverlayCrack | kOverlayCubeEdge), 0);
   EXPECT_THROW(OverlayJob(json{{"method", "guardband"}}), InputError);
+}
+
+// The crack layer marks the pixels the displacement metrics count for the same frame: some for
+// naive on a frame where it cracks, none for a watertight method.
+TEST(OverlayJob, CrackPixelsAreThoseTheDisplacementMetricsCount) {
+  const int frames = 60;
+  json request = {{"scene", "displaced"}, {"size", "96x96"}, {"msaa", 1}, {"tessellation", 8}, {"frame", 0}, {"frames", frames}};
+  const Scene scene = generate_scene("displaced", OverlayJob(request).render_job().generator_options());
+  ASSERT_TRUE(is_closed_mesh(scene));
+  // The first orbit frame on which naive cracks, by the metrics.
+  int frame = -1;
+  size_t expected = 0;
+  for (int f = 0; f < frames && frame < 0; f += 3) {
+    request["frame"] = f;
+    request["displacement_method"] = "naive";
+    const OverlayJob job(request);
+    const DisplacementReport report =
+        measure_displacement(shared_runtime(), scene, job.render_job().camera(scene), job.options(), 0, 0);
+    ASSERT_TRUE(report.crack_pixels.has_value());
+    if (*report.crack_pixels > 0) frame = f, expected = *report.crack_pixels;
+  }
+  ASSERT_GE(frame, 0) << "naive shows no crack on any frame of the orbit";
+  request["frame"] = frame;
+  for (const std::string method : {"naive", "zipper"}) {
+    request["displacement_method"] = method;
+    const OverlayJob job(request);
+    EXPECT_TRUE(job.crack_pixels_apply(scene));
+    Renderer renderer(shared_runtime());
+    renderer.load_scene(scene);
+    const json answer = job.run(shared_runtime(), renderer, scene, JobControl{});
+    const std::vector<uint8_t> flags = overlay_flags(answer);
+    const size_t marked = static_cast<size_t>(std::count_if(flags.begin(), flags.end(), [](uint8_t f) { return (f & kOverlayCrack) != 0; }));
+    EXPECT_EQ(answer.at("counts").at("crack"), marked) << method;
+    const DisplacementReport report =
+        measure_displacement(shared_runtime(), scene, job.render_job().camera(scene), job.options(), 0, 0);
+    EXPECT_EQ(marked, *report.crack_pixels) << method << " frame " << frame;
+    if (method == "naive") EXPECT_EQ(marked, expected);
+    if (method == "zipper") EXPECT_EQ(marked, 0u);
+    // The plan holds the crack render beside the frame's.
+    EXPECT_GT(job.plan(scene).device.total(), job.render_job().plan(scene).device.total());
+  }
+  // Without a displacement method the frame is not displaced: the layer does not apply.
+  request.erase("displacement_method");
+  EXPECT_FALSE(OverlayJob(request).crack_pixels_apply(scene));
+}
+
+// The lookup directions of an environment frame's sky are the camera's rays through the pixel
+// centres, computed here from the view and projection matrices; the cube-edge layer is
+// cube_edge_pixels of the frame's lookup directions and is not empty on envmap.
+TEST(OverlayJob, CubeEdgesAreWhereTheLookupDirectionsCubeFaceChanges) {
+  const json request = {{"scene", "envmap"}, {"size", "64x48"}, {"msaa", 4}};
+  const OverlayJob job(request);
+  const Scene scene = generate_scene("envmap", job.render_job().generator_options());
+  ASSERT_TRUE(OverlayJob::cube_edges_apply(scene));
+  EXPECT_FALSE(job.crack_pixels_apply(scene));
+  Renderer renderer(shared_runtime());
+  renderer.load_scene(scene);
+  const json answer = job.run(shared_runtime(), renderer, scene, JobControl{});
+  const std::vector<uint8_t> flags = overlay_flags(answer);
+  ASSERT_EQ(flags.size(), 64u * 48u);
+  const Camera camera = job.render_job().camera(scene);
+  const std::vector<glm::vec3> directions = lookup_directions(renderer, camera, job.options());
+  const std::vector<uint32_t> winners = renderer.read_sample_triangles();  // the directions' frame: 1 sample
+  const std::vector<uint8_t> expected = cube_edge_pixels(directions, 64, 48);
+  const glm::mat4 inverse = glm::inverse(glm::perspective(glm::radians(camera.fov_y_degrees), 64.0f / 48.0f, 0.1f, 100.0f) *
+                                         glm::lookAt(camera.eye, camera.target, camera.up));
+  size_t sky = 0, marked = 0;
+  for (int y = 0; y < 48; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      const size_t p = static_cast<size_t>(y) * 64 + x;
+      EXPECT_EQ((flags[p] & kOverlayCubeEdge) != 0, expected[p] != 0) << x << "," << y;
+      marked += (flags[p] & kOverlayCubeEdge) != 0;
+      if (winners[p] != SEAMCL_NO_TRIANGLE) continue;
+      const float nx = (x + 0.5f) / 64.0f * 2.0f - 1.0f, ny = 1.0f - (y + 0.5f) / 48.0f * 2.0f;
+      const glm::vec4 near = inverse * glm::vec4(nx, ny, -1.0f, 1.0f), far = inverse * glm::vec4(nx, ny, 1.0f, 1.0f);
+      const glm::vec3 ray = glm::normalize(glm::vec3(far) / far.w - glm::vec3(near) / near.w);
+      EXPECT_GT(glm::dot(ray, directions[p]), 1.0f - 1e-5f) << x << "," << y;
+      ++sky;
+    }
+  }
+  EXPECT_GT(sky, 100u);
+  EXPECT_EQ(answer.at("counts").at("cube_edge"), marked);
+  EXPECT_GT(marked, 10u);
+  EXPECT_EQ(answer.at("counts").at("crack"), 0);
+}
+
+// cube_edge_pixels on the rays of a camera looking at the +X/+Z cube edge, computed here: a pixel
+// is marked where its ray's largest component (a face chosen here, by its own comparisons) differs
+// from its right or lower neighbour's; no lookup and a jump wider than 0.25 radians mark nothing.
+TEST(OverlayCubeEdges, MarkWhereTheViewRaysCubeFaceChanges) {
+  const int w = 40, h = 30;
+  const glm::mat4 inverse = glm::inverse(glm::perspective(glm::radians(60.0f), float(w) / h, 0.1f, 100.0f) *
+                                         glm::lookAt(glm::vec3(0.0f), glm::vec3(1.0f, 0.6f, 1.0f), glm::vec3(0, 1, 0)));
+  std::vector<glm::vec3> rays;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const glm::vec4 far = inverse * glm::vec4((x + 0.5f) / w * 2.0f - 1.0f, 1.0f - (y + 0.5f) / h * 2.0f, 1.0f, 1.0f);
+      rays.push_back(glm::normalize(glm::vec3(far) / far.w));
+    }
+  }
+  auto face_of = [](glm::vec3 d) {
+    const glm::vec3 a = glm::abs(d);
+    if (a.x >= a.y && a.x >= a.z) return d.x >= 0 ? 0 : 1;
+    if (a.y >= a.z) return d.y >= 0 ? 2 : 3;
+    return d.z >= 0 ? 4 : 5;
+  };
+  const std::vector<uint8_t> marked = cube_edge_pixels(rays, w, h);
+  size_t count = 0;
+  std::vector<int> faces_seen(6, 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t p = static_cast<size_t>(y) * w + x;
+      const int f = face_of(rays[p]);
+      ++faces_seen[static_cast<size_t>(f)];
+      const bool expected = (x + 1 < w && face_of(rays[p + 1]) != f) || (y + 1 < h && face_of(rays[p + w]) != f);
+      EXPECT_EQ(marked[p] != 0, expected) << x << "," << y;
+      count += marked[p];
+    }
+  }
+  // The view holds the +X/+Z edge and the top face's edges: three faces, a line of pixels or more.
+  EXPECT_GT(faces_seen[0], 0);
+  EXPECT_GT(faces_seen[2], 0);
+  EXPECT_GT(faces_seen[4], 0);
+  EXPECT_GE(count, static_cast<size_t>(h));
+  // A pixel that looks nothing up marks nothing, nor does its neighbour on its account.
+  std::vector<glm::vec3> holes = rays;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t p = static_cast<size_t>(y) * w + x;
+      if (marked[p] && x + 1 < w && face_of(rays[p + 1]) != face_of(rays[p])) holes[p + 1] = glm::vec3(0.0f);
+    }
+  }
+  const std::vector<uint8_t> around = cube_edge_pixels(holes, w, h);
+  for (size_t p = 0; p < holes.size(); ++p)
+    if (holes[p] == glm::vec3(0.0f)) EXPECT_EQ(around[p], 0) << p;
+  // Two faces' directions far apart (a silhouette) are no cube edge.
+  const std::vector<glm::vec3> jump = {glm::vec3(1, 0, 0.2f), glm::vec3(0.2f, 0, -1)};
+  EXPECT_EQ(cube_edge_pixels(jump, 2, 1), (std::vector<uint8_t>{0, 0}));
+  const std::vector<glm::vec3> close = {glm::normalize(glm::vec3(1, 0, 0.99f)), glm::normalize(glm::vec3(0.99f, 0, 1))};
+  EXPECT_EQ(cube_edge_pixels(close, 2, 1), (std::vector<uint8_t>{1, 0}));
 }

@@ -603,7 +603,7 @@ TEST_F(Server, OverlaysAnswerTheLibrarysLayers) {
   const Scene scene = generate_scene("quad2", job.render_job().generator_options());
   Renderer renderer(seamcl_tests::shared_runtime());
   renderer.load_scene(scene);
-  EXPECT_EQ(json::parse(res->body), job.run(renderer, scene, JobControl{}));
+  EXPECT_EQ(json::parse(res->body), job.run(seamcl_tests::shared_runtime(), renderer, scene, JobControl{}));
   auto refused = c.Post("/v1/overlays", json{{"scene", "quad2"}, {"method", "guardband"}}.dump(), "application/json");
   ASSERT_TRUE(refused);
   EXPECT_EQ(refused->status, 400);

@@ -246,4 +246,48 @@ CubeReference cube_reference(Renderer& renderer, const Camera& camera, const Ren
   return out;
 }
 
+std::vector<glm::vec3> lookup_directions(Renderer& renderer, const Camera& camera, const RenderOptions& options) {
+  const Scene& scene = renderer.scene();
+  if (!scene.environment) throw std::invalid_argument("lookup_directions needs a scene with an environment");
+  RenderOptions one = options;
+  one.msaa = 1;
+  one.shading = ShadingMode::Pixel;
+  const RenderResult frame = renderer.render_directions(camera, one);
+  // A diffuse face writes its colour, an empty pixel without a skybox the background: the
+  // winners say which pixels looked the environment up.
+  const std::vector<uint32_t> winners = renderer.read_sample_triangles();
+  const std::vector<TriangleSetup> setups = renderer.read_setups();
+  std::vector<glm::vec3> out(frame.pixels.size(), glm::vec3(0.0f));
+  for (size_t p = 0; p < out.size(); ++p) {
+    const uint32_t slot = winners.at(p);
+    const bool looks_up = slot == SEAMCL_NO_TRIANGLE ? scene.environment->skybox
+                                                     : scene.faces.at(static_cast<size_t>(setups.at(slot).face)).roughness >= 0.0f;
+    const glm::vec3 d(frame.pixels[p]);
+    const float length = glm::length(d);
+    if (looks_up && length > 0.0f) out[p] = d / length;
+  }
+  return out;
+}
+
+std::vector<uint8_t> cube_edge_pixels(const std::vector<glm::vec3>& directions, int width, int height) {
+  const size_t pixels = static_cast<size_t>(width) * height;
+  if (directions.size() != pixels) throw std::invalid_argument("cube_edge_pixels: not width x height directions");
+  std::vector<int> face(pixels, -1);
+  for (size_t p = 0; p < pixels; ++p) {
+    if (glm::dot(directions[p], directions[p]) > 0.0f) face[p] = cube_coords(directions[p]).face;
+  }
+  auto crosses = [&](size_t a, size_t b) {
+    return face[a] >= 0 && face[b] >= 0 && face[a] != face[b] &&
+           glm::dot(glm::normalize(directions[a]), glm::normalize(directions[b])) > kContinuousCos;
+  };
+  std::vector<uint8_t> out(pixels, 0);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const size_t p = static_cast<size_t>(y) * width + x;
+      if ((x + 1 < width && crosses(p, p + 1)) || (y + 1 < height && crosses(p, p + width))) out[p] = 1;
+    }
+  }
+  return out;
+}
+
 }  // namespace seamcl

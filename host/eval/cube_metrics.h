@@ -3,6 +3,7 @@
 // across them, and the error of rendered frames against the environment integrated over each
 // pixel's footprint.
 #pragma once
+#include <cstdint>
 #include <vector>
 
 #include <seamcl/cl/cl_runtime.h>
@@ -53,5 +54,19 @@ struct CubeReference {
   size_t edge_pixels = 0;
 };
 CubeReference cube_reference(Renderer& renderer, const Camera& camera, const RenderOptions& options, int scale = 8);
+
+// Each pixel's environment lookup direction at its centre, unit length, rows top first: a frame of
+// the loaded scene (which has an environment) at `camera` and options' size through
+// render_directions at one sample, pixel shading; a reflective face's reflected view ray, the
+// skybox's view ray. Zero for a pixel that looks nothing up: a diffuse face, or no triangle and
+// no skybox.
+std::vector<glm::vec3> lookup_directions(Renderer& renderer, const Camera& camera, const RenderOptions& options);
+
+// The pixels a cube edge crosses: per pixel of a width x height image of lookup directions (rows
+// top first; zero: no lookup), 1 where the pixel and its right or its lower neighbour both look
+// up, their directions select different cube faces (cube_coords) and lie within 0.25 radians of
+// each other (the same as cube_reference's cube_edge: a silhouette between a reflection and the
+// sky is not a cube edge), 0 elsewhere.
+std::vector<uint8_t> cube_edge_pixels(const std::vector<glm::vec3>& directions, int width, int height);
 
 }  // namespace seamcl

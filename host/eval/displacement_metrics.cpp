@@ -314,9 +314,16 @@ size_t count_flag_pixels(const std::vector<uint32_t>& sample_triangles, int widt
 
 size_t count_crack_pixels(const Scene& flagged, const FrameParams& frame, const std::vector<uint32_t>& sample_triangles,
                           size_t first_flag_face) {
+  const std::vector<uint8_t> mask = crack_pixel_mask(flagged, frame, sample_triangles, first_flag_face);
+  return static_cast<size_t>(std::count(mask.begin(), mask.end(), uint8_t{1}));
+}
+
+std::vector<uint8_t> crack_pixel_mask(const Scene& flagged, const FrameParams& frame,
+                                      const std::vector<uint32_t>& sample_triangles, size_t first_flag_face) {
   const int width = frame.width, height = frame.height, samples = frame.sample_count;
   const size_t pixels = static_cast<size_t>(width) * height;
-  if (sample_triangles.size() < pixels * samples) throw std::invalid_argument("count_crack_pixels: too few samples");
+  if (sample_triangles.size() < pixels * samples) throw std::invalid_argument("crack_pixel_mask: too few samples");
+  std::vector<uint8_t> cracks(pixels, 0);
   // The samples a flag face won, and their pixels.
   std::vector<char> candidate(pixels * samples, 0), candidate_pixel(pixels, 0);
   bool any = false;
@@ -327,7 +334,7 @@ size_t count_crack_pixels(const Scene& flagged, const FrameParams& frame, const 
       any = true;
     }
   }
-  if (!any) return 0;
+  if (!any) return cracks;
   // The faces that may cover one of them: projected with the frame's matrix, boxes padded by two
   // pixels (setup's snapping moves a vertex by less); a face reaching behind the near plane is
   // kept whole. The rest cannot change a candidate's balance.
@@ -396,13 +403,36 @@ size_t count_crack_pixels(const Scene& flagged, const FrameParams& frame, const 
       }
     }
   }
-  size_t cracks = 0;
   for (size_t pixel = 0; pixel < pixels; ++pixel) {
     bool open = false;
     for (int k = 0; k < samples && !open; ++k) open = candidate[pixel * samples + k] && balance[pixel * samples + k] != 0;
-    cracks += open;
+    cracks[pixel] = open ? 1 : 0;
   }
   return cracks;
+}
+
+std::vector<uint8_t> frame_crack_pixels(ClRuntime& runtime, const Scene& scene, const Camera& camera,
+                                        const RenderOptions& options, size_t device_byte_limit) {
+  if (!options.displacement) throw InputError("displacement_method", "is needed to find crack pixels");
+  if (!is_closed_mesh(scene)) {
+    throw InputError("scene", "'" + scene.name + "' is not a closed mesh: crack pixels are found on closed meshes only");
+  }
+  // measure_displacement's steps 1 and 3 for one camera: the same settings, vertices, flagged
+  // scene and crack render.
+  PackedDisplacement packed = pack_displacement(scene, displacement_settings(scene, options, camera));
+  const int slots = packed.params.tessellation;
+  const bool adaptive = packed.adaptive();
+  TessellateLauncher stage(runtime);
+  stage.load(std::move(packed));
+  const Scene flagged = with_back_faces_flagged(scene, stage.tessellate(), slots, adaptive);
+  stage.release();
+  const RenderOptions crack_options = crack_render_options(options);
+  Renderer renderer(runtime);
+  renderer.set_device_byte_limit(device_byte_limit);
+  renderer.load_scene(flagged, crack_options.texels);
+  renderer.render(camera, crack_options);
+  return crack_pixel_mask(flagged, renderer.last_frame_params(), renderer.read_sample_triangles(),
+                          flagged.faces.size() / 2);
 }
 
 nlohmann::json DisplacementReport::to_json() const {

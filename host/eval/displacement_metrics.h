@@ -4,6 +4,7 @@
 #pragma once
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -97,6 +98,19 @@ size_t count_flag_pixels(const std::vector<uint32_t>& sample_triangles, int widt
 // pixels, the same records the device made.
 size_t count_crack_pixels(const Scene& flagged, const FrameParams& frame, const std::vector<uint32_t>& sample_triangles,
                           size_t first_flag_face);
+// The same pixels as a mask: per pixel (rows top first), 1 where count_crack_pixels counts one,
+// 0 elsewhere; count_crack_pixels is its sum.
+std::vector<uint8_t> crack_pixel_mask(const Scene& flagged, const FrameParams& frame,
+                                      const std::vector<uint32_t>& sample_triangles, size_t first_flag_face);
+
+// The crack pixels of one frame, as measure_displacement counts them for `camera` (orbit_frames
+// 0): `scene` (a closed mesh, is_closed_mesh) tessellated by the device with
+// options.displacement (required; adaptive factors from `camera`), drawn with its back faces
+// flagged (with_back_faces_flagged) at crack_render_options(options), crack_pixel_mask of that
+// frame. Its Renderer is held to `device_byte_limit` (0: none). InputError("scene") for an open
+// mesh, whose background shows past its boundary without any crack.
+std::vector<uint8_t> frame_crack_pixels(ClRuntime& runtime, const Scene& scene, const Camera& camera,
+                                        const RenderOptions& options, size_t device_byte_limit = 0);
 
 struct DisplacementReport {
   std::string method;

@@ -1,6 +1,7 @@
 #include <seamcl/jobs/compare_job.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <future>
@@ -11,6 +12,7 @@
 #include <seamcl/eval/metrics.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/pipeline/renderer.h>
+#include <seamcl/pipeline/stage_stop.h>
 
 namespace seamcl {
 namespace {
@@ -158,7 +160,17 @@ CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobCont
                                  (!reference_.use_cache && (asks_for(ReferenceKind::Paper) || asks_for(ReferenceKind::Box)));
   if (renders_reference) needs.push_back({reference_render_options(frame_, reference_), false});
   for (const MethodEntry& entry : entries_) needs.push_back({entry.options, false});
-  const std::future<void> programs = build_programs_ahead(runtime, scene, needs);
+  // A run that ends (cancelled, or failed) leaves out the builds not yet begun: the future's
+  // destructor then waits for the one under way only.
+  std::atomic<bool> builds_done{false};
+  const std::future<void> programs = build_programs_ahead(runtime, scene, needs, &builds_done);
+  struct EndBuilds {
+    std::atomic<bool>& done;
+    ~EndBuilds() { done = true; }
+  } end_builds{builds_done};
+  // The renders ask the same between their stages (a seam mask, the 8x reference, each entry's
+  // frames), for this run only (host/pipeline/stage_stop.h).
+  const StageStopScope stage_stop(control.should_stop);
   // Hashed once for the lock's key and every reference kind's cache key (hashing bakes every face).
   if (reference_.use_cache && reference_.scene_hash.empty()) reference_.scene_hash = scene_content_hash(scene);
   Renderer renderer(runtime);

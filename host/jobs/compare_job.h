@@ -70,7 +70,8 @@ class CompareJob {
   JobPlan plan(const Scene& scene) const;
 
   // Renders the seam masks and references (or reads them from the cache), then every entry.
-  // Cancelled when control.should_stop says so (between entries and renders).
+  // Cancelled when control.should_stop says so (between entries and renders, and between the
+  // stages of every render: the seam masks' and references' too).
   CompareRun run(ClRuntime& runtime, const Scene& scene, const JobControl& control,
                  const ReferenceLock& lock_reference = {});
 

@@ -1,7 +1,13 @@
 #include <seamcl/jobs/overlay_job.h>
 
+#include <algorithm>
+
 #include <seamcl/core/cancelled.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/eval/cube_metrics.h>
+#include <seamcl/eval/displacement_metrics.h>
+#include <seamcl/memory/render_memory.h>
+#include <seamcl/pipeline/stage_stop.h>
 
 namespace seamcl {
 namespace {
@@ -59,23 +65,64 @@ OverlayJob::OverlayJob(const json& request) : render_(request) {
                                "inside (any other method gives the same overlays)");
 }
 
-json OverlayJob::run(Renderer& renderer, const Scene& scene, const JobControl& control) const {
+bool OverlayJob::crack_pixels_apply(const Scene& scene) const {
+  return options().displacement && scene.displacement && is_closed_mesh(scene);
+}
+
+JobPlan OverlayJob::plan(const Scene& scene, size_t held_scene_bytes) const {
+  JobPlan plan = render_.plan(scene, held_scene_bytes);
+  if (!crack_pixels_apply(scene)) return plan;
+  // The crack render's scene: (T+1)^2 vertices and 2 T^2 one-texel faces a patch.
+  const auto t = static_cast<size_t>(std::max(options().tessellation, 1));
+  SceneSizes flagged;
+  flagged.vertices = scene.faces.size() * (t + 1) * (t + 1);
+  flagged.faces.assign(2 * scene.faces.size() * t * t, {1, 1});
+  const RenderOptions crack_options = crack_render_options(options());
+  const RenderMemory cracks = render_memory(flagged, crack_options);
+  plan.device.add(cracks.device_shares(frame_buffers_field(crack_options.msaa)));
+  plan.host.add(cracks.host_shares());
+  if (plan.unified.total() > 0) plan.unified.add(cracks.process_shares(frame_buffers_field(crack_options.msaa), true));
+  return plan;
+}
+
+json OverlayJob::run(ClRuntime& runtime, Renderer& renderer, const Scene& scene, const JobControl& control) const {
+  const StageStopScope stage_stop(control.should_stop);
+  const Camera camera = render_.camera(scene);
   throw_if_stopped(control.should_stop, "before the frame");
-  const RenderResult frame = renderer.render(render_.camera(scene), render_.options(), true);
+  const RenderResult frame = renderer.render(camera, render_.options(), true);
   throw_if_stopped(control.should_stop, "before the face edges");
   std::vector<uint8_t> flags =
       face_edge_pixels(renderer.last_frame_params(), renderer.read_setups(), renderer.read_sample_triangles());
-  size_t seam = 0, boundary = 0, edges = 0;
+  size_t seam = 0, boundary = 0, edges = 0, cracks = 0, cube_edges = 0;
   for (size_t p = 0; p < flags.size(); ++p) {
     edges += flags[p] != 0;
     const uint8_t m = frame.seam_mask.at(p);
     if (m == SEAMCL_MASK_SEAM) flags[p] |= kOverlaySeam, ++seam;
     if (m == SEAMCL_MASK_BOUNDARY) flags[p] |= kOverlayBoundary, ++boundary;
   }
+  if (cube_edges_apply(scene)) {
+    throw_if_stopped(control.should_stop, "before the cube edges");
+    const std::vector<uint8_t> crossed =
+        cube_edge_pixels(lookup_directions(renderer, camera, options()), frame.width, frame.height);
+    for (size_t p = 0; p < flags.size(); ++p)
+      if (crossed.at(p)) flags[p] |= kOverlayCubeEdge, ++cube_edges;
+  }
+  if (crack_pixels_apply(scene)) {
+    throw_if_stopped(control.should_stop, "before the crack pixels");
+    const std::vector<uint8_t> open = frame_crack_pixels(runtime, scene, camera, options(), control.device_byte_limit);
+    for (size_t p = 0; p < flags.size(); ++p)
+      if (open.at(p)) flags[p] |= kOverlayCrack, ++cracks;
+  }
   return {{"width", frame.width},
           {"height", frame.height},
-          {"layers", {{"seam", kOverlaySeam}, {"boundary", kOverlayBoundary}, {"face_edge", kOverlayFaceEdge}}},
-          {"counts", {{"seam", seam}, {"boundary", boundary}, {"face_edge", edges}}},
+          {"layers",
+           {{"seam", kOverlaySeam},
+            {"boundary", kOverlayBoundary},
+            {"face_edge", kOverlayFaceEdge},
+            {"crack", kOverlayCrack},
+            {"cube_edge", kOverlayCubeEdge}}},
+          {"counts",
+           {{"seam", seam}, {"boundary", boundary}, {"face_edge", edges}, {"crack", cracks}, {"cube_edge", cube_edges}}},
           {"pixels", base64(flags)}};
 }
 

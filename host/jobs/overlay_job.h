@@ -1,8 +1,12 @@
 // The overlay job: the debug layers of a frame the viewer draws over its images, from the
 // library's own outputs: the seam mask (pixels whose texture footprints cross an edge shared by two
-// faces, or a mesh boundary only; kernels/shade_resolve.cl built with SEAMCL_SEAM_MASK) and the
+// faces, or a mesh boundary only; kernels/shade_resolve.cl built with SEAMCL_SEAM_MASK), the
 // face edges (pixels whose samples, or whose right or lower neighbour's, belong to another face;
-// from the frame's sample winners and setups). What POST /v1/overlays runs.
+// from the frame's sample winners and setups), the crack pixels of a displaced closed mesh (the
+// pixels the displacement metrics count for this frame: eval/displacement_metrics.h,
+// frame_crack_pixels) and the cube edges of a scene with an environment (pixels whose lookup
+// direction selects another cube face than their right or lower neighbour's:
+// eval/cube_metrics.h, cube_edge_pixels). What POST /v1/overlays runs.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -21,6 +25,8 @@ namespace seamcl {
 constexpr uint8_t kOverlaySeam = 1;       // the seam mask's seam pixels
 constexpr uint8_t kOverlayBoundary = 2;   // the seam mask's boundary-only pixels
 constexpr uint8_t kOverlayFaceEdge = 4;   // a face edge crosses the pixel or its right or lower side
+constexpr uint8_t kOverlayCrack = 8;      // the background or a back face shows through a crack
+constexpr uint8_t kOverlayCubeEdge = 16;  // a cube edge crosses the pixel or its right or lower side
 
 // Face edges of a frame from its sample winners (sample_count per pixel) and the winners' setups:
 // kOverlayFaceEdge where the pixel's covered samples lie on more than one face, or where its face
@@ -36,11 +42,21 @@ class OverlayJob {
 
   const RenderJob& render_job() const { return render_; }
   const RenderOptions& options() const { return render_.options(); }
-  JobPlan plan(const Scene& scene, size_t held_scene_bytes = 0) const { return render_.plan(scene, held_scene_bytes); }
+  // The render's plan; where the crack layer applies (crack_pixels_apply), its crack render's
+  // Renderer added (held beside the render's: with_back_faces_flagged's micro-quads at the
+  // request's T, crack_render_options).
+  JobPlan plan(const Scene& scene, size_t held_scene_bytes = 0) const;
 
-  // {"width", "height", "layers": {"seam": 1, "boundary": 2, "face_edge": 4}, "counts": {layer: pixels},
-  //  "pixels": base64 of width * height bytes, rows top first, each the OR of its layers' bits}.
-  nlohmann::json run(Renderer& renderer, const Scene& scene, const JobControl& control) const;
+  // Whether a layer applies to the frame of `scene`: crack pixels to a closed mesh with
+  // displacement maps rendered with a displacement_method, cube edges to a scene with an
+  // environment. A layer that does not apply is all zeros, its count 0.
+  bool crack_pixels_apply(const Scene& scene) const;
+  static bool cube_edges_apply(const Scene& scene) { return scene.environment.has_value(); }
+
+  // {"width", "height", "layers": {"seam": 1, "boundary": 2, "face_edge": 4, "crack": 8, "cube_edge": 16},
+  //  "counts": {layer: pixels}, "pixels": base64 of width * height bytes, rows top first, each the
+  //  OR of its layers' bits}. `runtime` makes the crack render's Renderer.
+  nlohmann::json run(ClRuntime& runtime, Renderer& renderer, const Scene& scene, const JobControl& control) const;
 
  private:
   RenderJob render_;

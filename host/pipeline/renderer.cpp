@@ -467,17 +467,19 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   }
 }
 
-std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, const std::vector<ProgramNeed>& needs) {
+std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, const std::vector<ProgramNeed>& needs,
+                                       const std::atomic<bool>* stop) {
   std::vector<std::string> variants;
   for (const ProgramNeed& need : needs) {
     const std::string options = program_options(need.options.texels, sampler_params(need.options), need.with_seam_mask,
                                                  scene.environment.has_value());
     if (std::find(variants.begin(), variants.end(), options) == variants.end()) variants.push_back(options);
   }
-  return std::async(std::launch::async, [&runtime, variants = std::move(variants)] {
+  return std::async(std::launch::async, [&runtime, stop, variants = std::move(variants)] {
     // A build that fails is left to the render that uses it, which builds it again and reports
     // the error; the builds after it still run.
-    auto build = [&runtime](KernelProgram program, const std::string& options) {
+    auto build = [&runtime, stop](KernelProgram program, const std::string& options) {
+      if (stop && stop->load()) return;
       try {
         runtime.program(program, options);
       } catch (...) {

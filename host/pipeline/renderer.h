@@ -4,6 +4,7 @@
 // arguments are not).
 #pragma once
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <future>
@@ -79,8 +80,10 @@ struct ProgramNeed {
 // hold memory no plan counts. The future is ready (and its destructor returns) when every build has
 // ended, so a caller that stops early still waits for the build under way. A build that fails is
 // not reported here: the render that uses the variant builds it again and throws its error with
-// the build log.
-std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, const std::vector<ProgramNeed>& needs);
+// the build log. Once `stop` (when given; it must outlive the future) is set, the builds not yet
+// begun are left out: a cancelled job waits for the build under way only.
+std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, const std::vector<ProgramNeed>& needs,
+                                       const std::atomic<bool>* stop = nullptr);
 
 class Renderer {
  public:

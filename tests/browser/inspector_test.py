@@ -11,7 +11,7 @@ tests/browser/cdp.py) against a live `seamcl serve`:
 - a click on the same pixel of image B (clamp) shows B's record: the same face and uv, the
   neighbour named with weight 0 (clamp reads none of it);
 - the overlays' checkboxes draw, over A and B, exactly the pixels of the library's layers
-  (POST /v1/overlays: the seam mask, then the face edges too).
+  (POST /v1/overlays: the seam mask, then the face edges too; on envmap the cube edges too).
 
 Loopback only, bounded in time. Exits 0 on success, 1 on failure.
 
@@ -29,7 +29,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from cdp import Browser, CdpError  # noqa: E402
-from viewer_test import Checks, free_port, get, wait_idle, wait_ready  # noqa: E402
+from viewer_test import Checks, free_port, get, set_controls, wait_idle, wait_ready  # noqa: E402
 
 SIZE = 64
 MSAA = 4
@@ -134,6 +134,28 @@ def run(base, chromium, profile, screenshot, t, deadline):
                         "%s vs %d" % (drawn, expected))
         t.check(layers["counts"]["seam"] > 0 and layers["counts"]["face_edge"] > 0, "quad2 has seam and face-edge pixels",
                 str(layers["counts"]))
+        t.check(layers["counts"]["crack"] == 0 and layers["counts"]["cube_edge"] == 0,
+                "quad2's crack and cube-edge layers are there, empty", str(layers["counts"]))
+        # The cube edges of envmap, drawn with every layer on, as the library's.
+        page.eval("(() => { const e = document.getElementById('ov_cube'); e.checked = true; "
+                  "e.dispatchEvent(new Event('change')); })()")
+        set_controls(page, {"scene": "envmap"})
+        wait_idle(page, min(RENDER_WAIT_S, max(1.0, deadline - time.monotonic())), "the envmap render")
+        status, body = get(base + "/v1/overlays", {"scene": "envmap", "size": "%dx%d" % (SIZE, SIZE), "method": "traverse",
+                                                   "msaa": MSAA})
+        t.check(status == 200, "POST /v1/overlays answers for envmap", body[:200])
+        envmap = json.loads(body)
+        flags = base64.b64decode(envmap["pixels"])
+        mask = bits["seam"] | bits["boundary"] | bits["face_edge"] | bits["cube_edge"]
+        expected = sum(1 for f in flags if f & mask)
+        for canvas in ("ov_a", "ov_b"):
+            drawn = page.wait("(() => { const c = document.getElementById(%s); return !c.hidden && c.dataset.cubeEdge === %s "
+                              "&& c.dataset.drawn; })()" % (json.dumps(canvas), json.dumps(str(envmap["counts"]["cube_edge"]))),
+                              timeout=min(RENDER_WAIT_S, max(1.0, deadline - time.monotonic())), what=canvas + " drawn on envmap")
+            t.check(int(drawn) == expected, "%s with the cube edges draws the library's layer pixels" % canvas,
+                    "%s vs %d" % (drawn, expected))
+        t.check(envmap["counts"]["cube_edge"] > 0 and envmap["counts"]["crack"] == 0,
+                "envmap has cube-edge pixels and no crack pixels", str(envmap["counts"]))
         if screenshot:
             clip = page.eval("(() => { const a = document.getElementById('view_side').getBoundingClientRect(); "
                              "return {x: a.left, y: a.top, width: a.width, height: a.height, scale: 1}; })()")
