@@ -346,6 +346,15 @@ typedef struct {
   cl_uint pad0;
 } TessVertex;
 
+/* Shading of a displacement render with the displaced surface's normals (kernels/shade_resolve.cl):
+ * a micro-triangle's normal at a point is its three vertices' normals (tessellate.cl's
+ * displaced_normals) interpolated by the point's barycentrics in the domain, renormalised. */
+typedef struct {
+  cl_int tessellation;   /* T of the slot grid (TessellationParams.tessellation); 0: the face's own normal */
+  cl_int adaptive;       /* 1: cells (T-1, 0) and (0, T-1) split on their 10-01 diagonal (tessellated_setup) */
+  cl_int pad0, pad1;
+} DisplacedShading;
+
 /* Ptex's own separable filters (ptex_filter.cl): a texture as the Ptex library filters it. Every
  * face holds every resolution 2^i x 2^j (i <= ulog2, j <= vlog2) that the library would read, made
  * by its own reduction rules, in the file's units and channel order. */

@@ -141,8 +141,14 @@ __kernel void shade_inspect(__constant FrameParams* frame, __global const Triang
       r.dudy = uv.dudy;
       r.dvdy = uv.dvdy;
       const PtexSource no_ptex = 0;
+      DisplacedSource face_normals; /* the inspector lights with the face normal */
+      face_normals.params.tessellation = 0;
+      face_normals.params.adaptive = 0;
+      face_normals.params.pad0 = face_normals.params.pad1 = 0;
+      face_normals.vertices = 0;
+      face_normals.normals = 0;
       const float3 c = shade_fragment(frame, t, faces, neighbors, level_offsets, texels, srgb_to_linear,
-                                      reflective_faces, cube_texels, &no_ptex, px, py);
+                                      reflective_faces, cube_texels, &no_ptex, &face_normals, slot, px, py);
       r.color[0] = c.x;
       r.color[1] = c.y;
       r.color[2] = c.z;

@@ -9,6 +9,11 @@
  * own position. Resolve: box filter (mean over samples) into linear RGBA float, alpha 1.
  * Shading: uv and d(uv)/d(pixel) analytically from the 1/w, u/w, v/w planes, one texture lookup
  * (sample_texture with frame->sampler: the seam method), and lighting = light_color * (ambient + (1 - ambient) * max(0, n.l)) with the face normal.
+ * Displaced renders (displaced.tessellation > 0, displacement_normals=displaced): n is the
+ * displaced surface's normal instead (displaced_shading_normal): the micro-triangle's three
+ * vertices' normals (tessellate.cl's displaced_normals, the same bits on both sides of a watertight
+ * edge) weighted by the shading point's barycentrics in the triangle's domain uv (clamped to the
+ * triangle), renormalised; where that has no length, the face normal.
  * Reflective faces (FaceGpu.reflective >= 0, scenes with an environment, built with
  * -DSEAMCL_CUBE=1 only) look the reflected view ray up in the cube map instead (shade_reflection),
  * and uncovered samples show the environment when frame->environment.skybox is set.
@@ -30,7 +35,10 @@
  * |du/dy|) * width_scale, vw = (|dv/dx| + |dv/dy|) * width_scale (PtexFilter::eval's sums of a
  * renderer's derivatives), the seam rule in ptex.texture.seams; its channels shown through
  * ptex.rgb_source. A non-finite point shades black, a non-finite width reads a whole face.
- * Host guarantees: sample_triangle from raster of this frame; seam_mask holds width * height
+ * Host guarantees: sample_triangle from raster of this frame; with displaced.tessellation > 0,
+ * tess_vertices and tess_normals are this frame's tessellation (tessellate, displaced_normals) and
+ * input triangle t of the setups is micro-triangle t (null buffers otherwise, never read);
+ * seam_mask holds width * height
  * bytes when SEAMCL_SEAM_MASK is 1 (unused otherwise); in the Ptex variant, face i of the scene is
  * face i of ptex_faces (the other variants never read the ptex arguments; they may be null) and
  * no seam mask.
@@ -59,6 +67,39 @@ typedef int PtexSource; /* unused */
 typedef struct {
   float u, v, dudx, dvdx, dudy, dvdy;
 } SurfaceUv;
+
+/* A displaced render's shading normals: the tessellated vertices (their domain uv) and
+ * displaced_normals' unit normals; params.tessellation 0: none, the face normal lights. */
+typedef struct {
+  DisplacedShading params;
+  __global const TessVertex* vertices;
+  __global const float4* normals;
+} DisplacedSource;
+
+/* The lighting normal at domain point (u, v) of micro-triangle `tri`: the barycentrics of (u, v)
+ * in the triangle's vertices' uv, each clamped to >= 0 (a shading point extrapolated past an edge
+ * takes the normal of the triangle's nearest part), weighting the vertices' normals; renormalised.
+ * (0, 0, 0) where that has no finite length (the caller falls back to the face normal).
+ * Twin: displaced_shading_normal_reference (host/pipeline/stages/shade_resolve_twin.cpp). */
+SEAMCL_INLINE float3 displaced_shading_normal(const DisplacedSource* d, int tri, float u, float v) {
+  int id[3];
+  tess_triangle_vertices(tri, d->params.tessellation, d->params.adaptive, id);
+  const TessVertex a = d->vertices[id[0]], b = d->vertices[id[1]], c = d->vertices[id[2]];
+  const float e1u = b.u - a.u, e1v = b.v - a.v, e2u = c.u - a.u, e2v = c.v - a.v;
+  const float det = e1u * e2v - e2u * e1v;
+  const float pu = u - a.u, pv = v - a.v;
+  const float wb = (pu * e2v - e2u * pv) / det;
+  const float wc = (e1u * pv - pu * e1v) / det;
+  const float wa = 1.0f - wb - wc;
+  const float ka = wa > 0.0f ? wa : 0.0f, kb = wb > 0.0f ? wb : 0.0f, kc = wc > 0.0f ? wc : 0.0f;
+  const float4 na = d->normals[id[0]], nb = d->normals[id[1]], nc = d->normals[id[2]];
+  const float nx = ka * na.x + kb * nb.x + kc * nc.x;
+  const float ny = ka * na.y + kb * nb.y + kc * nc.y;
+  const float nz = ka * na.z + kb * nb.z + kc * nc.z;
+  const float length = sqrt(nx * nx + ny * ny + nz * nz);
+  if (!(length > 0.0f) || !isfinite(length)) return (float3)(0.0f);
+  return (float3)(nx / length, ny / length, nz / length);
+}
 
 SEAMCL_INLINE SurfaceUv interpolate_uv(__global const TriangleSetup* t, float x, float y) {
   const float dx = x - t->ref_x;
@@ -244,7 +285,8 @@ SEAMCL_INLINE float3 shade_fragment(__constant FrameParams* frame, __global cons
                              __global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
                              __global const uint* level_offsets, TEXEL_BUFFER texels,
                              __global const float* srgb_to_linear, __global const ReflectiveFace* reflective_faces,
-                             __global const float* cube_texels, const PtexSource* ptex, float x, float y) {
+                             __global const float* cube_texels, const PtexSource* ptex, const DisplacedSource* displaced,
+                             uint slot, float x, float y) {
   const SurfaceUv s = interpolate_uv(t, x, y);
 #if SEAMCL_CUBE
   const int reflective = faces[t->face].reflective;
@@ -258,8 +300,13 @@ SEAMCL_INLINE float3 shade_fragment(__constant FrameParams* frame, __global cons
                                        s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
 #endif
   __global const FaceGpu* face = faces + t->face;
-  const float n_dot_l = face->normal[0] * frame->light_dir[0] + face->normal[1] * frame->light_dir[1] +
-                        face->normal[2] * frame->light_dir[2];
+  float3 n = (float3)(face->normal[0], face->normal[1], face->normal[2]);
+  if (displaced->params.tessellation > 0) {
+    /* Records are slot-major: slot k of input triangle t at k * input_triangles + t. */
+    const float3 smooth = displaced_shading_normal(displaced, (int)(slot % (uint)frame->input_triangles), s.u, s.v);
+    if (smooth.x != 0.0f || smooth.y != 0.0f || smooth.z != 0.0f) n = smooth;
+  }
+  const float n_dot_l = n.x * frame->light_dir[0] + n.y * frame->light_dir[1] + n.z * frame->light_dir[2];
   const float lighting = frame->ambient + (1.0f - frame->ambient) * fmax(n_dot_l, 0.0f);
   return (float3)(albedo.x * frame->light_color[0], albedo.y * frame->light_color[1],
                   albedo.z * frame->light_color[2]) * lighting;
@@ -350,7 +397,8 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
                    __global FrameStats* stats, __global uchar* seam_mask,
                    __global const ReflectiveFace* reflective_faces, __global const float* cube_texels,
                    PtexShading ptex, __global const PtexFilterFace* ptex_faces, __global const uint* ptex_level_offsets,
-                   __global const uchar* ptex_texels) {
+                   __global const uchar* ptex_texels, DisplacedShading displaced,
+                   __global const TessVertex* tess_vertices, __global const float4* tess_normals) {
   /* Fragments are summed per work-group without atomics: a locked add per pixel waits for the
    * pixel's image store to drain (docs/performance.md, "faces" rows). */
   __local uint group_fragments[SEAMCL_TILE_SIZE * SEAMCL_TILE_SIZE];
@@ -371,6 +419,10 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
   (void)ptex_level_offsets;
   (void)ptex_texels;
 #endif
+  DisplacedSource displaced_source;
+  displaced_source.params = displaced;
+  displaced_source.vertices = tess_vertices;
+  displaced_source.normals = tess_normals;
   if (x < frame->width && y < frame->height) {
     const int samples = frame->sample_count;
     const int row = sample_pattern_row(samples);
@@ -389,7 +441,8 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
         }
         const float sample_x = (float)sample_fixed_x(x, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
         const float sample_y = (float)sample_fixed_y(y, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
-        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, &ptex_source, sample_x, sample_y);
+        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, &ptex_source,
+                              &displaced_source, slot, sample_x, sample_y);
 #if SEAMCL_SEAM_MASK
         crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,
                                                       srgb_to_linear, sample_x, sample_y));
@@ -428,7 +481,8 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
           shade_x = centroid_x / (float)covered;
           shade_y = centroid_y / (float)covered;
         }
-        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, &ptex_source, shade_x, shade_y) *
+        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, &ptex_source,
+                              &displaced_source, slot, shade_x, shade_y) *
                (float)covered;
 #if SEAMCL_SEAM_MASK
         crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,

@@ -1,4 +1,4 @@
-/* Stage 0 (displacement renders only): tessellation. Two kernels.
+/* Stage 0 (displacement renders only): tessellation. Three kernels.
  *
  * tessellate: one work-item per output vertex, patch p's vertex (i, j) at
  * p * (T+1)^2 + j * (T+1) + i (T = params->tessellation, 1..SEAMCL_MAX_TESSELLATION).
@@ -29,7 +29,23 @@
  * the inner grid's corner point may lie on the patch corner's side of the 00-11 diagonal, which
  * would turn a triangle over, while 10-01 passes through that point.
  * Every record's face is the patch, so shading reads the patch's colour texture and seam method.
- * Twin: host/pipeline/stages/tessellate_twin.cpp (tessellate); tessellated_setup at T = 1
+ *
+ * displaced_normals: one work-item per tessellated vertex, after tessellate; the unit normal of the
+ * displaced surface there, which shading interpolates across each micro-triangle. The sum of the
+ * cross products (v1 - v0) x (v2 - v0) (twice the area-weighted normal) of the micro-triangles
+ * around the slot, split as tessellated_setup splits them, summed over every copy of the point in
+ * (patch, j, i) order: inside a patch only its own slot; on a shared edge also the neighbour's slot
+ * at the same step; at a patch corner the corner of every patch at that mesh vertex (corner_copies
+ * from corner_offsets[vertex], packed in that order). Each copy's ring is read at that patch's own
+ * vertices except the point itself, which is this slot's position, so two patches whose copies of
+ * a point and of its ring agree bit for bit (the watertight methods) get the same bits. Then
+ * divided by its length; a zero or non-finite sum gives (0, 0, 0). w = 0.
+ * Twin: displaced_normal (host/eval/displacement_metrics.cpp): the sums are bit-exact (no
+ * contraction, the same order); the normalisation is exact where sqrt and division are correctly
+ * rounded (PoCL), else within their OpenCL 1.2 bounds (3 and 2.5 ulp).
+ * Host guarantees (displaced_normals): vertices from tessellate of these patches; corner_offsets
+ * holds positions + 1 entries; corner_copies entries patch * 4 + corner.
+ * Twins: host/pipeline/stages/tessellate_twin.cpp (tessellate); tessellated_setup at T = 1
  * without displacement equals triangle_setup exactly (tests/test_displacement.cpp). */
 
 SEAMCL_INLINE float disp_texel(__global const ushort* s, int columns, int i, int j) {
@@ -377,4 +393,86 @@ void tessellated_setup(__constant FrameParams* frame, __constant TessellationPar
     for (int i = 0; i < SEAMCL_SETUP_GROUP; ++i) sum += group_visible[i];
     if (sum > 0) atomic_add(&stats->visible_triangles, sum);
   }
+}
+
+
+/* Adds the cross products of the micro-triangles of patch q around its slot (qi, qj), cells in
+ * (cj, ci) order, each cell's two triangles in split order, the slot itself read as `own`. */
+SEAMCL_INLINE void normal_ring_sum(__global const TessVertex* vertices, const float* own, int q, int qi, int qj,
+                                   int t, int adaptive, float* n) {
+  for (int cj = qj - 1; cj <= qj; ++cj) {
+    for (int ci = qi - 1; ci <= qi; ++ci) {
+      if (ci < 0 || cj < 0 || ci >= t || cj >= t) continue;
+      const int flipped = tess_cell_flipped(ci, cj, t, adaptive);
+      for (int odd = 0; odd < 2; ++odd) {
+        float p[3][3];
+        int touches = 0;
+        for (int k = 0; k < 3; ++k) {
+          int di = 0, dj = 0;
+          tess_cell_corner(odd, k, flipped, &di, &dj);
+          const int gi = ci + di, gj = cj + dj;
+          const int centre = gi == qi && gj == qj;
+          touches |= centre;
+          __global const float* at = vertices[tess_vertex_index(q, gi, gj, t)].position;
+          for (int c = 0; c < 3; ++c) p[k][c] = centre ? own[c] : at[c];
+        }
+        if (!touches) continue;
+        const float ax = p[1][0] - p[0][0], ay = p[1][1] - p[0][1], az = p[1][2] - p[0][2];
+        const float bx = p[2][0] - p[0][0], by = p[2][1] - p[0][1], bz = p[2][2] - p[0][2];
+        n[0] = n[0] + (ay * bz - az * by);
+        n[1] = n[1] + (az * bx - ax * bz);
+        n[2] = n[2] + (ax * by - ay * bx);
+      }
+    }
+  }
+}
+
+/* Whether copy (pa, ja, ia) comes before (pb, jb, ib): by patch, then row, then column. */
+SEAMCL_INLINE int grid_point_before(int pa, int ia, int ja, int pb, int ib, int jb) {
+  return pa != pb ? pa < pb : (ja != jb ? ja < jb : ia < ib);
+}
+
+__kernel void displaced_normals(__constant TessellationParams* params, __global const DisplacementPatch* patches,
+                                __global const uint* corner_offsets, __global const uint* corner_copies,
+                                __global const TessVertex* vertices, int adaptive, __global float4* normals) {
+  const int t = params->tessellation;
+  const int side = t + 1;
+  const int id = (int)get_global_id(0);
+  if (id >= params->patches * side * side) return;
+  const int patch = id / (side * side);
+  const int i = (id % (side * side)) % side, j = (id % (side * side)) / side;
+  __global const DisplacementPatch* p = &patches[patch];
+  float own[3];
+  for (int c = 0; c < 3; ++c) own[c] = vertices[id].position[c];
+  float n[3] = {0.0f, 0.0f, 0.0f};
+  const int corner = (i == 0 || i == t) && (j == 0 || j == t);
+  if (corner) {
+    const int c = j == 0 ? (i == 0 ? 0 : 1) : (i == t ? 2 : 3);
+    const uint vertex = p->vertex[c];
+    for (uint e = corner_offsets[vertex]; e < corner_offsets[vertex + 1]; ++e) {
+      const int q = (int)(corner_copies[e] / 4u), qc = (int)(corner_copies[e] % 4u);
+      normal_ring_sum(vertices, own, q, (qc == 1 || qc == 2) ? t : 0, qc >= 2 ? t : 0, t, adaptive, n);
+    }
+  } else {
+    int e = -1, k = 0;
+    if (j == 0) { e = 0; k = i; }
+    else if (i == t) { e = 1; k = j; }
+    else if (j == t) { e = 2; k = t - i; }
+    else if (i == 0) { e = 3; k = t - j; }
+    int q = -1, qi = 0, qj = 0;
+    if (e >= 0 && p->neighbor[e] >= 0) {
+      q = p->neighbor[e];
+      const int step = p->neighbor_same_way[e] ? k : t - k;
+      const int qe = p->neighbor_edge[e];
+      qi = qe == 0 ? step : qe == 1 ? t : qe == 2 ? t - step : 0;
+      qj = qe == 0 ? 0 : qe == 1 ? step : qe == 2 ? t : t - step;
+    }
+    const int neighbour_first = q >= 0 && grid_point_before(q, qi, qj, patch, i, j);
+    if (neighbour_first) normal_ring_sum(vertices, own, q, qi, qj, t, adaptive, n);
+    normal_ring_sum(vertices, own, patch, i, j, t, adaptive, n);
+    if (q >= 0 && !neighbour_first) normal_ring_sum(vertices, own, q, qi, qj, t, adaptive, n);
+  }
+  const float length = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  const int usable = length > 0.0f && isfinite(length);
+  normals[id] = usable ? (float4)(n[0] / length, n[1] / length, n[2] / length, 0.0f) : (float4)(0.0f);
 }

@@ -105,9 +105,10 @@ TEST(CrackPixels, TorusCracksOnlyWhereTheGapIsOpen) {
   expect_cracks_only_where_the_gap_is_open(torus, 240, 270);
 }
 
-// The displaced surface's normals (displaced_normal), computed by each patch at its own copy of a
-// boundary point: bit for bit the same on both sides of every edge and at every mesh vertex for
-// the watertight methods, different for naive, whose positions differ.
+// The displaced surface's normals (the device's displaced_normals, which measure_displacement
+// reports and shading interpolates), computed by each patch at its own copy of a boundary point:
+// bit for bit the same on both sides of every edge and at every mesh vertex for the watertight
+// methods, different for naive, whose positions differ.
 TEST(DisplacedNormals, AgreeBitForBitAcrossEveryEdgeForTheWatertightMethods) {
   Scene plane = load_scene_source(kAssets + "plane.obj");
   attach_ptex_displacement(plane, kAssets + "rand_lo.ptx");

@@ -156,7 +156,9 @@ TEST(Displacement, EdgeDomainPointsAgreeFromEitherSide) {
 
 TEST(Displacement, TessellatedSetupAtT1EqualsTriangleSetup) {
   // At T = 1 without displacement the micro-triangles are the quads' own triangles: the
-  // tessellated setup must produce the same records as triangle_setup, bit for bit.
+  // tessellated setup must produce the same records as triangle_setup, bit for bit, and lit with
+  // the face normals (displacement_normals=face) the same image; lit with the displaced surface's
+  // normals (the default), whose corners average the patches around them, a different one.
   Scene scene = displaced();
   auto flat = std::make_shared<Displacement>(*scene.displacement);
   flat->scale = 0.0f;
@@ -171,6 +173,7 @@ TEST(Displacement, TessellatedSetupAtT1EqualsTriangleSetup) {
   const std::vector<TriangleSetup> plain_setups = renderer.read_setups();
   options.displacement = DisplacementMethod::Fixed;
   options.tessellation = 1;
+  options.displacement_normals = DisplacementNormals::Face;
   const RenderResult tessellated = renderer.render(scene.camera, options);
   const std::vector<TriangleSetup> tess_setups = renderer.read_setups();
   ASSERT_EQ(plain_setups.size(), tess_setups.size());
@@ -181,6 +184,10 @@ TEST(Displacement, TessellatedSetupAtT1EqualsTriangleSetup) {
   ASSERT_EQ(plain.pixels.size(), tessellated.pixels.size());
   EXPECT_EQ(std::memcmp(plain.pixels.data(), tessellated.pixels.data(), plain.pixels.size() * sizeof(glm::vec4)), 0);
   EXPECT_GT(tessellated.stats.fragments, 0u);
+  options.displacement_normals = DisplacementNormals::Displaced;
+  const RenderResult smooth = renderer.render(scene.camera, options);
+  EXPECT_EQ(smooth.stats.fragments, tessellated.stats.fragments);
+  EXPECT_NE(std::memcmp(plain.pixels.data(), smooth.pixels.data(), plain.pixels.size() * sizeof(glm::vec4)), 0);
 }
 
 TEST(Displacement, DefaultRendersAreUnchangedByTheScenesMaps) {

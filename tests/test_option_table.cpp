@@ -176,7 +176,7 @@ TEST(OptionTable, DocumentsAreTheTable) {
 TEST(OptionTable, DomainsAreTheTablesAndScenesNameTheirs) {
   using Domains = std::map<std::string, std::vector<std::string>>;
   EXPECT_EQ(render_option_domains(),
-            (Domains{{"cube", {"cube_method"}}, {"displacement", {"displacement_map", "displacement_method", "tessellation", "tessellation_pixels", "displacement_level"}}}));
+            (Domains{{"cube", {"cube_method"}}, {"displacement", {"displacement_map", "displacement_method", "tessellation", "tessellation_pixels", "displacement_level", "displacement_normals"}}}));
   for (const auto& [domain, keys] : render_option_domains())
     for (const std::string& key : keys) EXPECT_NE(find_option(render_option_table(), key), nullptr) << key;
   const json methods = server::methods_document(generate_scene("quad2", {}), server::ServerOptions{});

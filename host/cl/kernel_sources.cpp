@@ -35,12 +35,14 @@ std::vector<std::string> kernel_program_files(KernelProgram program) {
   switch (program) {
     case KernelProgram::Geometry:
       // tessellated_setup sets up its micro-triangles with triangle_setup.cl's functions.
-      return {"seamcl_types.h", "sample_pattern.h", "triangle_setup.cl", "binning.cl", "raster.cl", "tessellate.cl"};
+      return {"seamcl_types.h", "sample_pattern.h", "tessellation_grid.h", "triangle_setup.cl", "binning.cl", "raster.cl",
+              "tessellate.cl"};
     case KernelProgram::Shading:
       // ptex_filter.cl compiles to nothing outside the Ptex variant (SEAMCL_FILTER_PTEX), shade_inspect.cl
       // outside the inspector's (SEAMCL_INSPECT).
-      return {"seamcl_types.h", "sample_pattern.h", "texture_sample.cl", "cube_sample.cl", "ptex_filter.cl",
-              "shade_resolve.cl", "shade_inspect.cl"};
+      // tessellation_grid.h: a displaced render's micro-triangles, lit with their vertices' normals.
+      return {"seamcl_types.h", "sample_pattern.h", "tessellation_grid.h", "texture_sample.cl", "cube_sample.cl",
+              "ptex_filter.cl", "shade_resolve.cl", "shade_inspect.cl"};
     case KernelProgram::Sampling: return {"seamcl_types.h", "texture_sample.cl", "cube_sample.cl", "lookup_batch.cl"};
     case KernelProgram::PtexFilter: return {"seamcl_types.h", "ptex_filter.cl", "ptex_lookup_batch.cl"};
     case KernelProgram::Downsample: return {"seamcl_types.h", "downsample.cl"};

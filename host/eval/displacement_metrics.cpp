@@ -105,10 +105,17 @@ double median(std::vector<double> values) {
 
 }  // namespace
 
-DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<TessVertex>& vertices) {
+DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<TessVertex>& vertices,
+                            const std::vector<cl_float4>* normals) {
   DisplacementGap gap;
   const int t = packed.params.tessellation;
   if (vertices.size() != packed.vertex_count()) throw std::invalid_argument("measure_gap: vertex count does not match");
+  if (normals && normals->size() != vertices.size()) throw std::invalid_argument("measure_gap: normal count does not match");
+  auto normal_at = [&](const GridPoint& g) -> std::array<float, 3> {
+    if (!normals) return displaced_normal(packed, vertices, g.patch, g.i, g.j);
+    const cl_float4& n = (*normals)[vertex_index(g.patch, g.i, g.j, t)];
+    return {n.s[0], n.s[1], n.s[2]};
+  };
   // Shared edges, each once (from the lower-numbered patch), all T+1 points including corners.
   for (int p = 0; p < static_cast<int>(packed.patches.size()); ++p) {
     const DisplacementPatch& patch = packed.patches[static_cast<size_t>(p)];
@@ -142,10 +149,10 @@ DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<
       for (int i = 0; i <= t; i += (j == 0 || j == t) ? 1 : t) {
         const std::vector<GridPoint> copies = copies_of(packed, p, i, j);
         if (copies.size() < 2 || copies.front().patch != p || copies.front().i != i || copies.front().j != j) continue;
-        const std::array<float, 3> first = displaced_normal(packed, vertices, p, i, j);
+        const std::array<float, 3> first = normal_at({p, i, j});
         bool differ = false;
         for (size_t c = 1; c < copies.size(); ++c) {
-          const std::array<float, 3> other = displaced_normal(packed, vertices, copies[c].patch, copies[c].i, copies[c].j);
+          const std::array<float, 3> other = normal_at(copies[c]);
           for (int k = 0; k < 3; ++k) {
             gap.max_normal_gap =
                 std::max(gap.max_normal_gap, std::fabs(static_cast<double>(first[k]) - static_cast<double>(other[k])));
@@ -495,8 +502,9 @@ DisplacementReport measure_displacement(ClRuntime& runtime, const Scene& scene, 
   const bool adaptive = packed.adaptive();
   TessellateLauncher stage(runtime);
   stage.load(std::move(packed));
-  std::vector<TessVertex> vertices = stage.tessellate();
-  report.gap = measure_gap(stage.packed(), vertices);
+  const std::vector<cl_float4> normals = stage.tessellate_normals();  // what shading interpolates
+  std::vector<TessVertex> vertices = stage.read_vertices();
+  report.gap = measure_gap(stage.packed(), vertices, &normals);
   report.vertices = vertices.size();
   for (const TessVertex& v : vertices) report.samples += v.samples;
   stage.release();

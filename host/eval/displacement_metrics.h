@@ -29,13 +29,16 @@ struct DisplacementGap {
   size_t differing_pairs = 0;  // pairs whose positions are not equal coordinate by coordinate
   double max_edge_gap = 0.0;   // max_gap over the pairs inside shared edges (not at their ends)
   double max_corner_gap = 0.0; // max_gap over the pairs at mesh vertices
-  // The displaced surface's normal at each copy of a point on a patch boundary
-  // (displaced_normal), each copy's against the first's (lowest patch): the largest coordinate
-  // difference of the unit normals, and the points where any differs.
+  // The displaced surface's normal at each copy of a point on a patch boundary (the normals
+  // given, else displaced_normal), each copy's against the first's (lowest patch): the largest
+  // coordinate difference of the unit normals, and the points where any differs.
   double max_normal_gap = 0.0;
   size_t differing_normals = 0;
 };
-DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<TessVertex>& vertices);
+// `normals`: one per vertex, the device's (TessellateLauncher::tessellate_normals, what a
+// displaced render's shading interpolates); null: displaced_normal of each copy.
+DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<TessVertex>& vertices,
+                            const std::vector<cl_float4>* normals = nullptr);
 
 // The unit normal of the displaced surface at grid point (i, j) of `patch`, as that patch computes
 // it: the area-weighted sum of the micro-triangles around the point, its own and, for a point on
@@ -44,7 +47,8 @@ DisplacementGap measure_gap(const PackedDisplacement& packed, const std::vector<
 // this patch's copy. The triangles are summed in one order whichever patch asks (by patch, then
 // cell), so two patches whose copies of the point and of its ring agree bit for bit get the same
 // bits: a watertight method's normals agree across every edge exactly, and where the positions
-// differ (naive) the normals differ with them. Float arithmetic, as a kernel would do it.
+// differ (naive) the normals differ with them. Float arithmetic, as the kernel does it: the twin of
+// kernels/tessellate.cl's displaced_normals, whose normals light displaced renders.
 std::array<float, 3> displaced_normal(const PackedDisplacement& packed, const std::vector<TessVertex>& vertices,
                                       int patch, int i, int j);
 
@@ -139,7 +143,8 @@ struct DisplacementReport {
 void check_tessellation_levels(const Scene& scene, const std::vector<int>& levels);
 
 // Measures options.displacement (required) on `scene` at `camera`, or over `frames` frames of
-// its orbit when frames > 0: the gap from the device's tessellation, crack pixels from renders
+// its orbit when frames > 0: the gap (and the normal gap, of the device's displaced_normals) from
+// the device's tessellation, crack pixels from renders
 // of with_back_faces_flagged on those same vertices (closed meshes only; count_crack_pixels),
 // time per frame from `repeat` renders of the scene itself (median; repeat 0 leaves the times 0
 // for a caller that times its own renders).

@@ -246,13 +246,17 @@ RenderMemory render_memory(const SceneSizes& scene, const RenderOptions& options
   const size_t pixels = mul(width, height);
   const size_t tile_count = mul((width + SEAMCL_TILE_SIZE - 1) / SEAMCL_TILE_SIZE, (height + SEAMCL_TILE_SIZE - 1) / SEAMCL_TILE_SIZE);
   // A displacement render sets up T^2 micro-triangles per triangle (kernels/tessellate.cl), and
-  // holds the tessellated vertices (32 bytes each, counted with the setups).
+  // holds the tessellated vertices (32 bytes each) and their normals (16 bytes each), counted with
+  // the setups, and the corner table (a uint per mesh vertex and per patch corner).
   const size_t tess = options.displacement ? static_cast<size_t>(std::max(options.tessellation, 1)) : 1;
   const size_t slots = mul(mul(scene.triangle_count(), mul(tess, tess)), SEAMCL_CLIP_SLOTS);
   m.setups = device_array(slots, sizeof(TriangleSetup));
   // and how many slots setup wrote per input triangle (Renderer's slot_counts, a uint each).
   m.setups = add(m.setups, device_array(slots / SEAMCL_CLIP_SLOTS, sizeof(cl_uint)));
-  if (options.displacement) m.setups = add(m.setups, mul(mul(faces, mul(tess + 1, tess + 1)), 32));
+  if (options.displacement) {
+    m.setups = add(m.setups, mul(mul(faces, mul(tess + 1, tess + 1)), 32 + 16));
+    m.setups = add(m.setups, mul(add(add(scene.vertices, 1), mul(faces, 4)), sizeof(cl_uint)));
+  }
   // Tile counts and offsets, and binning's counters: one per tile for each chunk of input triangles.
   const size_t chunks = std::max<size_t>(bin_chunks(slots / SEAMCL_CLIP_SLOTS, tile_count).chunks, 1);
   m.tiles = mul(mul(2 + chunks, sizeof(cl_uint)), tile_count);

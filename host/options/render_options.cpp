@@ -62,6 +62,8 @@ constexpr std::array<std::pair<TexelFormat, const char*>, 2> kTexelFormats{
     {{TexelFormat::Rgba8, "rgba8"}, {TexelFormat::Rgba32f, "rgba32f"}}};
 constexpr std::array<std::pair<ShadingMode, const char*>, 3> kShadingModes{
     {{ShadingMode::Pixel, "pixel"}, {ShadingMode::Centroid, "centroid"}, {ShadingMode::Sample, "sample"}}};
+constexpr std::array<std::pair<DisplacementNormals, const char*>, 2> kDisplacementNormals{
+    {{DisplacementNormals::Displaced, "displaced"}, {DisplacementNormals::Face, "face"}}};
 constexpr std::array<std::pair<CubeMethod, const char*>, 10> kCubeMethods{
     {{CubeMethod::Clamp, "cube-clamp"},
      {CubeMethod::Seamless, "cube-seamless"},
@@ -83,6 +85,11 @@ std::vector<std::string> method_names() { return enum_names(kMethods); }
 std::optional<ShadingMode> parse_shading_mode(std::string_view name) { return parse_enum(name, kShadingModes); }
 std::string to_string(ShadingMode mode) { return enum_name(mode, kShadingModes); }
 std::vector<std::string> shading_mode_names() { return enum_names(kShadingModes); }
+std::optional<DisplacementNormals> parse_displacement_normals(std::string_view name) {
+  return parse_enum(name, kDisplacementNormals);
+}
+std::string to_string(DisplacementNormals normals) { return enum_name(normals, kDisplacementNormals); }
+std::vector<std::string> displacement_normals_names() { return enum_names(kDisplacementNormals); }
 std::optional<ImageFormat> parse_image_format(std::string_view name) { return parse_enum(name, kFormats); }
 std::string to_string(ImageFormat format) { return enum_name(format, kFormats); }
 
@@ -326,6 +333,13 @@ const std::vector<RenderField>& render_fields() {
          kDisplacementDomain},
         {integer("displacement_level", 0, kMaxDisplacementLevel, "Displacement: the maps' level every patch samples"),
          [](RenderOptions& o, const json& v) { o.displacement_level = v.get<int>(); }, displaced_only(json()), kDisplacementDomain},
+        {choice("displacement_normals", displacement_normals_names(),
+                "Displacement: light with the displaced surface's normals, computed alike on both sides of every "
+                "edge and interpolated across each micro-triangle, or with each patch's flat face normal",
+                "displacement normals"),
+         [](RenderOptions& o, const json& v) { o.displacement_normals = enum_value(v, kDisplacementNormals); },
+         [](const RenderOptions& o) { return o.displacement ? json(to_string(o.displacement_normals)) : json(); },
+         kDisplacementDomain},
     };
     // Defaults are RenderOptions' own initialisers, read through the same accessors; the two
     // displacement settings are written only with a method, so their defaults are read directly.
@@ -337,6 +351,8 @@ const std::vector<RenderField>& render_fields() {
         row.spec.default_value = defaults.tessellation;
       } else if (row.spec.key == "displacement_level") {
         row.spec.default_value = defaults.displacement_level;
+      } else if (row.spec.key == "displacement_normals") {
+        row.spec.default_value = to_string(defaults.displacement_normals);
       } else if (row.spec.key == "frames") {
         row.spec.default_value = defaults.frames;
       } else {

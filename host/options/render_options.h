@@ -52,6 +52,9 @@ enum class ZeroCoverage { Clamp, Nan };
 // Where a fragment is shaded: the pixel centre, the centroid of its covered samples, or every
 // sample (supersampling).
 enum class ShadingMode { Pixel, Centroid, Sample };
+// Displacement renders: the normal lighting reads, the displaced surface's at the micro-triangle's
+// vertices interpolated (kernels/tessellate.cl's displaced_normals), or the patch's flat face normal.
+enum class DisplacementNormals { Displaced, Face };
 enum class ImageFormat { Png, Exr };
 // How a cube-map lookup (reflective faces and the skybox of scenes with an environment) treats
 // the cube's edges; a setting of its own, since patch methods and cube methods never meet in one
@@ -85,6 +88,9 @@ bool needs_adjacency(Method method);
 std::optional<ShadingMode> parse_shading_mode(std::string_view name);
 std::string to_string(ShadingMode mode);
 std::vector<std::string> shading_mode_names();
+std::optional<DisplacementNormals> parse_displacement_normals(std::string_view name);
+std::string to_string(DisplacementNormals normals);
+std::vector<std::string> displacement_normals_names();
 std::optional<ImageFormat> parse_image_format(std::string_view name);
 std::string to_string(ImageFormat format);
 std::optional<Filter> parse_filter(std::string_view name);
@@ -146,6 +152,7 @@ struct RenderOptions {
   // Absent: uniform, every edge at T. Given: screen-space adaptive factors, each patch edge's
   // from its projected length over this many pixels a segment, clamped to 1..T.
   std::optional<float> tessellation_pixels;
+  DisplacementNormals displacement_normals = DisplacementNormals::Displaced;  // what lights the displaced surface
   float lod_bias = 0.0f;        // added to every lookup's mip level (-kMaxLodBias..kMaxLodBias)
 };
 

@@ -335,6 +335,20 @@ PackedDisplacement pack_displacement(const Scene& scene, const DisplacementSetti
       p.texcoord[k][3] = texcoord(lowest[v]);
     }
   }
+  // Patch corners by mesh vertex: faces in order, and within a face its corners in slot order
+  // (j, then i): corner 0 (0, 0), 1 (T, 0), 3 (0, T), 2 (T, T).
+  out.corner_offsets.assign(scene.positions.size() + 1, 0);
+  for (const Face& face : scene.faces)
+    for (uint32_t v : face.vertices) ++out.corner_offsets[v + 1];
+  for (size_t v = 0; v < scene.positions.size(); ++v) out.corner_offsets[v + 1] += out.corner_offsets[v];
+  out.corner_copies.resize(out.corner_offsets.back());
+  std::vector<cl_uint> filled(out.corner_offsets.begin(), out.corner_offsets.end() - 1);
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    for (int c : {0, 1, 3, 2}) {
+      const uint32_t v = scene.faces[f].vertices[static_cast<size_t>(c)];
+      out.corner_copies[filled[v]++] = static_cast<cl_uint>(f * 4 + static_cast<size_t>(c));
+    }
+  }
   return out;
 }
 

@@ -53,6 +53,11 @@ struct PackedDisplacement {
   std::vector<uint16_t> samples;           // every map at the chosen level
   std::vector<cl_float4> positions;        // the scene's, xyz, w = 1
   std::vector<cl_float4> normals;          // per mesh vertex: the mean of its faces' normals
+  // The patch corners at each mesh vertex, for the displaced surface's normals (displaced_normals):
+  // vertex v's are corner_copies[corner_offsets[v] .. corner_offsets[v + 1]), each patch * 4 +
+  // corner, in (patch, j, i) order of the corners' slots (the order displaced_normal sums in).
+  std::vector<cl_uint> corner_offsets;     // positions + 1
+  std::vector<cl_uint> corner_copies;      // 4 per patch
   TessellationParams params{};
   size_t matched_samples = 0;  // fixed: samples the edge matching changed
   size_t unmatched_edges = 0;  // fixed: shared edges whose resolutions do not nest (left as they are)

@@ -48,3 +48,5 @@ static_assert(sizeof(PtexShading) == 56, "PtexShading layout");
 static_assert(offsetof(PtexShading, width_scale) == 40);
 static_assert(offsetof(PtexShading, rgb_source) == 44);
 static_assert(offsetof(PtexFilterQuery, sharpness) == 24);
+static_assert(sizeof(DisplacedShading) == 16, "DisplacedShading layout");
+static_assert(offsetof(DisplacedShading, adaptive) == 4);

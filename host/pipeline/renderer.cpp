@@ -55,6 +55,7 @@ struct Renderer::Impl {
   TessellateLauncher tessellation{runtime};
   std::optional<DisplacementSettings> tessellation_settings;  // what `tessellation` holds
   bool displaced = false;        // this frame runs the tessellation stage
+  bool displaced_normals = false;  // and lights with the displaced surface's normals
   std::string program_key;       // the current shading program variant's build options
   bool direction_output = false;  // render_directions: SEAMCL_CUBE_DIRECTION
   // render_downsampled: the stage that reduces the image on the device before the read-back.
@@ -215,9 +216,16 @@ struct Renderer::Impl {
 
   ShadeSceneBuffers shade_scene_buffers() const {
     static const cl::Buffer none;
+    DisplacedShading lit{};
+    if (displaced && displaced_normals) {
+      lit.tessellation = tessellation.packed().params.tessellation;
+      lit.adaptive = tessellation.packed().adaptive() ? 1 : 0;
+    }
+    const bool smooth = lit.tessellation > 0;
     return ShadeSceneBuffers{faces,        neighbors,   level_offsets, texels, srgb_table, reflective_faces, cube_texels,
                              ptex_frame ? ptex_faces : none, ptex_frame ? ptex_level_offsets : none,
-                             ptex_frame ? ptex_texels : none, ptex_frame ? ptex_shading : PtexShading{}};
+                             ptex_frame ? ptex_texels : none, ptex_frame ? ptex_shading : PtexShading{}, lit,
+                             smooth ? tessellation.vertex_buffer() : none, smooth ? tessellation.normal_buffer() : none};
   }
 
   // The checks and settings of a frame with one of Ptex's own filters; InputError naming the field.
@@ -267,7 +275,7 @@ struct Renderer::Impl {
 
     if (displaced) {
       tessellation.enqueue(frame_params, setup.setups(), setup.slot_counts(), stats, p.input_triangles,
-                           ev.tessellate, ev.setup);
+                           displaced_normals, ev.tessellate, ev.setup);
     } else {
       setup.enqueue(frame_params, positions, faces, stats, p.input_triangles, ev.setup);
     }
@@ -411,6 +419,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
   impl_->use_kernels(options.texels, sampler, with_seam_mask);
   throw_if_stage_stopped("the frame");
   impl_->displaced = options.displacement.has_value();
+  impl_->displaced_normals = options.displacement_normals == DisplacementNormals::Displaced;
   if (impl_->displaced) {
     // Screen-space factors follow the camera: a frame whose factors differ loads them anew.
     DisplacementSettings settings = displacement_settings(*impl_->scene, options, camera);

@@ -71,6 +71,7 @@ def render(
     tessellation: int = ...,  # Displacement: each patch a (T+1)^2 grid
     tessellation_pixels: Optional[float] = ...,  # Displacement: screen-space adaptive factors, each patch edge's from its projected length over this many pixels a segment, clamped to 1..tessellation
     displacement_level: int = ...,  # Displacement: the maps' level every patch samples
+    displacement_normals: Literal['displaced', 'face'] = ...,  # Displacement: light with the displaced surface's normals, computed alike on both sides of every edge and interpolated across each micro-triangle, or with each patch's flat face normal
     repeat: int = ...,  # Render N times and report the median time per stage
     crack_orbit: int = ...,  # Displacement: count crack pixels over N frames of the scene's orbit instead of this frame
     export_mesh: Optional[str] = ...,  # Displacement: write the frame's tessellated patches, not merged, to a .obj or .ply file
@@ -100,6 +101,7 @@ def compare(
     tessellation: int = ...,  # Displacement: each patch a (T+1)^2 grid
     tessellation_pixels: Optional[float] = ...,  # Displacement: screen-space adaptive factors, each patch edge's from its projected length over this many pixels a segment, clamped to 1..tessellation
     displacement_level: int = ...,  # Displacement: the maps' level every patch samples
+    displacement_normals: Literal['displaced', 'face'] = ...,  # Displacement: light with the displaced surface's normals, computed alike on both sides of every edge and interpolated across each micro-triangle, or with each patch's flat face normal
     methods: Union[Sequence[Literal['clamp', 'black', 'discard', 'traverse', 'traverse-edges', 'guardband']], str] = ...,  # Comma list of seam methods
     msaa: Union[Sequence[Literal[1, 2, 4, 8, 16]], Literal[1, 2, 4, 8, 16], str] = ...,  # Comma list of MSAA rates
     repeat: int = ...,  # Timed renders per method and rate; ms reports median, min, max

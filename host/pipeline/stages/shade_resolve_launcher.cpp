@@ -44,6 +44,12 @@ void ShadeResolveLauncher::enqueue(const cl::Buffer& frame_params, const cl::Buf
     else kernel_.setArg(arg, sizeof(cl_mem), nullptr);  // a variant without Ptex never reads it
     ++arg;
   }
+  kernel_.setArg(arg++, scene.displaced);
+  for (const cl::Buffer* buffer : {&scene.tess_vertices, &scene.tess_normals}) {
+    if (scene.displaced.tessellation > 0) kernel_.setArg(arg, *buffer);
+    else kernel_.setArg(arg, sizeof(cl_mem), nullptr);  // face normals: never read
+    ++arg;
+  }
   const cl::NDRange tile_grid(static_cast<size_t>(p.tiles_x) * SEAMCL_TILE_SIZE, static_cast<size_t>(p.tiles_y) * SEAMCL_TILE_SIZE);
   const cl::NDRange tile_group(SEAMCL_TILE_SIZE, SEAMCL_TILE_SIZE);
   runtime_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, tile_grid, tile_group, nullptr, &events.emplace_back());

@@ -29,6 +29,11 @@ struct ShadeSceneBuffers {
   const cl::Buffer& ptex_level_offsets;
   const cl::Buffer& ptex_texels;
   PtexShading ptex;
+  // A displaced render lit with the displaced surface's normals (displaced.tessellation > 0): the
+  // tessellation stage's vertices and normals (null buffers otherwise).
+  DisplacedShading displaced;
+  const cl::Buffer& tess_vertices;
+  const cl::Buffer& tess_normals;
 };
 
 class ShadeResolveLauncher {

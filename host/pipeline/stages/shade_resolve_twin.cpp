@@ -1,6 +1,7 @@
 #include "pipeline/stages/shade_resolve_twin.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "pipeline/stages/ptex_filter_twin.h"
 #include "pipeline/stages/raster_twin.h"
@@ -30,8 +31,39 @@ SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y) {
   return r;
 }
 
+glm::vec3 displaced_shading_normal_reference(const DisplacedShadingReference& d, int tri, float u, float v) {
+  // tessellated_setup's vertices of micro-triangle `tri` (kernels/tessellation_grid.h).
+  const int t = d.params.tessellation;
+  const int patch = tri / (2 * t * t), cell = (tri / 2) % (t * t), ci = cell % t, cj = cell / t;
+  const bool flipped = d.params.adaptive && t >= 2 && ((ci == t - 1 && cj == 0) || (ci == 0 && cj == t - 1));
+  static constexpr int kPlain[2][3][2] = {{{0, 0}, {1, 0}, {1, 1}}, {{0, 0}, {1, 1}, {0, 1}}};
+  static constexpr int kFlipped[2][3][2] = {{{0, 0}, {1, 0}, {0, 1}}, {{1, 0}, {1, 1}, {0, 1}}};
+  const auto& corners = (flipped ? kFlipped : kPlain)[tri & 1];
+  size_t id[3];
+  for (int k = 0; k < 3; ++k) {
+    id[k] = (static_cast<size_t>(patch) * (t + 1) + static_cast<size_t>(cj + corners[k][1])) * (t + 1) +
+            static_cast<size_t>(ci + corners[k][0]);
+  }
+  const TessVertex &a = d.vertices->at(id[0]), &b = d.vertices->at(id[1]), &c = d.vertices->at(id[2]);
+  const float e1u = b.u - a.u, e1v = b.v - a.v, e2u = c.u - a.u, e2v = c.v - a.v;
+  const float det = e1u * e2v - e2u * e1v;
+  const float pu = u - a.u, pv = v - a.v;
+  const float wb = (pu * e2v - e2u * pv) / det;
+  const float wc = (e1u * pv - pu * e1v) / det;
+  const float wa = 1.0f - wb - wc;
+  const float ka = wa > 0.0f ? wa : 0.0f, kb = wb > 0.0f ? wb : 0.0f, kc = wc > 0.0f ? wc : 0.0f;
+  const cl_float4 &na = d.normals->at(id[0]), &nb = d.normals->at(id[1]), &nc = d.normals->at(id[2]);
+  const float nx = ka * na.s[0] + kb * nb.s[0] + kc * nc.s[0];
+  const float ny = ka * na.s[1] + kb * nb.s[1] + kc * nc.s[1];
+  const float nz = ka * na.s[2] + kb * nb.s[2] + kc * nc.s[2];
+  const float length = std::sqrt(nx * nx + ny * ny + nz * nz);
+  if (!(length > 0.0f) || !std::isfinite(length)) return glm::vec3(0.0f);
+  return glm::vec3(nx / length, ny / length, nz / length);
+}
+
 glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& f, const TriangleSetup& t, float x, float y,
-                                   const std::vector<float>* cube_texels, const PtexRenderTexture* ptex) {
+                                   const std::vector<float>* cube_texels, const PtexRenderTexture* ptex,
+                                   const DisplacedShadingReference* displaced, uint32_t slot) {
   const SurfaceUv s = interpolate_uv(t, x, y);
   const int reflective = scene.faces.at(t.face).reflective;
   if (reflective >= 0) return shade_reflection_reference(f, scene.reflective_faces.at(reflective), *cube_texels, s);
@@ -39,7 +71,13 @@ glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& 
       ptex ? glm::vec4(ptex_albedo_twin(*ptex, static_cast<int>(t.face), s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy), 1.0f)
            : sample_texture_reference(scene.textures(), t.face, f.sampler, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
   const FaceGpu& face = scene.faces.at(t.face);
-  const float n_dot_l = face.normal[0] * f.light_dir[0] + face.normal[1] * f.light_dir[1] + face.normal[2] * f.light_dir[2];
+  glm::vec3 n(face.normal[0], face.normal[1], face.normal[2]);
+  if (displaced && displaced->params.tessellation > 0) {
+    const glm::vec3 smooth =
+        displaced_shading_normal_reference(*displaced, static_cast<int>(slot / SEAMCL_CLIP_SLOTS), s.u, s.v);
+    if (smooth.x != 0.0f || smooth.y != 0.0f || smooth.z != 0.0f) n = smooth;
+  }
+  const float n_dot_l = n.x * f.light_dir[0] + n.y * f.light_dir[1] + n.z * f.light_dir[2];
   const float lighting = f.ambient + (1.0f - f.ambient) * std::fmax(n_dot_l, 0.0f);
   return glm::vec3(albedo.x * f.light_color[0], albedo.y * f.light_color[1], albedo.z * f.light_color[2]) * lighting;
 }
@@ -141,7 +179,8 @@ bool pixel_has_uncovered_fragment(const PackedScene& scene, const FrameParams& f
 ResolveReference shade_resolve_reference(const PackedScene& scene, const FrameParams& f,
                                          const std::vector<TriangleSetup>& setups,
                                          const std::vector<uint32_t>& sample_triangle,
-                                         const std::vector<float>* cube_texels, const PtexRenderTexture* ptex) {
+                                         const std::vector<float>* cube_texels, const PtexRenderTexture* ptex,
+                                         const DisplacedShadingReference* displaced) {
   const int samples = f.sample_count;
   const std::vector<SampleOffset>& pattern = sample_pattern(samples);
   constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
@@ -166,14 +205,15 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
         }
         const TriangleSetup& t = setups.at(slot);
         if (f.shading_mode == SEAMCL_SHADE_SAMPLE) {
-          sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s), cube_texels, ptex);
+          sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s), cube_texels, ptex, displaced, slot);
           if (with_mask) crosses = merge_mask(crosses, footprint_class(scene, f, t, sample_x(s), sample_y(s)));
           ++out.fragments;
           continue;
         }
         if (std::find(ids, ids + s, slot) != ids + s) continue;  // shaded at its first sample
         const PixelFragment fragment = pixel_fragment(f, t, ids, slot, x, y);
-        sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y, cube_texels, ptex) * static_cast<float>(fragment.covered);
+        sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y, cube_texels, ptex, displaced, slot) *
+               static_cast<float>(fragment.covered);
         if (with_mask) crosses = merge_mask(crosses, footprint_class(scene, f, t, fragment.x, fragment.y));
         ++out.fragments;
       }

@@ -19,13 +19,29 @@ struct SurfaceUv {
 };
 SurfaceUv interpolate_uv(const TriangleSetup& t, float x, float y);
 
+// A displaced render's shading normals (kernels/shade_resolve.cl's DisplacedSource): the
+// tessellated vertices and displaced_normals' normals, params.tessellation 0 for none.
+struct DisplacedShadingReference {
+  DisplacedShading params{};
+  const std::vector<TessVertex>* vertices = nullptr;
+  const std::vector<cl_float4>* normals = nullptr;
+};
+
+// The lighting normal at domain point (u, v) of micro-triangle `tri` (input order): its
+// vertices' normals weighted by (u, v)'s barycentrics in their uv, each clamped to >= 0,
+// renormalised; (0, 0, 0) where that has no finite length.
+glm::vec3 displaced_shading_normal_reference(const DisplacedShadingReference& d, int tri, float u, float v);
+
 // Colour of one fragment: texture lookup times the face's Lambert lighting; on a reflective face
 // the environment along the reflected ray (pipeline/stages/shade_resolve_reflection_twin.h), from
 // `cube_texels` (the renderer's Renderer::cube_texels(); needed by scenes with an environment only).
 // With `ptex` (the Ptex variant), the lookup is Ptex's own filter on its file (ptex_albedo_twin).
+// With `displaced` (tessellation > 0), lit by displaced_shading_normal_reference of the record's
+// micro-triangle, input order `slot` / SEAMCL_CLIP_SLOTS, where that has a length.
 glm::vec3 shade_fragment_reference(const PackedScene& scene, const FrameParams& frame, const TriangleSetup& t, float x,
                                    float y, const std::vector<float>* cube_texels = nullptr,
-                                   const PtexRenderTexture* ptex = nullptr);
+                                   const PtexRenderTexture* ptex = nullptr,
+                                   const DisplacedShadingReference* displaced = nullptr, uint32_t slot = 0);
 
 // A triangle's fragment in one pixel (pixel or centroid shading): the samples it covers and
 // where it is shaded. `ids` are the pixel's sample winners; `slot` must be among them.
@@ -60,6 +76,7 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
                                          const std::vector<TriangleSetup>& setups,
                                          const std::vector<uint32_t>& sample_triangle,
                                          const std::vector<float>* cube_texels = nullptr,
-                                         const PtexRenderTexture* ptex = nullptr);
+                                         const PtexRenderTexture* ptex = nullptr,
+                                         const DisplacedShadingReference* displaced = nullptr);
 
 }  // namespace seamcl
