@@ -42,7 +42,7 @@ SCENE = "paper"
 # the height of that compare: on 2 cores (2026-12-03, `seamcl compare --scene paper --size
 # 256x240 --methods traverse,clamp --msaa 1,2,4,8,16 --repeat 10`) setup took 4.2 s, the seam
 # masks and reference 4.0 s, the entries 4.9 s.
-CANCEL_IN = (("packing", 240), ("references", 232), ("entry 3/", 224))
+CANCEL_IN = (("packing", 240), ("references", 232), ("entry ", 224))
 
 
 def cpu_seconds(pid):
@@ -85,16 +85,19 @@ def run(base, pid, chromium, profile, t, deadline):
             set_controls(page, {"size": "%dx%d" % (side, side * height // 256)})
             wait_idle(page, min(RENDER_WAIT_S, left()), "the render at %dx%d" % (side, side * height // 256))
             idle = cpu_rate(pid, 1.0)
+            # The compare's CPU use is measured from its start to the phase, not over a window
+            # after it: on a quiet machine the last phase ends within a second of showing.
+            started_cpu, started = cpu_seconds(pid), time.monotonic()
             page.eval("document.getElementById('compare').click()")
             page.wait("document.getElementById('compare').dataset.state === 'running' && "
                       "!document.getElementById('compare_cancel').hidden", timeout=5, what="the compare running")
             page.wait("document.getElementById('progress').textContent.includes(%s) || "
                       "document.getElementById('compare').dataset.state !== 'running'" % json.dumps(phase_word),
                       timeout=min(RENDER_WAIT_S, left()), what="the compare's " + phase_word)
-            during = cpu_rate(pid, WINDOW_S)
+            during = (cpu_seconds(pid) - started_cpu) / max(1e-3, time.monotonic() - started)
             phase = page.eval("document.getElementById('progress').textContent")
             if page.eval("document.getElementById('compare').dataset.state") != "running":
-                t.check(False, "the compare is still running %s s after its %s" % (WINDOW_S, phase_word),
+                t.check(False, "the compare is still running when its %s shows" % phase_word,
                         page.eval("document.getElementById('compare_status').textContent"))
                 continue
             clicked = time.monotonic()
