@@ -156,7 +156,7 @@ TEST(KernelPrograms, EachBuildsAloneWithItsKernels) {
   const std::map<KernelProgram, std::pair<std::string, std::set<std::string>>> expected = {
       {KernelProgram::Geometry,
        {"",
-        {"triangle_setup", "bin_count", "bin_scan", "bin_fill", "raster", "sample_pattern", "tessellate",
+        {"triangle_setup", "bin_count", "bin_scan", "bin_fill", "raster", "sample_pattern", "tessellate", "displaced_normals",
          "tessellated_setup"}}},
       {KernelProgram::Shading, {"-DSEAMCL_CUBE=1 -DSEAMCL_SEAM_MASK=1 -DSEAMCL_INSPECT=1", {"shade_resolve", "shade_inspect"}}},
       {KernelProgram::Sampling,

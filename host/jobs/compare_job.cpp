@@ -172,10 +172,13 @@ CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobCont
   // frames), for this run only (host/pipeline/stage_stop.h).
   const StageStopScope stage_stop(control.should_stop);
   // Hashed once for the lock's key and every reference kind's cache key (hashing bakes every face).
+  // Hashing and packing each bake every face: a cancel is heard after each of them.
   if (reference_.use_cache && reference_.scene_hash.empty()) reference_.scene_hash = scene_content_hash(scene);
+  throw_if_stopped(control.should_stop, "after hashing the scene");
   Renderer renderer(runtime);
   renderer.set_device_byte_limit(control.device_byte_limit);
   renderer.load_scene(scene, frame_.texels);
+  throw_if_stopped(control.should_stop, "after packing the scene");
   CompareRun run;
   const int total = static_cast<int>(entries_.size());
   control.step(0, total);
