@@ -65,6 +65,8 @@ def consecutive_free_ports(n):
 
 
 def states(stats_port):
+    """HAProxy's state of each replica, UP or DOWN: "UP 1/2" (up, one failed check of the two that
+    take it out) is UP, "DOWN 1/1" (down, one good check of the one that brings it back) DOWN."""
     try:
         with urllib.request.urlopen(f"http://127.0.0.1:{stats_port}/stats;csv", timeout=2) as r:
             lines = r.read().decode().splitlines()
@@ -72,7 +74,8 @@ def states(stats_port):
         return {}
     header = lines[0].lstrip("# ").split(",")
     rows = [dict(zip(header, line.split(","))) for line in lines[1:]]
-    return {r["svname"]: r["status"] for r in rows if r.get("pxname") == "replicas" and r["svname"].startswith("replica")}
+    return {r["svname"]: r["status"].split(" ")[0] for r in rows
+            if r.get("pxname") == "replicas" and r["svname"].startswith("replica")}
 
 
 def wait_for(predicate, timeout_s, what):
