@@ -25,7 +25,9 @@
 // lookups and the kernels of every count.
 //
 // Run: build/seamcl_bench_lookups   (minutes: every filter on both sides; --benchmark_filter=
-// seamcl or =oiio to run one side; --benchmark_format=json sends the ratios to stderr).
+// seamcl or =oiio to run one side; --benchmark_format=json sends the ratios to stderr;
+// --lookups=N, 1024..16M, runs N lookups per launch instead of 4M: seconds, for checking the
+// benchmark rather than measuring with it).
 #include <benchmark/benchmark.h>
 
 #include <OpenImageIO/imageio.h>
@@ -61,7 +63,9 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr int kSide = 1024;
-constexpr size_t kLookups = size_t{1} << 22;  // 4M per kernel launch
+constexpr size_t kDefaultLookups = size_t{1} << 22;  // 4M per kernel launch
+constexpr size_t kMinLookups = 1024, kMaxLookups = size_t{1} << 24;
+size_t g_lookups = kDefaultLookups;  // --lookups=N: smaller runs that check the benchmark, not measure it
 constexpr int kMaxAniso = 16;
 
 struct Workload {
@@ -72,7 +76,7 @@ struct Workload {
 
 Workload make_workload() {
   Workload w;
-  w.lookups.resize(kLookups);
+  w.lookups.resize(g_lookups);
   std::mt19937 rng(2024u);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   const float side = static_cast<float>(kSide);
@@ -102,8 +106,8 @@ Workload make_workload() {
     const float aspect = std::clamp(std::sqrt(major2 / minor2), 1.0f, static_cast<float>(kMaxAniso));
     samples += std::max(1, static_cast<int>(2.0f * aspect - 1.0f));
   }
-  w.mean_probes = probes / static_cast<double>(kLookups);
-  w.oiio_mean_samples = samples / static_cast<double>(kLookups);
+  w.mean_probes = probes / static_cast<double>(g_lookups);
+  w.oiio_mean_samples = samples / static_cast<double>(g_lookups);
   return w;
 }
 
@@ -161,7 +165,7 @@ void bm_seamcl(benchmark::State& state, Filter filter, TexelFormat format, const
     total_ms += ms;
     launches += 1.0;
   }
-  record(state, name, launches * static_cast<double>(kLookups), total_ms / 1000.0);
+  record(state, name, launches * static_cast<double>(g_lookups), total_ms / 1000.0);
   if (filter == Filter::Aniso) state.counters["mean_probes"] = workload().mean_probes;
   lookups.set_aniso_grouped(false);
 }
@@ -196,17 +200,17 @@ double oiio_run(OIIO::TextureOpt::MipMode mip, size_t count, std::vector<float>&
 }
 
 void bm_oiio(benchmark::State& state, OIIO::TextureOpt::MipMode mip, const std::string& name) {
-  std::vector<float> out(4 * kLookups);
-  oiio_run(mip, kLookups / 8, out);  // warm-up: tiles into the cache, thread-local state
+  std::vector<float> out(4 * g_lookups);
+  oiio_run(mip, g_lookups / 8, out);  // warm-up: tiles into the cache, thread-local state
   double total = 0.0, runs = 0.0;
   for (auto _ : state) {
-    const double seconds = oiio_run(mip, kLookups, out);
+    const double seconds = oiio_run(mip, g_lookups, out);
     state.SetIterationTime(seconds);
     total += seconds;
     runs += 1.0;
   }
   benchmark::DoNotOptimize(out.data());
-  record(state, name, runs * static_cast<double>(kLookups), total);
+  record(state, name, runs * static_cast<double>(g_lookups), total);
   if (mip == OIIO::TextureOpt::MipModeAniso) state.counters["mean_samples_per_level"] = workload().oiio_mean_samples;
 }
 
@@ -247,7 +251,38 @@ void print_ratios(std::FILE* f) {
 
 }  // namespace
 
+// Takes --lookups=N out of argv (Google Benchmark refuses flags it does not know); false and a
+// message when N is not a whole number in [kMinLookups, kMaxLookups].
+bool take_lookups_flag(int& argc, char** argv) {
+  const std::string prefix = "--lookups=";
+  int kept = 1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind(prefix, 0) != 0) {
+      argv[kept++] = argv[i];
+      continue;
+    }
+    const std::string value = arg.substr(prefix.size());
+    size_t used = 0;
+    unsigned long long n = 0;
+    try {
+      n = std::stoull(value, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != value.size() || n < kMinLookups || n > kMaxLookups) {
+      std::fprintf(stderr, "--lookups must be a whole number from %zu to %zu, got '%s'\n", kMinLookups, kMaxLookups,
+                   value.c_str());
+      return false;
+    }
+    g_lookups = static_cast<size_t>(n);
+  }
+  argc = kept;
+  return true;
+}
+
 int main(int argc, char** argv) {
+  if (!take_lookups_flag(argc, argv)) return 2;
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   bool console = true;
@@ -310,7 +345,7 @@ int main(int argc, char** argv) {
   }
 
   std::fprintf(console ? stdout : stderr, "device: %s; %zu lookups per launch, %dx%d texture, %u host threads\n",
-               setup.runtime.device_description().c_str(), kLookups, kSide, kSide,
+               setup.runtime.device_description().c_str(), g_lookups, kSide, kSide,
                std::thread::hardware_concurrency());
   std::fflush(console ? stdout : stderr);
   benchmark::RunSpecifiedBenchmarks();

@@ -128,6 +128,12 @@ def main():
             lines = [line for line in text.splitlines() if any(line.startswith(r["target"]) for r in report["targets"])]
             check(len(lines) == len(report["targets"]) and all(("met" in l) or ("MISSED" in l) for l in lines),
                   f"a table line with a verdict per target: {lines}")
+        bench = os.path.join(args.build, "seamcl_bench_lookups")
+        if os.path.exists(bench):
+            for bad in ("0", "1023", "16777217", "4k", ""):
+                r = subprocess.run([bench, f"--lookups={bad}"], capture_output=True, text=True)
+                check(r.returncode == 2 and f"--lookups must be a whole number from 1024 to 16777216, got '{bad}'" in r.stderr,
+                      f"seamcl_bench_lookups --lookups={bad}: {r.returncode} {r.stderr[-300:]}")
         rc, text = speed_targets("--build", os.path.join(d, "nowhere"), "--out", out)
         check(rc == 2 and "--build: no seamcl binary" in text, f"a build folder without seamcl: {rc} {text}")
         rc, text = speed_targets("--build", args.build, "--rounds", "0", "--out", out)
