@@ -2,6 +2,7 @@
 // texel density (box-filtered from a finer neighbour, interpolated from a coarser one), corners
 // at every valence and at boundaries hold what guard_band.h says, the kernels read them as their
 // twin does, and they cost the memory reported.
+#include "sampler_twin_check.h"
 #include "test_meshes.h"
 #include "test_support.h"
 
@@ -131,16 +132,9 @@ TEST(KernelVsTwin, GuardBandEveryFilterAndStorage) {
                                         << to_string(filter));
         const SamplerParams sampler = sampler_params(Method::Guardband, filter, 8, ZeroCoverage::Clamp, band);
         const std::vector<glm::vec4> gpu = device.sample(sampler);
-        size_t bad = 0;
-        for (size_t i = 0; i < lookups.size(); ++i) {
-          const Lookup& l = lookups[i];
-          const glm::vec4 twin =
-              sample_texture_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
-          bool ok = true;
-          for (int c = 0; c < 4; ++c) ok &= std::fabs(gpu[i][c] - twin[c]) <= 1e-5f;
-          if (!ok && bad++ < 3) ADD_FAILURE() << "lookup " << i << ": gpu " << gpu[i].r << " twin " << twin.r;
-        }
-        EXPECT_EQ(bad, 0u);
+        EXPECT_EQ(seamcl_tests::twin_colour_mismatches(gpu, packed, sampler, lookups,
+                                                       [](float a, float b) { return std::fabs(a - b) <= 1e-5f; }),
+                  0u);
         // A sampler whose band differs from the packing is refused, not read out of bounds.
         EXPECT_THROW(device.sample(sampler_params(Method::Clamp, Filter::Trilinear, 8, ZeroCoverage::Clamp)),
                      std::logic_error);

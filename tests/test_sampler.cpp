@@ -16,6 +16,7 @@
 #include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/texture_lookups.h>
 #include "core/srgb.h"
+#include "sampler_twin_check.h"
 #include "test_support.h"
 #include "pipeline/stages/texture_sample_twin.h"
 
@@ -340,15 +341,8 @@ TEST(KernelVsTwin, AnisoGroupedByProbeCount) {
     double ms = -1.0;
     const std::vector<glm::vec4> gpu = device.sample(sampler, &ms);
     EXPECT_GE(ms, 0.0);
-    size_t bad = 0;
-    for (size_t i = 0; i < lookups.size(); ++i) {
-      const Lookup& l = lookups[i];
-      const glm::vec4 twin =
-          sample_texture_reference(packed.textures(), l.face, sampler, l.u, l.v, l.dudx, l.dvdx, l.dudy, l.dvdy);
-      bool ok = true;
-      for (int c = 0; c < 4; ++c) ok &= near(gpu[i][c], twin[c], 1e-5f);
-      if (!ok && bad++ < 3) ADD_FAILURE() << "lookup " << i << ": gpu " << gpu[i].r << " twin " << twin.r;
-    }
-    EXPECT_EQ(bad, 0u);
+    EXPECT_EQ(seamcl_tests::twin_colour_mismatches(gpu, packed, sampler, lookups,
+                                                   [](float a, float b) { return near(a, b, 1e-5f); }),
+              0u);
   }
 }

@@ -171,8 +171,8 @@ CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobCont
   // The renders ask the same between their stages (a seam mask, the 8x reference, each entry's
   // frames), for this run only (host/pipeline/stage_stop.h).
   const StageStopScope stage_stop(control.should_stop);
-  // Hashed once for the lock's key and every reference kind's cache key (hashing bakes every face).
-  // Hashing and packing each bake every face: a cancel is heard after each of them.
+  // Hashed once for the lock's key and every reference kind's cache key. Hashing and packing each
+  // bake every face, so a cancel is heard after each of them.
   if (reference_.use_cache && reference_.scene_hash.empty()) reference_.scene_hash = scene_content_hash(scene);
   throw_if_stopped(control.should_stop, "after hashing the scene");
   Renderer renderer(runtime);
