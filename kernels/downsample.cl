@@ -15,7 +15,8 @@
  * Each sum runs k = 0..taps-1 in order, each channel in float, a multiply then an add (no
  * contraction: seamcl_types.h), so the twin (downsample_twin) gives the same bits.
  * Host guarantees: image is width x height RGBA floats, mid out_width x height, out out_width x
- * out_height; 1 <= taps <= SEAMCL_MAX_DOWNSAMPLE_TAPS; global sizes exactly the counts above. */
+ * out_height; 1 <= taps <= SEAMCL_MAX_DOWNSAMPLE_TAPS; global sizes at least the counts above
+ * (rounded up to whole work-groups: the items past them return at once). */
 
 #define SEAMCL_MAX_DOWNSAMPLE_TAPS 64
 

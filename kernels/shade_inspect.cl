@@ -10,7 +10,8 @@
  * them). Reflective faces (cube-map lookups) report their colour only.
  * Host guarantees: the frame's setups, winners and scene buffers as shade_resolve read them;
  * window inside the image; records holds window_width * window_height * sample_count records,
- * pixel-major, row-major within the window.
+ * pixel-major, row-major within the window; the global size at least the window's (the items past
+ * it return at once).
  * Twin: host/pipeline/stages/shade_inspect_twin.cpp. */
 
 #ifndef SEAMCL_INSPECT

@@ -5,6 +5,9 @@
 #include "pipeline/stages/stage_buffers.h"
 
 namespace seamcl {
+namespace {
+constexpr size_t kGroupSide = 16;
+}  // namespace
 
 void DownsampleLauncher::build_kernels() {
   if (rows_() != nullptr) return;
@@ -39,8 +42,11 @@ void DownsampleLauncher::enqueue(const cl::Buffer& image, int width, int height,
   rows_.setArg(6, taps_n);
   rows_.setArg(7, weights_);
   rows_.setArg(8, mid_);
-  queue.enqueueNDRangeKernel(rows_, cl::NullRange, cl::NDRange(static_cast<size_t>(out_w), static_cast<size_t>(height)),
-                             cl::NullRange, nullptr, &passes.emplace_back());
+  // A fixed work-group (the kernels skip the items past the edge): with the driver's choice, which
+  // follows the image size, PoCL compiles both kernels again for every new size.
+  const cl::NDRange group(kGroupSide, kGroupSide);
+  queue.enqueueNDRangeKernel(rows_, cl::NullRange, cl::NDRange(round_up(out_w, kGroupSide), round_up(height, kGroupSide)),
+                             group, nullptr, &passes.emplace_back());
   columns_.setArg(0, mid_);
   columns_.setArg(1, cl_int{height});
   columns_.setArg(2, cl_int{out_w});
@@ -50,8 +56,8 @@ void DownsampleLauncher::enqueue(const cl::Buffer& image, int width, int height,
   columns_.setArg(6, taps_n);
   columns_.setArg(7, weights_);
   columns_.setArg(8, out_);
-  queue.enqueueNDRangeKernel(columns_, cl::NullRange, cl::NDRange(static_cast<size_t>(out_w), static_cast<size_t>(out_h)),
-                             cl::NullRange, nullptr, &passes.emplace_back());
+  queue.enqueueNDRangeKernel(columns_, cl::NullRange, cl::NDRange(round_up(out_w, kGroupSide), round_up(out_h, kGroupSide)),
+                             group, nullptr, &passes.emplace_back());
   out.resize(static_cast<size_t>(out_w) * out_h);
   queue.enqueueReadBuffer(out_, CL_FALSE, 0, out.size() * sizeof(cl_float4), out.data(), nullptr,
                           &readback.emplace_back());

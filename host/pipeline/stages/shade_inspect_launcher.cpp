@@ -1,5 +1,7 @@
 #include "pipeline/stages/shade_inspect_launcher.h"
 
+#include "pipeline/stages/stage_buffers.h"
+
 namespace seamcl {
 
 std::vector<InspectSample> ShadeInspectLauncher::inspect(const std::string& shading_options, const cl::Buffer& frame_params,
@@ -29,8 +31,11 @@ std::vector<InspectSample> ShadeInspectLauncher::inspect(const std::string& shad
   kernel.setArg(arg++, static_cast<cl_int>(window.height));
   kernel.setArg(arg++, out);
   cl::CommandQueue& queue = runtime_.queue();
-  queue.enqueueNDRangeKernel(kernel, cl::NullRange,
-                             cl::NDRange(static_cast<size_t>(window.width), static_cast<size_t>(window.height)));
+  // A fixed work-group (the kernel skips the items past the window): with the driver's choice,
+  // which follows the window's size, PoCL compiles the kernel again for every new window shape.
+  const size_t side = 8;
+  queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(round_up(window.width, side), round_up(window.height, side)),
+                             cl::NDRange(side, side));
   queue.enqueueReadBuffer(out, CL_TRUE, 0, records.size() * sizeof(InspectSample), records.data());
   return records;
 }
