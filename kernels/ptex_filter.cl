@@ -402,7 +402,7 @@ SEAMCL_INLINE uint ptexf_level(const PtexfState* s, PtexFilterFace f, int ulog2,
   return s->level_offsets[f.level_base + (uint)(ulog2 * (f.vlog2 + 1) + vlog2)];
 }
 
-SEAMCL_INLINE void ptexf_apply(PtexfState* s, PtexfKernel* k, int face) {
+SEAMCL_CALLED void ptexf_apply(PtexfState* s, PtexfKernel* k, int face) {
   const PtexFilterFace f = s->faces[face];
   const int nchan = s->tex.channels;
   /* Taps past the far side of a face (a kernel wider than the neighbour) are dropped. */
@@ -446,7 +446,7 @@ SEAMCL_INLINE void ptexf_across_edge(PtexfState* s, PtexfKernel* k, PtexFilterFa
   ptexf_apply(s, k, ptexf_adj_face(f, eid));
 }
 
-SEAMCL_INLINE void ptexf_corner(PtexfState* s, PtexfKernel* k, int faceid, PtexFilterFace f, int eid) {
+SEAMCL_CALLED void ptexf_corner(PtexfState* s, PtexfKernel* k, int faceid, PtexFilterFace f, int eid) {
   int aeid = eid;
   PtexFilterFace af = f;
   int cface[SEAMCL_PTEX_MAX_VALENCE];
