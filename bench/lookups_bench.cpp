@@ -20,10 +20,6 @@
 // where the mean probe count is computed on the host with the kernel's formula
 // N = min(ceil(major / minor), 16).
 //
-// aniso16-grouped: the same aniso lookups grouped by probe count (TextureLookups::
-// set_aniso_grouped); its time is the wall time of the planning pass, the host's ordering of the
-// lookups and the kernels of every count.
-//
 // Run: build/seamcl_bench_lookups   (minutes: every filter on both sides; --benchmark_filter=
 // seamcl or =oiio to run one side; --benchmark_format=json sends the ratios to stderr;
 // --lookups=N, 1024..16M, runs N lookups per launch instead of 4M: seconds, for checking the
@@ -151,9 +147,8 @@ void record(benchmark::State& state, const std::string& name, double lookups, do
   g_rates[name].push_back(rate);
 }
 
-void bm_seamcl(benchmark::State& state, Filter filter, TexelFormat format, const std::string& name, bool grouped) {
+void bm_seamcl(benchmark::State& state, Filter filter, TexelFormat format, const std::string& name) {
   TextureLookups& lookups = *g_setup->lookups.at(format);
-  lookups.set_aniso_grouped(grouped);
   const SamplerParams sampler = sampler_params(Method::Clamp, filter, kMaxAniso, ZeroCoverage::Clamp);
   double ms = 0.0;
   lookups.sample(sampler, &ms);  // warm-up: builds the program variant, PoCL's per-size compile
@@ -167,7 +162,6 @@ void bm_seamcl(benchmark::State& state, Filter filter, TexelFormat format, const
   }
   record(state, name, launches * static_cast<double>(g_lookups), total_ms / 1000.0);
   if (filter == Filter::Aniso) state.counters["mean_probes"] = workload().mean_probes;
-  lookups.set_aniso_grouped(false);
 }
 
 void oiio_range(OIIO::TextureOpt::MipMode mip, size_t begin, size_t end, float* out) {
@@ -237,15 +231,11 @@ void print_ratios(std::FILE* f) {
     const std::string s = fmt;
     std::fprintf(f, " seamcl %s (OIIO: float EXR, 2 threads):\n", fmt);
     line("seamcl aniso16 / OIIO aniso", rate("seamcl/aniso16/" + s) / rate("oiio/aniso16/f32"), "   (goal >= 10)");
-    line("seamcl aniso16 grouped / OIIO aniso", rate("seamcl/aniso16-grouped/" + s) / rate("oiio/aniso16/f32"),
-         "   (goal >= 10)");
     line("seamcl trilinear / OIIO trilinear", rate("seamcl/trilinear/" + s) / rate("oiio/trilinear/f32"),
          "   (goal >= 25)");
     line("seamcl bilinear / OIIO bilinear (NoMIP)", rate("seamcl/bilinear/" + s) / rate("oiio/bilinear/f32"), "");
     line("seamcl aniso16 / (seamcl trilinear / mean probes)",
          rate("seamcl/aniso16/" + s) / (rate("seamcl/trilinear/" + s) / probes), "   (goal >= 1.3)");
-    line("seamcl aniso16 grouped / (seamcl trilinear / mean probes)",
-         rate("seamcl/aniso16-grouped/" + s) / (rate("seamcl/trilinear/" + s) / probes), "   (goal >= 1.3)");
   }
 }
 
@@ -314,18 +304,16 @@ int main(int argc, char** argv) {
     Filter filter;
     const char* name;
     int iterations;
-    bool grouped;  // aniso lookups grouped by probe count (TextureLookups::set_aniso_grouped)
   };
-  const FilterCase filters[] = {{Filter::Bilinear, "bilinear", 5, false},
-                                {Filter::Trilinear, "trilinear", 5, false},
-                                {Filter::Aniso, "aniso16", 3, false},
-                                {Filter::Aniso, "aniso16-grouped", 3, true},
-                                {Filter::Ewa, "ewa16", 2, false}};
+  const FilterCase filters[] = {{Filter::Bilinear, "bilinear", 5},
+                                {Filter::Trilinear, "trilinear", 5},
+                                {Filter::Aniso, "aniso16", 3},
+                                {Filter::Ewa, "ewa16", 2}};
   for (const FilterCase& fc : filters) {
     for (TexelFormat format : {TexelFormat::Rgba8, TexelFormat::Rgba32f}) {
       const std::string name =
           std::string("seamcl/") + fc.name + (format == TexelFormat::Rgba8 ? "/rgba8" : "/rgba32f");
-      benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& s) { bm_seamcl(s, fc.filter, format, name, fc.grouped); })
+      benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& s) { bm_seamcl(s, fc.filter, format, name); })
           ->UseManualTime()
           ->Unit(benchmark::kMillisecond)
           ->Iterations(fc.iterations);

@@ -56,10 +56,7 @@
  * finite x but makes whatever it is added to depend on x, so the pair is no longer independent.
  * Kernels with a varying-length loop (aniso, ewa) stay scalar anyway; there a tie only costs, so
  * it is compiled out. */
-#ifndef SEAMCL_ANISO_GROUPED
-#define SEAMCL_ANISO_GROUPED 0
-#endif
-#if defined(SEAMCL_SAMPLER_FILTER) && SEAMCL_SAMPLER_FILTER >= SEAMCL_FILTER_ANISO && !SEAMCL_ANISO_GROUPED
+#if defined(SEAMCL_SAMPLER_FILTER) && SEAMCL_SAMPLER_FILTER >= SEAMCL_FILTER_ANISO
 #define TIE(x) 0.0f
 #define TIED(value, x) (value)
 #else

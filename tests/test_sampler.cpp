@@ -16,7 +16,6 @@
 #include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/texture_lookups.h>
 #include "core/srgb.h"
-#include "sampler_twin_check.h"
 #include "test_support.h"
 #include "pipeline/stages/texture_sample_twin.h"
 
@@ -313,36 +312,3 @@ TEST(ZeroCoverage, NanOnlyWhereEveryTapFallsOutside) {
   }
 }
 
-TEST(KernelVsTwin, AnisoGroupedByProbeCount) {
-  // TextureLookups::set_aniso_grouped: aniso lookups planned, ordered by probe count and run by
-  // one kernel per count must give the twin's colours, the non-finite lookups and those far
-  // outside included, at three biases. One variant, whose seventeen kernels each take seconds to
-  // build on PoCL: RGBA8 texels (the benchmark's storage) border-addressed and renormalised as
-  // discard does, at max_aniso 16 so that every count's kernel runs. The storage and method code
-  // is the ungrouped sampler's, held to the twin variant by variant above.
-  std::mt19937 rng(8);
-  const Scene scene = random_texture_scene(4);
-  const std::vector<Lookup> lookups = random_lookups(rng, static_cast<uint32_t>(scene.faces.size()), 3000);
-  const TexelFormat format = TexelFormat::Rgba8;
-  SamplerParams sampler{};
-  sampler.filter = SEAMCL_FILTER_ANISO;
-  sampler.address = SEAMCL_ADDRESS_BORDER;
-  sampler.renormalize = 1;
-  sampler.max_aniso = 16;
-  sampler.zero_coverage = SEAMCL_ZERO_COVERAGE_CLAMP;
-  const PackedScene packed = pack_scene(scene, format);
-  TextureLookups device(shared_runtime(), packed);
-  device.set_lookups(lookups);
-  device.set_aniso_grouped(true);
-  // The plans carry each probe's lod with the bias in it.
-  for (float lod_bias : {0.0f, -1.5f, 2.75f}) {
-    SCOPED_TRACE(testing::Message() << "lod_bias " << lod_bias);
-    sampler.lod_bias = lod_bias;
-    double ms = -1.0;
-    const std::vector<glm::vec4> gpu = device.sample(sampler, &ms);
-    EXPECT_GE(ms, 0.0);
-    EXPECT_EQ(seamcl_tests::twin_colour_mismatches(gpu, packed, sampler, lookups,
-                                                   [](float a, float b) { return near(a, b, 1e-5f); }),
-              0u);
-  }
-}

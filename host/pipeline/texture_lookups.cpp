@@ -1,8 +1,6 @@
 #include <seamcl/pipeline/texture_lookups.h>
 
 #include <algorithm>
-#include <array>
-#include <chrono>
 #include <stdexcept>
 
 #include <seamcl/pipeline/renderer.h>
@@ -49,75 +47,6 @@ TextureLookups::Kernels& TextureLookups::kernels_for(const SamplerParams& sample
   return it->second;
 }
 
-TextureLookups::GroupedKernels& TextureLookups::grouped_kernels_for(const SamplerParams& sampler) {
-  if (sampler.guard_band != guard_band_) {
-    throw std::logic_error("sampler guard band " + std::to_string(sampler.guard_band) + " on textures packed with " +
-                           std::to_string(guard_band_));
-  }
-  const std::string options = program_options(format_, sampler) + " -DSEAMCL_ANISO_GROUPED=1";
-  auto it = grouped_kernels_.find(options);
-  if (it == grouped_kernels_.end()) {
-    const cl::Program& program = runtime_.program(KernelProgram::Sampling, options);
-    GroupedKernels k{cl::Kernel(program, "aniso_plan_batch"), {}};
-    for (int n = 1; n <= SEAMCL_MAX_PROBES; ++n) {
-      k.groups.emplace_back(program, ("aniso_group_batch_" + std::to_string(n)).c_str());
-    }
-    it = grouped_kernels_.emplace(options, std::move(k)).first;
-  }
-  return it->second;
-}
-
-void TextureLookups::run_aniso_grouped(const SamplerParams& sampler) {
-  GroupedKernels& k = grouped_kernels_for(sampler);
-  const cl::Context& context = runtime_.context();
-  cl::CommandQueue& queue = runtime_.queue();
-  if (!plans_.get() || plans_.getInfo<CL_MEM_SIZE>() < count_ * 6 * sizeof(cl_float)) {
-    plans_ = cl::Buffer(context, CL_MEM_READ_WRITE, count_ * 6 * sizeof(cl_float));
-    probe_counts_ = cl::Buffer(context, CL_MEM_READ_WRITE, count_ * sizeof(cl_uchar));
-    order_ = cl::Buffer(context, CL_MEM_READ_ONLY, count_ * sizeof(cl_uint));
-  }
-  const size_t group = 64;
-  auto global = [&](size_t n) { return cl::NDRange((n + group - 1) / group * group); };
-  // Pass 1: every lookup's probes.
-  k.plan.setArg(0, faces_);
-  k.plan.setArg(1, sampler);
-  k.plan.setArg(2, lookups_);
-  k.plan.setArg(3, static_cast<cl_uint>(count_));
-  k.plan.setArg(4, plans_);
-  k.plan.setArg(5, probe_counts_);
-  queue.enqueueNDRangeKernel(k.plan, cl::NullRange, global(count_), cl::NDRange(group));
-  std::vector<cl_uchar> counts(count_);
-  queue.enqueueReadBuffer(probe_counts_, CL_TRUE, 0, count_, counts.data());
-  // The lookups ordered by probe count (a counting sort; in order within a count, so that
-  // neighbouring work-items keep their locality).
-  std::array<size_t, SEAMCL_MAX_PROBES + 2> first{};
-  for (cl_uchar n : counts) ++first[std::clamp<size_t>(n, 1, SEAMCL_MAX_PROBES) + 1];
-  for (size_t n = 1; n < first.size(); ++n) first[n] += first[n - 1];
-  std::array<size_t, SEAMCL_MAX_PROBES + 2> next = first;
-  std::vector<cl_uint> order(count_);
-  for (size_t i = 0; i < count_; ++i) order[next[std::clamp<size_t>(counts[i], 1, SEAMCL_MAX_PROBES)]++] = static_cast<cl_uint>(i);
-  queue.enqueueWriteBuffer(order_, CL_TRUE, 0, count_ * sizeof(cl_uint), order.data());
-  // Pass 2: each count's lookups through its kernel.
-  for (int n = 1; n <= SEAMCL_MAX_PROBES; ++n) {
-    const size_t begin = first[static_cast<size_t>(n)], end = first[static_cast<size_t>(n) + 1];
-    if (end == begin) continue;
-    cl::Kernel& kernel = k.groups[static_cast<size_t>(n - 1)];
-    kernel.setArg(0, faces_);
-    kernel.setArg(1, level_offsets_);
-    kernel.setArg(2, texels_);
-    kernel.setArg(3, srgb_table_);
-    kernel.setArg(4, sampler);
-    kernel.setArg(5, lookups_);
-    kernel.setArg(6, plans_);
-    kernel.setArg(7, order_);
-    kernel.setArg(8, static_cast<cl_uint>(begin));
-    kernel.setArg(9, static_cast<cl_uint>(end - begin));
-    kernel.setArg(10, colors_);
-    queue.enqueueNDRangeKernel(kernel, cl::NullRange, global(end - begin), cl::NDRange(group));
-  }
-  queue.finish();
-}
-
 void TextureLookups::set_lookups(const std::vector<Lookup>& lookups) {
   std::vector<float> packed;
   packed.reserve(lookups.size() * 7);
@@ -152,14 +81,6 @@ cl::Event TextureLookups::run(cl::Kernel& kernel, const SamplerParams& sampler, 
 std::vector<glm::vec4> TextureLookups::sample(const SamplerParams& sampler, double* kernel_ms) {
   std::vector<glm::vec4> out(count_);
   if (count_ == 0) return out;
-  if (aniso_grouped_ && sampler.filter == SEAMCL_FILTER_ANISO && sampler.traverse == SEAMCL_TRAVERSE_NONE) {
-    const auto start = std::chrono::steady_clock::now();
-    run_aniso_grouped(sampler);
-    const auto stop = std::chrono::steady_clock::now();
-    runtime_.queue().enqueueReadBuffer(colors_, CL_TRUE, 0, count_ * sizeof(cl_float4), out.data());
-    if (kernel_ms != nullptr) *kernel_ms = std::chrono::duration<double, std::milli>(stop - start).count();
-    return out;
-  }
   const cl::Event event = run(kernels_for(sampler).sample, sampler, false);
   runtime_.queue().enqueueReadBuffer(colors_, CL_TRUE, 0, count_ * sizeof(cl_float4), out.data());
   if (kernel_ms != nullptr) *kernel_ms = event_milliseconds(event);

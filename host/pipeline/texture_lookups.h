@@ -34,11 +34,6 @@ class TextureLookups {
   // Off: traverse filters every neighbour, skipping none (the kernels' SEAMCL_TRAVERSE_EARLY_OUT),
   // for the tests that check the early-outs change no bit. On by default, as renders run.
   void set_traverse_early_out(bool on) { traverse_early_out_ = on; }
-  // On: sample() runs aniso lookups without traverse grouped by probe count (a planning pass,
-  // the lookups ordered by count on the host, one kernel per count: the probe loop then has a
-  // uniform trip count and PoCL vectorises it); `kernel_ms` is then the wall time of all of it.
-  // Other samplers ignore it. Off by default.
-  void set_aniso_grouped(bool on) { aniso_grouped_ = on; }
 
  private:
   // The kernels of the program variant for a sampler configuration (built on first use).
@@ -47,24 +42,14 @@ class TextureLookups {
   };
   Kernels& kernels_for(const SamplerParams& sampler);
   cl::Event run(cl::Kernel& kernel, const SamplerParams& sampler, bool with_weights);
-  // The grouped aniso path of sample() (set_aniso_grouped), into colors_.
-  void run_aniso_grouped(const SamplerParams& sampler);
-  struct GroupedKernels {
-    cl::Kernel plan;
-    std::vector<cl::Kernel> groups;  // groups[n - 1] runs the lookups of n probes
-  };
-  GroupedKernels& grouped_kernels_for(const SamplerParams& sampler);
 
   ClRuntime& runtime_;
   TexelFormat format_;
   int guard_band_;
   std::map<std::string, Kernels> kernels_;
-  std::map<std::string, GroupedKernels> grouped_kernels_;
-  cl::Buffer plans_, probe_counts_, order_;  // the grouped path's, allocated on its first use
   cl::Buffer faces_, neighbors_, level_offsets_, texels_, srgb_table_, lookups_, colors_, weights_;
   size_t count_ = 0;
   bool traverse_early_out_ = true;
-  bool aniso_grouped_ = false;
 };
 
 }  // namespace seamcl
