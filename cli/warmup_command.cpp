@@ -1,5 +1,5 @@
 // seamcl warmup: the geometry program and every shading variant built ahead (or loaded from the
-// program cache), on every core, with a line per build on stderr; --list prints the variants' build options instead
+// program cache), on a thread per core, with a line per build on stderr; --list prints the variants' build options instead
 // (scripts and the kernel portability check read them). The work is the library's WarmupJob.
 #include <cstdio>
 #include <iostream>

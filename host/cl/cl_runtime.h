@@ -49,8 +49,9 @@ class ClRuntime {
 
   // Builds program_source(program) with `options` (e.g. "-DSEAMCL_TEXELS_F32=1") once per
   // distinct program and options (plus $SEAMCL_EXTRA_BUILD_OPTIONS, for experiments); later calls
-  // return the same program. Thread-safe, and calls for different variants build in parallel (a
-  // call for a variant being built waits for that build). With a program cache
+  // return the same program. Thread-safe: calls for different variants build at once where the
+  // driver compiles in parallel (PoCL 3.1 does not: one compiler lock per process), and a call
+  // for a variant being built waits for that build. With a program cache
   // (set_program_cache_dir), the binary is loaded from it when a whole entry for this device,
   // driver, source and options is there, else built from source and stored
   // (host/cl/program_cache.h).

@@ -1,5 +1,6 @@
 // The warm-up job: the geometry program and every shading variant built (or loaded from the
-// program cache, host/cl/program_cache.h) ahead of the first request, on every core, then one tiny
+// program cache, host/cl/program_cache.h) ahead of the first request on a thread per core (PoCL
+// 3.1 compiles one program at a time in a process, so there the threads take turns), then one tiny
 // frame of each rendered so that the driver compiles each kernel for its local size too (PoCL does
 // this on a kernel's first enqueue, and with its own cache cold that is slow enough to show in a
 // timed frame). What `seamcl warmup` runs; a service runs the same before it says it is ready.
