@@ -5,7 +5,8 @@ over the DevTools protocol, tests/browser/cdp.py) against a live `seamcl serve`:
 - a compare started from the page (the paper scene, every MSAA rate, about the largest size the
   server compares, the most repeats it allows) keeps the server busy: its process's CPU time
   (utime + stime of /proc/<pid>/stat) grows over a window while the
-  compare runs (0.4 of a core at least: the machine may be shared);
+  compare runs (a quarter of a core at least: the machine may be shared, and with 3 busy
+  processes on 2 cores the server got 0.43-0.66 of one on 2026-12-03);
 - the page's cancel button is pressed: within 2 s the server's CPU use is down, under a fifth of
   what it was during the compare (and under a quarter of a core) over the window that follows;
 - the server answers again afterwards (GET /health).
@@ -37,6 +38,8 @@ BUDGET_S = 280
 RENDER_WAIT_S = 150
 STOP_WITHIN_S = 2.0  # the claim: the server's CPU use is down this long after cancel
 WINDOW_S = 1.0       # the windows CPU use is measured over
+PAST_PHASE_S = 0.3   # how long the compare runs on after its phase shows before cancel
+BUSY_AT_LEAST = 0.25  # cores the compare keeps busy, at least, for its cancel to be measurable
 SCENE = "paper"
 # The phase in which cancel is pressed (a word of the job's progress line the page shows), and
 # the height of that compare: on 2 cores (2026-12-03, `seamcl compare --scene paper --size
@@ -85,8 +88,11 @@ def run(base, pid, chromium, profile, t, deadline):
             set_controls(page, {"size": "%dx%d" % (side, side * height // 256)})
             wait_idle(page, min(RENDER_WAIT_S, left()), "the render at %dx%d" % (side, side * height // 256))
             idle = cpu_rate(pid, 1.0)
-            # The compare's CPU use is measured from its start to the phase, not over a window
-            # after it: on a quiet machine the last phase ends within a second of showing.
+            # The compare's CPU use is measured from its start to a little after the phase shows:
+            # from the start only, the request's trip through the page and the job queue is most
+            # of the window when cancel comes in the first phase (0.37 of a core over 0.5 s on a
+            # loaded CI machine); over a window after the phase only, the last phase may end
+            # within a second on a quiet machine.
             started_cpu, started = cpu_seconds(pid), time.monotonic()
             page.eval("document.getElementById('compare').click()")
             page.wait("document.getElementById('compare').dataset.state === 'running' && "
@@ -94,6 +100,7 @@ def run(base, pid, chromium, profile, t, deadline):
             page.wait("document.getElementById('progress').textContent.includes(%s) || "
                       "document.getElementById('compare').dataset.state !== 'running'" % json.dumps(phase_word),
                       timeout=min(RENDER_WAIT_S, left()), what="the compare's " + phase_word)
+            time.sleep(PAST_PHASE_S)
             during = (cpu_seconds(pid) - started_cpu) / max(1e-3, time.monotonic() - started)
             phase = page.eval("document.getElementById('progress').textContent")
             if page.eval("document.getElementById('compare').dataset.state") != "running":
@@ -108,7 +115,7 @@ def run(base, pid, chromium, profile, t, deadline):
             detail = "idle %.2f, during %.2f, %.0f s after cancel %.2f cores; cancelled at: %s" % (
                 idle, during, STOP_WITHIN_S, later, phase)
             print(detail, flush=True)
-            t.check(during >= 0.4, "the compare keeps the server busy (%s)" % phase_word, detail)
+            t.check(during >= BUSY_AT_LEAST, "the compare keeps the server busy (%s)" % phase_word, detail)
             t.check(later < 0.2 * during and later < 0.25,
                     "cancel brings the server's CPU use down within %.0f s (%s)" % (STOP_WITHIN_S, phase_word), detail)
             status, body = get(base + "/health")
