@@ -32,7 +32,7 @@ struct CompareArgs {
 };
 
 // `first_reference`: the name of the reference `error` is measured against.
-void print_table(const json& out, const std::string& first_reference) {
+void print_compare_table(const json& out, const std::string& first_reference) {
   std::printf("%s %s; seam mask: pixels whose texture footprint crosses a face edge\n",
               out["scene"].get<std::string>().c_str(), out["size"].get<std::string>().c_str());
   for (const auto& [msaa, mask] : out["seam_mask"]["by_msaa"].items()) {
@@ -90,7 +90,7 @@ int run_compare(CompareArgs& args, const GlobalOptions& global) {
     out["memory"] = {{"peak_rss_bytes", process_memory().peak_rss_bytes}};
     std::cout << out.dump(2) << "\n";
   } else {
-    print_table(out, to_string(job.reference_kinds().front()));
+    print_compare_table(out, to_string(job.reference_kinds().front()));
   }
   return 0;
 }

@@ -33,7 +33,7 @@ std::string formatted(const char* format, double v) {
   return buffer;
 }
 
-void print_table(const json& out) {
+void print_cube_table(const json& out) {
   const auto scientific = [](const json& v) { return formatted("%.2e", v.get<double>()); };
   std::cout << "| n | method | error mean | edge error mean | edge error p99 | first-order jump | ms | cube MiB | seam step per lod 0..log2(n) |\n"
             << "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
@@ -65,7 +65,7 @@ int run(const CubeArgs& args, const GlobalOptions& global) {
     std::cout << out.dump(2) << "\n";
     return 0;
   }
-  print_table(out);
+  print_cube_table(out);
   std::cout << "\nedge pixels (footprint crosses a cube edge): " << out["edge_pixels"].get<size_t>() << " of "
             << job.frame().width * job.frame().height << "\n";
   return 0;

@@ -30,7 +30,7 @@ struct DisplacementArgs {
   bool no_progress = false;
 };
 
-void print_table(const json& out) {
+void print_displacement_table(const json& out) {
   std::printf("%s %s msaa %d, crack pixels over %d orbit frames%s\n", out["scene"].get<std::string>().c_str(),
               out["size"].get<std::string>().c_str(), out["msaa"].get<int>(), out["frames"].get<int>(),
               out["closed_mesh"].get<bool>() ? "" : " (open mesh: not counted)");
@@ -71,7 +71,7 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
   }
   // The frames asked for, where crack_frames is 0 on an open mesh.
   out["frames"] = request.value("frames", find_option(displacement_metrics_option_table(), "frames")->default_value.get<int>());
-  print_table(out);
+  print_displacement_table(out);
   return 0;
 }
 

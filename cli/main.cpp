@@ -16,6 +16,7 @@
 #include <seamcl/assets/ptex_displacement.h>
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/cl/cl_runtime.h>
+#include <seamcl/core/elapsed.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/io/image_io.h>
 #include <seamcl/jobs/render_job.h>
@@ -55,7 +56,7 @@ int run_render(const RenderArgs& args, const std::string& device) {
   source.generator = job.generator_options();
   source.displacement_map = options.displacement_map;
   Scene scene = load_scene_source(options.scene, options.texture, source);
-  const double scene_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - scene_start).count();
+  const double scene_ms = ms_since(scene_start);
 
   // A render this machine cannot hold is refused before it allocates.
   const JobPlan plan = job.plan(scene);

@@ -14,6 +14,7 @@
 #include <pthread.h>
 
 #include <seamcl/cl/cl_runtime.h>
+#include <seamcl/core/elapsed.h>
 #include <seamcl/core/input_error.h>
 #include "commands.h"
 #include "http_server.h"
@@ -95,7 +96,7 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
                  args.host.c_str(), args.port);
     return 1;
   }
-  const double listen_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double listen_ms = ms_since(start);
   std::fprintf(stderr,
                "seamcl serve: http://%s:%d/ on %s, %d threads, queue %d; listening after %.0f ms, warming the kernels "
                "(GET /health says \"ready\" when renders no longer wait)\n",

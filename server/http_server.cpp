@@ -7,6 +7,7 @@
 
 #include <httplib.h>
 
+#include <seamcl/core/elapsed.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/over_budget.h>
 #include <seamcl/pipeline/renderer.h>
@@ -25,10 +26,6 @@ namespace {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // The reference cache of POST /v1/compare: the server's own directory, not a user's ~/.cache.
 std::string server_cache_dir(const std::string& configured) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <seamcl/core/cancelled.h>
+#include <seamcl/core/elapsed.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/memory/compare_memory.h>
 #include <seamcl/io/image_encoding.h>
@@ -30,10 +31,6 @@ namespace {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // POST /v1/compare without a size: the render default (480x540) is over the compare limit, so
 // the largest size of the default's aspect within max_pixels (each side floored, at least 1).

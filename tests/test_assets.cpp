@@ -51,7 +51,7 @@ bool is_translation(uint8_t code) {
   return t[0] == 1.0f && t[4] == 1.0f;
 }
 
-std::string sample(const std::string& name) { return std::string(SEAMCL_TEST_ASSETS_DIR) + "/ptex/" + name; }
+std::string sample(const std::string& name) { return std::string(SEAMCL_TEST_ASSETS_DIR "/ptex/") + name; }
 
 // The message of an InputError thrown by `run`, with its field checked.
 template <typename Run>

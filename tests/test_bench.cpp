@@ -63,13 +63,13 @@ BenchProcess run_cli(const fs::path& dir, const std::string& args) {
   return r;
 }
 
-const char* kQuad2Bench = "bench --scene quad2 --methods discard,traverse,clamp --msaa 1,4 --size 48x48 --frames 3";
+const std::string kQuad2Bench = "bench --scene quad2 --methods discard,traverse,clamp --msaa 1,4 --size 48x48 --frames 3";
 
 class Bench : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new fs::path(bench_temp_dir());
-    run_ = new BenchProcess(run_cli(*dir_, std::string(kQuad2Bench) + " --json"));
+    run_ = new BenchProcess(run_cli(*dir_, kQuad2Bench + " --json"));
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);

@@ -43,8 +43,11 @@ std::string quoted(const std::string& s) {
   return out + "'";
 }
 
+}  // namespace
+
 // A fresh working directory per test; stdout and stderr captured outside it, so that "wrote no
-// file" means the directory's listing did not change.
+// file" means the directory's listing did not change. Outside the anonymous namespace, as the
+// tests derive from it.
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -101,6 +104,8 @@ class Cli : public ::testing::Test {
   fs::path root_, dir_;
   std::string launcher_;  // put before the binary: "timeout 30 " for a command that would otherwise run on
 };
+
+namespace {
 
 const std::string kQuad2Json = R"({
   "name": "q",

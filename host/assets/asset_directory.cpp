@@ -21,6 +21,19 @@
 #include <seamcl/memory/render_memory.h>
 
 namespace seamcl {
+
+// An open file, closed with it. Outside the anonymous namespace: AssetDirectory::OpenedFiles
+// holds these.
+struct AssetFileDescriptor {
+  int fd = -1;
+  explicit AssetFileDescriptor(int d) : fd(d) {}
+  ~AssetFileDescriptor() {
+    if (fd >= 0) ::close(fd);
+  }
+  AssetFileDescriptor(const AssetFileDescriptor&) = delete;
+  AssetFileDescriptor& operator=(const AssetFileDescriptor&) = delete;
+};
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -42,16 +55,6 @@ std::string stamp_text(const std::optional<FileStamp>& stamp) {
   out << stamp->bytes << "@" << stamp->modified.time_since_epoch().count();
   return out.str();
 }
-
-struct Descriptor {
-  int fd = -1;
-  explicit Descriptor(int d) : fd(d) {}
-  ~Descriptor() {
-    if (fd >= 0) ::close(fd);
-  }
-  Descriptor(const Descriptor&) = delete;
-  Descriptor& operator=(const Descriptor&) = delete;
-};
 
 // `relative` ('/'-separated, no '..', not absolute) opened for reading beneath `root_fd`, without
 // following a link out of it: -1 and errno on failure (EXDEV or ELOOP: a link out, or any link
@@ -100,7 +103,7 @@ std::string replace_all(std::string text, const std::string& from, const std::st
 // deferred image face); the links go with it.
 struct AssetDirectory::OpenedFiles {
   std::string dir;
-  std::vector<std::unique_ptr<Descriptor>> descriptors;
+  std::vector<std::unique_ptr<AssetFileDescriptor>> descriptors;
   std::map<std::string, std::string> relative_dirs;  // a link's directory -> the file's directory, relative
   std::vector<std::pair<std::string, std::string>> shown;  // a link's path -> the file's relative name
   std::map<std::string, std::string> links;  // a file's relative name -> its link (a file named twice is opened once)
@@ -205,7 +208,7 @@ std::vector<AssetEntry> AssetDirectory::list() const {
 
 std::string AssetDirectory::resolve(const std::string& name, const std::string& relative_to, const std::string& field) const {
   std::string relative;
-  Descriptor opened(open_checked(name, relative_to, field, relative));
+  AssetFileDescriptor opened(open_checked(name, relative_to, field, relative));
   return (fs::path(root_) / relative).string();
 }
 
@@ -223,7 +226,7 @@ std::shared_ptr<const Scene> AssetDirectory::load(const std::string& scene, cons
     if (const auto found = opened->relative_dirs.find(relative_to); found != opened->relative_dirs.end())
       base = (fs::path(root_) / found->second).string();
     std::string relative;
-    auto descriptor = std::make_unique<Descriptor>(open_checked(name, base, field, relative));
+    auto descriptor = std::make_unique<AssetFileDescriptor>(open_checked(name, base, field, relative));
     if (const auto known = opened->links.find(relative); known != opened->links.end()) return known->second;
     const std::string path = (fs::path(root_) / relative).string();
     if (!files->contains(path)) files->emplace(path, stamp_(path));

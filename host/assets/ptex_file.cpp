@@ -18,7 +18,7 @@ namespace seamcl {
 namespace {
 
 // The format's fixed sizes (Ptex's PtexIO.h); all integers are little-endian.
-constexpr uint32_t kMagic = 'P' | ('t' << 8) | ('e' << 16) | (uint32_t('x') << 24);
+constexpr uint32_t kPtexMagic = 'P' | ('t' << 8) | ('e' << 16) | (uint32_t('x') << 24);
 constexpr uint64_t kHeaderBytes = 64;
 constexpr uint64_t kExtHeaderBytes = 40;  // the most of it this reader knows
 constexpr uint64_t kFaceInfoBytes = 20;
@@ -257,7 +257,7 @@ class PtexDecoder {
 
   void read_header() {
     const std::span<const uint8_t> h = section(0, kHeaderBytes, "header");
-    if (load_u32(h.data()) != kMagic) fail("header: not a Ptex file (no \"Ptex\" magic number)");
+    if (load_u32(h.data()) != kPtexMagic) fail("header: not a Ptex file (no \"Ptex\" magic number)");
     header_.version = load_u32(h.data() + 4);
     header_.mesh_type = load_u32(h.data() + 8);
     header_.data_type = load_u32(h.data() + 12);

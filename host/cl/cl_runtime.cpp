@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <seamcl/core/elapsed.h>
 #include <seamcl/core/input_error.h>
 #include "cl/kernel_sources.h"
 
@@ -277,7 +278,7 @@ const cl::Program& ClRuntime::program(KernelProgram which, const std::string& op
       if (binaries.size() == 1 && cache.store(key, binaries.front())) counted.stored = 1;
     }
   }
-  counted.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  counted.ms = ms_since(start);
   slot->program = std::move(program);
   std::lock_guard<std::mutex> lock(programs_mutex_);
   stats_.built += counted.built;

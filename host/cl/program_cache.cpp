@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 
 // An entry: magic, key length, key, binary length, binary, FNV-64 of the binary. Lengths are
 // little-endian u64.
-constexpr char kMagic[8] = {'S', 'C', 'L', 'P', 'R', 'O', 'G', '1'};
+constexpr char kCacheFileMagic[8] = {'S', 'C', 'L', 'P', 'R', 'O', 'G', '1'};
 // A binary larger than this is not one of ours (PoCL's are a few MB): refused rather than read.
 constexpr uint64_t kMaxBinaryBytes = uint64_t{1} << 30;
 constexpr uint64_t kMaxKeyBytes = uint64_t{1} << 16;
@@ -84,8 +84,8 @@ std::optional<std::vector<unsigned char>> ProgramCache::load(const ProgramCacheK
   if (!in) return std::nullopt;
   std::vector<unsigned char> bytes(static_cast<size_t>(size));
   if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()))) return std::nullopt;
-  if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) return std::nullopt;
-  size_t at = sizeof kMagic;
+  if (bytes.size() < sizeof kCacheFileMagic || std::memcmp(bytes.data(), kCacheFileMagic, sizeof kCacheFileMagic) != 0) return std::nullopt;
+  size_t at = sizeof kCacheFileMagic;
   uint64_t key_bytes = 0, binary_bytes = 0, checksum = 0;
   const std::string expected = key.key();
   if (!get_u64(bytes, at, key_bytes) || key_bytes != expected.size() || bytes.size() - at < key_bytes) return std::nullopt;
@@ -113,7 +113,7 @@ bool ProgramCache::store(const ProgramCacheKey& key, const std::vector<unsigned 
   // the last rename wins with a whole entry either way.
   const std::string temp = file + ".tmp" + std::to_string(::getpid()) + "-" +
                            std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id()));
-  std::string header(kMagic, sizeof kMagic);
+  std::string header(kCacheFileMagic, sizeof kCacheFileMagic);
   const std::string text = key.key();
   put_u64(header, text.size());
   header += text;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <seamcl/core/elapsed.h>
 #include <seamcl/pipeline/cube_lookups.h>
 #include <seamcl/pipeline/packed_cube.h>
 #include <seamcl/scene/cube_map.h>
@@ -73,7 +74,7 @@ EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environme
   const bool border = cube_preparation(method).border;
   const size_t packed_floats = pack_cube_texels(cube, border).size();
   const double bake_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - bake_start).count();
+      ms_since(bake_start);
   CubeLookups lookups(runtime, cube, border);
   const CubeSampler sampler = cube_sampler(method, Filter::Trilinear, 16, size);
   EdgeMeasures out;

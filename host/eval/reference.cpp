@@ -23,6 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <seamcl/core/elapsed.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/version.h>
 #include "io/image_codec.h"
@@ -420,7 +421,7 @@ ReferenceImage make_reference(const Scene& scene, const Camera& camera, const Re
       ref.pixels = small.pixels;
       ref.kernel_ms = device_ms(small.ms);
     }
-    ref.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    ref.render_ms = ms_since(start);
     if (settings.use_cache) {
       if (write_cached(ref.cache_path, key, ref.width, ref.height, ref.pixels)) {
         trim_reference_cache(fs::path(ref.cache_path).parent_path().string(), settings.cache_max_bytes,
@@ -588,7 +589,7 @@ std::vector<ReferenceImage> reference_images(Renderer& renderer, const Camera& c
     ref.method = "albedo";
     ref.msaa = high.msaa;
     ref.pixels = downsample_mitchell(fine, high.width, high.height, kReferenceScale);
-    ref.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    ref.render_ms = ms_since(start);
     images.push_back(std::move(ref));
   }
   // The 8x frame's buffers are 64x a frame's: not kept for the renders that follow.
@@ -767,7 +768,7 @@ ReferenceImage seamless_reference(Renderer& seamless, const Camera& camera, cons
   ref.method = to_string(options.method);
   ref.msaa = frame.msaa;
   ref.pixels = seamless.render(camera, options).pixels;
-  ref.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  ref.render_ms = ms_since(start);
   return ref;
 }
 

@@ -82,12 +82,6 @@ void refuse_ignored(const json& request, const std::vector<std::string>& keys, c
     if (given(request, key)) throw InputError(key, "is ignored " + where + ": leave it out");
 }
 
-std::vector<std::string> strings_of(const json& items) {
-  std::vector<std::string> out;
-  for (const json& item : items) out.push_back(item.get<std::string>());
-  return out;
-}
-
 size_t count_nonfinite(const std::vector<glm::vec4>& pixels) {
   size_t n = 0;
   for (const glm::vec4& p : pixels)

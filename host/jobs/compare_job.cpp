@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <future>
 
+#include <seamcl/core/elapsed.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/memory/compare_memory.h>
 #include <seamcl/eval/displacement_metrics.h>
@@ -68,12 +69,6 @@ glm::vec3 parse_color(const std::string& text) {
     c[i] = v;
   }
   return c;
-}
-
-std::vector<std::string> strings_of(const json& items) {
-  std::vector<std::string> out;
-  for (const json& item : items) out.push_back(item.get<std::string>());
-  return out;
 }
 
 }  // namespace
@@ -142,7 +137,6 @@ JobPlan CompareJob::plan(const Scene& scene) const {
 CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobControl& control,
                            const ReferenceLock& lock_reference) {
   using Clock = std::chrono::steady_clock;
-  const auto ms_since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
   const Clock::time_point start = Clock::now();
   const Camera view = camera(scene);
   // The variants this compare renders with build while the scene is hashed and packed, in the

@@ -114,7 +114,7 @@ json CubeMetricsJob::run(ClRuntime& runtime, const Scene& source, const JobContr
     renderer.load_scene(scene);
     for (CubeMethod method : methods_) {
       throw_if_stopped(control.should_stop, "before " + to_string(method) + " at " + std::to_string(n));
-      control.report("[" + std::to_string(results.size() + 1) + "/" + std::to_string(total) + "] " + to_string(method) +
+      control.report(step_of(results.size() + 1, total) + to_string(method) +
                      " at " + std::to_string(n));
       RenderOptions options = frame_;
       options.cube_method = method;

@@ -122,7 +122,7 @@ json DisplacementMetricsJob::run(ClRuntime& runtime, const Scene& scene, const J
       RenderOptions options = frame_;
       options.displacement = method;
       options.tessellation = t;
-      control.report("[" + std::to_string(results.size() + 1) + "/" + std::to_string(total) + "] " + to_string(method) +
+      control.report(step_of(results.size() + 1, total) + to_string(method) +
                      " T " + std::to_string(t));
       json item = measure_displacement(runtime, scene, scene.camera, options, frames_, repeat_, control.device_byte_limit)
                       .to_json();

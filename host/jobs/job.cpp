@@ -1,6 +1,7 @@
 #include <seamcl/jobs/job.h>
 
 #include <algorithm>
+#include <cstdio>
 
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/over_budget.h>
@@ -28,6 +29,18 @@ void refuse_beyond_machine(const JobPlan& plan, const DeviceInfo& device) {
 void refuse_unknown_keys(const nlohmann::json& request, const std::vector<std::string>& known) {
   for (const auto& [key, value] : request.items())
     if (std::find(known.begin(), known.end(), key) == known.end()) throw InputError(key, "unknown option");
+}
+
+std::string step_of(size_t step, size_t total) {
+  char text[48];
+  std::snprintf(text, sizeof text, "[%zu/%zu] ", step, total);
+  return text;
+}
+
+std::vector<std::string> strings_of(const nlohmann::json& items) {
+  std::vector<std::string> out;
+  for (const nlohmann::json& item : items) out.push_back(item.get<std::string>());
+  return out;
 }
 
 }  // namespace seamcl

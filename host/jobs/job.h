@@ -70,4 +70,10 @@ void refuse_beyond_machine(const JobPlan& plan, const DeviceInfo& device);
 // job does not read would otherwise be ignored without a word.
 void refuse_unknown_keys(const nlohmann::json& request, const std::vector<std::string>& known);
 
+// "[step/total] ", the head of a job's progress line for one of its steps.
+std::string step_of(size_t step, size_t total);
+
+// The strings of a JSON array (a request's list option, already checked against its table).
+std::vector<std::string> strings_of(const nlohmann::json& items);
+
 }  // namespace seamcl

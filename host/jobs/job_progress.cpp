@@ -1,4 +1,5 @@
 #include <seamcl/jobs/job_progress.h>
+#include <seamcl/core/elapsed.h>
 
 #include <algorithm>
 
@@ -38,7 +39,7 @@ void JobProgressBoard::start(const std::string& id, JobControl& control) {
 void JobProgressBoard::finish(const std::string& id) {
   std::lock_guard lock(mutex_);
   if (const auto found = jobs_.find(id); found != jobs_.end() && found->second.finished_ms < 0)
-    found->second.finished_ms = std::chrono::duration<double, std::milli>(Clock::now() - found->second.started).count();
+    found->second.finished_ms = ms_since(found->second.started);
 }
 
 std::optional<nlohmann::json> JobProgressBoard::get(const std::string& id) const {
@@ -47,7 +48,7 @@ std::optional<nlohmann::json> JobProgressBoard::get(const std::string& id) const
   if (found == jobs_.end()) return std::nullopt;
   const Entry& e = found->second;
   const bool running = e.finished_ms < 0;
-  const double elapsed = running ? std::chrono::duration<double, std::milli>(Clock::now() - e.started).count() : e.finished_ms;
+  const double elapsed = running ? ms_since(e.started) : e.finished_ms;
   return nlohmann::json{{"id", id}, {"running", running}, {"line", e.line}, {"done", e.done}, {"total", e.total},
                         {"elapsed_ms", elapsed}};
 }

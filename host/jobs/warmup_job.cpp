@@ -8,6 +8,7 @@
 #include <mutex>
 #include <thread>
 
+#include <seamcl/core/elapsed.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
@@ -17,10 +18,6 @@ namespace {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 }  // namespace
 

@@ -18,8 +18,6 @@ SceneSizes seamless_scene_sizes(const Scene& scene) {
 
 namespace {
 
-size_t add(size_t a, size_t b) { return saturating_add(a, b); }
-size_t mul(size_t a, size_t b) { return saturating_mul(a, b); }
 
 // What a phase of one Renderer holds at most: the largest packing, each frame buffer at its max.
 // The frame buffers are driven by what drives the render that needs the most of them.
@@ -47,7 +45,7 @@ struct PhaseDevice {
   // Split as RenderMemory::device_shares splits one render's.
   MemoryShares shares(bool tile_lists_at_bound) const {
     MemoryShares out = frames.device_shares(multisample_field, tile_lists_at_bound);
-    out.add("scene", add(scene, constants));
+    out.add("scene", saturating_add(scene, constants));
     out.add("size", downsample);
     return out;
   }
@@ -65,8 +63,8 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   const bool high_res = std::any_of(kinds.begin(), kinds.end(), [](ReferenceKind k) { return k != ReferenceKind::Seamless; });
   if (kinds.empty()) throw std::logic_error("compare_memory: no reference");
 
-  const size_t pixels = mul(static_cast<size_t>(std::max(frame.width, 1)), static_cast<size_t>(std::max(frame.height, 1)));
-  const size_t frame_image = mul(pixels, sizeof(glm::vec4));
+  const size_t pixels = saturating_mul(static_cast<size_t>(std::max(frame.width, 1)), static_cast<size_t>(std::max(frame.height, 1)));
+  const size_t frame_image = saturating_mul(pixels, sizeof(glm::vec4));
 
   CompareMemory out;
   RenderOptions face_map_options = frame;  // as render_face_map renders it
@@ -110,7 +108,7 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
       if (kind == ReferenceKind::Box) weights = std::max(weights, box_taps().weights.size());
       if (kind == ReferenceKind::Paper) weights = std::max(weights, mitchell_taps().weights.size());
     }
-    phase1.downsample = add(mul(frame_image, kReferenceScale + 1), mul(weights, sizeof(float)));
+    phase1.downsample = saturating_add(saturating_mul(frame_image, kReferenceScale + 1), saturating_mul(weights, sizeof(float)));
   }
   if (analytic) phase1.include(out.analytic, "size");
   int largest_rate = 1;
@@ -135,7 +133,7 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
     seamless_frame.msaa = largest_rate;
     out.seamless = render_memory(*seamless_scene, seamless_frame);
     phase2_device = out.seamless.device_shares(frame_buffers_field(largest_rate), true);
-    phase2_device.add("scene", add(phase1.scene, phase1.constants));
+    phase2_device.add("scene", saturating_add(phase1.scene, phase1.constants));
   }
   const auto largest_phase = [&](bool tile_lists_at_bound) {
     return larger(larger(phase0.shares(tile_lists_at_bound), phase1.shares(tile_lists_at_bound)),
@@ -147,24 +145,24 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   out.device_bytes_bound = out.device_bound_shares.total();
 
   const size_t mask = pixels;  // one byte a pixel
-  const size_t masks = mul(mask, std::max<size_t>(rates.size(), 1));  // one seam mask per measured rate
+  const size_t masks = saturating_mul(mask, std::max<size_t>(rates.size(), 1));  // one seam mask per measured rate
   // Every reference is kept at the frame's size: one per high-resolution kind, one per rate for seamless.
   const size_t high_res_kinds = static_cast<size_t>(
       std::count_if(kinds.begin(), kinds.end(), [](ReferenceKind k) { return k != ReferenceKind::Seamless; }));
-  const size_t references = mul(frame_image, add(high_res_kinds, seamless ? rates.size() : 0));
+  const size_t references = saturating_mul(frame_image, saturating_add(high_res_kinds, seamless ? rates.size() : 0));
   // render_face_map: its image, the winners and setups read back, the face per slot, the map.
   MemoryShares face_map(
-      "size", add(add(out.face_map.host_image, mul(pixels, sizeof(uint32_t))), mul(pixels, sizeof(int32_t))));
-  face_map.add("scene", add(out.face_map.setups, mul(mul(scene.triangle_count(), SEAMCL_CLIP_SLOTS), sizeof(uint32_t))));
+      "size", saturating_add(saturating_add(out.face_map.host_image, saturating_mul(pixels, sizeof(uint32_t))), saturating_mul(pixels, sizeof(int32_t))));
+  face_map.add("scene", saturating_add(out.face_map.setups, saturating_mul(saturating_mul(scene.triangle_count(), SEAMCL_CLIP_SLOTS), sizeof(uint32_t))));
   face_map.add("size", masks);
   // The device reduces the 8x frame (render_downsampled): its read-back is frame-sized, kept once
   // and copied to each kind. The analytic reference reads back its 8x render, the winners (one
   // uint a pixel at 1 sample), the setups, and makes an albedo image of the 8x frame.
-  MemoryShares high_res_host("size", add(masks, references));
-  if (high_res) high_res_host.add("size", mul(frame_image, 2));
+  MemoryShares high_res_host("size", saturating_add(masks, references));
+  if (high_res) high_res_host.add("size", saturating_mul(frame_image, 2));
   if (analytic) {
     const size_t fine_pixels = out.analytic.host_image / sizeof(glm::vec4);
-    high_res_host.add("size", add(mul(out.analytic.host_image, 2), mul(fine_pixels, sizeof(uint32_t))));
+    high_res_host.add("size", saturating_add(saturating_mul(out.analytic.host_image, 2), saturating_mul(fine_pixels, sizeof(uint32_t))));
     high_res_host.add("scene", out.analytic.setups);
   }
   const size_t seamless_held = seamless ? out.seamless.host_scene : 0;  // seamless_scene's result
@@ -173,13 +171,13 @@ CompareMemory compare_memory(const SceneSizes& scene, const RenderOptions& frame
   // Phase 2: the seamless Scene, the second Renderer's copy and packing, one image per rate.
   MemoryShares phase2_host;
   if (seamless) {
-    phase2_host.add("size", add(masks, references));
-    phase2_host.add("scene", add(mul(seamless_held, 2), out.seamless.host_packed));
+    phase2_host.add("size", saturating_add(masks, references));
+    phase2_host.add("scene", saturating_add(saturating_mul(seamless_held, 2), out.seamless.host_packed));
   }
-  MemoryShares phase3_host("size", add(add(references, masks), out.entries.empty() ? 0 : frame_image));  // and a read-back
-  for (size_t i = 0; i < entries.size(); ++i) phase3_host.add("size", add(frame_image, mul(pixels, sizeof(float))));
+  MemoryShares phase3_host("size", saturating_add(saturating_add(references, masks), out.entries.empty() ? 0 : frame_image));  // and a read-back
+  for (size_t i = 0; i < entries.size(); ++i) phase3_host.add("size", saturating_add(frame_image, saturating_mul(pixels, sizeof(float))));
   out.host_shares = larger(larger(phase1_host, phase2_host), phase3_host);
-  out.host_shares.add("scene", add(out.face_map.host_scene, largest_packed));  // the Renderer's Scene copy and packing
+  out.host_shares.add("scene", saturating_add(out.face_map.host_scene, largest_packed));  // the Renderer's Scene copy and packing
   // Each load_scene of a deferred scene makes its faces again while it packs (RenderMemory::host_making).
   size_t making = std::max(out.face_map.host_making, out.reference.host_making);
   for (const RenderMemory& entry : out.entries) making = std::max(making, entry.host_making);

@@ -43,7 +43,7 @@ std::vector<int> lowest_face_at_vertex(const Scene& scene, Eligible eligible) {
   return out;
 }
 
-int corner_of(const Face& face, uint32_t vertex) {
+int corner_holding(const Face& face, uint32_t vertex) {
   for (int c = 0; c < 4; ++c) {
     if (face.vertices[c] == vertex) return c;
   }
@@ -85,7 +85,7 @@ size_t match_edge_samples(const Scene& scene, std::vector<DisplacementMap>& maps
     for (int c = 0; c < 4; ++c) {
       const uint32_t v = scene.faces[f].vertices[c];
       const auto o = static_cast<size_t>(owner[v]);
-      const uint16_t value = round_to_multiple(corner_sample(maps[o], corner_of(scene.faces[o], v)), 64);
+      const uint16_t value = round_to_multiple(corner_sample(maps[o], corner_holding(scene.faces[o], v)), 64);
       set(corner_sample(maps[f], c), value);
     }
   }
@@ -318,13 +318,13 @@ PackedDisplacement pack_displacement(const Scene& scene, const DisplacementSetti
       const int z = lowest_mapped[v];
       p.corner_value[k] = z < 0 ? 0.0f
                                 : static_cast<float>(corner_sample(maps[static_cast<size_t>(z)],
-                                                                   corner_of(scene.faces[static_cast<size_t>(z)], v))) /
+                                                                   corner_holding(scene.faces[static_cast<size_t>(z)], v))) /
                                       65535.0f;
       // Ownership: this corner's uv in its own face, in the owners of its two edges, in the
       // corner's owner (the lowest-numbered face of each).
       auto texcoord = [&](int owner) {
         const auto o = static_cast<size_t>(owner);
-        const int c = corner_of(scene.faces[o], v);
+        const int c = corner_holding(scene.faces[o], v);
         return DisplacementTexcoord{owner, kCornerUv[c][0], kCornerUv[c][1]};
       };
       const int edge_before = (k + 3) % 4;

@@ -31,7 +31,7 @@ namespace {
 
 constexpr std::array<std::string_view, 3> kLayoutNames{"equirect", "cross", "faces"};  // enum order
 
-std::string size_text(int width, int height) { return std::to_string(width) + " x " + std::to_string(height); }
+std::string image_size_text(int width, int height) { return std::to_string(width) + " x " + std::to_string(height); }
 
 // Bilinear at continuous texel coordinates (x, y), texel centres at integers, in a width x height
 // block of `texels` starting at `first`; x wraps when `wrap_x`, else clamps; y clamps.
@@ -80,11 +80,11 @@ EnvironmentImage environment_image_from_pixels(EnvironmentLayout layout, const s
     const DecodedImage& image = images[k];
     if (image.width < 1 || image.height < 1 || image.width > kMaxEnvironmentImageSide ||
         image.height > kMaxEnvironmentImageSide)
-      throw InputError(fields[k], "is " + size_text(image.width, image.height) + "; each side must be in 1.." +
+      throw InputError(fields[k], "is " + image_size_text(image.width, image.height) + "; each side must be in 1.." +
                                       std::to_string(kMaxEnvironmentImageSide));
     if (image.pixels.size() != static_cast<size_t>(image.width) * image.height)
       throw InputError(fields[k], "holds " + std::to_string(image.pixels.size()) + " pixels for " +
-                                      size_text(image.width, image.height));
+                                      image_size_text(image.width, image.height));
     total += image.pixels.size();
     if (total > kMaxEnvironmentTexels)
       throw InputError(fields[k], "the environment's images hold more than " + std::to_string(kMaxEnvironmentTexels) +
@@ -103,7 +103,7 @@ EnvironmentImage environment_image_from_pixels(EnvironmentLayout layout, const s
   if (layout == EnvironmentLayout::Equirect) {
     const DecodedImage& image = images[0];
     if (image.width != 2 * image.height)
-      throw InputError(fields[0], "is " + size_text(image.width, image.height) +
+      throw InputError(fields[0], "is " + image_size_text(image.width, image.height) +
                                       "; layout 'equirect' needs width = 2 x height");
     out.width = image.width;
     out.height = image.height;
@@ -116,8 +116,8 @@ EnvironmentImage environment_image_from_pixels(EnvironmentLayout layout, const s
     const int n = images[0].width;
     for (size_t k = 0; k < 6; ++k)
       if (images[k].width != images[k].height || images[k].width != n)
-        throw InputError(fields[k], "is " + size_text(images[k].width, images[k].height) +
-                                        "; the six faces must be square and of one size (" + size_text(n, n) + ")");
+        throw InputError(fields[k], "is " + image_size_text(images[k].width, images[k].height) +
+                                        "; the six faces must be square and of one size (" + image_size_text(n, n) + ")");
     out.width = n;
     out.height = 6 * n;
     for (const DecodedImage& image : images)
@@ -129,7 +129,7 @@ EnvironmentImage environment_image_from_pixels(EnvironmentLayout layout, const s
   const bool horizontal = image.width * 3 == image.height * 4 && image.width % 4 == 0;
   const bool vertical = image.width * 4 == image.height * 3 && image.width % 3 == 0;
   if (!horizontal && !vertical)
-    throw InputError(fields[0], "is " + size_text(image.width, image.height) +
+    throw InputError(fields[0], "is " + image_size_text(image.width, image.height) +
                                     "; layout 'cross' needs 4 x 3 or 3 x 4 square faces (width : height = 4 : 3 or "
                                     "3 : 4, a whole number of texels per face)");
   const int n = horizontal ? image.width / 4 : image.width / 3;

@@ -6,7 +6,6 @@ namespace seamcl {
 namespace {
 
 constexpr size_t kGroup = 64;
-size_t round_up(size_t value, size_t multiple) { return (value + multiple - 1) / multiple * multiple; }
 
 template <typename T>
 cl::Buffer upload(ClRuntime& runtime, const std::vector<T>& data) {
