@@ -2,12 +2,21 @@
 // tessellation tests: a torus made here and the Ptex cube with tunnels.
 #pragma once
 #include <string>
+#include <vector>
 
+#include <seamcl/options/displacement_method.h>
 #include <seamcl/scene/scene.h>
 
 namespace seamcl_tests {
 
 inline const std::string kPtexAssets = std::string(SEAMCL_TEST_ASSETS_DIR) + "/ptex/";
+
+// Every displacement method, and the ones that claim a watertight surface.
+inline const std::vector<seamcl::DisplacementMethod> kAllDisplacementMethods{
+    seamcl::DisplacementMethod::Naive, seamcl::DisplacementMethod::Zipper, seamcl::DisplacementMethod::Ownership,
+    seamcl::DisplacementMethod::Fixed, seamcl::DisplacementMethod::PtexFilter};
+inline const std::vector<seamcl::DisplacementMethod> kWatertightMethods{
+    seamcl::DisplacementMethod::Zipper, seamcl::DisplacementMethod::Ownership, seamcl::DisplacementMethod::Fixed};
 
 // A torus of rings x sides quads (major radius 1, minor 0.35, axis y), counter-clockwise from
 // outside, with maps of different resolutions baked face by face: the hole makes it

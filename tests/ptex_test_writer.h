@@ -5,6 +5,8 @@
 #pragma once
 #include <zlib.h>
 
+#include <nlohmann/json.hpp>
+
 #include <array>
 #include <cstdint>
 #include <cstring>
@@ -17,6 +19,15 @@
 namespace seamcl_tests {
 
 inline std::string ptex_assets_dir() { return std::string(SEAMCL_TEST_ASSETS_DIR) + "/ptex"; }
+
+// The sample files of tests/assets/ptex/, each with values the Ptex library wrote (golden/).
+inline constexpr const char* kPtexSamples[] = {"black", "cellnoise", "cube_text", "rand_lo", "wave_lo"};
+
+// tests/assets/ptex/golden/<name>.json: what the Ptex library read from the sample <name>.ptx.
+inline nlohmann::json ptex_golden(const std::string& name) {
+  std::ifstream in(ptex_assets_dir() + "/golden/" + name + ".json");
+  return nlohmann::json::parse(in);
+}
 
 inline std::vector<uint8_t> read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -32,12 +32,9 @@ using namespace seamcl;
 using seamcl_tests::cube_obj;
 using seamcl_tests::make_torus;
 using seamcl_tests::shared_runtime;
+using seamcl_tests::kAllDisplacementMethods;
+using seamcl_tests::kWatertightMethods;
 
-const std::vector<DisplacementMethod> kAllMethods{DisplacementMethod::Naive, DisplacementMethod::Zipper,
-                                                  DisplacementMethod::Ownership, DisplacementMethod::Fixed,
-                                                  DisplacementMethod::PtexFilter};
-const std::vector<DisplacementMethod> kWatertight{DisplacementMethod::Zipper, DisplacementMethod::Ownership,
-                                                  DisplacementMethod::Fixed};
 
 // A factor per edge from its two vertices alone (so both faces agree), spread over 1..max.
 std::vector<std::array<int, 4>> hashed_factors(const Scene& scene, int max_factor) {
@@ -188,7 +185,7 @@ TEST(AdaptiveFactors, SlotGridTilesEveryPatchWithoutFoldsAtEveryFactorMix) {
 TEST(AdaptiveTessellation, KernelEqualsTwinBitForBitWithMixedFactors) {
   const Scene scene = generate_scene("displaced", {});
   for (int t : {1, 3, 16}) {
-    for (DisplacementMethod m : kAllMethods) {
+    for (DisplacementMethod m : kAllDisplacementMethods) {
       const PackedDisplacement packed = pack_displacement(scene, {m, t, 0, hashed_factors(scene, t)});
       const std::vector<TessVertex> device = device_tessellation(packed);
       const std::vector<TessVertex> twin = tessellate_reference(packed);
@@ -206,7 +203,7 @@ TEST(AdaptiveTessellation, KernelEqualsTwinBitForBitWithMixedFactors) {
 TEST(AdaptiveTessellation, WatertightMethodsKeepGapAndNormalGapZeroWithMixedFactors) {
   for (const Scene& scene : {generate_scene("displaced", {}), cube_obj(), make_torus(16, 8)}) {
     for (int t : {3, 8}) {
-      for (DisplacementMethod m : kAllMethods) {
+      for (DisplacementMethod m : kAllDisplacementMethods) {
         const PackedDisplacement packed = pack_displacement(scene, {m, t, 0, hashed_factors(scene, t)});
         const DisplacementGap gap = measure_gap(packed, device_tessellation(packed));
         EXPECT_GT(gap.compared_pairs, 0u);
@@ -235,7 +232,7 @@ TEST(AdaptiveTessellation, ScreenSpaceFactorsShowNoCrackPixelForTheWatertightMet
     for (const auto& face : screen_space_edge_factors(scene, view_projection(scene.camera, 240, 270), 240, 270, pixels, t))
       factors.insert(face.begin(), face.end());
     EXPECT_GE(factors.size(), 3u) << scene.name << ": the factors must be mixed";
-    for (DisplacementMethod m : kWatertight) {
+    for (DisplacementMethod m : kWatertightMethods) {
       const DisplacementReport r =
           measure_displacement(shared_runtime(), scene, scene.camera, adaptive_options(m, t, pixels, 240, 270, 4), 8, 0);
       EXPECT_EQ(r.gap.max_gap, 0.0) << scene.name << " " << to_string(m);

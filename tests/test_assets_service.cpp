@@ -25,7 +25,7 @@ using seamcl_tests::LiveServer;
 
 namespace {
 
-std::string sample(const std::string& name) { return std::string(SEAMCL_TEST_ASSETS_DIR) + "/ptex/" + name; }
+std::string ptex_sample_path(const std::string& name) { return std::string(SEAMCL_TEST_ASSETS_DIR "/ptex/") + name; }
 
 class Workspace {
  public:
@@ -74,11 +74,11 @@ TEST(AssetsCli, BadMeshesAndPtexFilesExit2WithOneLineNamingTheField) {
     std::string args, field, text;
   };
   for (const Case& c : {Case{"render --scene triangle.obj -o out.png", "scene:", "face 0 (0-based; line 4) has 3 vertices"},
-                        Case{"render --scene " + sample("plane.obj") + " --texture broken.ptx -o out.png", "texture:", "broken.ptx"},
+                        Case{"render --scene " + ptex_sample_path("plane.obj") + " --texture broken.ptx -o out.png", "texture:", "broken.ptx"},
                         Case{"render --scene broken.ptx -o out.png", "scene:", "broken.ptx"},
-                        Case{"render --scene " + sample("plane.obj") + " --texture " + sample("cube_text.ptx") + " -o out.png",
+                        Case{"render --scene " + ptex_sample_path("plane.obj") + " --texture " + ptex_sample_path("cube_text.ptx") + " -o out.png",
                              "texture:", "has 72 faces"},
-                        Case{"compare --scene paper --texture " + sample("wave_lo.ptx") + " --methods discard --msaa 1", "texture:",
+                        Case{"compare --scene paper --texture " + ptex_sample_path("wave_lo.ptx") + " --methods discard --msaa 1", "texture:",
                              "goes with an .obj scene"},
                         Case{"bench --scene missing.obj --methods discard --msaa 1 --frames 1 --no-errors", "scene:", "no such file"}}) {
     SCOPED_TRACE(c.args);
@@ -94,7 +94,7 @@ TEST(AssetsCli, BadMeshesAndPtexFilesExit2WithOneLineNamingTheField) {
 TEST(AssetsCli, RendersAMeshWithItsPtexAtTheAskedSize) {
   Workspace w;
   const Workspace::Result r =
-      w.run("render --scene " + sample("plane.obj") + " --texture " + sample("wave_lo.ptx") + " --frame 3 --frames 8 --size 40x30 -o plane.png");
+      w.run("render --scene " + ptex_sample_path("plane.obj") + " --texture " + ptex_sample_path("wave_lo.ptx") + " --frame 3 --frames 8 --size 40x30 -o plane.png");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   int width = 0, height = 0;
   seamcl::read_image(w.path("plane.png").string(), width, height);
@@ -104,8 +104,8 @@ TEST(AssetsCli, RendersAMeshWithItsPtexAtTheAskedSize) {
 
 TEST(AssetsService, ListsRendersAndRefusesEveryWayOutOfTheDirectory) {
   Workspace w;
-  fs::copy_file(sample("plane.obj"), w.path("assets/plane.obj"));
-  fs::copy_file(sample("wave_lo.ptx"), w.path("assets/maps/wave_lo.ptx"));
+  fs::copy_file(ptex_sample_path("plane.obj"), w.path("assets/plane.obj"));
+  fs::copy_file(ptex_sample_path("wave_lo.ptx"), w.path("assets/maps/wave_lo.ptx"));
   w.write("outside/secret.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
   fs::create_symlink(w.path("outside/secret.obj"), w.path("assets/escape.obj"));
 
@@ -125,7 +125,7 @@ TEST(AssetsService, ListsRendersAndRefusesEveryWayOutOfTheDirectory) {
   EXPECT_EQ(assets.at("assets")[0].at("name"), "maps/wave_lo.ptx");
   EXPECT_EQ(assets.at("assets")[0].at("kind"), "ptex");
   EXPECT_EQ(assets.at("assets")[1].at("name"), "plane.obj");
-  EXPECT_EQ(assets.at("assets")[1].at("bytes"), fs::file_size(sample("plane.obj")));
+  EXPECT_EQ(assets.at("assets")[1].at("bytes"), fs::file_size(ptex_sample_path("plane.obj")));
 
   const json render = {{"scene", "plane.obj"}, {"texture", "maps/wave_lo.ptx"}, {"size", "32x24"}, {"method", "traverse"}};
   for (int i = 0; i < 2; ++i) {
@@ -165,8 +165,8 @@ TEST(AssetsService, ListsRendersAndRefusesEveryWayOutOfTheDirectory) {
 
 TEST(AssetsService, WithoutAssetsNoFileIsReachableAndAHugeAssetIsRefusedNotLoaded) {
   Workspace w;
-  fs::copy_file(sample("plane.obj"), w.path("assets/plane.obj"));
-  fs::copy_file(sample("wave_lo.ptx"), w.path("assets/wave_lo.ptx"));
+  fs::copy_file(ptex_sample_path("plane.obj"), w.path("assets/plane.obj"));
+  fs::copy_file(ptex_sample_path("wave_lo.ptx"), w.path("assets/wave_lo.ptx"));
   {
     seamcl::server::ServerOptions options;
     options.threads = 1;
@@ -175,7 +175,7 @@ TEST(AssetsService, WithoutAssetsNoFileIsReachableAndAHugeAssetIsRefusedNotLoade
     const auto listing = client.Get("/v1/assets");
     ASSERT_TRUE(listing);
     EXPECT_EQ(json::parse(listing->body).at("enabled"), false);
-    const auto answer = client.Post("/v1/render", json{{"scene", sample("plane.obj")}}.dump(), "application/json");
+    const auto answer = client.Post("/v1/render", json{{"scene", ptex_sample_path("plane.obj")}}.dump(), "application/json");
     ASSERT_TRUE(answer);
     EXPECT_EQ(answer->status, 400);
     EXPECT_EQ(json::parse(answer->body).at("field"), "scene");
@@ -200,8 +200,8 @@ TEST(AssetsService, WithoutAssetsNoFileIsReachableAndAHugeAssetIsRefusedNotLoade
 // naming the budget, at exactly the figure it renders.
 TEST(AssetsService, ADeferredPtexsKeptBytesCountAgainstTheHostBudget) {
   Workspace w;
-  fs::copy_file(sample("ptex_test_object.obj"), w.path("assets/object.obj"));
-  fs::copy_file(sample("cellnoise.ptx"), w.path("assets/cellnoise.ptx"));
+  fs::copy_file(ptex_sample_path("ptex_test_object.obj"), w.path("assets/object.obj"));
+  fs::copy_file(ptex_sample_path("cellnoise.ptx"), w.path("assets/cellnoise.ptx"));
   const json body = {{"scene", "object.obj"}, {"texture", "cellnoise.ptx"}, {"size", "16x16"}};
 
   // What the server measures a request against, from the library as the server loads the asset.
@@ -214,7 +214,7 @@ TEST(AssetsService, ADeferredPtexsKeptBytesCountAgainstTheHostBudget) {
   const seamcl::RenderMemory render = seamcl::render_memory(sizes, options);
   const size_t render_bytes = std::max(seamcl::scene_render_memory(sizes, options).host_bytes(), render.host_bytes());
   const size_t kept = scene.texture_source_bytes;
-  ASSERT_EQ(kept, fs::file_size(sample("cellnoise.ptx")));
+  ASSERT_EQ(kept, fs::file_size(ptex_sample_path("cellnoise.ptx")));
   ASSERT_EQ(render.host_scene, seamcl::scene_host_bytes(sizes) + kept);  // the file, with the Renderer's copy
   const size_t held = seamcl::scene_host_bytes(sizes);  // the request's own copy: records, no texels
   ASSERT_LT(render_bytes + held, scene.texel_count() * sizeof(glm::vec4)) << "a float copy of the texels is counted";
@@ -249,11 +249,11 @@ TEST(AssetsService, ADeferredPtexsKeptBytesCountAgainstTheHostBudget) {
 // cache's key (two maps on the same mesh are two scenes, not one served twice).
 TEST(AssetsService, DisplacementMapIsAnAssetNamedByItsField) {
   Workspace w;
-  fs::copy_file(sample("plane.obj"), w.path("assets/plane.obj"));
-  fs::copy_file(sample("rand_lo.ptx"), w.path("assets/maps/rand_lo.ptx"));
-  fs::copy_file(sample("wave_lo.ptx"), w.path("assets/maps/wave_lo.ptx"));
-  fs::copy_file(sample("cellnoise.ptx"), w.path("assets/cellnoise.ptx"));
-  fs::copy_file(sample("rand_lo.ptx"), w.path("outside/secret.ptx"));
+  fs::copy_file(ptex_sample_path("plane.obj"), w.path("assets/plane.obj"));
+  fs::copy_file(ptex_sample_path("rand_lo.ptx"), w.path("assets/maps/rand_lo.ptx"));
+  fs::copy_file(ptex_sample_path("wave_lo.ptx"), w.path("assets/maps/wave_lo.ptx"));
+  fs::copy_file(ptex_sample_path("cellnoise.ptx"), w.path("assets/cellnoise.ptx"));
+  fs::copy_file(ptex_sample_path("rand_lo.ptx"), w.path("outside/secret.ptx"));
   fs::create_symlink(w.path("outside/secret.ptx"), w.path("assets/escape.ptx"));
 
   seamcl::server::ServerOptions options;

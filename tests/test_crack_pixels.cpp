@@ -24,6 +24,7 @@ namespace {
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;
+using seamcl_tests::kWatertightMethods;
 
 using seamcl_tests::cube_obj;
 using seamcl_tests::kPtexAssets;
@@ -40,8 +41,6 @@ RenderOptions crack_options(DisplacementMethod method, int t, int width, int hei
   return o;
 }
 
-const std::vector<DisplacementMethod> kWatertight{DisplacementMethod::Zipper, DisplacementMethod::Ownership,
-                                                  DisplacementMethod::Fixed};
 
 // The counts each method shows on both meshes, for docs/displacement.md (not run by ctest:
 // `seamcl_tests --gtest_also_run_disabled_tests --gtest_filter='*CrackPixelsReport*'`).
@@ -64,7 +63,7 @@ TEST(CrackPixelsReport, DISABLED_PrintsEveryMethod) {
 void expect_cracks_only_where_the_gap_is_open(const Scene& scene, int width, int height) {
   ASSERT_TRUE(is_closed_mesh(scene));
   for (int t : {4, 9}) {
-    for (DisplacementMethod m : kWatertight) {
+    for (DisplacementMethod m : kWatertightMethods) {
       const DisplacementReport r =
           measure_displacement(shared_runtime(), scene, scene.camera, crack_options(m, t, width, height, 4), 8, 0);
       ASSERT_EQ(r.gap.max_gap, 0.0) << scene.name << " " << to_string(m) << " T=" << t;
@@ -91,7 +90,7 @@ TEST(CrackPixels, PtexCubeWithTunnelsCracksOnlyWhereTheGapIsOpen) {
 TEST(CrackPixels, TheIssuesCubeCommandCountsNoneForTheWatertightMethods) {
   const Scene scene = cube_obj();
   for (int t : {4, 16}) {
-    for (DisplacementMethod m : kWatertight) {
+    for (DisplacementMethod m : kWatertightMethods) {
       const DisplacementReport r =
           measure_displacement(shared_runtime(), scene, scene.camera, crack_options(m, t, 480, 540, 4), 8, 0);
       EXPECT_EQ(r.crack_pixels.value_or(1), 0u) << to_string(m) << " T=" << t;
@@ -114,7 +113,7 @@ TEST(DisplacedNormals, AgreeBitForBitAcrossEveryEdgeForTheWatertightMethods) {
   attach_ptex_displacement(plane, kAssets + "rand_lo.ptx");
   for (const Scene& scene : {generate_scene("displaced", {}), cube_obj(), make_torus(16, 8), plane}) {
     for (int t : {3, 8}) {
-      for (DisplacementMethod m : kWatertight) {
+      for (DisplacementMethod m : kWatertightMethods) {
         const DisplacementReport r =
             measure_displacement(shared_runtime(), scene, scene.camera, crack_options(m, t, 32, 32, 1), 0, 0);
         EXPECT_EQ(r.gap.max_normal_gap, 0.0) << scene.name << " " << to_string(m) << " T=" << t;

@@ -32,12 +32,8 @@ using namespace seamcl;
 using seamcl_tests::cube_obj;
 using seamcl_tests::make_torus;
 using seamcl_tests::shared_runtime;
+using seamcl_tests::kAllDisplacementMethods;
 
-const std::vector<DisplacementMethod> kAllMethods{DisplacementMethod::Naive, DisplacementMethod::Zipper,
-                                                  DisplacementMethod::Ownership, DisplacementMethod::Fixed,
-                                                  DisplacementMethod::PtexFilter};
-const std::vector<DisplacementMethod> kWatertight{DisplacementMethod::Zipper, DisplacementMethod::Ownership,
-                                                  DisplacementMethod::Fixed};
 
 // Mixed edge factors 1..t, each shared edge's the same from both faces (a hash of its vertices).
 std::vector<std::array<int, 4>> mixed_factors(const Scene& scene, int t) {
@@ -92,7 +88,7 @@ TEST(DisplacedNormals, KernelEqualsTwinAtEveryVertex) {
     for (int t : {1, 3, 8}) {
       for (bool adaptive : {false, true}) {
         if (adaptive && t == 1) continue;
-        for (DisplacementMethod m : kAllMethods) {
+        for (DisplacementMethod m : kAllDisplacementMethods) {
           const DeviceSurface s = device_surface(
               pack_displacement(scene, {m, t, 0, adaptive ? mixed_factors(scene, t) : std::vector<std::array<int, 4>>{}}));
           ASSERT_EQ(s.normals.size(), s.vertices.size());
@@ -121,7 +117,7 @@ TEST(DisplacedNormals, KernelEqualsTwinAtEveryVertex) {
 TEST(DisplacedNormals, DeviceNormalsAgreeBitForBitAcrossEdgesWithMixedFactors) {
   for (const Scene& scene : {generate_scene("displaced", {}), make_torus(16, 8)}) {
     for (int t : {4, 8}) {
-      for (DisplacementMethod m : kAllMethods) {
+      for (DisplacementMethod m : kAllDisplacementMethods) {
         if (m == DisplacementMethod::PtexFilter) continue;  // not watertight, and not always open either
         const DeviceSurface s = device_surface(pack_displacement(scene, {m, t, 0, mixed_factors(scene, t)}));
         const DisplacementGap gap = measure_gap(s.packed, s.vertices, &s.normals);

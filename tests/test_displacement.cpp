@@ -14,6 +14,7 @@
 #include <seamcl/options/render_options.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
+#include "displacement_test_scenes.h"
 #include "pipeline/displacement_packing.h"
 #include "pipeline/stages/tessellate_launcher.h"
 #include "scene/displaced_scene.h"
@@ -26,12 +27,9 @@ namespace {
 
 using namespace seamcl;
 using seamcl_tests::shared_runtime;
+using seamcl_tests::kAllDisplacementMethods;
+using seamcl_tests::kWatertightMethods;
 
-const std::vector<DisplacementMethod> kAllMethods{DisplacementMethod::Naive, DisplacementMethod::Zipper,
-                                                  DisplacementMethod::Ownership, DisplacementMethod::Fixed,
-                                                  DisplacementMethod::PtexFilter};
-const std::vector<DisplacementMethod> kWatertight{DisplacementMethod::Zipper, DisplacementMethod::Ownership,
-                                                  DisplacementMethod::Fixed};
 
 const Scene& displaced() {
   static const Scene scene = generate_scene("displaced", {});
@@ -78,7 +76,7 @@ TEST(Displacement, SceneIsClosedWithMixedResolutionsAndRotations) {
 }
 
 TEST(Displacement, KernelMatchesTwinBitForBit) {
-  for (DisplacementMethod method : kAllMethods) {
+  for (DisplacementMethod method : kAllDisplacementMethods) {
     for (int t : {1, 3, 16}) {
       PackedDisplacement packed;
       const std::vector<TessVertex> device = device_tessellation(displaced(), {method, t, 0}, &packed);
@@ -118,7 +116,7 @@ TEST(Displacement, VerticesLieOnTheDisplacedSurface) {
 }
 
 TEST(Displacement, WatertightMethodsHaveExactlyZeroGapAtEveryLevel) {
-  for (DisplacementMethod method : kWatertight) {
+  for (DisplacementMethod method : kWatertightMethods) {
     for (int t : {1, 2, 3, 7, 16, 64}) {
       PackedDisplacement packed;
       const std::vector<TessVertex> v = device_tessellation(displaced(), {method, t, 0}, &packed);
@@ -231,7 +229,7 @@ TEST(Displacement, ZeroGapForEveryRotationOfANeighbour) {
       for (int k = 0; k < ra; ++k) rotate_face(scene, *d, a);
       for (int k = 0; k < rb; ++k) rotate_face(scene, *d, b);
       scene.displacement = d;
-      for (DisplacementMethod method : kWatertight) {
+      for (DisplacementMethod method : kWatertightMethods) {
         for (int t : {3, 8}) {
           PackedDisplacement packed;
           const std::vector<TessVertex> v = device_tessellation(scene, {method, t, 0}, &packed);
@@ -245,7 +243,7 @@ TEST(Displacement, ZeroGapForEveryRotationOfANeighbour) {
 
 TEST(Displacement, CoarserLevelsStayWatertight) {
   for (int level : {1, 2, 5}) {
-    for (DisplacementMethod method : kWatertight) {
+    for (DisplacementMethod method : kWatertightMethods) {
       PackedDisplacement packed;
       const std::vector<TessVertex> v = device_tessellation(displaced(), {method, 16, level}, &packed);
       const DisplacementGap gap = measure_gap(packed, v);
@@ -275,7 +273,7 @@ TEST(Displacement, FixedNeedsMatchedMapsAndSaysWhatMatchingChanged) {
 TEST(Displacement, CostsFollowTheMethod) {
   const int t = 8;
   std::map<DisplacementMethod, size_t> samples, bytes;
-  for (DisplacementMethod method : kAllMethods) {
+  for (DisplacementMethod method : kAllDisplacementMethods) {
     const PackedDisplacement packed = pack_displacement(displaced(), {method, t, 0});
     size_t taken = 0;
     for (const TessVertex& v : tessellate_reference(packed)) taken += v.samples;

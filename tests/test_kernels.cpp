@@ -71,14 +71,14 @@ void expect_plane_near(const cl_float* gpu, const cl_float* twin, const char* wh
   }
 }
 
-struct Case {
+struct KernelCase {
   std::string name;
   Scene scene;
   RenderOptions options;
 };
 
-std::vector<Case> cases() {
-  std::vector<Case> out;
+std::vector<KernelCase> kernel_cases() {
+  std::vector<KernelCase> out;
   auto options = [](int w, int h, int msaa, ShadingMode shading) {
     RenderOptions o;
     o.width = w;
@@ -104,7 +104,7 @@ std::vector<Case> cases() {
 
 TEST(KernelVsTwin, EveryStageOnBuiltInAndRandomScenes) {
   Renderer renderer(shared_runtime());
-  for (const Case& c : cases()) {
+  for (const KernelCase& c : kernel_cases()) {
     SCOPED_TRACE(c.name);
     renderer.load_scene(c.scene);
     const RenderResult result = renderer.render(c.scene.camera, c.options);

@@ -32,7 +32,6 @@ using namespace seamcl_tests;
 // uint8 values become v * (1 / 255), exactly as Ptex converts them.
 constexpr float kByte = 1.0f / 255.0f;
 
-const char* const kSamples[] = {"black", "cellnoise", "cube_text", "rand_lo", "wave_lo"};
 
 // The samples are read once: cube_text alone is 25 M texels.
 const PtexFile& sample(const std::string& name) {
@@ -40,11 +39,6 @@ const PtexFile& sample(const std::string& name) {
   auto it = files.find(name);
   if (it == files.end()) it = files.emplace(name, read_ptex_file(ptex_assets_dir() + "/" + name + ".ptx")).first;
   return it->second;
-}
-
-json golden(const std::string& name) {
-  std::ifstream in(ptex_assets_dir() + "/golden/" + name + ".json");
-  return json::parse(in);
 }
 
 // One quantum of the file's type: Ptex's reductions and averages round to it.
@@ -87,10 +81,10 @@ std::string parse_error(const std::vector<uint8_t>& bytes, const PtexLimits& lim
 }
 
 TEST(Ptex, ReadsGoldenFaceFacts) {
-  for (const char* name : kSamples) {
+  for (const char* name : kPtexSamples) {
     SCOPED_TRACE(name);
     const PtexFile& file = sample(name);
-    const json g = golden(name);
+    const json g = ptex_golden(name);
     EXPECT_EQ(static_cast<int>(file.data_type), g["data_type"].get<int>());
     EXPECT_EQ(file.channels, g["channels"].get<int>());
     EXPECT_EQ(file.alpha_channel, g["alpha_channel"].get<int>());
@@ -116,10 +110,10 @@ TEST(Ptex, ReadsGoldenFaceFacts) {
 }
 
 TEST(Ptex, ReadsGoldenValues) {
-  for (const char* name : kSamples) {
+  for (const char* name : kPtexSamples) {
     SCOPED_TRACE(name);
     const PtexFile& file = sample(name);
-    const json g = golden(name);
+    const json g = ptex_golden(name);
     ASSERT_EQ(g["texels"].size(), 64u);
     for (const json& t : g["texels"]) {
       const int face = t["face"].get<int>();
@@ -133,10 +127,10 @@ TEST(Ptex, ReadsGoldenValues) {
 // Ptex's 1x1 level is the constant data its writer stored (the mean of the last stored reduction,
 // rounded down to the type): seamcl takes it as is for the 1x1 level.
 TEST(Ptex, OneByOneLevelIsTheFilesFaceAverage) {
-  for (const char* name : kSamples) {
+  for (const char* name : kPtexSamples) {
     SCOPED_TRACE(name);
     const PtexFile& file = sample(name);
-    const json g = golden(name);
+    const json g = ptex_golden(name);
     ASSERT_FALSE(g["face_average"].empty());
     for (size_t f = 0; f < g["face_average"].size(); ++f) {
       const TextureLevel& last = file.textures.at(f).levels.back();
@@ -150,7 +144,7 @@ TEST(Ptex, OneByOneLevelIsTheFilesFaceAverage) {
 // Every chain has the shape of seamcl's MipChain (non-square faces included) and a scene made of
 // them passes validate_scene.
 TEST(Ptex, ChainsHaveSeamclShapesAndPassValidateScene) {
-  for (const char* name : kSamples) {
+  for (const char* name : kPtexSamples) {
     SCOPED_TRACE(name);
     const PtexFile& file = sample(name);
     Scene scene;
@@ -184,7 +178,7 @@ TEST(Ptex, ChainsHaveSeamclShapesAndPassValidateScene) {
 // Each level is the 2x2 mean of the one above within one quantum of the file's type: stored
 // reductions are Ptex's rounded ones, the rest are made here exactly.
 TEST(Ptex, LevelsAreBoxFiltersOfTheLevelAbove) {
-  for (const char* name : kSamples) {
+  for (const char* name : kPtexSamples) {
     SCOPED_TRACE(name);
     const PtexFile& file = sample(name);
     const float tolerance = quantum(file.data_type) * 1.01f;

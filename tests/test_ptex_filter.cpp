@@ -27,9 +27,10 @@ namespace seamcl {
 namespace {
 
 using nlohmann::json;
+using seamcl_tests::kPtexSamples;
 using seamcl_tests::ptex_assets_dir;
+using seamcl_tests::ptex_golden;
 
-const char* const kSamples[] = {"black", "cellnoise", "cube_text", "rand_lo", "wave_lo"};
 
 const PtexStored& stored_sample(const std::string& name) {
   static std::map<std::string, PtexStored> files;
@@ -45,11 +46,6 @@ const PtexFilterData& filter_sample(const std::string& name) {
   return it->second;
 }
 
-json golden(const std::string& name) {
-  std::ifstream in(ptex_assets_dir() + "/golden/" + name + ".json");
-  return json::parse(in);
-}
-
 int filter_code(const std::string& name) {
   if (name == "bilinear") return SEAMCL_PTEX_BILINEAR;
   if (name == "gaussian") return SEAMCL_PTEX_GAUSSIAN;
@@ -60,8 +56,8 @@ int filter_code(const std::string& name) {
 }
 
 TEST(PtexFilter, MatchesThePtexLibraryOnEveryGoldenValue) {
-  for (const char* name : kSamples) {
-    const json g = golden(name);
+  for (const char* name : kPtexSamples) {
+    const json g = ptex_golden(name);
     const PtexFilterData& data = filter_sample(name);
     ASSERT_EQ(g["filtered"].size(), 96u) << name;
     std::map<std::string, double> largest;
@@ -92,7 +88,7 @@ TEST(PtexFilter, MatchesThePtexLibraryOnEveryGoldenValue) {
 // Values of the file's scale (0..1 for integer files, as the library returns them): 1e-4 is well
 // under a uint8 step and the float rounding of a wide kernel's sums stays far below it.
 TEST(PtexFilter, MatchesThePtexLibraryOnEveryFilterNearEdgesCornersAndResolutionChanges) {
-  for (const char* name : kSamples) {
+  for (const char* name : kPtexSamples) {
     const PtexFilterData& data = filter_sample(name);
     const std::vector<seamcl_tests::PtexGoldenLookup> lookups = seamcl_tests::ptex_golden_filter_lookups(name);
     ASSERT_GE(lookups.size(), 1000u) << name;

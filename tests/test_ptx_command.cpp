@@ -22,9 +22,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using seamcl_tests::kPtexSamples;
 using seamcl_tests::ptex_assets_dir;
+using seamcl_tests::ptex_golden;
 
-const char* const kSamples[] = {"black", "cellnoise", "cube_text", "rand_lo", "wave_lo"};
 
 struct Process {
   int exit_code = -1;
@@ -42,11 +43,6 @@ std::string quoted(const std::string& s) {
   std::string out = "'";
   for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return out + "'";
-}
-
-json golden(const std::string& name) {
-  std::ifstream in(ptex_assets_dir() + "/golden/" + name + ".json");
-  return json::parse(in);
 }
 
 std::string sample_path(const std::string& name) { return quoted(ptex_assets_dir() + "/" + name + ".ptx"); }
@@ -92,8 +88,8 @@ class PtxCommand : public ::testing::Test {
 };
 
 TEST_F(PtxCommand, InfoGivesThePtexLibrarysFaceFactsAndAverages) {
-  for (const char* name : kSamples) {
-    const json g = golden(name);
+  for (const char* name : kPtexSamples) {
+    const json g = ptex_golden(name);
     const Process p = run("ptx info " + sample_path(name));
     ASSERT_EQ(p.exit_code, 0) << p.err;
     const json info = json::parse(p.out);
@@ -121,8 +117,8 @@ TEST_F(PtxCommand, InfoGivesThePtexLibrarysFaceFactsAndAverages) {
 }
 
 TEST_F(PtxCommand, DumpGivesThePtexLibrarysTexels) {
-  for (const char* name : kSamples) {
-    const json g = golden(name);
+  for (const char* name : kPtexSamples) {
+    const json g = ptex_golden(name);
     // One face of the golden texels per sample (the one with most of them), every golden texel on it.
     std::map<int, std::vector<json>> by_face;
     for (const json& t : g["texels"]) by_face[t["face"].get<int>()].push_back(t);
@@ -156,8 +152,8 @@ TEST_F(PtxCommand, DumpGivesThePtexLibrarysTexels) {
 }
 
 TEST_F(PtxCommand, LookupGivesThePtexLibrarysFilteredValuesFromTheDevice) {
-  for (const char* name : kSamples) {
-    const json g = golden(name);
+  for (const char* name : kPtexSamples) {
+    const json g = ptex_golden(name);
     const std::string queries = write(std::string(name) + ".json", g["filtered"].dump());
     const Process p = run("ptx lookup " + sample_path(name) + " --queries " + queries);
     ASSERT_EQ(p.exit_code, 0) << p.err;
@@ -175,7 +171,7 @@ TEST_F(PtxCommand, LookupGivesThePtexLibrarysFilteredValuesFromTheDevice) {
     std::cout << "[ptx lookup, device] " << name << ": largest difference " << largest << "\n";
   }
   // One lookup from the flags: the first golden entry of cellnoise.
-  const json first = golden("cellnoise")["filtered"][0];
+  const json first = ptex_golden("cellnoise")["filtered"][0];
   std::ostringstream args;
   args.precision(9);
   args << "ptx lookup " << sample_path("cellnoise") << " --face " << first["face"].get<int>() << " --u "

@@ -18,7 +18,6 @@ SceneSizes seamless_scene_sizes(const Scene& scene) {
 
 namespace {
 
-
 // What a phase of one Renderer holds at most: the largest packing, each frame buffer at its max.
 // The frame buffers are driven by what drives the render that needs the most of them.
 struct PhaseDevice {
