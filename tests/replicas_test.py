@@ -190,6 +190,13 @@ def main():
         except subprocess.TimeoutExpired:
             proc.kill()
         check(proc.returncode == 0, f"replicas stopped cleanly ({proc.returncode})")
+        if failures:  # what a failure in a loaded CI run needs to be read: each replica's log
+            for name in ("replica0.log", "replica1.log"):
+                try:
+                    with open(os.path.join(work, name)) as f:
+                        print(f"--- the last lines of {name}:\n" + "".join(f.readlines()[-25:]), flush=True)
+                except OSError as e:
+                    print(f"--- {name}: {e}", flush=True)
         shutil.rmtree(work, ignore_errors=True)
     if failures:
         print(f"{len(failures)} checks failed", flush=True)
