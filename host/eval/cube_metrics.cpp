@@ -73,8 +73,7 @@ EdgeMeasures measure_cube_edges(ClRuntime& runtime, const Environment& environme
   const CubeMap cube = bake_cube_for(method, radiance, size, environment.bake_samples);
   const bool border = cube_preparation(method).border;
   const size_t packed_floats = pack_cube_texels(cube, border).size();
-  const double bake_ms =
-      ms_since(bake_start);
+  const double bake_ms = ms_since(bake_start);
   CubeLookups lookups(runtime, cube, border);
   const CubeSampler sampler = cube_sampler(method, Filter::Trilinear, 16, size);
   EdgeMeasures out;
