@@ -43,6 +43,8 @@ std::vector<int> lowest_face_at_vertex(const Scene& scene, Eligible eligible) {
   return out;
 }
 
+// The first corner of `face` that holds `vertex`; 0 when none does (adjacency.cpp's corner_of
+// asks a stricter question: exactly one corner, else -1).
 int corner_holding(const Face& face, uint32_t vertex) {
   for (int c = 0; c < 4; ++c) {
     if (face.vertices[c] == vertex) return c;
