@@ -1,9 +1,10 @@
 // seamcl bench: the bench job (host/jobs/bench_job.h) from the command line: its flags from the
-// job's option table, the reference cache's settings, --check (the plan's refusal only), a table
-// or the job's JSON printed.
+// job's option table, the reference cache's settings, the error frames' images where --images says,
+// --check (the plan's refusal only), a table or the job's JSON printed.
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -27,6 +28,7 @@ using nlohmann::json;
 struct BenchArgs {
   std::unique_ptr<OptionFlags> options;
   ReferenceCacheFlags cache;
+  std::optional<std::string> images;  // a directory; empty is refused, not taken for none
   bool check_only = false;
   bool json_out = false;
 };
@@ -73,7 +75,9 @@ void print_orbit(const json& out) {
 
 int run_bench(BenchArgs& args, const GlobalOptions& global) {
   // Validate everything before any work.
+  const std::string images_dir = given_value(args.images, "images", "leave out --images to write no images");
   BenchJob job(args.options->request());
+  if (!images_dir.empty()) job.refuse_images("images");
   args.cache.apply(job.reference_settings());  // checked with --sweep too: an empty --cache is a mistake
   ClRuntime runtime(global.device);
   SceneSourceOptions source;
@@ -92,11 +96,12 @@ int run_bench(BenchArgs& args, const GlobalOptions& global) {
     }
     return 0;
   }
+  if (!images_dir.empty()) make_output_directory(images_dir, "images");
   JobControl control;
   control.progress = [](const std::string& line) { std::fprintf(stderr, "bench: %s\n", line.c_str()); };
   control.should_stop = stop_on_interrupt();
   control.device_byte_limit = device_memory_bound(runtime.info());
-  const json out = job.run(runtime, scene, control);
+  const json out = job.run(runtime, scene, control, images_dir);
   if (args.json_out) {
     std::cout << out.dump(2) << "\n";
   } else if (job.is_sweep()) {
@@ -115,6 +120,10 @@ Command add_bench_command(CLI::App& app) {
       "bench", "Time every method x MSAA rate side by side over an orbit of frames, with errors against the reference");
   args->options = std::make_unique<OptionFlags>(cmd, bench_option_table());
   args->cache.add_to(cmd);
+  cmd->add_option("--images", args->images,
+                  "Write each error frame's reference, seam masks and every entry's image (PNG) into DIR/frame_<k>/, "
+                  "as compare --images does for its frame (FLIP over them: scripts/farm --flip, examples/orbit_flip.py)")
+      ->type_name("DIR");
   cmd->add_flag("--check", args->check_only,
                 "Validate the options (and the scene), refuse a bench this machine cannot hold, and exit without rendering");
   cmd->add_flag("--json", args->json_out, "Print one JSON object");

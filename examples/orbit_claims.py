@@ -5,6 +5,7 @@
         --methods clamp,black,discard,traverse-edges,traverse --msaa 1,2,4,8 --seam-mask footprint
     /usr/bin/python3 examples/orbit_claims.py OUT/merged.json -o docs/results/accuracy/orbit
     /usr/bin/python3 examples/orbit_claims.py OUT/shards/part-*.json -o DIR   # the parts done so far
+    /usr/bin/python3 examples/orbit_claims.py OUT/merged.json --flip OUT/flip.json -o DIR   # a farm --flip batch
 
 Reads the bench JSON's pooled errors (every pixel of every error frame) and writes into -o. Given
 several parts of one batch (`--shard K/N` runs, e.g. while a farm is still running), it pools them
@@ -15,6 +16,9 @@ says which frames the parts cover. Files:
                Discard / Traverse seam-error ratio per rate and the paper's claims judged by the
                rules of accuracy_study.py; the clamp and black controls over traverse;
   claims.json  the same, with the bench's batch options.
+With --flip (examples/orbit_flip.py's pooled figures of the same error frames, e.g. a `farm --flip`
+batch's flip.json) every entry also gets its FLIP means (all pixels, seam mask, off it) and the
+Discard / Traverse seam FLIP ratio per rate is given beside the error's.
 Refuses (exit 2) a JSON that is not a bench run with errors. Needs only the standard library and
 accuracy_study.py's rules (it imports matplotlib, like every chart here).
 """
@@ -68,6 +72,20 @@ def frame_blocks(benches):
     return ", ".join(f"{a}..{e - 1}" for a, e in blocks)
 
 
+def add_flip(entries, flip, error_frames, path):
+    """Each entry's FLIP means from orbit_flip.py's pooled figures; ValueError when they are of
+    other entries or other frames."""
+    by_entry = {(e["method"], e["msaa"]): e for e in flip["entries"]}
+    if sorted(by_entry) != sorted((e["method"], e["msaa"]) for e in entries):
+        raise ValueError(f"{path}: FLIP of other entries than the bench's")
+    if sorted(flip["frames"]) != sorted(error_frames):
+        raise ValueError(f"{path}: FLIP of frames {flip['frames'][:3]}... ({len(flip['frames'])}), "
+                         f"the bench's error frames are {sorted(error_frames)[:3]}... ({len(error_frames)})")
+    for e in entries:
+        f = by_entry[(e["method"], e["msaa"])]
+        e.update({key: f[key] for key in ("flip_mean", "flip_seam_mean", "flip_off_mean")})
+
+
 def claims_md(benches, entries, analysis, source):
     f = study.fmt
     bench = benches[0]
@@ -97,6 +115,19 @@ def claims_md(benches, entries, analysis, source):
         L.append(f"Control {c} / traverse seam error per rate: " +
                  ", ".join(f"{k}x {x:.3f}" for k, x in v["over_traverse"].items()))
     L.append("")
+    if any("flip_mean" in e for e in entries):
+        L += [f"FLIP (flip-evaluator, LDR, its default viewing condition) of every entry's image against the "
+              f"reference on each of the {error_frames} error frames, pooled over their pixels:", "",
+              "| method | msaa | FLIP mean | seam FLIP mean | off-seam FLIP mean |", "| --- | ---: | ---: | ---: | ---: |"]
+        L += [f"| {e['method']} | {e['msaa']} | {f(e['flip_mean'], '.4f')} | {f(e['flip_seam_mean'], '.4f')} | "
+              f"{f(e['flip_off_mean'], '.4f')} |" for e in entries]
+        L.append("")
+        for t, r in analysis["flip_ratios"].items():
+            L.append(f"Discard / {t} seam FLIP per rate: " + ", ".join(f"{k}x {v:.3f}" for k, v in r.items()))
+        for c in analysis["controls"]:
+            r = study.ratios(entries, c, "traverse", "flip_seam_mean")
+            L.append(f"Control {c} / traverse seam FLIP per rate: " + ", ".join(f"{k}x {x:.3f}" for k, x in r.items()))
+        L.append("")
     return "\n".join(L)
 
 
@@ -105,6 +136,7 @@ def main(argv=None):
                                  formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
     ap.add_argument("bench_json", nargs="+", help="seamcl bench --json output, a farm's merged.json, or parts of one batch")
     ap.add_argument("-o", "--out", required=True, help="directory for claims.md and claims.json")
+    ap.add_argument("--flip", help="examples/orbit_flip.py's pooled FLIP of the same error frames (farm --flip: flip.json)")
     args = ap.parse_args(argv)
     benches = []
     for path in args.bench_json:
@@ -130,6 +162,12 @@ def main(argv=None):
             print("orbit_claims: two parts cover the same frames", file=sys.stderr)
             return 2
         entries = entries_of(benches)
+        if args.flip:
+            with open(args.flip) as fh:
+                add_flip(entries, json.load(fh), [k for b in benches for k in b["error_frames"]], args.flip)
+    except OSError as e:
+        print(f"orbit_claims: {args.flip}: {e.strerror}", file=sys.stderr)
+        return 2
     except (KeyError, IndexError, TypeError, ValueError) as e:
         print(f"orbit_claims: {e}", file=sys.stderr)
         return 2
@@ -147,6 +185,9 @@ def main(argv=None):
                     os.path.join(args.out, "claims.json"))
     for t, r in analysis["ratios"].items():
         print(f"orbit_claims: discard / {t} seam error " + ", ".join(f"{k}x {v:.3f}" for k, v in r.items()))
+    for t, r in analysis["flip_ratios"].items():
+        if r:
+            print(f"orbit_claims: discard / {t} seam FLIP " + ", ".join(f"{k}x {v:.3f}" for k, v in r.items()))
     for name in ("claims.md", "claims.json"):
         print(os.path.join(args.out, name))
     return 0

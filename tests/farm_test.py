@@ -5,7 +5,9 @@
    temporal pairs, counts, maxima and curves; charts and farm.json are written;
 2. a worker killed (SIGKILL) while it runs a part: Dask reschedules the part on the other worker,
    the part has two starts, and the merged result is still the unsharded one;
-3. a rerun after one part's file was removed runs that part only (resume).
+3. a rerun after one part's file was removed runs that part only (resume);
+4. with --flip, each part's FLIP figures pooled into flip.json equal examples/orbit_flip.py's on
+   the unsharded run's own images (`bench --images`), and no part leaves images behind.
 
 Usage: farm_test.py --seamcl build/seamcl. Fails (exit 1), never skips, when distributed cannot
 be imported: scripts/install-deps installs python3-distributed for /usr/bin/python3.
@@ -26,6 +28,7 @@ import time
 sys.dont_write_bytecode = True
 HERE = os.path.dirname(os.path.abspath(__file__))
 FARM = os.path.join(os.path.dirname(HERE), "scripts", "farm")
+ORBIT_FLIP = os.path.join(os.path.dirname(HERE), "examples", "orbit_flip.py")
 
 BENCH = ["--scene", "quad2", "--methods", "discard,traverse", "--msaa", "1,4", "--size", "40x36",
          "--frames", "8", "--reference-frames", "3"]
@@ -137,12 +140,49 @@ def main():
             check(summary["ran"] == [3] and summary["resumed"] == [1, 2, 4],
                   f"resume ran part 3 only (ran {summary['ran']}, resumed {summary['resumed']})")
             exact_keys_equal(json.load(open(os.path.join(out, "merged.json"))), whole, "resumed")
+
+            # 4. FLIP through the farm against FLIP of the unsharded run's images.
+            images = os.path.join(tmp, "images")
+            subprocess.run([SEAMCL, "bench", *BENCH, "--images", images, "--json"], check=True, timeout=240,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            folders = sorted(os.listdir(images))
+            check(folders == ["frame_000000", "frame_000003", "frame_000006"], f"bench --images: one folder per error frame ({folders})")
+            names = sorted(os.listdir(os.path.join(images, "frame_000003")))
+            expected = sorted(["reference.png", "seam_mask_msaa1.png", "seam_mask_msaa4.png", "discard_msaa1.png",
+                               "discard_msaa4.png", "traverse_msaa1.png", "traverse_msaa4.png"])
+            check(names == expected, f"bench --images: the frame's reference, masks and entries ({names})")
+            direct = os.path.join(tmp, "direct.flip.json")
+            subprocess.run(["/usr/bin/python3", ORBIT_FLIP, "measure", images, "-o", direct, "--jobs", "2"], check=True,
+                           timeout=240, stdout=subprocess.DEVNULL)
+            direct = json.load(open(direct))
+            leftovers_before = {n for n in os.listdir(tempfile.gettempdir()) if n.startswith("seamcl-farm-")}
+            out = os.path.join(tmp, "flip")
+            args = farm_args(farm, out, 3, ["--flip", "--no-charts"])
+            farm.prepare_out(args)
+            summary = farm.run_batch(client, args, log=print)
+            pooled = json.load(open(os.path.join(out, "flip.json")))
+            check(pooled["frames"] == [0, 3, 6], f"flip.json covers the error frames ({pooled['frames']})")
+            check(len(summary["part_flip_s"]) == 3, "every part measured its FLIP")
+            for p, d in zip(pooled["entries"], direct["entries"]):
+                name = f"{d['method']} x{d['msaa']}"
+                check((p["method"], p["msaa"], p["frames"], p["pixels"], p["seam_pixels"], p["off_pixels"]) ==
+                      (d["method"], d["msaa"], 3, 40 * 36 * 3, d["seam_pixels"], d["off_pixels"]),
+                      f"FLIP {name}: entry, frames and pixel counts equal the unsharded run's")
+                for key in ("flip_mean", "flip_seam_mean", "flip_off_mean"):
+                    check(d[key] is not None and abs(p[key] - d[key]) <= 1e-9 and 0.0 <= d[key] <= 1.0,
+                          f"FLIP {name}: {key} {p[key]} equals the unsharded run's {d[key]}")
+            by = {(e["method"], e["msaa"]): e for e in pooled["entries"]}
+            check(by[("discard", 1)]["flip_seam_mean"] > 0.0, "FLIP sees the 1x seams")
+            leftovers = {n for n in os.listdir(tempfile.gettempdir()) if n.startswith("seamcl-farm-")}
+            check(leftovers <= leftovers_before, f"no part left its images behind ({sorted(leftovers - leftovers_before)})")
         finally:
             client.close()
             cluster.close()
 
         # The command line refuses what it sets itself and bad counts, naming them.
         for bad, needle in ((["--shards", "0"], "--shards"), (["--shards", "2", "--", "--shard", "1/2"], "--shard"),
+                            (["--shards", "2", "--flip", "--", *BENCH, "--images", "x"], "--images"),
+                            (["--shards", "2", "--flip", "--", *BENCH, "--no-errors"], "--no-errors"),
                             (["--shards", "20", "--", *BENCH], "shard: 20 parts of 8 frames")):
             proc = subprocess.run([sys.executable, FARM, "--out", os.path.join(tmp, "bad"), "--seamcl", SEAMCL, *bad],
                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=60)

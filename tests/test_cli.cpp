@@ -385,6 +385,12 @@ TEST_F(Cli, EmptyOptionValuesAreInputErrors) {
                      "reference_method: must not be empty");
   expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --cache '' --check", "cache: must not be empty");
   expect_input_error("bench --scene quad2 --sweep msaa --cache '' --check", "cache: must not be empty");
+  expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --images '' --check", "images: must not be empty");
+  // bench --images writes the error frames: a bench without any is refused before any work.
+  expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --no-errors --images /tmp/unused --check",
+                     "images: writes the orbit's error frames: no_errors leaves none");
+  expect_input_error("bench --scene quad2 --sweep msaa --images /tmp/unused --check",
+                     "images: writes the orbit's error frames: a sweep has none");
   expect_input_error("--device '' render --scene quad2 --size 16x16", "device: must not be empty");
   expect_input_error("--device '' devices", "device: must not be empty");
   // serve would listen until stopped: the timeout ends it where the refusal is missing.

@@ -153,6 +153,15 @@ std::vector<uint8_t> off_seam_pixels_only(const std::vector<uint8_t>& mask) {
   return off;
 }
 
+std::vector<glm::vec4> seam_mask_image(const std::vector<uint8_t>& mask) {
+  std::vector<glm::vec4> image(mask.size());
+  for (size_t i = 0; i < mask.size(); ++i)
+    image[i] = mask[i] == SEAMCL_MASK_SEAM       ? glm::vec4(1)
+               : mask[i] == SEAMCL_MASK_BOUNDARY ? glm::vec4(0.2f, 0.2f, 0.2f, 1.0f)
+                                                 : glm::vec4(0, 0, 0, 1);
+  return image;
+}
+
 std::vector<float> pixel_distances(const std::vector<glm::vec4>& test, const std::vector<glm::vec4>& reference) {
   if (test.size() != reference.size()) {
     throw std::invalid_argument("pixel_distances: " + std::to_string(test.size()) + " test pixels vs " +

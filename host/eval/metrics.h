@@ -84,6 +84,9 @@ std::vector<std::string> seam_mask_kind_names();
 std::vector<uint8_t> seam_pixels_only(const std::vector<uint8_t>& mask);
 // The pixels off every edge as 0/1: the mask's value 0 (SEAMCL_MASK_NONE).
 std::vector<uint8_t> off_seam_pixels_only(const std::vector<uint8_t>& mask);
+// A mask drawn for viewing and for tools that read it back (examples/accuracy_study.py): seam
+// pixels white, mesh-boundary rims grey (0.2 linear), the rest black. Opaque linear RGBA.
+std::vector<glm::vec4> seam_mask_image(const std::vector<uint8_t>& mask);
 
 struct ErrorStats {
   size_t pixels = 0;  // finite pixels counted (inside the mask, if any)

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <map>
 #include <memory>
 
@@ -10,6 +12,7 @@
 #include <seamcl/core/input_error.h>
 #include <seamcl/memory/bench_memory.h>
 #include <seamcl/batch/bench_merge.h>
+#include <seamcl/io/image_io.h>
 #include <seamcl/jobs/compare_job.h>
 #include <seamcl/memory/render_memory.h>
 #include <seamcl/pipeline/renderer.h>
@@ -307,8 +310,20 @@ void BenchJob::refuse_beyond_machine(const Scene& scene, const DeviceInfo& devic
   seamcl::refuse_beyond_machine(planned.device, planned.host, device, planned.what);
 }
 
-json BenchJob::run(ClRuntime& runtime, const Scene& scene, const JobControl& control) {
-  if (!is_sweep()) return run_orbit(runtime, scene, control);
+std::string frame_images_folder(int frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06d", frame);
+  return name;
+}
+
+void BenchJob::refuse_images(const std::string& field) const {
+  if (is_sweep()) throw InputError(field, "writes the orbit's error frames: a sweep has none (leave out sweep)");
+  if (!with_errors_) throw InputError(field, "writes the orbit's error frames: no_errors leaves none");
+}
+
+json BenchJob::run(ClRuntime& runtime, const Scene& scene, const JobControl& control, const std::string& images_dir) {
+  if (!images_dir.empty()) refuse_images("images");
+  if (!is_sweep()) return run_orbit(runtime, scene, control, images_dir);
   SweepSettings settings = sweep_settings();
   // The sweeps report once per point and take no stop hook: the point's report is where a stop is
   // asked for.
@@ -321,7 +336,8 @@ json BenchJob::run(ClRuntime& runtime, const Scene& scene, const JobControl& con
   return run_scaling_sweeps(runtime, sweep_axes_, settings);
 }
 
-json BenchJob::run_orbit(ClRuntime& runtime, const Scene& scene, const JobControl& control) {
+json BenchJob::run_orbit(ClRuntime& runtime, const Scene& scene, const JobControl& control,
+                         const std::string& images_dir) {
   const auto wall_start = std::chrono::steady_clock::now();
   ReferenceSettings reference = reference_;
   // Once, not per reference frame: hashing bakes every face.
@@ -437,6 +453,18 @@ json BenchJob::run_orbit(ClRuntime& runtime, const Scene& scene, const JobContro
                                         {"seam_mean", seam.pixels > 0 ? json(seam.mean) : json(nullptr)}});
       }
     }
+    if (frame_reference && !images_dir.empty()) {
+      const std::filesystem::path dir = std::filesystem::path(images_dir) / frame_images_folder(k);
+      std::filesystem::create_directories(dir);
+      write_image((dir / "reference.png").string(), frame_.width, frame_.height, frame_reference->pixels);
+      for (const auto& [rate, mask] : masks)
+        write_image((dir / ("seam_mask_msaa" + std::to_string(rate) + ".png")).string(), frame_.width, frame_.height,
+                    seam_mask_image(mask));
+      for (const Accum& a : acc) {
+        const std::string stem = a.entry.method_name + "_msaa" + std::to_string(a.entry.options.msaa);
+        write_image((dir / (stem + ".png")).string(), frame_.width, frame_.height, a.current.pixels);
+      }
+    }
     for (DifferenceAccum& d : diffs) {
       const std::vector<uint8_t>& mask = masks.at(d.msaa);
       d.pool.add(compare_images(acc[d.a].current.pixels, acc[d.b].current.pixels, &mask), mask);
@@ -476,6 +504,7 @@ json BenchJob::run_orbit(ClRuntime& runtime, const Scene& scene, const JobContro
               {"wall_s", wall_s},
               {"results", results},
               {"differences", differences}};
+  if (!images_dir.empty()) out["images"] = images_dir;
   if (with_errors_) {
     out["reference"] = {{"method", reference_method},
                         {"msaa", reference_msaa},

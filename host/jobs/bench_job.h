@@ -30,6 +30,9 @@ namespace seamcl {
 // sweep_repeats.
 const OptionTable& bench_option_table();
 
+// The folder of error frame k's images under a bench's images directory: frame_<k, 6 digits>.
+std::string frame_images_folder(int frame);
+
 class BenchJob {
  public:
   // Parses and checks everything a bench reads before any work; InputError naming the field, also
@@ -59,12 +62,21 @@ class BenchJob {
   // device, frames, shard, reference_frames, errors, error_frames, order, seam_mask, seam_radius,
   // seam_pixels_per_frame, options, wall_s, results, differences and, with errors, reference; for
   // sweeps run_scaling_sweeps' JSON. One progress line per frame (per sweep point); Cancelled
-  // between frames (points) when control.should_stop says so.
-  nlohmann::json run(ClRuntime& runtime, const Scene& scene, const JobControl& control);
+  // between frames (points) when control.should_stop says so. With `images_dir` (an existing
+  // directory; refuse_images says when it is allowed) every error frame k also writes, into
+  // images_dir/frame_images_folder(k), what compare --images writes for its frame: reference.png,
+  // seam_mask_msaa<N>.png per rate and <method>_msaa<N>.png per entry (for FLIP afterwards:
+  // examples/orbit_flip.py).
+  nlohmann::json run(ClRuntime& runtime, const Scene& scene, const JobControl& control,
+                     const std::string& images_dir = "");
+  // InputError naming `field` when this bench has no error frames to write images of (a sweep,
+  // no_errors).
+  void refuse_images(const std::string& field) const;
 
  private:
   SweepSettings sweep_settings() const;
-  nlohmann::json run_orbit(ClRuntime& runtime, const Scene& scene, const JobControl& control);
+  nlohmann::json run_orbit(ClRuntime& runtime, const Scene& scene, const JobControl& control,
+                           const std::string& images_dir);
   int error_frame_count() const;
 
   RenderOptions frame_;

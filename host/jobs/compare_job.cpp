@@ -239,15 +239,9 @@ std::vector<json> write_compare_images(const CompareRun& run, const RenderOption
     write_image((dir / ("reference_seamless_msaa" + std::to_string(msaa) + ".png")).string(), reference.width,
                 reference.height, reference.pixels);
   }
-  for (const auto& [msaa, mask] : run.targets.masks) {
-    std::vector<glm::vec4> mask_image(mask.size());
-    // Seams white, mesh boundary rims grey, the rest black.
-    for (size_t i = 0; i < mask.size(); ++i)
-      mask_image[i] = mask[i] == SEAMCL_MASK_SEAM       ? glm::vec4(1)
-                      : mask[i] == SEAMCL_MASK_BOUNDARY ? glm::vec4(0.2f, 0.2f, 0.2f, 1.0f)
-                                                        : glm::vec4(0, 0, 0, 1);
-    write_image((dir / ("seam_mask_msaa" + std::to_string(msaa) + ".png")).string(), frame.width, frame.height, mask_image);
-  }
+  for (const auto& [msaa, mask] : run.targets.masks)
+    write_image((dir / ("seam_mask_msaa" + std::to_string(msaa) + ".png")).string(), frame.width, frame.height,
+                seam_mask_image(mask));
   std::vector<json> paths;
   for (const EntryResult& measured : run.measured) {
     const RenderResult& result = measured.last;
