@@ -7,8 +7,11 @@
  * footprint's axes in level-0 texels, the levels and probe count the frame's filter reads, the
  * tap weight inside the own face (the method's address mode) and, where traverse reads them, the
  * weight of each edge neighbour's and diagonal face's taps (accumulate_across, as traverse sums
- * them). Reflective faces (cube-map lookups) report their colour only.
- * Host guarantees: the frame's setups, winners and scene buffers as shade_resolve read them;
+ * them). Reflective faces (cube-map lookups) report their colour only. A displaced render's
+ * fragments are lit as shade_resolve lights them: with the displaced surface's normals where
+ * displaced.tessellation > 0, else with the face normal.
+ * Host guarantees: the frame's setups, winners and scene buffers as shade_resolve read them (with
+ * displaced.tessellation > 0, the frame's tess_vertices and tess_normals);
  * window inside the image; records holds window_width * window_height * sample_count records,
  * pixel-major, row-major within the window; the global size at least the window's (the items past
  * it return at once).
@@ -71,8 +74,9 @@ __kernel void shade_inspect(__constant FrameParams* frame, __global const Triang
                             __global const uint* level_offsets, TEXEL_BUFFER texels,
                             __global const float* srgb_to_linear, __global const uint* sample_triangle,
                             __global const ReflectiveFace* reflective_faces, __global const float* cube_texels,
-                            int adjacency, int window_x, int window_y, int window_width, int window_height,
-                            __global InspectSample* records) {
+                            DisplacedShading displaced, __global const TessVertex* tess_vertices,
+                            __global const float4* tess_normals, int adjacency, int window_x, int window_y,
+                            int window_width, int window_height, __global InspectSample* records) {
   const int wx = (int)get_global_id(0);
   const int wy = (int)get_global_id(1);
   if (wx >= window_width || wy >= window_height) return;
@@ -83,6 +87,10 @@ __kernel void shade_inspect(__constant FrameParams* frame, __global const Triang
   __global const uint* ids = sample_triangle + ((size_t)y * (size_t)frame->width + (size_t)x) * (size_t)samples;
   __global InspectSample* out = records + ((size_t)wy * (size_t)window_width + (size_t)wx) * (size_t)samples;
   const SamplerParams sampler = frame->sampler;
+  DisplacedSource displaced_source;
+  displaced_source.params = displaced;
+  displaced_source.vertices = tess_vertices;
+  displaced_source.normals = tess_normals;
   for (int s = 0; s < samples; ++s) {
     InspectSample r;
     const uint slot = ids[s];
@@ -142,14 +150,8 @@ __kernel void shade_inspect(__constant FrameParams* frame, __global const Triang
       r.dudy = uv.dudy;
       r.dvdy = uv.dvdy;
       const PtexSource no_ptex = 0;
-      DisplacedSource face_normals; /* the inspector lights with the face normal */
-      face_normals.params.tessellation = 0;
-      face_normals.params.adaptive = 0;
-      face_normals.params.pad0 = face_normals.params.pad1 = 0;
-      face_normals.vertices = 0;
-      face_normals.normals = 0;
       const float3 c = shade_fragment(frame, t, faces, neighbors, level_offsets, texels, srgb_to_linear,
-                                      reflective_faces, cube_texels, &no_ptex, &face_normals, slot, px, py);
+                                      reflective_faces, cube_texels, &no_ptex, &displaced_source, slot, px, py);
       r.color[0] = c.x;
       r.color[1] = c.y;
       r.color[2] = c.z;

@@ -7,8 +7,10 @@
 #include <seamcl/assets/ptex_displacement.h>
 #include <seamcl/assets/scene_source.h>
 #include <seamcl/scene/scene_generators.h>
+#include "pipeline/stages/tessellate_launcher.h"
 #include "scene/displaced_scene.h"
 #include "scene/displacement_map.h"
+#include "test_support.h"
 
 namespace seamcl_tests {
 
@@ -71,6 +73,25 @@ Scene cube_obj() {
   Scene scene = load_scene_source(kPtexAssets + "cube.obj");
   attach_ptex_displacement(scene, kPtexAssets + "cube_text.ptx");
   return scene;
+}
+
+DisplacedShadingReference DeviceSurface::shading(DisplacementNormals normals) const {
+  DisplacedShadingReference out;
+  out.params.tessellation = normals == DisplacementNormals::Displaced ? packed.params.tessellation : 0;
+  out.params.adaptive = packed.adaptive() ? 1 : 0;
+  out.vertices = &vertices;
+  out.normals = &this->normals;
+  return out;
+}
+
+DeviceSurface device_surface(PackedDisplacement packed) {
+  TessellateLauncher stage(shared_runtime());
+  stage.load(std::move(packed));
+  DeviceSurface out;
+  out.normals = stage.tessellate_normals();
+  out.vertices = stage.read_vertices();
+  out.packed = stage.packed();
+  return out;
 }
 
 }  // namespace seamcl_tests

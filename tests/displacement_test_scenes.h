@@ -1,11 +1,15 @@
 // Closed displaced meshes that are not star-shaped, shared by the crack and adaptive
-// tessellation tests: a torus made here and the Ptex cube with tunnels.
+// tessellation tests: a torus made here and the Ptex cube with tunnels; and a displaced surface
+// as the device tessellates it, for the shading twins.
 #pragma once
 #include <string>
 #include <vector>
 
 #include <seamcl/options/displacement_method.h>
+#include <seamcl/options/render_options.h>
 #include <seamcl/scene/scene.h>
+#include "pipeline/displacement_packing.h"
+#include "pipeline/stages/shade_resolve_twin.h"
 
 namespace seamcl_tests {
 
@@ -25,5 +29,15 @@ seamcl::Scene make_torus(int rings, int sides);
 
 // tests/assets/ptex/cube.obj (72 quads with tunnels) displaced by cube_text.ptx.
 seamcl::Scene cube_obj();
+
+// The tessellation stage's vertices and normals of `packed`, read back from the device.
+struct DeviceSurface {
+  seamcl::PackedDisplacement packed;
+  std::vector<TessVertex> vertices;  // kernels/seamcl_types.h: a C struct outside the namespace
+  std::vector<cl_float4> normals;
+  // What the shading twins take for a render lit by `normals` (the face normal: none).
+  seamcl::DisplacedShadingReference shading(seamcl::DisplacementNormals normals) const;
+};
+DeviceSurface device_surface(seamcl::PackedDisplacement packed);
 
 }  // namespace seamcl_tests

@@ -30,6 +30,8 @@ namespace {
 
 using namespace seamcl;
 using seamcl_tests::cube_obj;
+using seamcl_tests::device_surface;
+using seamcl_tests::DeviceSurface;
 using seamcl_tests::make_torus;
 using seamcl_tests::shared_runtime;
 using seamcl_tests::kAllDisplacementMethods;
@@ -45,22 +47,6 @@ std::vector<std::array<int, 4>> mixed_factors(const Scene& scene, int t) {
       out[f][static_cast<size_t>(k)] = 1 + static_cast<int>((h >> 7) % static_cast<uint32_t>(t));
     }
   }
-  return out;
-}
-
-struct DeviceSurface {
-  PackedDisplacement packed;
-  std::vector<TessVertex> vertices;
-  std::vector<cl_float4> normals;
-};
-
-DeviceSurface device_surface(PackedDisplacement packed) {
-  TessellateLauncher stage(shared_runtime());
-  stage.load(std::move(packed));
-  DeviceSurface out;
-  out.normals = stage.tessellate_normals();
-  out.vertices = stage.read_vertices();
-  out.packed = stage.packed();
   return out;
 }
 
@@ -274,11 +260,7 @@ TEST(DisplacedNormals, ShadeKernelMatchesTwinWithDisplacedNormals) {
         const std::vector<uint32_t> winners = renderer.read_sample_triangles();
         const DeviceSurface s = device_surface(pack_displacement(scene, displacement_settings(scene, options, scene.camera)));
         EXPECT_EQ(s.packed.adaptive(), adaptive);
-        DisplacedShadingReference displaced;
-        displaced.params.tessellation = normals == DisplacementNormals::Displaced ? s.packed.params.tessellation : 0;
-        displaced.params.adaptive = s.packed.adaptive() ? 1 : 0;
-        displaced.vertices = &s.vertices;
-        displaced.normals = &s.normals;
+        const DisplacedShadingReference displaced = s.shading(normals);
         const ResolveReference twin = shade_resolve_reference(renderer.packed_scene(), frame, setups, winners, nullptr,
                                                               nullptr, &displaced);
         EXPECT_EQ(result.stats.fragments, twin.fragments);

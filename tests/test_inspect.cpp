@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <optional>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -17,8 +18,10 @@
 #include <seamcl/jobs/overlay_job.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
+#include "displacement_test_scenes.h"
 #include "pipeline/stages/shade_inspect_launcher.h"
 #include "pipeline/stages/shade_inspect_twin.h"
+#include "pipeline/tessellation_factors.h"
 #include "test_support.h"
 
 using namespace seamcl;
@@ -61,8 +64,14 @@ std::vector<Case> cases() {
     o.filter = filter;
     return o;
   };
+  // Displaced, lit by the displaced surface's normals as the render lights it.
+  RenderOptions displaced = options(96, 72, 4, ShadingMode::Pixel, Method::Discard, Filter::Aniso);
+  displaced.displacement = DisplacementMethod::Ownership;
+  displaced.tessellation = 4;
+  displaced.displacement_normals = DisplacementNormals::Displaced;
   return {
       {"paper traverse aniso 4x pixel", "paper", options(120, 135, 4, ShadingMode::Pixel, Method::Traverse, Filter::Aniso)},
+      {"displaced ownership T4 discard aniso 4x pixel", "displaced", displaced},
       {"quad2 traverse-edges trilinear 8x centroid", "quad2",
        options(67, 45, 8, ShadingMode::Centroid, Method::TraverseEdges, Filter::Trilinear)},
       {"cube discard ewa 2x sample", "cube", options(50, 50, 2, ShadingMode::Sample, Method::Discard, Filter::Ewa)},
@@ -102,9 +111,17 @@ TEST(KernelVsTwin, InspectRecordsEqualTheTwinsAndResolveToTheFrame) {
     const PixelWindow window = seam_window(frame, 8);
     const std::vector<InspectSample> gpu = renderer.inspect_last_frame(window.x, window.y, window.width, window.height);
     const FrameParams params = renderer.last_frame_params();
+    std::optional<seamcl_tests::DeviceSurface> surface;
+    DisplacedShadingReference lit;
+    if (c.options.displacement) {
+      surface = seamcl_tests::device_surface(
+          pack_displacement(scene, displacement_settings(scene, c.options, scene.camera)));
+      lit = surface->shading(c.options.displacement_normals);
+      ASSERT_GT(lit.params.tessellation, 0);
+    }
     const std::vector<InspectSample> twin =
         shade_inspect_reference(renderer.packed_scene(), params, renderer.read_setups(), renderer.read_sample_triangles(),
-                                window.x, window.y, window.width, window.height);
+                                window.x, window.y, window.width, window.height, nullptr, surface ? &lit : nullptr);
     ASSERT_EQ(gpu.size(), twin.size());
     ASSERT_EQ(gpu.size(), static_cast<size_t>(window.width * window.height * params.sample_count));
     for (size_t i = 0; i < gpu.size(); ++i) {

@@ -24,6 +24,12 @@ std::vector<InspectSample> ShadeInspectLauncher::inspect(const std::string& shad
   kernel.setArg(arg++, sample_triangle);
   kernel.setArg(arg++, scene.reflective_faces);
   kernel.setArg(arg++, scene.cube_texels);
+  kernel.setArg(arg++, scene.displaced);
+  for (const cl::Buffer* buffer : {&scene.tess_vertices, &scene.tess_normals}) {
+    if (scene.displaced.tessellation > 0) kernel.setArg(arg, *buffer);
+    else kernel.setArg(arg, sizeof(cl_mem), nullptr);  // face normals: never read
+    ++arg;
+  }
   kernel.setArg(arg++, static_cast<cl_int>(adjacency ? 1 : 0));
   kernel.setArg(arg++, static_cast<cl_int>(window.x));
   kernel.setArg(arg++, static_cast<cl_int>(window.y));

@@ -55,7 +55,8 @@ std::vector<InspectSample> shade_inspect_reference(const PackedScene& scene, con
                                                    const std::vector<TriangleSetup>& setups,
                                                    const std::vector<uint32_t>& sample_triangle, int window_x,
                                                    int window_y, int window_width, int window_height,
-                                                   const std::vector<float>* cube_texels) {
+                                                   const std::vector<float>* cube_texels,
+                                                   const DisplacedShadingReference* displaced) {
   const int samples = f.sample_count;
   const std::vector<SampleOffset>& pattern = sample_pattern(samples);
   constexpr float to_pixels = 1.0f / SEAMCL_SUBPIXEL_ONE;
@@ -105,7 +106,7 @@ std::vector<InspectSample> shade_inspect_reference(const PackedScene& scene, con
         r.dvdx = uv.dvdx;
         r.dudy = uv.dudy;
         r.dvdy = uv.dvdy;
-        const glm::vec3 c = shade_fragment_reference(scene, f, t, px, py, cube_texels);
+        const glm::vec3 c = shade_fragment_reference(scene, f, t, px, py, cube_texels, nullptr, displaced, slot);
         r.color[0] = c.x;
         r.color[1] = c.y;
         r.color[2] = c.z;
