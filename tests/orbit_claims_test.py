@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """examples/orbit_claims.py against seamcl itself: a small bench run whole and in two parts; the
 script's claims from the whole run and from the parts pooled must agree (means to 1e-12), the
-parts' frames must be named, and bad input is refused with exit 2.
+parts' frames must be named, and bad input is refused with exit 2. With the whole run's images
+(`bench --images`), examples/orbit_flip.py's FLIP goes beside the errors (`--flip`): every entry
+gets its FLIP means, the black control stands apart, and FLIP of other frames is refused.
 
     tests/orbit_claims_test.py --seamcl build/seamcl
 """
@@ -16,12 +18,18 @@ from script_checks import Checks
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPT = os.path.join(ROOT, "examples", "orbit_claims.py")
+ORBIT_FLIP = os.path.join(ROOT, "examples", "orbit_flip.py")
 BENCH = ["bench", "--scene", "quad2", "--size", "48x48", "--frames", "4", "--methods", "clamp,black,discard,traverse",
          "--msaa", "1,4", "--seam-mask", "footprint", "--json"]
 
 
-def claims(paths, out):
-    r = subprocess.run([sys.executable, SCRIPT, *paths, "-o", out], capture_output=True, text=True)
+def claims(paths, out, extra=()):
+    r = subprocess.run([sys.executable, SCRIPT, *paths, "-o", out, *extra], capture_output=True, text=True)
+    return r.returncode, r.stdout + r.stderr
+
+
+def orbit_flip(*arguments):
+    r = subprocess.run([sys.executable, ORBIT_FLIP, *arguments], capture_output=True, text=True)
     return r.returncode, r.stdout + r.stderr
 
 
@@ -34,7 +42,8 @@ def main():
     with tempfile.TemporaryDirectory() as d:
         env = dict(os.environ, SEAMCL_CACHE_DIR=os.path.join(d, "cache"))
         runs = {}
-        for name, extra in (("whole", []), ("part1", ["--shard", "1/2"]), ("part2", ["--shard", "2/2"])):
+        images = os.path.join(d, "images")
+        for name, extra in (("whole", ["--images", images]), ("part1", ["--shard", "1/2"]), ("part2", ["--shard", "2/2"])):
             r = subprocess.run([args.seamcl, *BENCH, *extra], capture_output=True, text=True, env=env)
             if r.returncode != 0:
                 print(r.stderr)
@@ -65,6 +74,38 @@ def main():
             check(all(v > 2 for v in black.values()), f"black stands apart from traverse: {black}")
             md = open(os.path.join(d, "parts", "claims.md")).read()
             check("frames 0..3 of the orbit" in md and "seam mask `footprint`" in md, "claims.md header")
+        # FLIP of the whole run's frames beside its errors.
+        flip = os.path.join(d, "flip.json")
+        code, out = orbit_flip("measure", images, "-o", flip, "--jobs", "2")
+        check(code == 0, f"orbit_flip measure: exit {code}: {out}")
+        code, out = claims([runs["whole"]], os.path.join(d, "flip"), ["--flip", flip])
+        check(code == 0 and "discard / traverse seam FLIP 1x" in out, f"claims --flip: exit {code}: {out}")
+        if code == 0:
+            with_flip = json.load(open(os.path.join(d, "flip", "claims.json")))
+            for e in with_flip["entries"]:
+                check(all(e.get(k) is not None and 0.0 <= e[k] <= 1.0 for k in ("flip_mean", "flip_seam_mean")),
+                      f"{e['method']} x{e['msaa']}: FLIP means in [0, 1]: {e.get('flip_mean')}, {e.get('flip_seam_mean')}")
+            by = {(e["method"], e["msaa"]): e for e in with_flip["entries"]}
+            # FLIP is bounded by 1 and saturates at black's seams, so it parts the controls less
+            # than the error does (which the check above holds to 2x).
+            check(by[("black", 1)]["flip_seam_mean"] > 1.5 * by[("traverse", 1)]["flip_seam_mean"],
+                  f"FLIP sets the black control apart: {by[('black', 1)]['flip_seam_mean']} against "
+                  f"{by[('traverse', 1)]['flip_seam_mean']}")
+            check(set(with_flip["analysis"]["flip_ratios"].get("traverse", {})) == {"1", "4"},
+                  f"discard / traverse FLIP ratios {with_flip['analysis']['flip_ratios']}")
+            md = open(os.path.join(d, "flip", "claims.md")).read()
+            check("| seam FLIP mean |" in md and "Discard / traverse seam FLIP per rate" in md, "claims.md FLIP table")
+            # FLIP of other frames than the bench's error frames is refused.
+            other_frames = json.load(open(flip))
+            other_frames["frames"] = [f + 1 for f in other_frames["frames"]]
+            bad_flip = os.path.join(d, "other_frames.json")
+            json.dump(other_frames, open(bad_flip, "w"))
+            code, out = claims([runs["whole"]], os.path.join(d, "x"), ["--flip", bad_flip])
+            check(code == 2 and "FLIP of frames" in out, f"FLIP of other frames: {code} {out}")
+        code, out = orbit_flip("pool", flip, flip, "-o", os.path.join(d, "twice.json"))
+        check(code == 2 and "is also in" in out, f"orbit_flip pool of one part twice: {code} {out}")
+        code, out = orbit_flip("measure", d, "-o", os.path.join(d, "none.json"))
+        check(code == 2 and "no frame_<k> folders" in out, f"orbit_flip measure without frames: {code} {out}")
         # Refusals: a part twice, parts of different batches, what is not a bench.
         code, out = claims([runs["part1"], runs["part1"]], os.path.join(d, "x"))
         check(code == 2 and "two parts cover the same frames" in out, f"part twice: {code} {out}")
