@@ -39,9 +39,16 @@ struct ServeArgs {
   long long assets_cache_mib = 512;
   long long request_memory_mib = 1024;
   long long memory_bound_mib = 0;  // 0: half the physical memory
+  bool print_openapi = false;
 };
 
 int run_serve(const ServeArgs& args, const GlobalOptions& global) {
+  if (args.print_openapi) {
+    // The document alone, before any device is opened: docs/http-api.md is generated from it.
+    std::fwrite(server::openapi_json().data(), 1, server::openapi_json().size(), stdout);
+    std::fputc('\n', stdout);
+    return 0;
+  }
   // An empty address would listen wherever the resolver puts "" (loopback here), not where meant.
   if (args.host.empty()) throw InputError("host", "must not be empty (leave out --host for 127.0.0.1)");
   const std::string cache_dir =
@@ -150,6 +157,8 @@ Command add_serve_command(CLI::App& app) {
                     "go first); a request that does not fit gets 503; 0: half the physical memory [0]");
   serve->add_option("--deadline", args->deadline_s,
                     "Seconds a request may wait for a render slot before it is answered 503; 0: no limit [60]");
+  serve->add_flag("--openapi", args->print_openapi,
+                  "Print the OpenAPI document the service answers at GET /openapi.json and exit (no device is opened)");
   return Command{serve, [args](const GlobalOptions& global) { return run_serve(*args, global); }};
 }
 
