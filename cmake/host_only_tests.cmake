@@ -81,6 +81,7 @@ set(SEAMCL_HOST_ONLY_TESTS
   Generators.*
   GuardBand.*
   ImageEncoding.*
+  Srgb8.*
   ImageIo.*
   JobsBench.BadInputNamesTheField
   JobsCube.BadInputNamesTheField

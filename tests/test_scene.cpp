@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -251,6 +252,32 @@ TEST(Scene, SurfacePatternIsBoundedColourfulAndDetailed) {
   EXPECT_GT(mean_chroma / kSegments, 0.15);
   // Smooth: bounded slope (a stripe of 0.15 units at full contrast would be ~6 per unit).
   EXPECT_LT(pattern_lipschitz_bound(), 40.0f);
+}
+
+TEST(Scene, SurfacePatternsEqualSurfacePatternAtEveryPoint) {
+  // The batched pattern (the bakes') against the one-point pattern (the analytic reference's):
+  // equal to the bit, for counts that fill its lanes and counts that leave some empty.
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> coordinate(-40.0f, 40.0f);
+  for (size_t count : {size_t{1}, size_t{7}, size_t{8}, size_t{9}, size_t{1000}}) {
+    std::vector<glm::vec3> points(count);
+    for (glm::vec3& p : points) p = {coordinate(random), coordinate(random), coordinate(random)};
+    std::vector<glm::vec4> colors(count, glm::vec4(-1.0f));
+    surface_patterns(points.data(), count, colors.data());
+    for (size_t i = 0; i < count; ++i) {
+      const glm::vec4 one = surface_pattern(points[i]);
+      for (int c = 0; c < 4; ++c)
+        ASSERT_EQ(std::bit_cast<uint32_t>(colors[i][c]), std::bit_cast<uint32_t>(one[c]))
+            << "point " << i << " of " << count << ", channel " << c << ": " << colors[i][c] << " vs " << one[c];
+    }
+  }
+  // A bake through the batch equals a bake a point at a time.
+  const std::array<glm::vec3, 4> corners = {glm::vec3(0.1f, 0.0f, 0.3f), glm::vec3(1.3f, 0.2f, 0.1f),
+                                            glm::vec3(1.1f, 1.4f, 0.0f), glm::vec3(-0.2f, 1.0f, 0.4f)};
+  const TextureLevel batched = bake_face_texture(corners, 37, 5, surface_patterns);
+  const TextureLevel single = bake_face_texture(corners, 37, 5, [](glm::vec3 p) { return surface_pattern(p); });
+  ASSERT_EQ(batched.texels.size(), single.texels.size());
+  for (size_t t = 0; t < batched.texels.size(); ++t) ASSERT_EQ(batched.texels[t], single.texels[t]) << "texel " << t;
 }
 
 TEST(Scene, OrbitCameraMath) {

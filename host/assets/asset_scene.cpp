@@ -66,11 +66,11 @@ Scene scene_from_mesh(ObjMesh mesh, int texture_size, const std::string& mesh_na
     }
     scene.texture_source = [corners = std::make_shared<const std::vector<std::array<glm::vec3, 4>>>(std::move(corners)),
                             texture_size](size_t f) {
-      return build_mip_chain(bake_face_texture(corners->at(f), texture_size, texture_size, surface_pattern));
+      return build_mip_chain(bake_face_texture(corners->at(f), texture_size, texture_size, surface_patterns));
     };
   } else {
     for (Face& face : scene.faces)
-      face.texture = build_mip_chain(bake_face_texture(scene.corners(face), texture_size, texture_size, surface_pattern));
+      face.texture = build_mip_chain(bake_face_texture(scene.corners(face), texture_size, texture_size, surface_patterns));
   }
   frame_camera(scene);
   validate_scene(scene);

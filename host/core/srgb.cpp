@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <vector>
+#include <limits>
 
 namespace seamcl {
 
@@ -21,55 +21,69 @@ const std::array<float, 256>& srgb_to_linear_table() {
 
 namespace {
 
-// Linear values at which the 8-bit sRGB code steps up: the decode of (k + 0.5) / 255. Encoding
-// by counting thresholds equals rounding the exact sRGB curve, without a pow per channel.
-const std::array<float, 255>& srgb8_thresholds() {
-  static const std::array<float, 255> table = [] {
-    std::array<float, 255> t{};
+// The 8-bit encode as two tables. thresholds[k] is the linear value at which the code steps up
+// from k (the decode of (k + 0.5) / 255), so encoding by counting thresholds equals rounding the
+// exact sRGB curve without a pow per channel; thresholds[255] is +inf, which no value passes.
+// start_codes holds the code of the smallest float of each top-16-bit pattern: no such bucket
+// holds more than one threshold in [0, 1), so one compare finishes the encode, without a branch.
+struct Srgb8Encoding {
+  std::array<float, 256> thresholds;
+  std::array<uint8_t, 65536> start_codes;
+};
+
+const Srgb8Encoding& srgb8_encoding() {
+  static const Srgb8Encoding encoding = [] {
+    Srgb8Encoding e{};
     for (int k = 0; k < 255; ++k) {
       const double c = (k + 0.5) / 255.0;
-      t[k] = static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+      e.thresholds[k] = static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
     }
-    return t;
-  }();
-  return table;
-}
-
-// The code of the smallest float sharing each top-16-bit pattern: a starting point from which
-// encode_srgb_channel steps up at most a few codes.
-const std::vector<uint8_t>& srgb8_start_codes() {
-  static const std::vector<uint8_t> table = [] {
-    const auto& t = srgb8_thresholds();
-    std::vector<uint8_t> codes(65536, 255);
+    e.thresholds[255] = std::numeric_limits<float>::infinity();
     for (uint32_t high = 0; high < 65536; ++high) {
       const float x = std::bit_cast<float>(high << 16);
+      uint8_t code = 255;
       if (!(x > 0.0f)) {
-        codes[high] = 0;
+        code = 0;
       } else if (x < 1.0f) {
-        codes[high] = static_cast<uint8_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin());
+        code = static_cast<uint8_t>(std::upper_bound(e.thresholds.begin(), e.thresholds.begin() + 255, x) -
+                                    e.thresholds.begin());
       }
+      e.start_codes[high] = code;
     }
-    return codes;
+    return e;
   }();
-  return table;
+  return encoding;
 }
 
-uint32_t encode_srgb_channel(float linear) {
+inline uint32_t encode_channel(const Srgb8Encoding& e, float linear) {
   if (!(linear > 0.0f)) return 0;  // also NaN
   if (linear >= 1.0f) return 255;
-  const auto& t = srgb8_thresholds();
-  uint32_t code = srgb8_start_codes()[std::bit_cast<uint32_t>(linear) >> 16];
-  while (code < 255 && linear >= t[code]) ++code;
-  return code;
+  const uint32_t code = e.start_codes[std::bit_cast<uint32_t>(linear) >> 16];
+  return code + (linear >= e.thresholds[code] ? 1u : 0u);
+}
+
+// Alpha is stored linearly: round(255 a), halves away from zero as std::lround does, without its
+// libm call (x - floor(x) is exact in double for x in [0, 255]).
+inline uint32_t encode_alpha(float alpha) {
+  const double x = std::isnan(alpha) ? 0.0 : std::clamp(static_cast<double>(alpha), 0.0, 1.0) * 255.0;
+  const auto whole = static_cast<uint32_t>(x);
+  return whole + (x - whole >= 0.5 ? 1u : 0u);
+}
+
+inline uint32_t encode_texel(const Srgb8Encoding& e, const glm::vec4& linear) {
+  return encode_channel(e, linear.r) | encode_channel(e, linear.g) << 8 | encode_channel(e, linear.b) << 16 |
+         encode_alpha(linear.a) << 24;
 }
 
 }  // namespace
 
 uint32_t encode_srgb8(const glm::vec4& linear) {
-  const double alpha_clamped = std::isnan(linear.a) ? 0.0 : std::clamp(static_cast<double>(linear.a), 0.0, 1.0);
-  const auto alpha = static_cast<uint32_t>(std::lround(alpha_clamped * 255.0));
-  return encode_srgb_channel(linear.r) | encode_srgb_channel(linear.g) << 8 | encode_srgb_channel(linear.b) << 16 |
-         alpha << 24;
+  return encode_texel(srgb8_encoding(), linear);
+}
+
+void encode_srgb8(const glm::vec4* linear, size_t count, uint32_t* packed) {
+  const Srgb8Encoding& e = srgb8_encoding();
+  for (size_t i = 0; i < count; ++i) packed[i] = encode_texel(e, linear[i]);
 }
 
 glm::vec4 decode_srgb8(uint32_t packed) {

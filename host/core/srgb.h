@@ -3,6 +3,7 @@
 // rounding.
 #pragma once
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -13,6 +14,8 @@ namespace seamcl {
 const std::array<float, 256>& srgb_to_linear_table();
 // Linear RGBA in [0,1] -> RGBA8 packed r | g << 8 | b << 16 | a << 24, RGB sRGB-encoded.
 uint32_t encode_srgb8(const glm::vec4& linear);
+// The same for `count` texels, into packed[0 .. count).
+void encode_srgb8(const glm::vec4* linear, size_t count, uint32_t* packed);
 glm::vec4 decode_srgb8(uint32_t packed);
 
 }  // namespace seamcl

@@ -29,6 +29,15 @@ void store_texel(PackedScene& out, size_t at, const glm::vec4& texel) {
   }
 }
 
+// store_texel for `count` texels in a row from `at`: the packed scene's bulk, encoded in one call.
+void store_texels(PackedScene& out, size_t at, const glm::vec4* texels, size_t count) {
+  if (out.format == TexelFormat::Rgba8) {
+    encode_srgb8(texels, count, &out.texels8[at]);
+  } else {
+    for (size_t i = 0; i < count; ++i) store_texel(out, at + i, texels[i]);
+  }
+}
+
 // Writes face f's levels (banded when guard_band > 0) at their offsets in `out`'s texels.
 void pack_face_texels(const Scene& scene, PackedScene& out, size_t f, size_t first_level) {
   // A deferred face's chain is made here and dropped on return: one face's floats at a time.
@@ -45,8 +54,7 @@ void pack_face_texels(const Scene& scene, PackedScene& out, size_t f, size_t fir
       throw std::logic_error("pack_scene: face " + std::to_string(f) + " level " + std::to_string(l) +
                              " holds other than its size's texels");
     }
-    size_t at = out.level_offsets[first_level + l];
-    for (const glm::vec4& texel : level.texels) store_texel(out, at++, texel);
+    store_texels(out, out.level_offsets[first_level + l], level.texels.data(), level.texels.size());
   }
 }
 

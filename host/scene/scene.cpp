@@ -214,37 +214,50 @@ glm::vec3 face_point(const std::array<glm::vec3, 4>& corners, float u, float v) 
 }
 
 TextureLevel bake_face_texture(const std::array<glm::vec3, 4>& corners, int width, int height,
-                               const std::function<glm::vec4(glm::vec3)>& surface_color) {
+                               const SurfaceColors& surface_colors) {
   TextureLevel level;
   level.width = width;
   level.height = height;
   level.texels.resize(static_cast<size_t>(width) * height);
+  std::vector<glm::vec3> row(static_cast<size_t>(width));
   for (int j = 0; j < height; ++j) {
     const float v = (static_cast<float>(j) + 0.5f) / static_cast<float>(height);
     for (int i = 0; i < width; ++i) {
       const float u = (static_cast<float>(i) + 0.5f) / static_cast<float>(width);
-      level.texels[static_cast<size_t>(j) * width + i] = surface_color(face_point(corners, u, v));
+      row[static_cast<size_t>(i)] = face_point(corners, u, v);
     }
+    surface_colors(row.data(), row.size(), &level.texels[static_cast<size_t>(j) * width]);
   }
   return level;
 }
 
-glm::vec4 surface_pattern(glm::vec3 p) {
-  // Each channel sums two waves with different directions and wavelengths (0.5 to 0.75 units,
-  // so features of 0.25 to 0.4), and the colour changes along every direction of every surface.
-  // Light round spots (about 0.15 units, where three wave families peak together) add small
-  // features in which a shifted or mismatched seam shows at once. Stripes would read as seams
-  // (dark lines are what black's edges look like), so there are none. Waves 0-2 and 3-5 are the
-  // channels' (r, g, b), 6-8 the spots'.
-  constexpr int kWaves = 9;
-  constexpr float kWaveX[kWaves] = {7.1f, -4.4f, 3.6f, -2.7f, 10.8f, 2.4f, 6.3f, -3.1f, 1.2f};
-  constexpr float kWaveY[kWaves] = {2.3f, 6.2f, -7.7f, 9.4f, -3.1f, 4.9f, 1.1f, 6.0f, -6.6f};
-  constexpr float kWaveZ[kWaves] = {-3.9f, 8.3f, 5.1f, 4.6f, 2.2f, -11.2f, 3.7f, -3.5f, 5.2f};
-  constexpr float kPhase[kWaves] = {0.3f, 2.9f, 4.1f, 1.7f, 0.8f, 5.3f, 0.0f, 1.3f, 2.2f};
-  float sine[kWaves];
-  for (int k = 0; k < kWaves; ++k)
-    sine[k] = smooth_sine(kWaveX[k] * p.x + kWaveY[k] * p.y + kWaveZ[k] * p.z + kPhase[k]);
+TextureLevel bake_face_texture(const std::array<glm::vec3, 4>& corners, int width, int height,
+                               const std::function<glm::vec4(glm::vec3)>& surface_color) {
+  return bake_face_texture(corners, width, height, [&](const glm::vec3* points, size_t count, glm::vec4* colors) {
+    for (size_t i = 0; i < count; ++i) colors[i] = surface_color(points[i]);
+  });
+}
 
+namespace {
+
+// surface_pattern's waves. Each channel sums two waves with different directions and wavelengths
+// (0.5 to 0.75 units, so features of 0.25 to 0.4), and the colour changes along every direction
+// of every surface. Light round spots (about 0.15 units, where three wave families peak together)
+// add small features in which a shifted or mismatched seam shows at once. Stripes would read as
+// seams (dark lines are what black's edges look like), so there are none. Waves 0-2 and 3-5 are
+// the channels' (r, g, b), 6-8 the spots'.
+constexpr int kWaves = 9;
+constexpr float kWaveX[kWaves] = {7.1f, -4.4f, 3.6f, -2.7f, 10.8f, 2.4f, 6.3f, -3.1f, 1.2f};
+constexpr float kWaveY[kWaves] = {2.3f, 6.2f, -7.7f, 9.4f, -3.1f, 4.9f, 1.1f, 6.0f, -6.6f};
+constexpr float kWaveZ[kWaves] = {-3.9f, 8.3f, 5.1f, 4.6f, 2.2f, -11.2f, 3.7f, -3.5f, 5.2f};
+constexpr float kPhase[kWaves] = {0.3f, 2.9f, 4.1f, 1.7f, 0.8f, 5.3f, 0.0f, 1.3f, 2.2f};
+
+inline float surface_wave(int k, float x, float y, float z) {
+  return smooth_sine(kWaveX[k] * x + kWaveY[k] * y + kWaveZ[k] * z + kPhase[k]);
+}
+
+// The colour of surface_pattern from its nine waves' values at the point.
+glm::vec4 surface_color_of_waves(const float (&sine)[kWaves]) {
   glm::vec3 color(0.5f + 0.22f * sine[0] + 0.16f * sine[3],
                   0.5f + 0.22f * sine[1] + 0.16f * sine[4],
                   0.5f + 0.22f * sine[2] + 0.16f * sine[5]);
@@ -257,6 +270,50 @@ glm::vec4 surface_pattern(glm::vec3 p) {
   }
   color = glm::mix(color, glm::vec3(0.95f, 0.93f, 0.85f), 0.8f * std::sqrt(spot));
   return glm::vec4(glm::clamp(color, glm::vec3(0.05f), glm::vec3(0.95f)), 1.0f);
+}
+
+}  // namespace
+
+glm::vec4 surface_pattern(glm::vec3 p) {
+  float sine[kWaves];
+  for (int k = 0; k < kWaves; ++k) sine[k] = surface_wave(k, p.x, p.y, p.z);
+  return surface_color_of_waves(sine);
+}
+
+void surface_patterns(const glm::vec3* points, size_t count, glm::vec4* colors) {
+  // The waves of 8 points at a time, each wave over the 8 as one loop that vectorises (the
+  // waves are most of the pattern's cost); the same operations in the same order as
+  // surface_pattern, so every colour equals its.
+  constexpr size_t kLanes = 8;
+  for (size_t first = 0; first < count; first += kLanes) {
+    const size_t lanes = std::min(kLanes, count - first);
+    float x[kLanes] = {}, y[kLanes] = {}, z[kLanes] = {};
+    for (size_t l = 0; l < lanes; ++l) {
+      x[l] = points[first + l].x;
+      y[l] = points[first + l].y;
+      z[l] = points[first + l].z;
+    }
+    float waves[kWaves][kLanes];
+    for (int k = 0; k < kWaves; ++k)
+      for (size_t l = 0; l < kLanes; ++l) waves[k][l] = surface_wave(k, x[l], y[l], z[l]);
+    // surface_color_of_waves lane by lane, glm's mix (x (1 - a) + y a) and clamp written out.
+    float rgb[3][kLanes];
+    constexpr float kSpotColor[3] = {0.95f, 0.93f, 0.85f};
+    for (size_t l = 0; l < kLanes; ++l) {
+      float spot = 1.0f;
+      for (int k = 6; k < 9; ++k) {
+        const float s = 0.5f + 0.5f * waves[k][l];
+        spot *= s * s;
+      }
+      const float a = 0.8f * std::sqrt(spot);
+      for (int c = 0; c < 3; ++c) {
+        const float base = 0.5f + 0.22f * waves[c][l] + 0.16f * waves[c + 3][l];
+        const float mixed = base * (1.0f - a) + kSpotColor[c] * a;
+        rgb[c][l] = std::min(std::max(mixed, 0.05f), 0.95f);
+      }
+    }
+    for (size_t l = 0; l < lanes; ++l) colors[first + l] = glm::vec4(rgb[0][l], rgb[1][l], rgb[2][l], 1.0f);
+  }
 }
 
 glm::vec4 detail_pattern(glm::vec3 p, float texel_spacing) {
@@ -389,13 +446,21 @@ void check_color(glm::vec3 c, const std::string& field) {
 }
 
 void check_texel_magnitudes(const MipChain& chain, const std::string& field) {
-  for (size_t k = 0; k < chain.levels.size(); ++k)
-    for (const glm::vec4& texel : chain.levels[k].texels)
+  for (size_t k = 0; k < chain.levels.size(); ++k) {
+    // One compare a channel, which NaN fails too, over the level's floats (a loop that vectorises:
+    // every baked texel passes here); only a level that fails is walked again for the message.
+    const std::vector<glm::vec4>& texels = chain.levels[k].texels;
+    const float* channels = reinterpret_cast<const float*>(texels.data());  // 4 floats a glm::vec4
+    int outside = 0;
+    for (size_t c = 0, n = 4 * texels.size(); c < n; ++c) outside |= !(std::fabs(channels[c]) <= kMaxColorMagnitude);
+    if (!outside) continue;
+    for (const glm::vec4& texel : texels)
       if (!is_finite(texel)) {
         throw InputError(field, "mip level " + std::to_string(k) + " has a non-finite texel");
       } else if (glm::any(glm::greaterThan(glm::abs(texel), glm::vec4(kMaxColorMagnitude)))) {
         throw InputError(field, "mip level " + std::to_string(k) + " has a texel of magnitude over 1e9");
       }
+  }
 }
 
 void validate_scene(const Scene& scene) {

@@ -61,8 +61,14 @@ struct Face {
 // so that texture content baked from a function of this point is continuous across shared edges.
 glm::vec3 face_point(const std::array<glm::vec3, 4>& corners, float u, float v);
 
+// Colours at surface points: colors[i] for points[i], i < count. A bake asks for a row of texels
+// at a time, so that a pattern can be evaluated over many points at once (surface_patterns).
+using SurfaceColors = std::function<void(const glm::vec3* points, size_t count, glm::vec4* colors)>;
+
 // Level 0 of a face texture of the given size, each texel the function at its centre's surface
 // point (face_point at ((i+.5)/w, (j+.5)/h)).
+TextureLevel bake_face_texture(const std::array<glm::vec3, 4>& corners, int width, int height,
+                               const SurfaceColors& surface_colors);
 TextureLevel bake_face_texture(const std::array<glm::vec3, 4>& corners, int width, int height,
                                const std::function<glm::vec4(glm::vec3)>& surface_color);
 
@@ -179,6 +185,9 @@ void set_constant_textures(Scene& scene, glm::vec4 color);
 // baked from it is continuous across every shared edge and any seam error shows. It holds no
 // lines (only waves of colour and round light spots), so nothing in it reads as a seam.
 glm::vec4 surface_pattern(glm::vec3 p);
+// surface_pattern at points[0 .. count) into colors, equal to it at every point and several times
+// faster over a row (the generators' bakes).
+void surface_patterns(const glm::vec3* points, size_t count, glm::vec4* colors);
 
 // Texel-scale detail: a colourful function of the 3D point whose features (half a wavelength)
 // are 2 to 4 times `texel_spacing` wide, in [0.05, 0.95], alpha 1. Continuous across every

@@ -47,39 +47,62 @@ std::function<glm::vec4(size_t, glm::vec3)> albedo_function(TextureContent conte
   };
 }
 
-// Face f's chain baked from `albedo` at its texel centres.
-MipChain bake_face_chain(const std::array<glm::vec3, 4>& corners, TextureSize size,
-                         const std::function<glm::vec4(size_t, glm::vec3)>& albedo, size_t f) {
-  return build_mip_chain(bake_face_texture(corners, size.width, size.height, [&](glm::vec3 p) { return albedo(f, p); }));
+// The albedo over a row of points at once (what the bakes ask for), equal at every point to
+// albedo_function's with the same arguments: the plain surface content, the generators' usual
+// one, through surface_patterns, anything else a point at a time.
+using FaceColors = std::function<void(size_t face, const glm::vec3* points, size_t count, glm::vec4* colors)>;
+
+FaceColors face_colors_function(TextureContent content, float texel_spacing, const GeneratorOptions& options) {
+  if (options.constant_color || content != TextureContent::Surface) {
+    return [albedo = albedo_function(content, texel_spacing, options)](size_t face, const glm::vec3* points,
+                                                                       size_t count, glm::vec4* colors) {
+      for (size_t i = 0; i < count; ++i) colors[i] = albedo(face, points[i]);
+    };
+  }
+  return [tint = options.tint](size_t face, const glm::vec3* points, size_t count, glm::vec4* colors) {
+    surface_patterns(points, count, colors);
+    if (!tint) return;
+    const glm::vec4 factor(face_tint(face), 1.0f);
+    for (size_t i = 0; i < count; ++i) colors[i] = colors[i] * factor;
+  };
 }
 
-// Texture contents for every face, in parallel, baked from scene.albedo: baking the paper
-// scene's ~9 million texels is most of its generation time, and faces are independent, so the
-// result does not depend on the number of threads or their timing. With defer, nothing is baked:
-// every face gets its sizes and scene.texture_source the same recipe (its own copy of the
-// corners and the albedo, so it stays right in any copy of the scene), baked when packed.
-void bake_textures(Scene& scene, const std::vector<TextureSize>& sizes, bool defer) {
+// Face f's chain baked from `colors` at its texel centres.
+MipChain bake_face_chain(const std::array<glm::vec3, 4>& corners, TextureSize size, const FaceColors& colors,
+                         size_t f) {
+  return build_mip_chain(bake_face_texture(corners, size.width, size.height,
+                                           [&](const glm::vec3* points, size_t count, glm::vec4* out) {
+                                             colors(f, points, count, out);
+                                           }));
+}
+
+// Texture contents for every face, in parallel, baked from `colors` (scene.albedo's): baking the
+// paper scene's ~9 million texels is most of its generation time, and faces are independent, so
+// the result does not depend on the number of threads or their timing. With defer, nothing is
+// baked: every face gets its sizes and scene.texture_source the same recipe (its own copy of the
+// corners and the colours, so it stays right in any copy of the scene), baked when packed.
+void bake_textures(Scene& scene, const std::vector<TextureSize>& sizes, const FaceColors& colors, bool defer) {
   if (defer) {
     struct Recipe {
       std::vector<std::array<glm::vec3, 4>> corners;
       std::vector<TextureSize> sizes;
-      std::function<glm::vec4(size_t, glm::vec3)> albedo;
+      FaceColors colors;
     };
     auto recipe = std::make_shared<Recipe>();
     for (const Face& face : scene.faces) recipe->corners.push_back(scene.corners(face));
     recipe->sizes = sizes;
-    recipe->albedo = scene.albedo;
+    recipe->colors = colors;
     for (size_t f = 0; f < scene.faces.size(); ++f)
       scene.faces[f].texture = deferred_mip_chain(sizes[f].width, sizes[f].height);
     scene.texture_source = [recipe = std::shared_ptr<const Recipe>(std::move(recipe))](size_t f) {
-      return bake_face_chain(recipe->corners.at(f), recipe->sizes.at(f), recipe->albedo, f);
+      return bake_face_chain(recipe->corners.at(f), recipe->sizes.at(f), recipe->colors, f);
     };
     scene.texture_source_bytes = 0;  // whatever made the faces before is dropped
     return;
   }
   // Faces are handed out one at a time because their sizes differ by up to 64x.
   for_each_face_in_parallel(scene.faces.size(), [&](size_t f) {
-    scene.faces[f].texture = bake_face_chain(scene.corners(scene.faces[f]), sizes[f], scene.albedo, f);
+    scene.faces[f].texture = bake_face_chain(scene.corners(scene.faces[f]), sizes[f], colors, f);
   });
 }
 
@@ -87,8 +110,10 @@ void bake_textures(Scene& scene, const std::vector<TextureSize>& sizes, bool def
 // generator's own content.
 void paint_textures(Scene& scene, const std::vector<TextureSize>& sizes, const GeneratorOptions& options,
                     TextureContent content = TextureContent::Surface) {
-  scene.albedo = albedo_function(options.content.value_or(content), median_spacing(scene, sizes), options);
-  bake_textures(scene, sizes, options.defer_textures);
+  const TextureContent painted = options.content.value_or(content);
+  const float spacing = median_spacing(scene, sizes);
+  scene.albedo = albedo_function(painted, spacing, options);
+  bake_textures(scene, sizes, face_colors_function(painted, spacing, options), options.defer_textures);
 }
 
 // A grid of nx x nz quads over [x0, x1] x [z0, z1] at height y, facing +y (counter-clockwise seen
