@@ -240,6 +240,15 @@ TextureLevel bake_face_texture(const std::array<glm::vec3, 4>& corners, int widt
 
 namespace {
 
+// On x86-64, surface_patterns is also compiled for AVX2 (8 lanes a vector instead of SSE2's 4) and
+// the CPU picks at load time. AVX2 brings no FMA, so both compute the same roundings: the
+// colours are the same on every CPU.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define SEAMCL_AVX2_CLONE __attribute__((target_clones("avx2", "default")))
+#else
+#define SEAMCL_AVX2_CLONE
+#endif
+
 // surface_pattern's waves. Each channel sums two waves with different directions and wavelengths
 // (0.5 to 0.75 units, so features of 0.25 to 0.4), and the colour changes along every direction
 // of every surface. Light round spots (about 0.15 units, where three wave families peak together)
@@ -280,7 +289,7 @@ glm::vec4 surface_pattern(glm::vec3 p) {
   return surface_color_of_waves(sine);
 }
 
-void surface_patterns(const glm::vec3* points, size_t count, glm::vec4* colors) {
+SEAMCL_AVX2_CLONE void surface_patterns(const glm::vec3* points, size_t count, glm::vec4* colors) {
   // The waves of 8 points at a time, each wave over the 8 as one loop that vectorises (the
   // waves are most of the pattern's cost); the same operations in the same order as
   // surface_pattern, so every colour equals its.
