@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """The `device` label splits the registered tests in two: `ctest -L device` and `ctest -LE device`
 list every test once between them, the GoogleTests that open no OpenCL device (the patterns of
-cmake/host_only_tests.cmake) are outside the label and every other GoogleTest inside it.
+cmake/host_only_tests.cmake) are outside the label and every other GoogleTest inside it. A
+host-only GoogleTest is a CTest of its own; a suite's device tests run together as the CTest
+`Suite.*` (cmake/write_gtest_ctests.cmake): every GoogleTest runs in exactly one CTest.
 
     tests/device_labels_test.py --ctest ctest --build build --source .
 
@@ -10,6 +12,7 @@ no OpenCL driver to be found (`OCL_ICD_VENDORS=/nonexistent`); docs/architecture
 """
 import argparse
 import fnmatch
+import json
 import os
 import re
 import subprocess
@@ -49,22 +52,46 @@ def main():
     if not device or not host:
         failures.append("%d tests labelled device, %d not: one side is empty" % (len(device), len(host)))
 
-    # A GoogleTest is named Suite.Test; the CTests added by hand are named that way too, so the
-    # GoogleTests are told apart by the patterns alone: each must match a test outside the label
-    # (a stale pattern would hide a renamed test's move to `device`) and none inside it.
+    # The GoogleTests each CTest runs: its command's --gtest_filter, a list of Suite.Test names.
+    shown = json.loads(subprocess.run([args.ctest, "--test-dir", args.build, "--show-only=json-v1"], check=True,
+                                      capture_output=True, text=True).stdout)
+    runs = {}
+    for test in shown["tests"]:
+        command = test.get("command", [])
+        # The two test binaries' CTests (the sanitized fuzz build runs a test of theirs once more).
+        if not command or os.path.basename(command[0]) not in ("seamcl_tests", "seamcl_oiio_tests"):
+            continue
+        filters = [a.split("=", 1)[1] for a in command if a.startswith("--gtest_filter=")]
+        if filters:
+            runs[test["name"]] = filters[0].split(":")
+    gtest_device = [g for name in device if name in runs for g in runs[name]]
+    gtest_host = [g for name in host if name in runs for g in runs[name]]
+    ran = gtest_device + gtest_host
+    if len(ran) != len(set(ran)):
+        failures.append("a GoogleTest runs in two CTests: %s" % sorted({g for g in ran if ran.count(g) > 1})[:5])
+    for name, gtests in runs.items():
+        if name in host and gtests != [name]:
+            failures.append("%s, outside the device label, runs other than itself: %s" % (name, gtests[:3]))
+        if name in device and (not name.endswith(".*") or any(g.split(".")[0] != name[:-2] for g in gtests)):
+            failures.append("%s, labelled device, runs tests of other suites or is not named Suite.*: %s" % (name, gtests[:3]))
+    if not gtest_device or not gtest_host:
+        failures.append("%d GoogleTests in device CTests, %d outside: one side is empty" % (len(gtest_device), len(gtest_host)))
+
+    # Each pattern must match a GoogleTest outside the label (a stale pattern would hide a renamed
+    # test's move to `device`) and none inside it.
     patterns = host_only_patterns(args.source)
     for pattern in patterns:
-        if not any(fnmatch.fnmatchcase(name, pattern) for name in host):
+        if not any(fnmatch.fnmatchcase(g, pattern) for g in gtest_host):
             failures.append("cmake/host_only_tests.cmake: %s matches no test outside the device label" % pattern)
-        inside = [name for name in device if fnmatch.fnmatchcase(name, pattern)]
+        inside = [g for g in gtest_device if fnmatch.fnmatchcase(g, pattern)]
         if inside:
             failures.append("%s matches tests labelled device: %s" % (pattern, inside[:5]))
     # Tests each side must hold whatever the list says: parsers outside, the runtime inside.
     for name in ("SceneJson.*", "OptionTable.BoundsAreEnforcedNamingTheKey", "Ptex.*", "RenderOptions.*"):
-        if not any(fnmatch.fnmatchcase(t, name) for t in host):
+        if not any(fnmatch.fnmatchcase(g, name) for g in gtest_host):
             failures.append("%s should be outside the device label" % name)
     for name in ("ClRuntime.PicksADeviceAndListsIt", "Server.*", "KernelVsTwin.*", "Hostile.*"):
-        if not any(fnmatch.fnmatchcase(t, name) for t in device) or any(fnmatch.fnmatchcase(t, name) for t in host):
+        if not any(fnmatch.fnmatchcase(g, name) for g in gtest_device) or any(fnmatch.fnmatchcase(g, name) for g in gtest_host):
             failures.append("%s should all be labelled device" % name)
 
     print("%d tests: %d labelled device, %d not" % (len(every), len(device), len(host)))
