@@ -64,6 +64,21 @@ def main():
         filters = [a.split("=", 1)[1] for a in command if a.startswith("--gtest_filter=")]
         if filters:
             runs[test["name"]] = filters[0].split(":")
+    # Every GoogleTest the binaries list (but the DISABLED_ reports) runs in some CTest.
+    binaries = {test["command"][0] for test in shown["tests"]
+                if test.get("command") and os.path.basename(test["command"][0]) in ("seamcl_tests", "seamcl_oiio_tests")}
+    listed_gtests = set()
+    for binary in binaries:
+        suite = ""
+        for line in subprocess.run([binary, "--gtest_list_tests"], check=True, capture_output=True, text=True).stdout.splitlines():
+            line = line.split("  #")[0]
+            if line.endswith(".") and not line.startswith(" "):
+                suite = line
+            elif line.startswith("  ") and "DISABLED_" not in suite + line:
+                listed_gtests.add(suite + line.strip())
+    registered = {g for gtests in runs.values() for g in gtests}
+    if listed_gtests - registered:
+        failures.append("GoogleTests no CTest runs: %s" % sorted(listed_gtests - registered)[:5])
     gtest_device = [g for name in device if name in runs for g in runs[name]]
     gtest_host = [g for name in host if name in runs for g in runs[name]]
     ran = gtest_device + gtest_host
