@@ -32,7 +32,7 @@ void store_texel(PackedScene& out, size_t at, const glm::vec4& texel) {
 // store_texel for `count` texels in a row from `at`: the packed scene's bulk, encoded in one call.
 void store_texels(PackedScene& out, size_t at, const glm::vec4* texels, size_t count) {
   if (out.format == TexelFormat::Rgba8) {
-    encode_srgb8(texels, count, &out.texels8[at]);
+    encode_srgb8(texels, count, out.texels8.data() + at);
   } else {
     for (size_t i = 0; i < count; ++i) store_texel(out, at + i, texels[i]);
   }
