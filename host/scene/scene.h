@@ -185,8 +185,8 @@ void set_constant_textures(Scene& scene, glm::vec4 color);
 // baked from it is continuous across every shared edge and any seam error shows. It holds no
 // lines (only waves of colour and round light spots), so nothing in it reads as a seam.
 glm::vec4 surface_pattern(glm::vec3 p);
-// surface_pattern at points[0 .. count) into colors, equal to it at every point and several times
-// faster over a row (the generators' bakes).
+// surface_pattern at points[0 .. count) into colors, equal to it at every point, over many points
+// at once (the generators' bakes: it evaluates 8 a time on vectors).
 void surface_patterns(const glm::vec3* points, size_t count, glm::vec4* colors);
 
 // Texel-scale detail: a colourful function of the 3D point whose features (half a wavelength)
