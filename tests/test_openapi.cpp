@@ -1,13 +1,15 @@
 // The OpenAPI document (server/openapi.json) checked against what the server really accepts: the
 // option tables and bounds of the shared parser (host/options/render_options), the compare limits
-// of ServerOptions, the built-in scenes, and the inline scene format of docs/scene-format.md. A
+// of ServerOptions, the built-in scenes, and the scene forms of the scene parser (host/scene). A
 // client generated from the document (or a fuzzer such as schemathesis) then sends what the
 // parser takes, and every value the document rules out is one the parser refuses.
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <fstream>
-#include <functional>
+#include <cmath>
+#include <iterator>
+#include <map>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -21,8 +23,10 @@
 #include <seamcl/eval/reference.h>
 #include <seamcl/io/image_encoding.h>
 #include <seamcl/options/render_options.h>
+#include <seamcl/scene/environment.h>
 #include <seamcl/scene/scene.h>
 #include <seamcl/scene/scene_generators.h>
+#include <seamcl/scene/scene_json.h>
 #include "http_server.h"
 
 using nlohmann::json;
@@ -35,9 +39,18 @@ const json& document() {
   return doc;
 }
 
+// A schema with its references followed. A field with its own description or default wraps its
+// type as allOf: [{$ref}] (OpenAPI 3.0 ignores a $ref's siblings): the type with those merged in.
 json resolve(const json& node) {
-  if (node.is_object() && node.contains("$ref"))
-    return resolve(document().at(json::json_pointer(node.at("$ref").get<std::string>().substr(1))));
+  if (!node.is_object()) return node;
+  if (node.contains("$ref")) return resolve(document().at(json::json_pointer(node.at("$ref").get<std::string>().substr(1))));
+  if (node.contains("allOf") && node.at("allOf").size() == 1) {
+    json merged = resolve(node.at("allOf")[0]);
+    for (const auto& [key, value] : node.items()) {
+      if (key != "allOf") merged[key] = value;
+    }
+    return merged;
+  }
   return node;
 }
 
@@ -222,49 +235,12 @@ TEST(OpenApi, CompareListPatternsAreTheListParsers) {
   }
 }
 
-// ---- The inline scene: the document's schema against docs/scene-format.md's field tables.
+// ---- The scene forms against the scene parser (parse_scene_json). docs/scene-format.md's field
+// tables are generated from these schemas (scripts/http-reference --tables, checked by
+// Docs.HttpReferenceMatchesOpenApi), so what holds here holds for the page too.
 
-// One row of a field table: its path (faces[i].texture.width), type text and whether required.
-struct DocumentedField {
-  std::string path;
-  std::string type;
-  bool required;
-};
-
-// The field tables of docs/scene-format.md: section 1 (the generator form) and section 2 (an
-// explicit scene). A cell may name several fields ("`camera.eye`, `camera.target`") or abbreviate
-// a sibling ("`faces[i].texture.width`, `.height`").
-std::vector<std::vector<DocumentedField>> documented_scene_forms() {
-  std::ifstream in(std::string(SEAMCL_EXAMPLES_DIR) + "/../docs/scene-format.md");
-  EXPECT_TRUE(in) << "docs/scene-format.md not found";
-  std::vector<std::vector<DocumentedField>> forms;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.starts_with("## 1.") || line.starts_with("## 2.")) forms.emplace_back();
-    if (line.starts_with("## Errors") || line.starts_with("### ")) {
-      if (!forms.empty() && forms.size() == 2) break;
-    }
-    if (forms.empty() || !line.starts_with("| `")) continue;
-    std::vector<std::string> cells;
-    std::stringstream row(line.substr(1));
-    for (std::string cell; std::getline(row, cell, '|');) cells.push_back(cell);
-    if (cells.size() < 3) continue;
-    const bool required = cells[2].find("yes") != std::string::npos;
-    std::string previous;
-    std::stringstream names(cells[0]);
-    for (std::string name; std::getline(names, name, ',');) {
-      const size_t open = name.find('`'), close = name.rfind('`');
-      name = name.substr(open + 1, close - open - 1);
-      if (name.starts_with(".")) name = previous.substr(0, previous.rfind('.')) + name;
-      forms.back().push_back({name, cells[1], required});
-      previous = name;
-    }
-  }
-  return forms;
-}
-
-// The schema of a documented path ("faces[i].texture.width") inside `form`, with the object that
-// holds it (for its required list); null when the schema has no such property.
+// The schema of a path ("faces[i].texture.width") inside `form`, with the object that holds it
+// (for its required list); null when the schema has no such property.
 std::pair<json, json> schema_at(const json& form, const std::string& path) {
   json node = resolve(form), parent;
   std::stringstream parts(path);
@@ -275,40 +251,11 @@ std::pair<json, json> schema_at(const json& form, const std::string& path) {
     parent = node;
     node = resolve(node.at("properties").at(part));
     if (element) {
-      parent = json::object();  // the items of an array are not required by name
+      if (!node.contains("items")) return {json(), json()};
       node = resolve(node.at("items"));
     }
   }
   return {node, parent};
-}
-
-void expect_documented_type(const json& node, const std::string& type, const std::string& path) {
-  const std::string t = node.value("type", "");
-  auto is_triple = [&](const char* item_type) {
-    return t == "array" && node.value("minItems", 0) == 3 && node.value("maxItems", 0) == 3 &&
-           resolve(node.at("items")).value("type", "") == item_type;
-  };
-  if (type.find("array of 4 integers") != std::string::npos) {
-    EXPECT_TRUE(t == "array" && node.value("minItems", 0) == 4 && node.value("maxItems", 0) == 4 &&
-                resolve(node.at("items")).value("type", "") == "integer")
-        << path << ": " << node.dump();
-  } else if (type.find("array") != std::string::npos) {
-    EXPECT_EQ(t, "array") << path;
-  } else if (type.find("[x, y, z]") != std::string::npos || type.find("[r, g, b]") != std::string::npos) {
-    EXPECT_TRUE(is_triple("number")) << path << ": " << node.dump();
-  } else if (type.find("\"detail\"") != std::string::npos) {
-    EXPECT_EQ(node.value("enum", json()), json(texture_content_names())) << path;
-  } else if (type.find("\"surface\"") != std::string::npos) {
-    EXPECT_EQ(node.value("enum", json()), json({"surface", "constant"})) << path;
-  } else {
-    for (const char* simple : {"string", "integer", "number", "boolean", "object"}) {
-      if (type.find(simple) != std::string::npos) {
-        EXPECT_EQ(t, simple) << path << ": " << node.dump();
-        return;
-      }
-    }
-    ADD_FAILURE() << path << ": undocumented type text " << type;
-  }
 }
 
 // The scene forms of the document: the branches of RenderRequest.scene that are objects.
@@ -324,10 +271,252 @@ std::vector<json> scene_object_forms(const json& scene) {
   return out;
 }
 
-TEST(OpenApi, SceneIsABuiltInNameOrAnInlineSceneOfTheDocumentedFormat) {
+// One field of a scene form at any depth ("faces[i].texture.width"), its schema (references
+// followed) and whether the object that holds it requires it.
+struct SchemaField {
+  std::string path;
+  json schema;
+  bool required;
+};
+
+void collect_fields(const json& object, const std::string& prefix, std::vector<SchemaField>& out) {
+  const json required = object.value("required", json::array());
+  const json properties = object.value("properties", json::object());
+  for (const auto& [key, child] : properties.items()) {
+    const json node = resolve(child);
+    out.push_back({prefix + key, node, std::find(required.begin(), required.end(), key) != required.end()});
+    if (node.value("type", "") == "object") collect_fields(node, prefix + key + ".", out);
+    if (node.value("type", "") == "array" && resolve(node.value("items", json::object())).value("type", "") == "object")
+      collect_fields(resolve(node.at("items")), prefix + key + "[i].", out);
+  }
+}
+
+std::vector<SchemaField> schema_fields(const json& form) {
+  std::vector<SchemaField> out;
+  collect_fields(resolve(form), "", out);
+  return out;
+}
+
+// Where a schema path is in a document: its JSON pointer and the name the parser's errors give it
+// ("faces[1].roughness"), at the first array element that holds the rest of the path.
+struct Location {
+  json::json_pointer pointer;
+  std::string field;
+};
+
+std::optional<Location> locate(const json& node, const std::vector<std::string>& parts, size_t k, const Location& at) {
+  if (k == parts.size()) return at;
+  std::string part = parts[k];
+  const bool element = part.ends_with("[i]");
+  if (element) part.resize(part.size() - 3);
+  if (!node.is_object() || !node.contains(part)) return std::nullopt;
+  const Location here{at.pointer / part, at.field.empty() ? part : at.field + "." + part};
+  if (!element) return locate(node.at(part), parts, k + 1, here);
+  for (size_t i = 0; i < node.at(part).size(); ++i) {
+    const Location item{here.pointer / i, here.field + "[" + std::to_string(i) + "]"};
+    if (std::optional<Location> found = locate(node.at(part).at(i), parts, k + 1, item)) return found;
+  }
+  return std::nullopt;
+}
+
+std::optional<Location> locate(const json& doc, const std::string& path) {
+  std::vector<std::string> parts;
+  std::stringstream in(path);
+  for (std::string part; std::getline(in, part, '.');) parts.push_back(part);
+  return locate(doc, parts, 0, Location{json::json_pointer(), ""});
+}
+
+// The parser's refusal of a scene document; nullopt when it takes it. Textures stay deferred, so
+// nothing is baked.
+std::optional<InputError> refusal(const json& doc) {
+  GeneratorOptions options;
+  options.defer_textures = true;
+  try {
+    parse_scene_json(doc, {}, options);
+    return std::nullopt;
+  } catch (const InputError& error) {
+    return error;
+  }
+}
+
+// What a parsed scene holds, for telling whether a field written as its default changes it.
+json scene_state(const json& doc) {
+  GeneratorOptions options;
+  options.defer_textures = true;
+  const Scene s = parse_scene_json(doc, {}, options);
+  auto v = [](glm::vec3 x) { return json{x.x, x.y, x.z}; };
+  json faces = json::array();
+  for (const Face& face : s.faces) faces.push_back({face.roughness, face.texture.width(), face.texture.height()});
+  json normals = json::array();
+  for (const glm::vec3& n : s.normals) normals.push_back(v(n));
+  json state = {{"name", s.name},
+                {"texels, light and background", scene_content_hash(s)},
+                {"faces", faces},
+                {"normals", normals},
+                {"camera", {v(s.camera.eye), v(s.camera.target), v(s.camera.up), s.camera.fov_y_degrees}}};
+  if (s.orbit) state["orbit"] = {v(s.orbit->center), s.orbit->radius, s.orbit->height, s.orbit->start_degrees};
+  if (s.environment) {
+    const Environment& e = *s.environment;
+    const AnalyticEnvironment& a = e.analytic;
+    state["environment"] = {e.cube_size,    e.bake_samples,  e.skybox,    e.constant ? v(*e.constant) : json(),
+                            v(a.sun_direction), a.sun_radius, v(a.sun_color), v(a.zenith), v(a.horizon), v(a.ground)};
+  }
+  return state;
+}
+
+// Documents that between them hold every field of a form, each field once at least.
+const json kEveryExplicitField = json::parse(R"({
+  "name": "every_field",
+  "positions": [[-1, -0.5, 0], [0, -0.5, 0], [1, -0.5, 0], [-1, 0.5, 0], [0, 0.5, 0], [1, 0.5, 0]],
+  "normals": [[0, 0, 1], [0, 0, 1], [0, 0, 1], [0, 0, 1], [0, 0, 1], [0, 0, 1]],
+  "faces": [
+    {"vertices": [0, 1, 4, 3], "texture": {"width": 8, "height": 4, "content": "surface", "color": [0.8, 0.7, 0.6]}},
+    {"vertices": [1, 2, 5, 4], "roughness": 0.5, "texture": {"width": 4, "height": 4, "content": "constant", "color": [0.2, 0.3, 0.4]}}
+  ],
+  "camera": {"eye": [0, 0, 2.7], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_degrees": 40},
+  "orbit": {"center": [0, 0, 0], "radius": 2.7, "height": 0.5, "start_degrees": 10},
+  "light": {"to_light": [0.3, 0.5, 1], "color": [1, 0.9, 0.8], "ambient": 0.3},
+  "background": [0.1, 0.1, 0.1],
+  "environment": {"cube_size": 8, "bake_samples": 1, "skybox": false, "constant": [0.5, 0.5, 0.5],
+                  "sun_direction": [0, 1, 0], "sun_radius": 0.2, "sun_color": [1, 1, 1], "zenith": [0, 0, 1],
+                  "horizon": [1, 1, 1], "ground": [0.2, 0.2, 0.2]}
+})");
+const json kEveryGeneratorField[] = {
+    json::parse(R"({"generator": "quad2", "options": {"tint": false}})"),
+    json::parse(R"({"generator": "paper", "options": {"tint": true, "constant_color": [0.5, 0.6, 0.7],
+                    "content": "detail", "faces": 400, "texture_scale_log2": -1}})"),
+    json::parse(R"({"generator": "envmap", "options": {"roughness": [0, 0.5, 1], "environment": {"cube_size": 8,
+                    "bake_samples": 1, "skybox": false, "constant": [0.5, 0.5, 0.5], "sun_direction": [0, 1, 0],
+                    "sun_radius": 0.2, "sun_color": [1, 1, 1], "zenith": [0, 0, 1], "horizon": [1, 1, 1],
+                    "ground": [0.2, 0.2, 0.2]}}})")};
+
+// Fields the schema cannot mark required because another field decides (OpenAPI 3.0 has no
+// if/then), each refused when removed from kEveryExplicitField (face 0 is diffuse, face 1
+// reflective), naming the field or the one that needs it.
+const std::map<std::string, std::string> kRequiredByAnother = {
+    {"environment", "faces[1].roughness"}, {"normals", "normals"}, {"faces[i].texture", "faces[0].texture"}};
+
+std::string refusal_text(const std::optional<InputError>& error) { return error ? error->what() : "taken"; }
+
+// The fields a scene file may use and an inline scene may not (it names no files), so the
+// document leaves them out: docs/scene-format.md describes them by hand.
+const std::map<std::string, std::set<std::string>> kFileOnlyFields = {
+    {"environment", {"file", "layout", "faces"}},
+    {"options.environment", {"file", "layout", "faces"}},
+    {"faces[i].texture", {"image"}}};
+
+// An object of the document at `at` (schema path `path`) with a field its schema lacks is refused
+// naming that field, and the fields the refusal lists as known are the schema's and the file-only ones.
+void expect_only_the_schemas_fields(const json& doc, const Location& at, const json& object, const std::string& path) {
+  json extra = doc;
+  extra[at.pointer / "no_such_field"] = 1;
+  const std::optional<InputError> error = refusal(extra);
+  const std::string field = at.field.empty() ? "no_such_field" : at.field + ".no_such_field";
+  ASSERT_TRUE(error && error->field() == field) << field << ": " << refusal_text(error);
+  const std::string text = error->what();
+  const size_t open = text.find("(known: "), close = text.rfind(')');
+  ASSERT_TRUE(open != std::string::npos && close > open) << text;
+  std::set<std::string> known;
+  std::stringstream names(text.substr(open + 8, close - open - 8));
+  for (std::string name; std::getline(names, name, ',');) known.insert(name.substr(name.find_first_not_of(' ')));
+  std::set<std::string> documented;
+  const json properties = object.value("properties", json::object());
+  for (const auto& [key, unused] : properties.items()) documented.insert(key);
+  if (const auto file_only = kFileOnlyFields.find(path); file_only != kFileOnlyFields.end())
+    documented.insert(file_only->second.begin(), file_only->second.end());
+  EXPECT_EQ(known, documented) << (path.empty() ? "the scene" : path) << ": the parser's fields, then the document's";
+}
+
+// Every field of `form`, in the documents that hold it: the documents are taken; a field of the
+// wrong type, or outside the schema's bounds or enum, is refused naming it; a field removed is
+// refused naming it when the schema requires it, and taken otherwise; a field set to the schema's
+// default leaves the scene as without it; and every object refuses a field the schema lacks.
+void expect_parser_takes_the_schema(const json& form, const std::vector<json>& documents) {
+  for (const json& doc : documents) EXPECT_EQ(refusal_text(refusal(doc)), "taken") << doc.dump();
+  const auto refuses_naming = [](const json& doc, const std::string& field) {
+    const std::optional<InputError> error = refusal(doc);
+    return error && error->field() == field;
+  };
+  for (const SchemaField& field : schema_fields(form)) {
+    const json* doc = nullptr;
+    std::optional<Location> at;
+    for (const json& candidate : documents) {
+      if (!doc && (at = locate(candidate, field.path))) doc = &candidate;
+    }
+    if (!doc) {
+      ADD_FAILURE() << field.path << ": no test document holds it";
+      continue;
+    }
+    const json& schema = field.schema;
+    const std::string type = schema.value("type", "");
+    // Removed.
+    json removed = *doc;
+    removed.at(at->pointer.parent_pointer()).erase(at->pointer.back());
+    const auto required_by = kRequiredByAnother.find(field.path);
+    if (field.required || required_by != kRequiredByAnother.end()) {
+      const std::string named = field.required ? at->field : required_by->second;
+      EXPECT_TRUE(refuses_naming(removed, named)) << at->field << " removed: " << refusal_text(refusal(removed));
+    } else {
+      EXPECT_EQ(refusal_text(refusal(removed)), "taken") << at->field << " removed";
+    }
+    // The wrong type.
+    json wrong = *doc;
+    wrong[at->pointer] = type == "string" ? json(7) : json("text");
+    EXPECT_TRUE(refuses_naming(wrong, at->field)) << at->field << " as " << wrong[at->pointer].dump() << ": "
+                                                  << refusal_text(refusal(wrong));
+    // Its default, written out.
+    if (schema.contains("default")) {
+      json written = *doc;
+      written[at->pointer] = schema.at("default");
+      const json difference = json::diff(scene_state(removed), scene_state(written));
+      EXPECT_TRUE(difference.empty()) << at->field << " = " << schema.at("default").dump() << " changes the scene at "
+                                      << difference.front().value("path", "") << " (absent, then written)";
+    }
+    // Its bounds and enum: for a scalar, and for an array's numbers (as the array's first element).
+    const bool array = type == "array";
+    const json bounded = array ? resolve(schema.value("items", json::object())) : schema;
+    const std::string bounded_field = array ? at->field + "[0]" : at->field;
+    const json::json_pointer bounded_pointer = array ? at->pointer / 0 : at->pointer;
+    const bool integer = bounded.value("type", "") == "integer";
+    for (const char* side : {"minimum", "maximum"}) {
+      if (!bounded.contains(side) || !bounded.at(side).is_number()) continue;
+      const double bound = bounded.at(side).get<double>();
+      if (std::abs(bound) >= 1e38) continue;  // a float's range: the finite checks
+      const bool low = std::string(side) == "minimum";
+      const bool exclusive = bounded.value(low ? "exclusiveMinimum" : "exclusiveMaximum", false);
+      const double step = integer ? 1.0 : 1e-3 * std::max(1.0, std::abs(bound));
+      json at_bound = *doc, beyond = *doc;
+      at_bound[bounded_pointer] = integer ? json(static_cast<long long>(bound)) : json(bound);
+      beyond[bounded_pointer] = integer ? json(static_cast<long long>(low ? bound - step : bound + step))
+                                        : json(exclusive ? bound : low ? bound - step : bound + step);
+      if (!exclusive && !bounded.contains("enum")) {
+        EXPECT_EQ(refusal_text(refusal(at_bound)), "taken") << bounded_field << " = " << at_bound[bounded_pointer];
+      }
+      EXPECT_TRUE(refuses_naming(beyond, bounded_field))
+          << bounded_field << " = " << beyond[bounded_pointer] << ": " << refusal_text(refusal(beyond));
+    }
+    if (bounded.contains("enum")) {
+      for (const json& value : bounded.at("enum")) {
+        json member = *doc;
+        member[bounded_pointer] = value;
+        EXPECT_EQ(refusal_text(refusal(member)), "taken") << bounded_field << " = " << value;
+      }
+      json outsider = *doc;
+      outsider[bounded_pointer] = integer ? json(bounded.at("enum").back().get<long long>() - 1) : json("no-such-value");
+      EXPECT_TRUE(refuses_naming(outsider, bounded_field))
+          << bounded_field << " = " << outsider[bounded_pointer] << ": " << refusal_text(refusal(outsider));
+    }
+    // A field the schema lacks, in an object: refused, and the fields the refusal lists as known
+    // are the schema's (and those only scene files may use).
+    if (type == "object") expect_only_the_schemas_fields(*doc, *at, schema, field.path);
+  }
+  expect_only_the_schemas_fields(documents.front(), Location{json::json_pointer(), ""}, resolve(form), "");
+}
+
+// A scene is a built-in name (in the GET query and in both bodies) or one of two object forms.
+TEST(OpenApi, SceneIsABuiltInNameOrOneOfTwoObjectForms) {
   std::vector<std::string> built_in;
   for (const GeneratorInfo& g : scene_generators()) built_in.push_back(g.name);
-  // A name: the built-in scenes, in the GET query and in both bodies.
   EXPECT_EQ(query_parameter("scene").value("enum", json()), json(built_in));
   for (const char* request : {"RenderRequest", "CompareRequest"}) {
     const json scene = resolve(schema(request).at("properties").at("scene"));
@@ -341,49 +530,28 @@ TEST(OpenApi, SceneIsABuiltInNameOrAnInlineSceneOfTheDocumentedFormat) {
     }
     EXPECT_TRUE(name_form) << request << ".scene has no string form";
     const std::vector<json> forms = scene_object_forms(scene);
-    const std::vector<std::vector<DocumentedField>> documented = documented_scene_forms();
     ASSERT_EQ(forms.size(), 2u) << request << ": the generator form and the explicit form";
-    ASSERT_EQ(documented.size(), 2u);
-    for (size_t f = 0; f < 2; ++f) {
-      // Which schema form is this documented form: the one that has its first field.
-      const json* form = nullptr;
-      for (const json& candidate : forms) {
-        if (schema_at(candidate, documented[f][0].path).first.is_object()) form = &candidate;
-      }
-      ASSERT_NE(form, nullptr) << request << ": no form with " << documented[f][0].path;
-      std::set<std::string> documented_paths;
-      for (const DocumentedField& field : documented[f]) {
-        documented_paths.insert(field.path);
-        const auto [node, parent] = schema_at(*form, field.path);
-        ASSERT_TRUE(node.is_object()) << request << ": " << field.path << " is not in the schema";
-        expect_documented_type(node, field.type, field.path);
-        const json required = parent.value("required", json::array());
-        const std::string leaf = field.path.substr(field.path.rfind('.') + 1);
-        const bool in_required = std::find(required.begin(), required.end(), leaf) != required.end();
-        if (!parent.empty()) EXPECT_EQ(in_required, field.required) << request << ": " << field.path << " required";
-      }
-      // No more fields than the format has, at every level (unknown fields are errors).
-      std::function<void(const json&, const std::string&)> walk = [&](const json& node, const std::string& prefix) {
-        if (node.value("type", "") == "array" && node.contains("items")) {
-          walk(resolve(node.at("items")), prefix + "[i]");
-          return;
-        }
-        if (node.value("type", "") != "object") return;
-        EXPECT_EQ(node.value("additionalProperties", json(true)), json(false)) << request << ": " << prefix;
-        const json properties = node.value("properties", json::object());
-        for (const auto& [key, child] : properties.items()) {
-          const std::string path = prefix.empty() ? key : prefix + "." + key;
-          const json resolved = resolve(child);
-          const bool documented_here = documented_paths.contains(path);
-          bool documented_below = false;
-          for (const std::string& p : documented_paths) documented_below |= p.starts_with(path + ".") || p.starts_with(path + "[i].");
-          EXPECT_TRUE(documented_here || documented_below) << request << ": " << path << " is not in docs/scene-format.md";
-          walk(resolved, path);
-        }
-      };
-      walk(*form, "");
-    }
+    EXPECT_NE(forms[0], forms[1]);
+    for (const json& form : forms) EXPECT_TRUE(form == schema("GeneratorScene") || form == schema("InlineScene"));
   }
+}
+
+TEST(OpenApi, InlineSceneIsWhatTheSceneParserTakes) {
+  expect_parser_takes_the_schema(schema("InlineScene"), {kEveryExplicitField});
+  // The conditionally required fields are optional where their condition does not hold.
+  json reflective_without_texture = kEveryExplicitField;
+  reflective_without_texture["faces"][1].erase("texture");
+  EXPECT_EQ(refusal_text(refusal(reflective_without_texture)), "taken");
+  json all_diffuse = kEveryExplicitField;
+  all_diffuse["faces"][1].erase("roughness");
+  all_diffuse.erase("environment");
+  all_diffuse.erase("normals");
+  EXPECT_EQ(refusal_text(refusal(all_diffuse)), "taken");
+}
+
+TEST(OpenApi, GeneratorSceneIsWhatTheSceneParserTakes) {
+  expect_parser_takes_the_schema(schema("GeneratorScene"),
+                                 std::vector<json>(std::begin(kEveryGeneratorField), std::end(kEveryGeneratorField)));
 }
 
 TEST(OpenApi, SceneFormConstraintsMatchTheFormat) {

@@ -53,7 +53,7 @@ using namespace seamcl;
 
 namespace {
 
-// ---- A validator for the JSON-Schema subset the OpenAPI document uses: $ref (local), type,
+// ---- A validator for the JSON-Schema subset the OpenAPI document uses: $ref (local), allOf, type,
 // properties, required, additionalProperties: false, enum, items, minimum, maximum, nullable.
 void validate(const json& value, const json& schema, const json& root, const std::string& path,
               std::vector<std::string>& errors) {
@@ -66,6 +66,7 @@ void validate(const json& value, const json& schema, const json& root, const std
     validate(value, root.at(json::json_pointer(ref.substr(1))), root, path, errors);
     return;
   }
+  for (const json& part : schema.value("allOf", json::array())) validate(value, part, root, path, errors);
   if (value.is_null() && schema.value("nullable", false)) return;
   if (schema.contains("type")) {
     const std::string type = schema.at("type");
@@ -124,8 +125,18 @@ const json& openapi() {
   return doc;
 }
 
+// A schema with its references followed. A field with its own description or default wraps its
+// type as allOf: [{$ref}] (OpenAPI 3.0 ignores a $ref's siblings): the type with those merged in.
 json resolve(const json& node) {
+  if (!node.is_object()) return node;
   if (node.contains("$ref")) return resolve(openapi().at(json::json_pointer(node.at("$ref").get<std::string>().substr(1))));
+  if (node.contains("allOf") && node.at("allOf").size() == 1) {
+    json merged = resolve(node.at("allOf")[0]);
+    for (const auto& [key, value] : node.items()) {
+      if (key != "allOf") merged[key] = value;
+    }
+    return merged;
+  }
   return node;
 }
 

@@ -187,7 +187,8 @@ Environment read_environment(const json& value, const std::string& path) {
   if (const json* v = fields.optional("skybox")) e.skybox = read_bool(*v, fields.path_of("skybox"));
   if (const json* v = fields.optional("constant")) e.constant = read_color(*v, fields.path_of("constant"));
   AnalyticEnvironment& a = e.analytic;
-  if (const json* v = fields.optional("sun_direction")) a.sun_direction = read_vec3(*v, fields.path_of("sun_direction"));
+  const json* sun_direction = fields.optional("sun_direction");
+  if (sun_direction) a.sun_direction = read_vec3(*sun_direction, fields.path_of("sun_direction"));
   if (const json* v = fields.optional("sun_radius")) a.sun_radius = read_float(*v, fields.path_of("sun_radius"));
   if (const json* v = fields.optional("sun_color")) a.sun_color = read_color(*v, fields.path_of("sun_color"));
   if (const json* v = fields.optional("zenith")) a.zenith = read_color(*v, fields.path_of("zenith"));
@@ -201,7 +202,8 @@ Environment read_environment(const json& value, const std::string& path) {
     const std::string sub = error.field().substr(std::min(error.field().size(), prefix.size()));
     throw InputError(path + sub, std::string(error.what()).substr(error.field().size() + 2));
   }
-  a.sun_direction = glm::normalize(a.sun_direction);
+  // Only a given direction: the default is unit already, and normalising it again can move its last bit.
+  if (sun_direction) a.sun_direction = glm::normalize(a.sun_direction);
   return e;
 }
 
@@ -483,7 +485,8 @@ using SceneSource = std::variant<GeneratorRequest, Scene>;
 
 SceneSource read_document(const json& doc, const std::string& default_name, const FaceImageLoader& load_image,
                           bool defer) {
-  if (doc.is_object() && doc.contains("generator")) return read_generator_request(doc);
+  // "options" without "generator" is the generator form missing its name, not an explicit scene.
+  if (doc.is_object() && (doc.contains("generator") || doc.contains("options"))) return read_generator_request(doc);
   return read_explicit_scene(doc, default_name, load_image, defer);
 }
 
