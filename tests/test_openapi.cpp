@@ -28,31 +28,16 @@
 #include <seamcl/scene/scene_generators.h>
 #include <seamcl/scene/scene_json.h>
 #include "http_server.h"
+#include "openapi_document.h"
 
 using nlohmann::json;
 using namespace seamcl;
 
 namespace {
 
-const json& document() {
-  static const json doc = json::parse(server::openapi_json());
-  return doc;
-}
+const json& document() { return seamcl_tests::openapi_document(); }
 
-// A schema with its references followed. A field with its own description or default wraps its
-// type as allOf: [{$ref}] (OpenAPI 3.0 ignores a $ref's siblings): the type with those merged in.
-json resolve(const json& node) {
-  if (!node.is_object()) return node;
-  if (node.contains("$ref")) return resolve(document().at(json::json_pointer(node.at("$ref").get<std::string>().substr(1))));
-  if (node.contains("allOf") && node.at("allOf").size() == 1) {
-    json merged = resolve(node.at("allOf")[0]);
-    for (const auto& [key, value] : node.items()) {
-      if (key != "allOf") merged[key] = value;
-    }
-    return merged;
-  }
-  return node;
-}
+json resolve(const json& node) { return seamcl_tests::resolve_schema(node); }
 
 const json& schema(const std::string& name) { return document().at("components").at("schemas").at(name); }
 

@@ -45,6 +45,7 @@
 #include <seamcl/scene/scene_generators.h>
 #include <seamcl/scene/scene_json.h>
 #include "http_server.h"
+#include "openapi_document.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -120,25 +121,9 @@ std::string schema_errors(const json& value, const json& schema, const json& roo
   return out;
 }
 
-const json& openapi() {
-  static const json doc = json::parse(server::openapi_json());
-  return doc;
-}
+const json& openapi() { return seamcl_tests::openapi_document(); }
 
-// A schema with its references followed. A field with its own description or default wraps its
-// type as allOf: [{$ref}] (OpenAPI 3.0 ignores a $ref's siblings): the type with those merged in.
-json resolve(const json& node) {
-  if (!node.is_object()) return node;
-  if (node.contains("$ref")) return resolve(openapi().at(json::json_pointer(node.at("$ref").get<std::string>().substr(1))));
-  if (node.contains("allOf") && node.at("allOf").size() == 1) {
-    json merged = resolve(node.at("allOf")[0]);
-    for (const auto& [key, value] : node.items()) {
-      if (key != "allOf") merged[key] = value;
-    }
-    return merged;
-  }
-  return node;
-}
+json resolve(const json& node) { return seamcl_tests::resolve_schema(node); }
 
 // The documented JSON schema of `status` for `method path`; fails the test when undocumented.
 json response_schema(const std::string& method, const std::string& path, int status) {
