@@ -101,6 +101,7 @@ set(SEAMCL_HOST_ONLY_TESTS
   Metrics.CurveThresholdsAreLogSpacedFrom1e4To1
   Metrics.IdenticalImagesHaveZeroError
   Metrics.OnePixelOffByKnownVector
+  Metrics.ErrorStatsAreTheirSortedDefinitions
   Metrics.NonFinitePixelsAreCountedAndExcluded
   Metrics.SizeMismatchThrows
   Metrics.SeamMaskIsFaceBoundariesDilatedByTwoChebyshev

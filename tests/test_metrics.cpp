@@ -89,6 +89,43 @@ TEST(Metrics, OnePixelOffByKnownVector) {
   EXPECT_DOUBLE_EQ(e2.all.curve[31], 0.01);  // 10^-0.9 = 0.126 > 0.125: only 0.625 is >= it
 }
 
+// The statistics by their definitions, over the sorted distances: the mean, the largest, the
+// ceil(0.99 n)-th smallest, and per threshold the share at or above it (compared in float).
+TEST(Metrics, ErrorStatsAreTheirSortedDefinitions) {
+  std::mt19937 rng(7);
+  const std::vector<double> x = error_curve_thresholds();
+  for (size_t n : {1u, 2u, 99u, 100u, 101u, 4097u}) {
+    std::vector<float> distance(n);
+    for (size_t i = 0; i < n; ++i) {
+      // Half on a threshold exactly (as float), half spread over [0, 2].
+      distance[i] = i % 2 ? static_cast<float>(x[rng() % x.size()]) : seamcl_tests::uniform(rng, 0.0f, 2.0f);
+    }
+    std::vector<uint8_t> mask(n);
+    for (size_t i = 0; i < n; ++i) mask[i] = i % 3 != 0 || n < 3;
+    const std::vector<uint8_t>* no_mask = nullptr;
+    for (const std::vector<uint8_t>* m : {no_mask, static_cast<const std::vector<uint8_t>*>(&mask)}) {
+      std::vector<float> sorted;
+      for (size_t i = 0; i < n; ++i) {
+        if (!m || (*m)[i]) sorted.push_back(distance[i]);
+      }
+      std::sort(sorted.begin(), sorted.end());
+      const ErrorStats s = error_stats(distance, m);
+      const size_t k = sorted.size();
+      ASSERT_EQ(s.pixels, k);
+      double sum = 0;
+      for (float v : sorted) sum += v;
+      EXPECT_NEAR(s.mean, sum / static_cast<double>(k), 1e-12 * std::max(1.0, sum)) << n;
+      EXPECT_EQ(s.max, sorted.back()) << n;
+      EXPECT_EQ(s.p99, sorted[static_cast<size_t>(std::ceil(0.99 * static_cast<double>(k))) - 1]) << n;
+      ASSERT_EQ(s.curve.size(), x.size());
+      for (size_t i = 0; i < x.size(); ++i) {
+        const auto first = std::lower_bound(sorted.begin(), sorted.end(), static_cast<float>(x[i]));
+        EXPECT_EQ(s.curve[i], static_cast<double>(sorted.end() - first) / static_cast<double>(k)) << n << " x = " << x[i];
+      }
+    }
+  }
+}
+
 TEST(Metrics, NonFinitePixelsAreCountedAndExcluded) {
   const std::vector<glm::vec4> ref0 = constant_image(50, {0.5f, 0.5f, 0.5f, 1.0f});
   std::vector<glm::vec4> ref = ref0, test = ref0;
