@@ -5,8 +5,9 @@ over the DevTools protocol, tests/browser/cdp.py) against a live `seamcl serve`:
 - a compare started from the page (the paper scene, every MSAA rate, about the largest size the
   server compares, the most repeats it allows) keeps the server busy: its process's CPU time
   (utime + stime of /proc/<pid>/stat) grows over a window while the
-  compare runs (0.15 of a core at least: the machine may be shared, and with 3 busy processes
-  on 2 cores the server got 0.43-0.66 of one on 2026-12-03, at load 8-10 0.22 on 2026-12-04);
+  compare runs (0.10 of a core at least: the machine may be shared, and with 3 busy processes
+  on 2 cores the server got 0.43-0.66 of one on 2026-12-03, beside six busy loops and three
+  other tests 0.13 on 2026-12-04);
 - the page's cancel button is pressed: within 2 s the server's CPU use is down, under a fifth of
   what it was during the compare (and under a quarter of a core) over the window that follows;
 - the server answers again afterwards (GET /health).
@@ -39,10 +40,11 @@ RENDER_WAIT_S = 150
 STOP_WITHIN_S = 2.0  # the claim: the server's CPU use is down this long after cancel
 WINDOW_S = 1.0       # the windows CPU use is measured over
 PAST_PHASE_S = 0.3   # how long the compare runs on after its phase shows before cancel
-# Cores the compare keeps busy, at least, for its cancel to be measurable: at load 8-10 on 2 cores
-# the server got 0.22 of one while packing (a fresh clone's CI, 2026-12-04). The check that tells
-# a working cancel from none is the next one: CPU use after it under a fifth of this.
-BUSY_AT_LEAST = 0.15
+# Cores the compare keeps busy, at least, for its cancel to be measurable: beside six busy loops
+# and three other tests on 2 cores the server got 0.13 of one while packing (a fresh clone's CI,
+# 2026-12-04). The check that tells a working cancel from none is the next one: CPU use after it
+# under a fifth of this, where a cancel that did nothing leaves it where it was.
+BUSY_AT_LEAST = 0.10
 SCENE = "paper"
 # The phase in which cancel is pressed (a word of the job's progress line the page shows), and
 # the height of that compare: on 2 cores (2026-12-03, `seamcl compare --scene paper --size
