@@ -8,8 +8,10 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <optional>
+#include <random>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -537,6 +539,62 @@ TEST(OpenApi, InlineSceneIsWhatTheSceneParserTakes) {
 TEST(OpenApi, GeneratorSceneIsWhatTheSceneParserTakes) {
   expect_parser_takes_the_schema(schema("GeneratorScene"),
                                  std::vector<json>(std::begin(kEveryGeneratorField), std::end(kEveryGeneratorField)));
+}
+
+// The documents that hold every field, mutated at random (a value replaced by another type, an
+// extreme number, a non-finite one, a long or deep array; a member removed or added): the parser
+// takes each or refuses it with an InputError naming a field, and nothing else escapes.
+TEST(OpenApi, MutatedSceneDocumentsAreTakenOrRefusedNamingAField) {
+  std::vector<json> documents = {kEveryExplicitField};
+  documents.insert(documents.end(), std::begin(kEveryGeneratorField), std::end(kEveryGeneratorField));
+  json deep = json::array();
+  for (int k = 0; k < 64; ++k) deep = json::array({deep});
+  const std::vector<json> replacements = {
+      json(nullptr), json(true), json(-1), json(0), json(1e39), json(-1e39), json(1e308), json(2147483648LL),
+      json(-9223372036854775807LL - 1), json(0.5), json(std::numeric_limits<double>::quiet_NaN()),
+      json(std::numeric_limits<double>::infinity()), json(""), json("\xff\xfe"), json::array(), json::object(),
+      json::array({1, 2, 3}), json(std::vector<int>(1000, 7)), deep, json::array({json::array({0, 0, 0})})};
+  std::mt19937 rng(2026);
+  int taken = 0, refused = 0;
+  for (int round = 0; round < 3000; ++round) {
+    json doc = documents[rng() % documents.size()];
+    for (int edit = 0, edits = 1 + static_cast<int>(rng() % 3); edit < edits; ++edit) {
+      const json flat = doc.flatten();
+      std::vector<std::string> leaves;
+      for (const auto& [pointer, unused] : flat.items()) leaves.push_back(pointer);
+      if (leaves.empty()) break;
+      std::string at = leaves[rng() % leaves.size()];
+      if (at.empty()) break;  // the document itself emptied
+      // Sometimes the leaf's parent (an array or an object) instead of the leaf.
+      if (rng() % 3 == 0 && at.rfind('/') > 0) at.resize(at.rfind('/'));
+      const std::string key = at.substr(at.rfind('/') + 1);
+      json& parent = doc[json::json_pointer(at.substr(0, at.rfind('/')))];
+      switch (rng() % 3) {
+        case 0: doc[json::json_pointer(at)] = replacements[rng() % replacements.size()]; break;
+        case 1:
+          if (parent.is_object()) parent.erase(key);
+          else if (parent.is_array() && !parent.empty()) parent.erase(parent.size() - 1);
+          break;
+        default:
+          if (parent.is_object()) parent["added_" + std::to_string(edit)] = 1;
+          else if (parent.is_array() && !parent.empty()) parent.push_back(parent.front());
+      }
+    }
+    try {
+      GeneratorOptions options;
+      options.defer_textures = true;
+      parse_scene_json(doc, {}, options);
+      ++taken;
+    } catch (const InputError& error) {
+      EXPECT_FALSE(error.field().empty()) << error.what() << "\n" << doc.dump();
+      ++refused;
+    } catch (const std::exception& other) {
+      ADD_FAILURE() << "not an InputError: " << other.what() << "\n" << doc.dump();
+    }
+  }
+  // Both outcomes occur, so the mutations neither always break the document nor never do.
+  EXPECT_GT(taken, 100);
+  EXPECT_GT(refused, 1000);
 }
 
 TEST(OpenApi, SceneFormConstraintsMatchTheFormat) {
