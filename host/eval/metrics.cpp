@@ -200,14 +200,14 @@ ErrorStats error_stats(const std::vector<float>& distance, const std::vector<uin
   // Distances are floats: thresholds compare in float, so a distance equal to x (as float) counts.
   std::vector<float> thresholds(x.size());
   for (size_t i = 0; i < x.size(); ++i) thresholds[i] = static_cast<float>(x[i]);
-  // at_least[k]: the distances with exactly k thresholds at or below them.
-  std::vector<size_t> at_least(x.size() + 1, 0);
+  // passing[k]: the distances that reach exactly k thresholds (threshold <= distance).
+  std::vector<size_t> passing(x.size() + 1, 0);
   double sum = 0;
   float max = values.front();
   for (float v : values) {
     sum += v;
     max = std::max(max, v);
-    ++at_least[static_cast<size_t>(std::upper_bound(thresholds.begin(), thresholds.end(), v) - thresholds.begin())];
+    ++passing[static_cast<size_t>(std::upper_bound(thresholds.begin(), thresholds.end(), v) - thresholds.begin())];
   }
   const size_t n = values.size();
   s.mean = sum / static_cast<double>(n);
@@ -215,10 +215,10 @@ ErrorStats error_stats(const std::vector<float>& distance, const std::vector<uin
   const size_t rank = std::clamp<size_t>(static_cast<size_t>(std::ceil(0.99 * static_cast<double>(n))), 1, n);  // 1-based
   std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(rank - 1), values.end());
   s.p99 = values[rank - 1];
-  // curve[i]: the share at or above threshold i, those with more than i thresholds at or below them.
+  // curve[i]: the share at or above threshold i, the distances that reach more than i thresholds.
   size_t above = 0;
   for (size_t i = x.size(); i-- > 0;) {
-    above += at_least[i + 1];
+    above += passing[i + 1];
     s.curve[i] = static_cast<double>(above) / static_cast<double>(n);
   }
   return s;
