@@ -57,9 +57,18 @@ SEAMCL_INLINE void inspect_levels(InspectSample* r, const FaceGpu* face, Sampler
   r->level1 = filter == SEAMCL_FILTER_BILINEAR ? r->level0 : min(r->level0 + 1, face->level_count - 1);
 }
 
+/* The weight of the own face's taps in the lookup, with the method's address mode. A call, as
+ * inspect_across is: the inspector reads one window, and each inlined copy is a whole filter. */
+SEAMCL_CALLED float inspect_own_weight(const FaceGpu* face, __global const uint* level_offsets, TEXEL_BUFFER texels,
+                                       __global const float* srgb_to_linear, SamplerParams sampler, SurfaceUv s) {
+  return filter_texture(face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler), SAMPLER_ADDRESS(sampler),
+                        sampler.max_aniso, sampler.lod_bias, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy)
+      .weight;
+}
+
 /* The weight of face `other`'s taps in the lookup at (u, v) carried there by `map`, as traverse
- * sums it (0 for no face). */
-SEAMCL_INLINE float inspect_across(__global const FaceGpu* faces, int other, uint map, float distance_u,
+ * sums it (0 for no face). A call: the kernel asks it at eight places. */
+SEAMCL_CALLED float inspect_across(__global const FaceGpu* faces, int other, uint map, float distance_u,
                                    float distance_v, __global const uint* level_offsets, TEXEL_BUFFER texels,
                                    __global const float* srgb_to_linear, SamplerParams sampler, SurfaceUv s) {
   FilterSum sum = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
@@ -159,10 +168,7 @@ __kernel void shade_inspect(__constant FrameParams* frame, __global const Triang
         r.reflective = 1;
       } else {
         inspect_levels(&r, &face, sampler, uv.dudx, uv.dvdx, uv.dudy, uv.dvdy);
-        r.own_weight = filter_texture(&face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(sampler),
-                                      SAMPLER_ADDRESS(sampler), sampler.max_aniso, sampler.lod_bias, uv.u, uv.v,
-                                      uv.dudx, uv.dvdx, uv.dudy, uv.dvdy)
-                           .weight;
+        r.own_weight = inspect_own_weight(&face, level_offsets, texels, srgb_to_linear, sampler, uv);
         const int traverse = SAMPLER_TRAVERSE(sampler);
         /* Without adjacency (packed only for the methods and masks that read it) the buffer is a
          * one-element stand-in: the faces around stay -1. */

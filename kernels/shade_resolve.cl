@@ -281,7 +281,10 @@ __attribute__((noinline)) float4 ptex_albedo(const PtexSource* ptex, int face, S
 }
 #endif
 
-SEAMCL_INLINE float3 shade_fragment(__constant FrameParams* frame, __global const TriangleSetup* t,
+/* A call, not inlined: the kernel calls it from two loops (per sample; per pixel and triangle), and
+ * each inlined copy holds the whole sampler, most of a variant's compile time. The work-group loop
+ * around it does not vectorise either way (docs/performance.md, "shading variants' compile"). */
+SEAMCL_CALLED float3 shade_fragment(__constant FrameParams* frame, __global const TriangleSetup* t,
                              __global const FaceGpu* faces, __global const FaceNeighbors* neighbors,
                              __global const uint* level_offsets, TEXEL_BUFFER texels,
                              __global const float* srgb_to_linear, __global const ReflectiveFace* reflective_faces,
@@ -320,8 +323,9 @@ SEAMCL_INLINE uchar merge_mask(uchar a, uchar b) {
                                                                   : (uchar)SEAMCL_MASK_NONE;
 }
 
-/* The weight the filter of `face` at (u, v) puts inside the face, border-addressed. */
-SEAMCL_INLINE float weight_inside(__constant FrameParams* frame, const FaceGpu* face, __global const uint* level_offsets,
+/* The weight the filter of `face` at (u, v) puts inside the face, border-addressed. A call: the
+ * mask asks it up to 13 times per fragment, and each inlined copy is a whole filter. */
+SEAMCL_CALLED float weight_inside(__constant FrameParams* frame, const FaceGpu* face, __global const uint* level_offsets,
                                   TEXEL_BUFFER texels, __global const float* srgb_to_linear, float u, float v,
                                   float dudx, float dvdx, float dudy, float dvdy) {
   return filter_texture(face, level_offsets, texels, srgb_to_linear, SAMPLER_FILTER(frame->sampler),

@@ -148,9 +148,12 @@ def main():
 
         # Stop replica 0 under load; its supervisor starts it again.
         victim = first["replicas"][0]
+        # Counted from the stop, not from HAProxy's DOWN: on a quiet machine the restarted replica
+        # is UP again within a few hundred ms of DOWN, while both clients still wait out HAProxy's
+        # turn-around before the retry of a request that met the stopped replica.
+        before_stop = load.count()
         os.kill(victim["pid"], signal.SIGTERM)
         wait_for(lambda: states(stats_port).get("replica0") == "DOWN", 30, "HAProxy marks replica0 DOWN")
-        during = load.count()
 
         def restarted():
             with open(os.path.join(work, "replicas.json")) as f:
@@ -158,14 +161,15 @@ def main():
 
         wait_for(restarted, 30, "replica0 started again")
         wait_for(lambda: states(stats_port).get("replica0") == "UP", 120, "restarted replica0 UP after warming")
-        served_while_down = load.count() - during
+        served_while_out = load.count() - before_stop
         after = load.count()
         wait_for(lambda: load.count() >= after + 20, 60, "20 more requests with both replicas UP")
         load.stop.set()
         for t in load.threads:
             t.join(timeout=70)
         check(not load.failed, f"no failed request of {load.count()} ({load.failed[:3]})")
-        check(served_while_down > 0, f"requests served while replica0 was down ({served_while_down})")
+        # More than the two clients' requests the stopping replica may still have finished.
+        check(served_while_out > 2, f"requests served from replica0's stop to its return ({served_while_out})")
         check(states(stats_port) == {"replica0": "UP", "replica1": "UP"}, f"both UP at the end ({states(stats_port)})")
 
         # The restarted replica got no render before it was warm: in its log after the second
