@@ -14,7 +14,8 @@
 #define SEAMCL_INLINE inline __attribute__((always_inline))
 /* Except a large helper called from many places in a kernel whose work-group loop does not
  * vectorise anyway (data-dependent loops per work-item): inlined at every call, it multiplies
- * PoCL's compile time and the code's size (docs/performance.md has the Ptex filter's figures). */
+ * PoCL's compile time and the code's size (docs/performance.md has the Ptex filter's and the
+ * shading kernel's figures). */
 #define SEAMCL_CALLED __attribute__((noinline))
 /* A prefetch of the cache line at p, to read it or to write it: clang's builtin is the one PoCL
  * turns into an instruction; everywhere else OpenCL C's own prefetch(). Only under PoCL
