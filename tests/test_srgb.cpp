@@ -2,6 +2,8 @@
 // rounding at every step, the ends, linear alpha, and a run encoded at once equal to each texel.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -48,4 +50,37 @@ TEST(Srgb8, EncodingARunEqualsEncodingEachTexel) {
   std::vector<uint32_t> packed(texels.size());
   encode_srgb8(texels.data(), texels.size(), packed.data());
   for (size_t i = 0; i < texels.size(); ++i) EXPECT_EQ(packed[i], encode_srgb8(texels[i])) << i;
+}
+
+TEST(Srgb8, EveryFloatPatternEncodesAsTheCurveCountsIt) {
+  // A code is the number of steps (decoded half-codes) at or below the value: NaN, negatives and
+  // zero are 0, 1 and above (+inf too) are 255. Every 4096th bit pattern, both signs, so every
+  // top-16-bit bucket of the encoder's table is met 16 times, and each step's neighbours.
+  std::vector<float> steps;
+  for (int k = 0; k < 255; ++k) {
+    const double half_code = (k + 0.5) / 255.0;
+    steps.push_back(static_cast<float>(half_code <= 0.04045 ? half_code / 12.92
+                                                             : std::pow((half_code + 0.055) / 1.055, 2.4)));
+  }
+  const auto expected = [&](float x) -> uint32_t {
+    if (!(x > 0.0f)) return 0;
+    if (x >= 1.0f) return 255;
+    return static_cast<uint32_t>(std::upper_bound(steps.begin(), steps.end(), x) - steps.begin());
+  };
+  std::vector<float> values;
+  for (uint64_t bits = 0; bits <= 0xffffffffu; bits += 4096) values.push_back(std::bit_cast<float>(static_cast<uint32_t>(bits)));
+  for (float step : steps) {
+    values.push_back(std::nextafter(step, 0.0f));
+    values.push_back(step);
+    values.push_back(std::nextafter(step, 1.0f));
+  }
+  values.push_back(std::nextafter(1.0f, 0.0f));
+  values.push_back(std::numeric_limits<float>::denorm_min());
+  values.push_back(-std::numeric_limits<float>::infinity());
+  std::vector<glm::vec4> texels;
+  for (float x : values) texels.emplace_back(x, 0.0f, 0.0f, 0.0f);
+  std::vector<uint32_t> packed(texels.size());
+  encode_srgb8(texels.data(), texels.size(), packed.data());
+  for (size_t i = 0; i < values.size(); ++i)
+    ASSERT_EQ(packed[i], expected(values[i])) << "bits " << std::bit_cast<uint32_t>(values[i]) << " (" << values[i] << ")";
 }

@@ -23,7 +23,7 @@ namespace {
 
 // The 8-bit encode as two tables. thresholds[k] is the linear value at which the code steps up
 // from k (the decode of (k + 0.5) / 255), so encoding by counting thresholds equals rounding the
-// exact sRGB curve without a pow per channel; thresholds[255] is +inf, which no value passes.
+// exact sRGB curve without a pow per channel; thresholds[255] is +inf, which only +inf passes.
 // start_codes holds the code of the smallest float of each top-16-bit pattern: no such bucket
 // holds more than one threshold in [0, 1), so one compare finishes the encode, without a branch.
 struct Srgb8Encoding {
@@ -55,19 +55,24 @@ const Srgb8Encoding& srgb8_encoding() {
   return encoding;
 }
 
+// Without a branch: a texture's values are anywhere in [0, 1], so which side of a threshold a
+// channel falls on is a coin toss, and mispredicted branches were a third of a bulk encode's time.
+// Negative and zero patterns start at code 0 and pass no threshold; 1 and above start at 255,
+// and +inf, which passes thresholds[255], is held there by the min. NaN fails linear > 0: the
+// bucket of +inf holds NaNs too.
 inline uint32_t encode_channel(const Srgb8Encoding& e, float linear) {
-  if (!(linear > 0.0f)) return 0;  // also NaN
-  if (linear >= 1.0f) return 255;
   const uint32_t code = e.start_codes[std::bit_cast<uint32_t>(linear) >> 16];
-  return code + (linear >= e.thresholds[code] ? 1u : 0u);
+  const uint32_t stepped = std::min(code + static_cast<uint32_t>(linear >= e.thresholds[code]), 255u);
+  return stepped & (0u - static_cast<uint32_t>(linear > 0.0f));
 }
 
 // Alpha is stored linearly: round(255 a), halves away from zero as std::lround does, without its
-// libm call (x - floor(x) is exact in double for x in [0, 255]).
+// libm call (x - floor(x) is exact in double for x in [0, 255]). NaN and negatives fail a >= 0.
 inline uint32_t encode_alpha(float alpha) {
-  const double x = std::isnan(alpha) ? 0.0 : std::clamp(static_cast<double>(alpha), 0.0, 1.0) * 255.0;
+  const float kept = alpha >= 0.0f ? std::min(alpha, 1.0f) : 0.0f;
+  const double x = static_cast<double>(kept) * 255.0;
   const auto whole = static_cast<uint32_t>(x);
-  return whole + (x - whole >= 0.5 ? 1u : 0u);
+  return whole + static_cast<uint32_t>(x - whole >= 0.5);
 }
 
 inline uint32_t encode_texel(const Srgb8Encoding& e, const glm::vec4& linear) {
