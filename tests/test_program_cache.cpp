@@ -7,11 +7,15 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/cl/program_cache.h>
@@ -283,4 +287,62 @@ TEST(Warmup, RequestIsChecked) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "thread");
   }
+}
+
+// The program cache as a process finds it ($SEAMCL_CACHE_DIR, no $SEAMCL_PROGRAM_CACHE): on PoCL a
+// render reads binaries but writes none (asking PoCL for one compiles every kernel), a warm-up
+// writes them, and the next process's render loads them and draws the same image. Elsewhere the
+// render writes them itself.
+TEST(ProgramCache, WarmupWritesWhatLaterProcessesLoad) {
+  TempDir dir("default");
+  // The suite's tests share a process: the variables go back as they were.
+  struct RestoreEnv {
+    std::vector<std::pair<std::string, std::optional<std::string>>> saved;
+    RestoreEnv() {
+      for (const char* name : {"SEAMCL_CACHE_DIR", "SEAMCL_PROGRAM_CACHE"}) {
+        const char* value = std::getenv(name);
+        saved.emplace_back(name, value ? std::optional<std::string>(value) : std::nullopt);
+      }
+    }
+    ~RestoreEnv() {
+      for (const auto& [name, value] : saved) value ? ::setenv(name.c_str(), value->c_str(), 1) : ::unsetenv(name.c_str());
+    }
+  } restore;
+  ::setenv("SEAMCL_CACHE_DIR", dir.path.string().c_str(), 1);
+  ::unsetenv("SEAMCL_PROGRAM_CACHE");
+  const std::string programs = (dir.path / "programs").string();
+  std::vector<glm::vec4> before_warmup;
+  bool pocl = false;
+  {
+    ClRuntime runtime;
+    pocl = runtime.info().platform.find("Portable Computing Language") != std::string::npos;
+    EXPECT_EQ(runtime.program_cache_dir(), programs);
+    EXPECT_EQ(runtime.program_cache_writes(), !pocl);
+    before_warmup = tiny_frame(runtime);
+    const ClRuntime::ProgramStats stats = runtime.program_stats();
+    EXPECT_EQ(stats.built, 2);
+    EXPECT_EQ(stats.stored, pocl ? 0 : 2);
+  }
+  const RenderOptions defaults;
+  const std::string default_options = program_options(defaults.texels, sampler_params(defaults));
+  const std::vector<WarmupVariant> all = warmup_variants();
+  const auto variant = std::find_if(all.begin(), all.end(), [&](const WarmupVariant& v) { return v.build_options == default_options; });
+  ASSERT_NE(variant, all.end()) << "no warm-up variant builds the default render's program";
+  {
+    ClRuntime runtime;
+    const WarmupReport report = WarmupJob(nlohmann::json{{"no_render", true}}).run(runtime, {*variant});
+    EXPECT_EQ(report.built + report.loaded, 2);
+    EXPECT_EQ(runtime.program_stats().stored, report.built) << "a warm-up writes what it builds, PoCL too";
+  }
+  ClRuntime later;
+  const std::vector<glm::vec4> after_warmup = tiny_frame(later);
+  const ClRuntime::ProgramStats stats = later.program_stats();
+  EXPECT_EQ(stats.built, 0);
+  EXPECT_EQ(stats.loaded, 2);
+  ASSERT_EQ(after_warmup.size(), before_warmup.size());
+  for (size_t p = 0; p < after_warmup.size(); ++p) ASSERT_EQ(after_warmup[p], before_warmup[p]) << "pixel " << p;
+  ::setenv("SEAMCL_PROGRAM_CACHE", "off", 1);
+  ClRuntime without;
+  EXPECT_EQ(without.program_cache_dir(), "");
+  EXPECT_FALSE(without.program_cache_writes());
 }

@@ -201,14 +201,17 @@ ClRuntime::ClRuntime(const std::string& device_filter) {
   queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
   driver_version_ = trimmed(device_.getInfo<CL_DRIVER_VERSION>());
   // PoCL keeps its own build cache, and asking it for CL_PROGRAM_BINARIES compiles every kernel of
-  // the program, not only those a run launches (docs/benchmarks.md has the cost), so seamcl keeps
-  // binaries by default for other drivers only. SEAMCL_PROGRAM_CACHE=1 (or on) keeps them on PoCL too; 0 (or off) nowhere.
+  // the program, not only those a run launches (docs/performance.md has the cost), so on PoCL
+  // seamcl writes binaries only when asked (seamcl warmup) or with SEAMCL_PROGRAM_CACHE=1 (or on),
+  // and reads those there: a load skips PoCL's preprocessing of the source on every build.
+  // 0 (or off): no program cache.
   const char* use = std::getenv("SEAMCL_PROGRAM_CACHE");
   const std::string wanted = use ? lower(use) : "";
   const bool pocl = info_.platform.find("Portable Computing Language") != std::string::npos;
-  const bool keep = wanted == "1" || wanted == "on" || (!pocl && wanted != "0" && wanted != "off");
-  const std::string cache_dir = keep ? (std::filesystem::path(default_cache_dir()) / "programs").string() : "";
+  const bool none = wanted == "0" || wanted == "off";
+  const std::string cache_dir = none ? "" : (std::filesystem::path(default_cache_dir()) / "programs").string();
   program_cache_ = std::make_unique<ProgramCache>(cache_dir);
+  program_cache_writes_ = !none && (wanted == "1" || wanted == "on" || !pocl);
 }
 
 std::string ClRuntime::device_description() const {
@@ -229,6 +232,12 @@ ProgramCacheKey ClRuntime::program_cache_key(KernelProgram program, const std::s
 void ClRuntime::set_program_cache_dir(const std::string& directory) {
   std::lock_guard<std::mutex> lock(programs_mutex_);
   program_cache_ = std::make_unique<ProgramCache>(directory);
+  program_cache_writes_ = true;
+}
+
+bool ClRuntime::program_cache_writes() const {
+  std::lock_guard<std::mutex> lock(programs_mutex_);
+  return program_cache_writes_ && program_cache_->enabled();
 }
 
 std::string ClRuntime::program_cache_dir() const {
@@ -236,15 +245,17 @@ std::string ClRuntime::program_cache_dir() const {
   return program_cache_->directory();
 }
 
-const cl::Program& ClRuntime::program(KernelProgram which, const std::string& options) {
+const cl::Program& ClRuntime::program(KernelProgram which, const std::string& options, CacheWrite write) {
   ProgramSlot* slot = nullptr;
   ProgramCache cache("");
+  bool writes = false;
   {
     std::lock_guard<std::mutex> lock(programs_mutex_);
     std::unique_ptr<ProgramSlot>& held = programs_[{which, options}];
     if (!held) held = std::make_unique<ProgramSlot>();
     slot = held.get();  // slots are never removed: the pointer stays valid
     cache = *program_cache_;
+    writes = program_cache_writes_ || write == CacheWrite::Always;
   }
   std::lock_guard<std::mutex> building(slot->mutex);
   if (slot->program) return *slot->program;
@@ -273,7 +284,7 @@ const cl::Program& ClRuntime::program(KernelProgram which, const std::string& op
     program = std::make_unique<cl::Program>(context_, program_source(which));
     program->build(std::vector<cl::Device>{device_}, all_options.c_str());
     counted.built = 1;
-    if (cache.enabled()) {
+    if (cache.enabled() && writes) {
       std::vector<std::vector<unsigned char>> binaries = program->getInfo<CL_PROGRAM_BINARIES>();
       if (binaries.size() == 1 && cache.store(key, binaries.front())) counted.stored = 1;
     }

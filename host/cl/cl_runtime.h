@@ -47,22 +47,30 @@ class ClRuntime {
   const DeviceInfo& info() const { return info_; }
   std::string device_description() const;  // "<device> (<platform>, <version>)"
 
+  // Whether a program built from source is written to the program cache: where the runtime's
+  // configuration says (program_cache_writes()), or always (a build ahead: seamcl warmup).
+  enum class CacheWrite { AsConfigured, Always };
+
   // Builds program_source(program) with `options` (e.g. "-DSEAMCL_TEXELS_F32=1") once per
   // distinct program and options (plus $SEAMCL_EXTRA_BUILD_OPTIONS, for experiments); later calls
   // return the same program. Thread-safe: calls for different variants build at once where the
   // driver compiles in parallel (PoCL 3.1 does not: one compiler lock per process), and a call
-  // for a variant being built waits for that build. With a program cache
-  // (set_program_cache_dir), the binary is loaded from it when a whole entry for this device,
-  // driver, source and options is there, else built from source and stored
-  // (host/cl/program_cache.h).
-  const cl::Program& program(KernelProgram program, const std::string& options = "");
+  // for a variant being built waits for that build. With a program cache, the binary is loaded
+  // from it when a whole entry for this device, driver, source and options is there, else built
+  // from source and, as `write` says, stored (host/cl/program_cache.h).
+  const cl::Program& program(KernelProgram program, const std::string& options = "",
+                             CacheWrite write = CacheWrite::AsConfigured);
   double program_build_ms() const;  // wall time of every build and cache load so far
 
-  // Where program binaries are kept: default_cache_dir()/programs by default on drivers other than
-  // PoCL (which caches its own builds), on PoCL too with $SEAMCL_PROGRAM_CACHE "1" or "on", nowhere
-  // with "0" or "off"; empty: none. Programs already built stay.
+  // Where program binaries are kept: default_cache_dir()/programs, nowhere with
+  // $SEAMCL_PROGRAM_CACHE "0" or "off"; empty: none. Binaries there are always read. Builds are
+  // written there by default on drivers other than PoCL; on PoCL only with $SEAMCL_PROGRAM_CACHE
+  // "1" or "on", or when the caller asks (CacheWrite::Always), because asking PoCL for a binary
+  // compiles every kernel of the program (docs/performance.md). set_program_cache_dir reads and
+  // writes there. Programs already built stay.
   void set_program_cache_dir(const std::string& directory);
   std::string program_cache_dir() const;
+  bool program_cache_writes() const;
   // The cache key of `program` built with `options` on this device.
   ProgramCacheKey program_cache_key(KernelProgram program, const std::string& options) const;
 
@@ -89,8 +97,9 @@ class ClRuntime {
   std::string driver_version_;
   std::map<std::pair<KernelProgram, std::string>, std::unique_ptr<ProgramSlot>> programs_;
   std::unique_ptr<ProgramCache> program_cache_;
+  bool program_cache_writes_ = false;
   ProgramStats stats_;
-  mutable std::mutex programs_mutex_;  // programs_, program_cache_ and stats_
+  mutable std::mutex programs_mutex_;  // programs_, program_cache_, program_cache_writes_ and stats_
 };
 
 // Milliseconds between an event's start and end (from CL_QUEUE_PROFILING_ENABLE).

@@ -111,9 +111,9 @@ WarmupReport WarmupJob::run(ClRuntime& runtime, const std::vector<WarmupVariant>
       const ClRuntime::ProgramStats was = runtime.program_stats();
       try {
         if (i == 0) {
-          runtime.program(KernelProgram::Geometry);
+          runtime.program(KernelProgram::Geometry, "", ClRuntime::CacheWrite::Always);
         } else {
-          runtime.program(KernelProgram::Shading, variants[i - 1].build_options);
+          runtime.program(KernelProgram::Shading, variants[i - 1].build_options, ClRuntime::CacheWrite::Always);
         }
       } catch (...) {
         std::lock_guard<std::mutex> lock(report_mutex);

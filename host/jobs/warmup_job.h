@@ -3,7 +3,8 @@
 // 3.1 compiles one program at a time in a process, so there the threads take turns), then one tiny
 // frame of each rendered so that the driver compiles each kernel for its local size too (PoCL does
 // this on a kernel's first enqueue, and with its own cache cold that is slow enough to show in a
-// timed frame). What `seamcl warmup` runs; a service runs the same before it says it is ready.
+// timed frame). What `seamcl warmup` runs. Its builds are written to the program cache on every
+// driver, PoCL too (ClRuntime::CacheWrite::Always), so that later processes load them.
 #pragma once
 #include <functional>
 #include <string>
