@@ -26,6 +26,8 @@
  * neighbour as traverse reads it (at the neighbour's own resolution, so a coarser neighbour's
  * taps reach further back) crosses when it weighs more than the tolerance inside the neighbour;
  * likewise carried onto the diagonal face past a valence-4 corner (what traverse reads there).
+ * Each of these weighs 0 unevaluated where traverse's bound (neighbor_may_contribute) shows that
+ * no tap can fall inside the face it is evaluated on.
  * SEAMCL_MASK_SEAM: some footprint crosses an edge shared with a neighbour (or leaves the face
  * past a corner only); else SEAMCL_MASK_BOUNDARY: some footprint crosses a mesh boundary edge
  * only; else SEAMCL_MASK_NONE, and there every seam method returns the same colour.
@@ -334,12 +336,24 @@ SEAMCL_CALLED float weight_inside(__constant FrameParams* frame, const FaceGpu* 
       .weight;
 }
 
+/* Traverse's bound (neighbor_may_contribute): false when no tap of this frame's filter at a point
+ * distance_u / distance_v outside face `g` (-1: the other axis, which never decides) can fall
+ * inside it, so that its weight there is exactly 0 and need not be evaluated. */
+SEAMCL_INLINE int may_weigh_inside(__constant FrameParams* frame, const FaceGpu* g, int swapped, float distance_u,
+                                   float distance_v, const SurfaceUv* s) {
+  return !SEAMCL_TRAVERSE_EARLY_OUT ||
+         neighbor_may_contribute(g, swapped, SAMPLER_FILTER(frame->sampler), frame->sampler.max_aniso,
+                                 frame->sampler.lod_bias, distance_u, distance_v, s->dudx, s->dvdx, s->dudy, s->dvdy);
+}
+
 /* The weight the same filter puts inside face `other` at this point and footprint carried into its
- * uv by the map (an edge's or a corner's), as traverse reads it there. */
+ * uv by the map (an edge's or a corner's), as traverse reads it there: 0 where traverse's bound
+ * rules the face out (distance_u / distance_v from it, as may_weigh_inside). */
 SEAMCL_INLINE float weight_carried(__constant FrameParams* frame, __global const FaceGpu* faces, int other,
-                                   uint map, __global const uint* level_offsets, TEXEL_BUFFER texels,
-                                   __global const float* srgb_to_linear, const SurfaceUv* s) {
+                                   uint map, float distance_u, float distance_v, __global const uint* level_offsets,
+                                   TEXEL_BUFFER texels, __global const float* srgb_to_linear, const SurfaceUv* s) {
   const FaceGpu g = faces[other];
+  if (!may_weigh_inside(frame, &g, (map & SEAMCL_MAP_SWAP) != 0, distance_u, distance_v, s)) return 0.0f;
   const UvMap decoded = decode_uv_map(map);
   const float* m = decoded.t;
   return weight_inside(frame, &g, level_offsets, texels, srgb_to_linear, m[0] * s->u + m[1] * s->v + m[2],
@@ -360,15 +374,21 @@ SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global cons
   const float own = weight_inside(frame, &face, level_offsets, texels, srgb_to_linear, s.u, s.v, s.dudx, s.dvdx,
                                   s.dudy, s.dvdy);
   int seam = 0, boundary = 0, any_edge = 0;
+  /* How far the point lies inside each edge (as traverse measures it): the distance its mirror
+   * and its carried footprints lie outside the face they are evaluated on. */
+  const float inside[4] = {s.v, 1.0f - s.u, 1.0f - s.v, s.u};
   for (int k = 0; k < 4; ++k) {
     /* Mirrored across edge k: v = 0, u = 1, v = 1, u = 0. */
     const int across_v = (k & 1) == 0;
+    const float distance_u = across_v ? -1.0f : inside[k], distance_v = across_v ? inside[k] : -1.0f;
     const float offset = k == 1 || k == 2 ? 2.0f : 0.0f;
     const float mu = across_v ? s.u : offset - s.u, mv = across_v ? offset - s.v : s.v;
     const float mdudx = across_v ? s.dudx : -s.dudx, mdudy = across_v ? s.dudy : -s.dudy;
     const float mdvdx = across_v ? -s.dvdx : s.dvdx, mdvdy = across_v ? -s.dvdy : s.dvdy;
-    const float beyond = weight_inside(frame, &face, level_offsets, texels, srgb_to_linear, mu, mv, mdudx, mdvdx,
-                                       mdudy, mdvdy);
+    const float beyond = may_weigh_inside(frame, &face, 0, distance_u, distance_v, &s)
+                             ? weight_inside(frame, &face, level_offsets, texels, srgb_to_linear, mu, mv, mdudx,
+                                             mdvdx, mdudy, mdvdy)
+                             : 0.0f;
     const int crosses = !(beyond <= tolerance);
     any_edge |= crosses;
     const int other = n->neighbor[k];
@@ -376,15 +396,20 @@ SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global cons
       boundary |= crosses;
       continue;
     }
-    const float reach = weight_carried(frame, faces, other, n->edge_map[k], level_offsets, texels, srgb_to_linear, &s);
+    const float reach = weight_carried(frame, faces, other, n->edge_map[k], distance_u, distance_v, level_offsets,
+                                       texels, srgb_to_linear, &s);
     seam |= crosses | !(reach <= tolerance);
   }
   /* The diagonal face past each valence-4 corner, as traverse reads it: a coarser one's taps can
-   * reach back over the corner although no edge's footprint crosses. */
+   * reach back over the corner although no edge's footprint crosses. Corner k lies between edges
+   * k - 1 and k. */
   for (int k = 0; k < 4; ++k) {
     const int other = n->corner[k];
     if (other < 0) continue;
-    const float reach = weight_carried(frame, faces, other, n->corner_map[k], level_offsets, texels, srgb_to_linear, &s);
+    const float a = inside[(k + 3) & 3], b = inside[k];
+    const int b_along_v = (k & 1) == 0;
+    const float reach = weight_carried(frame, faces, other, n->corner_map[k], b_along_v ? a : b, b_along_v ? b : a,
+                                       level_offsets, texels, srgb_to_linear, &s);
     seam |= !(reach <= tolerance);
   }
   /* Taps outside past a corner only (no edge's mirror saw them): a seam, to be safe. */

@@ -6,8 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <set>
+#include <string>
+#include <vector>
 
+#include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/eval/metrics.h>
 #include <seamcl/pipeline/renderer.h>
@@ -187,4 +191,57 @@ TEST(SeamMask, GuardbandIsRefusedWithTheReason) {
   // footprint_seam_mask renders with black whatever the method.
   EXPECT_EQ(footprint_seam_mask(renderer, scene.camera, options),
             footprint_seam_mask(renderer, scene.camera, small_frame(1)));
+}
+
+TEST(SeamMask, TraversesBoundChangesNoPixel) {
+  // The mask skips each evaluation that traverse's bound (neighbor_may_contribute) shows would
+  // weigh nothing; built without the bound (SEAMCL_TRAVERSE_EARLY_OUT=0) it evaluates all 13 per
+  // fragment, and every mask must be the same. Paper's faces have textures of 16 to 128 texels a
+  // side, so coarser neighbours (whose taps reach further) are met.
+  struct Frame {
+    const char* scene;
+    RenderOptions options;
+    std::vector<uint8_t> mask;
+  };
+  std::vector<Frame> frames;
+  for (const char* name : {"paper", "closeup-corner", "mixed"}) {
+    const Scene scene = generate_scene(name, {});
+    Renderer bounded(shared_runtime());
+    bounded.load_scene(scene);
+    for (Filter filter : {Filter::Aniso, Filter::Ewa, Filter::Bilinear}) {
+      for (int msaa : {1, 4}) {
+        RenderOptions options = small_frame(msaa, filter);
+        options.width = 96;
+        options.height = 80;
+        frames.push_back({name, options, footprint_seam_mask(bounded, scene.camera, options)});
+      }
+    }
+  }
+  // A runtime of its own, whose programs are all built while the variable asks for every evaluation.
+  const char* saved = std::getenv("SEAMCL_EXTRA_BUILD_OPTIONS");
+  const std::string previous = saved ? saved : "";
+  ::setenv("SEAMCL_EXTRA_BUILD_OPTIONS", "-DSEAMCL_TRAVERSE_EARLY_OUT=0", 1);
+  struct Restore {
+    bool had;
+    std::string value;
+    ~Restore() { had ? ::setenv("SEAMCL_EXTRA_BUILD_OPTIONS", value.c_str(), 1) : ::unsetenv("SEAMCL_EXTRA_BUILD_OPTIONS"); }
+  } restore{saved != nullptr, previous};
+  ClRuntime every_evaluation;
+  size_t seam_pixels = 0;
+  std::string loaded;
+  Renderer unbounded(every_evaluation);
+  for (const Frame& frame : frames) {
+    if (loaded != frame.scene) {
+      const Scene scene = generate_scene(frame.scene, {});
+      unbounded.load_scene(scene);
+      loaded = frame.scene;
+    }
+    const std::vector<uint8_t> without = footprint_seam_mask(unbounded, unbounded.scene().camera, frame.options);
+    ASSERT_EQ(frame.mask.size(), without.size());
+    size_t differing = 0;
+    for (size_t p = 0; p < without.size(); ++p) differing += frame.mask[p] != without[p];
+    EXPECT_EQ(differing, 0u) << frame.scene << " " << to_string(frame.options.filter) << " msaa " << frame.options.msaa;
+    seam_pixels += count_set(without);
+  }
+  EXPECT_GT(seam_pixels, 0u);
 }

@@ -88,8 +88,17 @@ uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const Tr
   auto weight_inside = [&](uint32_t face, float u, float v, float dudx, float dvdx, float dudy, float dvdy) {
     return filter_texture_reference(textures, face, f.sampler, SEAMCL_ADDRESS_BORDER, u, v, dudx, dvdx, dudy, dvdy).weight;
   };
+  // Traverse's bound: false when no tap at a point distance_u / distance_v outside `face` (-1: the
+  // axis that never decides) can fall inside it, so the weight there is exactly 0, unevaluated.
+  auto may_weigh_inside = [&](const FaceGpu& face, bool swapped, float distance_u, float distance_v) {
+    return neighbor_may_contribute(face, swapped, f.sampler.filter, f.sampler.max_aniso, f.sampler.lod_bias, 0,
+                                   distance_u, distance_v, s.dudx, s.dvdx, s.dudy, s.dvdy);
+  };
   // The same filter on face `other` at this point and footprint carried into its uv by map m.
-  auto weight_carried = [&](int32_t other, const float* m) {
+  auto weight_carried = [&](int32_t other, uint8_t map, float distance_u, float distance_v) {
+    const auto m = map_coefficients(map);
+    if (!may_weigh_inside(scene.faces.at(static_cast<size_t>(other)), map_swaps_axes(m.data()), distance_u, distance_v))
+      return 0.0f;
     return weight_inside(static_cast<uint32_t>(other), m[0] * s.u + m[1] * s.v + m[2], m[3] * s.u + m[4] * s.v + m[5],
                          m[0] * s.dudx + m[1] * s.dvdx, m[3] * s.dudx + m[4] * s.dvdx, m[0] * s.dudy + m[1] * s.dvdy,
                          m[3] * s.dudy + m[4] * s.dvdy);
@@ -99,13 +108,20 @@ uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const Tr
   const float own = weight_inside(t.face, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
   const FaceNeighbors& n = scene.neighbors.at(t.face);
   bool seam = false, boundary = false, any_edge = false;
+  // How far the point lies inside each edge: how far its mirror and carried footprints lie
+  // outside the face they are evaluated on.
+  const float inside[4] = {s.v, 1.0f - s.u, 1.0f - s.v, s.u};
   for (int k = 0; k < 4; ++k) {
     // The point and footprint mirrored across edge k (v = 0, u = 1, v = 1, u = 0): the weight
     // there is what the (symmetric) filter puts beyond edge k.
     const bool across_v = (k & 1) == 0;
+    const float distance_u = across_v ? -1.0f : inside[k], distance_v = across_v ? inside[k] : -1.0f;
     const float offset = k == 1 || k == 2 ? 2.0f : 0.0f;
-    const float beyond = across_v ? weight_inside(t.face, s.u, offset - s.v, s.dudx, -s.dvdx, s.dudy, -s.dvdy)
-                                  : weight_inside(t.face, offset - s.u, s.v, -s.dudx, s.dvdx, -s.dudy, s.dvdy);
+    float beyond = 0.0f;
+    if (may_weigh_inside(scene.faces.at(t.face), false, distance_u, distance_v)) {
+      beyond = across_v ? weight_inside(t.face, s.u, offset - s.v, s.dudx, -s.dvdx, s.dudy, -s.dvdy)
+                        : weight_inside(t.face, offset - s.u, s.v, -s.dudx, s.dvdx, -s.dudy, s.dvdy);
+    }
     const bool crosses = !(beyond <= tolerance);
     any_edge = any_edge || crosses;
     if (n.neighbor[k] < 0) {
@@ -113,14 +129,17 @@ uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const Tr
       continue;
     }
     // The same filter on the neighbour, as traverse carries it there.
-    const float reach = weight_carried(n.neighbor[k], map_coefficients(n.edge_map[k]).data());
+    const float reach = weight_carried(n.neighbor[k], n.edge_map[k], distance_u, distance_v);
     seam = seam || crosses || !(reach <= tolerance);
   }
   // The diagonal face past each valence-4 corner, as traverse reads it: a coarser one's taps can
-  // reach back over the corner although no edge's footprint crosses.
+  // reach back over the corner although no edge's footprint crosses. Corner k lies between edges
+  // k - 1 and k.
   for (int k = 0; k < 4; ++k) {
     if (n.corner[k] < 0) continue;
-    const float reach = weight_carried(n.corner[k], map_coefficients(n.corner_map[k]).data());
+    const float a = inside[(k + 3) & 3], b = inside[k];
+    const bool b_along_v = (k & 1) == 0;
+    const float reach = weight_carried(n.corner[k], n.corner_map[k], b_along_v ? a : b, b_along_v ? b : a);
     seam = seam || !(reach <= tolerance);
   }
   seam = seam || (!any_edge && !(own >= 1.0f - tolerance));  // past a corner only
