@@ -1,4 +1,4 @@
-// seamcl warmup: the geometry program and every shading variant built ahead (or loaded from the
+// seamcl warmup: the geometry and downsample programs and every shading variant built ahead (or loaded from the
 // program cache), on a thread per core, with a line per build on stderr; --list prints the variants' build options instead
 // (scripts and the kernel portability check read them). The work is the library's WarmupJob.
 #include <cstdio>
@@ -37,7 +37,7 @@ int run_warmup(const WarmupArgs& args, const GlobalOptions& global) {
     out["device"] = runtime.device_description();
     std::cout << out.dump(2) << "\n";
   } else {
-    std::printf("%d variants (and the geometry program): %d built, %d from the program cache (%d damaged entries rebuilt), %d threads; "
+    std::printf("%d variants (and the geometry and downsample programs): %d built, %d from the program cache (%d damaged entries rebuilt), %d threads; "
                 "build %.0f ms, frames %.0f ms, total %.0f ms\n",
                 report.variants, report.built, report.loaded, report.cache_rejected, report.threads, report.build_ms,
                 report.render_ms, report.total_ms);

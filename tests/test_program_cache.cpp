@@ -254,14 +254,17 @@ TEST(Warmup, BuildsInParallelThenRendersEachWithProgress) {
   EXPECT_EQ(report.built + report.loaded, static_cast<int>(std::set<std::string>{three[0].build_options,
                                                                                  three[1].build_options,
                                                                                  three[2].build_options}
-                                                                 .size()) + 1)
-      << "each distinct shading variant and the geometry program they share";
-  ASSERT_EQ(lines.size(), 7u);  // four built (the geometry program among them), three rendered
-  EXPECT_NE(lines[0].find("built 1/4"), std::string::npos) << lines[0];
+                                                                 .size()) + 2)
+      << "each distinct shading variant and the geometry and downsample programs they share";
+  ASSERT_EQ(lines.size(), 8u);  // five built (the geometry and downsample programs among them), three rendered
+  EXPECT_NE(lines[0].find("built 1/5"), std::string::npos) << lines[0];
   EXPECT_EQ(std::count_if(lines.begin(), lines.end(),
                           [](const std::string& l) { return l.find(": geometry stages") != std::string::npos; }),
             1);
-  EXPECT_NE(lines[6].find("rendered 3/3: " + three[2].name), std::string::npos) << lines[6];
+  EXPECT_EQ(std::count_if(lines.begin(), lines.end(),
+                          [](const std::string& l) { return l.find(": downsample") != std::string::npos; }),
+            1);
+  EXPECT_NE(lines[7].find("rendered 3/3: " + three[2].name), std::string::npos) << lines[7];
   EXPECT_EQ(report.cache_dir, dir.path.string());
   EXPECT_GE(report.total_ms, report.build_ms + report.render_ms - 1.0);
 
@@ -331,7 +334,7 @@ TEST(ProgramCache, WarmupWritesWhatLaterProcessesLoad) {
   {
     ClRuntime runtime;
     const WarmupReport report = WarmupJob(nlohmann::json{{"no_render", true}}).run(runtime, {*variant});
-    EXPECT_EQ(report.built + report.loaded, 2);
+    EXPECT_EQ(report.built + report.loaded, 3) << "the geometry, downsample and default shading programs";
     EXPECT_EQ(runtime.program_stats().stored, report.built) << "a warm-up writes what it builds, PoCL too";
   }
   ClRuntime later;

@@ -103,17 +103,19 @@ WarmupReport WarmupJob::run(ClRuntime& runtime, const std::vector<WarmupVariant>
   std::atomic<int> done{0};
   std::mutex report_mutex;  // progress lines and the first error
   std::exception_ptr failure;
-  // Build 0 is the geometry program every variant shares; build i > 0 is variant i - 1's shading.
-  const size_t builds = variants.size() + 1;
+  // Builds 0 and 1 are the programs every variant shares: the geometry stages, and the downsample
+  // of every compare's reference; build i > 1 is variant i - 2's shading.
+  constexpr size_t kShared = 2;
+  const size_t builds = variants.size() + kShared;
   auto build = [&] {
     for (size_t i = next++; i < builds; i = next++) {
       const Clock::time_point one = Clock::now();
       const ClRuntime::ProgramStats was = runtime.program_stats();
       try {
-        if (i == 0) {
-          runtime.program(KernelProgram::Geometry, "", ClRuntime::CacheWrite::Always);
+        if (i < kShared) {
+          runtime.program(i == 0 ? KernelProgram::Geometry : KernelProgram::Downsample, "", ClRuntime::CacheWrite::Always);
         } else {
-          runtime.program(KernelProgram::Shading, variants[i - 1].build_options, ClRuntime::CacheWrite::Always);
+          runtime.program(KernelProgram::Shading, variants[i - kShared].build_options, ClRuntime::CacheWrite::Always);
         }
       } catch (...) {
         std::lock_guard<std::mutex> lock(report_mutex);
@@ -127,7 +129,8 @@ WarmupReport WarmupJob::run(ClRuntime& runtime, const std::vector<WarmupVariant>
         const bool loaded = runtime.program_stats().loaded > was.loaded;
         char line[256];
         std::snprintf(line, sizeof line, "built %d/%zu: %s (%.0f ms%s)", finished, builds,
-                      i == 0 ? "geometry stages" : variants[i - 1].name.c_str(), ms_since(one),
+                      i == 0 ? "geometry stages" : i == 1 ? "downsample" : variants[i - kShared].name.c_str(),
+                      ms_since(one),
                       loaded ? ", from the program cache" : "");
         std::lock_guard<std::mutex> lock(report_mutex);
         progress(line);

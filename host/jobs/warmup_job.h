@@ -1,10 +1,11 @@
-// The warm-up job: the geometry program and every shading variant built (or loaded from the
-// program cache, host/cl/program_cache.h) ahead of the first request on a thread per core (PoCL
-// 3.1 compiles one program at a time in a process, so there the threads take turns), then one tiny
-// frame of each rendered so that the driver compiles each kernel for its local size too (PoCL does
-// this on a kernel's first enqueue, and with its own cache cold that is slow enough to show in a
-// timed frame). What `seamcl warmup` runs. Its builds are written to the program cache on every
-// driver, PoCL too (ClRuntime::CacheWrite::Always), so that later processes load them.
+// The warm-up job: the geometry and downsample programs and every shading variant built (or
+// loaded from the program cache, host/cl/program_cache.h) ahead of the first request on a thread
+// per core (PoCL 3.1 compiles one program at a time in a process, so there the threads take
+// turns), then one tiny frame of each rendered so that the driver compiles each kernel for its
+// local size too (PoCL does this on a kernel's first enqueue, and with its own cache cold that is
+// slow enough to show in a timed frame). What `seamcl warmup` runs. Its builds are written to the
+// program cache on every driver, PoCL too (ClRuntime::CacheWrite::Always), so that later
+// processes load them.
 #pragma once
 #include <functional>
 #include <string>
@@ -47,8 +48,8 @@ struct WarmupReport {
   nlohmann::json to_json() const;
 };
 
-// One line per finished build ("built 3/29: traverse trilinear (812 ms)"; the geometry stages'
-// program, which every variant shares, is one of them) and per tiny frame.
+// One line per finished build ("built 3/30: traverse trilinear (812 ms)"; the geometry stages' and
+// the downsample's programs, which every variant shares, are two of them) and per tiny frame.
 using WarmupProgress = std::function<void(const std::string&)>;
 
 class WarmupJob {
