@@ -228,7 +228,7 @@ typedef struct {
   cl_float light_color[3];
   cl_float ambient;         /* lighting = light_color * (ambient + (1-ambient) * max(0, n.l)) */
   cl_float background[3];   /* linear RGB of samples no triangle covers */
-  cl_int pad0;
+  cl_int mask_only;         /* with SEAMCL_SEAM_MASK: 1 shades no fragment (black), the mask alone is wanted */
   SamplerParams sampler;
   EnvironmentParams environment; /* cube-map lookups (reflective faces, skybox); size 0: none */
 } FrameParams;

@@ -28,6 +28,7 @@
  * likewise carried onto the diagonal face past a valence-4 corner (what traverse reads there).
  * Each of these weighs 0 unevaluated where traverse's bound (neighbor_may_contribute) shows that
  * no tap can fall inside the face it is evaluated on.
+ * With frame->mask_only the fragments are not shaded (they add black): a render for its mask alone.
  * SEAMCL_MASK_SEAM: some footprint crosses an edge shared with a neighbour (or leaves the face
  * past a corner only); else SEAMCL_MASK_BOUNDARY: some footprint crosses a mesh boundary edge
  * only; else SEAMCL_MASK_NONE, and there every seam method returns the same colour.
@@ -470,8 +471,9 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
         }
         const float sample_x = (float)sample_fixed_x(x, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
         const float sample_y = (float)sample_fixed_y(y, row, s) * (1.0f / SEAMCL_SUBPIXEL_ONE);
-        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, &ptex_source,
-                              &displaced_source, slot, sample_x, sample_y);
+        if (!SEAMCL_SEAM_MASK || !frame->mask_only)
+          sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, &ptex_source,
+                                &displaced_source, slot, sample_x, sample_y);
 #if SEAMCL_SEAM_MASK
         crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,
                                                       srgb_to_linear, sample_x, sample_y));
@@ -510,9 +512,10 @@ void shade_resolve(__constant FrameParams* frame, __global const TriangleSetup* 
           shade_x = centroid_x / (float)covered;
           shade_y = centroid_y / (float)covered;
         }
-        sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, &ptex_source,
-                              &displaced_source, slot, shade_x, shade_y) *
-               (float)covered;
+        if (!SEAMCL_SEAM_MASK || !frame->mask_only)
+          sum += shade_fragment(frame, setups + slot, faces, neighbors, level_offsets, texels, srgb_to_linear, reflective_faces, cube_texels, &ptex_source,
+                                &displaced_source, slot, shade_x, shade_y) *
+                 (float)covered;
 #if SEAMCL_SEAM_MASK
         crosses = merge_mask(crosses, footprint_class(frame, setups + slot, faces, neighbors, level_offsets, texels,
                                                       srgb_to_linear, shade_x, shade_y));

@@ -95,6 +95,22 @@ TEST(SeamMask, MaskedRenderGivesTheSameImage) {
   for (size_t p = 0; p < plain.pixels.size(); ++p) ASSERT_EQ(plain.pixels[p], masked.pixels[p]) << "pixel " << p;
 }
 
+TEST(SeamMask, MaskAloneIsTheShadedRendersMask) {
+  // render_seam_mask leaves the fragments unshaded (what footprint_seam_mask wants); the mask is
+  // the one a shaded render with the mask output gives.
+  const Scene scene = generate_scene("closeup-corner", {});
+  Renderer renderer(shared_runtime());
+  renderer.load_scene(scene);
+  for (const RenderOptions& options : {small_frame(1), small_frame(4, Filter::Ewa), small_frame(4, Filter::Aniso, ShadingMode::Sample)}) {
+    const std::vector<uint8_t> alone = renderer.render_seam_mask(scene.camera, options);
+    EXPECT_EQ(renderer.last_frame_params().mask_only, 1);
+    const RenderResult shaded = renderer.render(scene.camera, options, true);
+    EXPECT_EQ(renderer.last_frame_params().mask_only, 0);
+    EXPECT_EQ(alone, shaded.seam_mask) << to_string(options.filter) << " msaa " << options.msaa;
+    EXPECT_GT(count_set(alone), 0u);
+  }
+}
+
 TEST(SeamMask, EmptyOnASingleFaceFarFromItsEdges) {
   const Scene scene = single_big_face();
   Renderer renderer(shared_runtime());

@@ -114,7 +114,7 @@ std::vector<uint8_t> seam_mask(const FaceMap& faces, int radius) {
 
 std::vector<uint8_t> footprint_seam_mask(Renderer& renderer, const Camera& camera, RenderOptions options) {
   options.method = Method::Black;
-  return renderer.render(camera, options, true).seam_mask;
+  return renderer.render_seam_mask(camera, options);
 }
 
 namespace {

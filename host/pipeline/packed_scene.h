@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <seamcl/core/uninitialized_allocator.h>
 #include <seamcl/pipeline/gpu_types.h>
 #include <seamcl/pipeline/texture_view.h>
 #include <seamcl/scene/scene.h>
@@ -19,8 +20,9 @@ struct PackedScene {
   TexelFormat format = TexelFormat::Rgba8;
   int guard_band = 0;                   // band texels stored around every level (guardband method)
   size_t band_texels = 0;               // of all stored texels, those in bands
-  std::vector<uint32_t> texels8;        // RGBA8, sRGB-encoded RGB (format Rgba8)
-  std::vector<float> texels32;          // linear RGBA32F, 4 floats a texel (format Rgba32f)
+  // The texels: pack_scene sizes them unwritten and writes every one, faces in parallel.
+  UninitializedVector<uint32_t> texels8;  // RGBA8, sRGB-encoded RGB (format Rgba8)
+  UninitializedVector<float> texels32;    // linear RGBA32F, 4 floats a texel (format Rgba32f)
   std::vector<ReflectiveFace> reflective_faces;  // of faces with roughness >= 0 (FaceGpu.reflective)
 
   int input_triangles() const { return static_cast<int>(faces.size() * 2); }

@@ -58,6 +58,7 @@ struct Renderer::Impl {
   bool displaced_normals = false;  // and lights with the displaced surface's normals
   std::string program_key;       // the current shading program variant's build options
   bool direction_output = false;  // render_directions: SEAMCL_CUBE_DIRECTION
+  bool mask_only = false;         // seam_mask: FrameParams.mask_only
   // render_downsampled: the stage that reduces the image on the device before the read-back.
   DownsampleLauncher downsampler{runtime};
   const DownsampleTaps* downsample_taps = nullptr;
@@ -185,8 +186,8 @@ struct Renderer::Impl {
     last_params = FrameParams{};
   }
 
-  template <typename T>
-  cl::Buffer upload(const std::vector<T>& data) {
+  template <typename T, typename Allocator>
+  cl::Buffer upload(const std::vector<T, Allocator>& data) {
     // OpenCL refuses zero-sized buffers; one element of padding keeps empty arrays legal.
     const size_t bytes = std::max<size_t>(data.size(), 1) * sizeof(T);
     cl::Buffer buffer(runtime.context(), CL_MEM_READ_ONLY, bytes);
@@ -200,8 +201,8 @@ struct Renderer::Impl {
   // large scenes' tables showed in the peak memory); the array outlives the buffer
   // (release_scene_buffers and upload_cube drop the buffers first, and renders wait for their
   // commands). Elsewhere a device copy, as upload() makes.
-  template <typename T>
-  cl::Buffer upload_shared(const std::vector<T>& data) {
+  template <typename T, typename Allocator>
+  cl::Buffer upload_shared(const std::vector<T, Allocator>& data) {
     if (data.empty() || runtime.device().getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>() != CL_TRUE) return upload(data);
     return cl::Buffer(runtime.context(), CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, data.size() * sizeof(T),
                       const_cast<T*>(data.data()));
@@ -436,6 +437,7 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
     FrameParams params = make_frame_params(*impl_->scene, camera, options, impl_->bin_capacity);
     if (impl_->displaced) params.input_triangles = static_cast<cl_int>(impl_->tessellation.packed().triangle_count());
     if (impl_->direction_output) params.environment.sampler.method = SEAMCL_CUBE_DIRECTION;
+    params.mask_only = with_seam_mask && impl_->mask_only ? 1 : 0;
     impl_->reserve_frame_buffers(params);
     impl_->bin_capacity = params.bin_capacity;
     impl_->last_params = params;
@@ -519,6 +521,18 @@ RenderResult Renderer::render_directions(const Camera& camera, const RenderOptio
     return result;
   } catch (...) {
     impl_->direction_output = false;
+    throw;
+  }
+}
+
+std::vector<uint8_t> Renderer::render_seam_mask(const Camera& camera, const RenderOptions& options) {
+  impl_->mask_only = true;
+  try {
+    RenderResult result = render(camera, options, true);
+    impl_->mask_only = false;
+    return std::move(result.seam_mask);
+  } catch (...) {
+    impl_->mask_only = false;
     throw;
   }
 }

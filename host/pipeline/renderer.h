@@ -141,6 +141,8 @@ class Renderer {
   // renders without it pay nothing). The mask reads the faces' own texels without guard bands:
   // with Method::Guardband it throws InputError("method"); any other method gives the same mask.
   RenderResult render(const Camera& camera, const RenderOptions& options, bool with_seam_mask = false);
+  // The seam mask alone (render with_seam_mask, the fragments left unshaded: FrameParams.mask_only).
+  std::vector<uint8_t> render_seam_mask(const Camera& camera, const RenderOptions& options);
 
   // The frame at `options`' size, resolved on the device and reduced there by taps.factor on
   // both axes (kernels/downsample.cl), then read back small: the result's width, height and

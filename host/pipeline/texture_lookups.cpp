@@ -9,10 +9,10 @@
 namespace seamcl {
 namespace {
 
-template <typename T>
-cl::Buffer read_only_buffer(const cl::Context& context, const std::vector<T>& data) {
+template <typename T, typename Allocator>
+cl::Buffer read_only_buffer(const cl::Context& context, const std::vector<T, Allocator>& data) {
   // One element of padding keeps empty arrays legal (OpenCL refuses zero-sized buffers).
-  std::vector<T> padded = data;
+  std::vector<T> padded(data.begin(), data.end());
   if (padded.empty()) padded.resize(1);
   return cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, padded.size() * sizeof(T), padded.data());
 }

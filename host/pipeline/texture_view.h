@@ -6,6 +6,7 @@
 
 #include <glm/glm.hpp>
 
+#include <seamcl/core/uninitialized_allocator.h>
 #include <seamcl/options/texel_format.h>
 #include <seamcl/pipeline/gpu_types.h>
 
@@ -18,8 +19,8 @@ struct TextureView {
   const std::vector<FaceNeighbors>* neighbors;  // read by traverse and the seam mask; may be empty
   const std::vector<uint32_t>* level_offsets;
   TexelFormat format;
-  const std::vector<uint32_t>* texels8;   // RGBA8 sRGB
-  const std::vector<float>* texels32;     // linear RGBA32F, 4 floats a texel
+  const UninitializedVector<uint32_t>* texels8;  // RGBA8 sRGB
+  const UninitializedVector<float>* texels32;    // linear RGBA32F, 4 floats a texel
   int guard_band = 0;                     // texels of band stored around every level (guardband)
 };
 

@@ -224,15 +224,17 @@ ResolveReference shade_resolve_reference(const PackedScene& scene, const FramePa
         }
         const TriangleSetup& t = setups.at(slot);
         if (f.shading_mode == SEAMCL_SHADE_SAMPLE) {
-          sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s), cube_texels, ptex, displaced, slot);
+          if (!(with_mask && f.mask_only))
+            sum += shade_fragment_reference(scene, f, t, sample_x(s), sample_y(s), cube_texels, ptex, displaced, slot);
           if (with_mask) crosses = merge_mask(crosses, footprint_class(scene, f, t, sample_x(s), sample_y(s)));
           ++out.fragments;
           continue;
         }
         if (std::find(ids, ids + s, slot) != ids + s) continue;  // shaded at its first sample
         const PixelFragment fragment = pixel_fragment(f, t, ids, slot, x, y);
-        sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y, cube_texels, ptex, displaced, slot) *
-               static_cast<float>(fragment.covered);
+        if (!(with_mask && f.mask_only))
+          sum += shade_fragment_reference(scene, f, t, fragment.x, fragment.y, cube_texels, ptex, displaced, slot) *
+                 static_cast<float>(fragment.covered);
         if (with_mask) crosses = merge_mask(crosses, footprint_class(scene, f, t, fragment.x, fragment.y));
         ++out.fragments;
       }
