@@ -512,29 +512,24 @@ std::string program_options(TexelFormat format, const SamplerParams& sampler, bo
          (with_seam_mask ? " -DSEAMCL_SEAM_MASK=1" : "") + (environment ? " -DSEAMCL_CUBE=1" : "");
 }
 
+namespace {
+// A render mode flag of the Renderer's, set for one render and cleared however it ends.
+struct FlagForOneRender {
+  bool& flag;
+  explicit FlagForOneRender(bool& f) : flag(f) { flag = true; }
+  ~FlagForOneRender() { flag = false; }
+};
+}  // namespace
+
 RenderResult Renderer::render_directions(const Camera& camera, const RenderOptions& options) {
   if (!has_scene() || !impl_->scene->environment) throw std::logic_error("render_directions needs an environment");
-  impl_->direction_output = true;
-  try {
-    RenderResult result = render(camera, options);
-    impl_->direction_output = false;
-    return result;
-  } catch (...) {
-    impl_->direction_output = false;
-    throw;
-  }
+  const FlagForOneRender directions(impl_->direction_output);
+  return render(camera, options);
 }
 
 std::vector<uint8_t> Renderer::render_seam_mask(const Camera& camera, const RenderOptions& options) {
-  impl_->mask_only = true;
-  try {
-    RenderResult result = render(camera, options, true);
-    impl_->mask_only = false;
-    return std::move(result.seam_mask);
-  } catch (...) {
-    impl_->mask_only = false;
-    throw;
-  }
+  const FlagForOneRender mask_only(impl_->mask_only);
+  return std::move(render(camera, options, true).seam_mask);
 }
 
 RenderResult Renderer::render_downsampled(const Camera& camera, const RenderOptions& options, const DownsampleTaps& taps) {
