@@ -123,7 +123,7 @@ int run_devices(const std::string& device) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  seamcl::return_large_blocks_at_once();  // freed textures leave the process (render_memory.h)
+  seamcl::set_allocator_thresholds();  // freed textures leave the process, faces' chains are reused (render_memory.h)
   CLI::App app{"seamcl: render per-face textured scenes with OpenCL and compare texture seam methods"};
   app.require_subcommand(0, 1);
   std::optional<std::string> given_device;

@@ -27,7 +27,9 @@
  * taps reach further back) crosses when it weighs more than the tolerance inside the neighbour;
  * likewise carried onto the diagonal face past a valence-4 corner (what traverse reads there).
  * Each of these weighs 0 unevaluated where traverse's bound (neighbor_may_contribute) shows that
- * no tap can fall inside the face it is evaluated on.
+ * no tap can fall inside the face it is evaluated on; the own filter's weight (whether taps leave
+ * the face past a corner only) is evaluated only where some edge's bound did not rule its mirror
+ * out: elsewhere every tap lies inside.
  * With frame->mask_only the fragments are not shaded (they add black): a render for its mask alone.
  * SEAMCL_MASK_SEAM: some footprint crosses an edge shared with a neighbour (or leaves the face
  * past a corner only); else SEAMCL_MASK_BOUNDARY: some footprint crosses a mesh boundary edge
@@ -371,10 +373,10 @@ SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global cons
   const FaceGpu face = faces[t->face];
   __global const FaceNeighbors* n = neighbors + t->face;
   const float tolerance = SEAMCL_SEAM_WEIGHT_TOLERANCE;
-  /* NaN weights (a non-finite footprint) count as crossing: nothing shows they stay inside. */
-  const float own = weight_inside(frame, &face, level_offsets, texels, srgb_to_linear, s.u, s.v, s.dudx, s.dvdx,
-                                  s.dudy, s.dvdy);
   int seam = 0, boundary = 0, any_edge = 0;
+  /* Whether some edge's bound left the mirror to be evaluated: where none did, every tap lies
+   * inside the face and the own weight below is whole. */
+  int near_edge = 0;
   /* How far the point lies inside each edge (as traverse measures it): the distance its mirror
    * and its carried footprints lie outside the face they are evaluated on. */
   const float inside[4] = {s.v, 1.0f - s.u, 1.0f - s.v, s.u};
@@ -386,10 +388,11 @@ SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global cons
     const float mu = across_v ? s.u : offset - s.u, mv = across_v ? offset - s.v : s.v;
     const float mdudx = across_v ? s.dudx : -s.dudx, mdudy = across_v ? s.dudy : -s.dudy;
     const float mdvdx = across_v ? -s.dvdx : s.dvdx, mdvdy = across_v ? -s.dvdy : s.dvdy;
-    const float beyond = may_weigh_inside(frame, &face, 0, distance_u, distance_v, &s)
-                             ? weight_inside(frame, &face, level_offsets, texels, srgb_to_linear, mu, mv, mdudx,
-                                             mdvdx, mdudy, mdvdy)
-                             : 0.0f;
+    const int may_cross = may_weigh_inside(frame, &face, 0, distance_u, distance_v, &s);
+    near_edge |= may_cross;
+    const float beyond = may_cross ? weight_inside(frame, &face, level_offsets, texels, srgb_to_linear, mu, mv, mdudx,
+                                                   mdvdx, mdudy, mdvdy)
+                                   : 0.0f;
     const int crosses = !(beyond <= tolerance);
     any_edge |= crosses;
     const int other = n->neighbor[k];
@@ -413,8 +416,15 @@ SEAMCL_INLINE uchar footprint_class(__constant FrameParams* frame, __global cons
                                        level_offsets, texels, srgb_to_linear, &s);
     seam |= !(reach <= tolerance);
   }
-  /* Taps outside past a corner only (no edge's mirror saw them): a seam, to be safe. */
-  seam |= !any_edge && !(own >= 1.0f - tolerance);
+  /* Taps outside past a corner only (no edge's mirror saw them): a seam, to be safe. NaN weights (a
+   * non-finite footprint, which no bound rules out) count as crossing: nothing shows they stay
+   * inside. Evaluated last and only near an edge: most fragments lie too far inside their face
+   * for any tap to leave it, and this was the one whole filter each of them paid. */
+  if (!any_edge && near_edge) {
+    const float own = weight_inside(frame, &face, level_offsets, texels, srgb_to_linear, s.u, s.v, s.dudx, s.dvdx,
+                                    s.dudy, s.dvdy);
+    seam |= !(own >= 1.0f - tolerance);
+  }
   return seam ? (uchar)SEAMCL_MASK_SEAM : boundary ? (uchar)SEAMCL_MASK_BOUNDARY : (uchar)SEAMCL_MASK_NONE;
 }
 #endif

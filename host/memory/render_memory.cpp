@@ -313,9 +313,10 @@ size_t status_kilobytes(const std::string& status, const std::string& key) {
 
 }  // namespace
 
-void return_large_blocks_at_once() {
+void set_allocator_thresholds() {
 #if defined(__GLIBC__)
   mallopt(M_MMAP_THRESHOLD, 1 << 20);
+  mallopt(M_TRIM_THRESHOLD, 4 << 20);
 #endif
 }
 

@@ -241,13 +241,16 @@ void refuse_beyond_machine(const RenderMemory& memory, int msaa, const DeviceInf
 void refuse_beyond_machine(const MemoryShares& device_bytes, const MemoryShares& host_bytes, const DeviceInfo& device,
                            const std::string& what);
 
-// Makes the allocator give blocks of 1 MiB and more back to the system as soon as they are freed
-// (glibc: a fixed mmap threshold; nothing elsewhere). glibc raises its threshold to the largest
-// block freed so far, so the float chains and decoded images of large deferred faces, made and
-// freed one by one while packing, were kept in its arenas and held through the render, raising
-// the peak RSS of scenes with large image faces (measured in docs/compare.md). For a process's
-// start, before any thread allocates.
-void return_large_blocks_at_once();
+// Sets the allocator's thresholds for packing (glibc; nothing elsewhere). Blocks of 1 MiB and
+// more go back to the system as soon as they are freed: glibc raises its mmap threshold to the
+// largest block freed so far, so the float chains and decoded images of large deferred faces, made
+// and freed one by one while packing, were kept in its arenas and held through the render, raising
+// the peak RSS of scenes with large image faces (measured in docs/compare.md). Fixing that
+// threshold also fixes the trim threshold at glibc's 128 KiB, so each smaller face's chain, freed
+// at the top of its thread's arena, was handed back (madvise) and faulted in again for the next
+// face; up to 4 MiB of free top is kept instead (docs/performance.md, "bake" rows). For a
+// process's start, before any thread allocates.
+void set_allocator_thresholds();
 
 // What one loaded scene costs, measured after a render: for `render --json` and the benches.
 struct MeasuredMemory {

@@ -104,10 +104,9 @@ uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const Tr
                          m[3] * s.dudy + m[4] * s.dvdy);
   };
   constexpr float tolerance = SEAMCL_SEAM_WEIGHT_TOLERANCE;
-  // NaN weights count as crossing: nothing shows the footprint stays inside.
-  const float own = weight_inside(t.face, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
   const FaceNeighbors& n = scene.neighbors.at(t.face);
   bool seam = false, boundary = false, any_edge = false;
+  bool near_edge = false;  // some edge's bound left its mirror to evaluate: else every tap is inside
   // How far the point lies inside each edge: how far its mirror and carried footprints lie
   // outside the face they are evaluated on.
   const float inside[4] = {s.v, 1.0f - s.u, 1.0f - s.v, s.u};
@@ -119,6 +118,7 @@ uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const Tr
     const float offset = k == 1 || k == 2 ? 2.0f : 0.0f;
     float beyond = 0.0f;
     if (may_weigh_inside(scene.faces.at(t.face), false, distance_u, distance_v)) {
+      near_edge = true;
       beyond = across_v ? weight_inside(t.face, s.u, offset - s.v, s.dudx, -s.dvdx, s.dudy, -s.dvdy)
                         : weight_inside(t.face, offset - s.u, s.v, -s.dudx, s.dvdx, -s.dudy, s.dvdy);
     }
@@ -142,7 +142,12 @@ uint8_t footprint_class(const PackedScene& scene, const FrameParams& f, const Tr
     const float reach = weight_carried(n.corner[k], n.corner_map[k], b_along_v ? a : b, b_along_v ? b : a);
     seam = seam || !(reach <= tolerance);
   }
-  seam = seam || (!any_edge && !(own >= 1.0f - tolerance));  // past a corner only
+  // Past a corner only; the own filter only near an edge, as the kernel. NaN weights count as
+  // crossing: nothing shows the footprint stays inside.
+  if (!any_edge && near_edge) {
+    const float own = weight_inside(t.face, s.u, s.v, s.dudx, s.dvdx, s.dudy, s.dvdy);
+    seam = seam || !(own >= 1.0f - tolerance);
+  }
   return seam ? SEAMCL_MASK_SEAM : boundary ? SEAMCL_MASK_BOUNDARY : SEAMCL_MASK_NONE;
 }
 
