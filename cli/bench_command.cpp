@@ -79,7 +79,7 @@ int run_bench(BenchArgs& args, const GlobalOptions& global) {
   BenchJob job(args.options->request());
   if (!images_dir.empty()) job.refuse_images("images");
   args.cache.apply(job.reference_settings());  // checked with --sweep too: an empty --cache is a mistake
-  ClRuntime runtime(global.device);
+  ClRuntime& runtime = cli::command_runtime(global.device);
   SceneSourceOptions source;
   source.generator = job.generator_options();
   source.displacement_map = job.frame().displacement_map;

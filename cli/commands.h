@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
 
 namespace seamcl::cli {
@@ -48,6 +49,17 @@ inline std::string given_value(const std::optional<std::string>& given, const st
                                const std::string& without_it) {
   if (given && given->empty()) throw InputError(field, "must not be empty (" + without_it + ")");
   return given.value_or("");
+}
+
+// The OpenCL runtime a command runs on, never destroyed: the process's exit frees what it holds,
+// so a command's end does not wait for PoCL to release the programs it built or loaded (destroying
+// their LLVM modules took 20-30 ms at the end of every compare, docs/performance.md). A process runs
+// one command, so one is made (held by a static pointer: still reachable to a leak checker). A
+// --device that matches none throws InputError, before any work.
+inline ClRuntime& command_runtime(const std::string& device) {
+  static ClRuntime* runtime = nullptr;
+  runtime = new ClRuntime(device);
+  return *runtime;
 }
 
 struct GlobalOptions {

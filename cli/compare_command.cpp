@@ -64,7 +64,8 @@ int run_compare(CompareArgs& args, const GlobalOptions& global) {
   const std::string images_dir = given_value(args.images, "images", "leave out --images to write no images");
   CompareJob job(args.options->request());
   args.cache.apply(job.reference_settings());
-  ClRuntime runtime(global.device);  // a --device that matches none: refused before any work
+  // A --device that matches none: refused before any work.
+  ClRuntime& runtime = cli::command_runtime(global.device);
   SceneSourceOptions source;
   source.generator = job.generator_options();
   source.displacement_map = job.frame().displacement_map;

@@ -51,7 +51,8 @@ void print_cube_table(const json& out) {
 int run(const CubeArgs& args, const GlobalOptions& global) {
   const std::string images_dir = given_value(args.images, "images", "leave out --images to write no images");
   const CubeMetricsJob job(args.options->request());
-  ClRuntime runtime(global.device);  // a --device that matches none: refused before any work
+  // A --device that matches none: refused before any work.
+  ClRuntime& runtime = cli::command_runtime(global.device);
   // Through host/assets, so that a scene file's environment may be an image file.
   const Scene scene = load_scene_source(job.frame().scene);
   const JobPlan plan = job.plan(scene);

@@ -52,7 +52,8 @@ int run(const DisplacementArgs& args, const GlobalOptions& global) {
       given_value(args.displacement_map, "displacement_map", "leave out --displacement-map to use the scene's own maps");
   const json request = args.options->request();
   const DisplacementMetricsJob job(request);
-  ClRuntime runtime(global.device);  // a --device that matches none: refused before any work
+  // A --device that matches none: refused before any work.
+  ClRuntime& runtime = cli::command_runtime(global.device);
   Scene scene = load_scene_source(job.frame().scene);
   if (!displacement_map.empty()) attach_ptex_displacement(scene, displacement_map);
   const JobPlan plan = job.plan(scene);

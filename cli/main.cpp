@@ -50,7 +50,8 @@ int run_render(const RenderArgs& args, const std::string& device) {
   if (args.options->given("crack_orbit") && !args.json_out)
     throw InputError("crack_orbit", "counts the cracks of a displaced render in --json's displacement block: give --json too");
 
-  ClRuntime runtime(device);  // a --device that matches none is bad input too: refused before any work
+  // A --device that matches none is bad input too: refused before any work.
+  ClRuntime& runtime = cli::command_runtime(device);
   const auto scene_start = std::chrono::steady_clock::now();
   SceneSourceOptions source;
   source.generator = job.generator_options();

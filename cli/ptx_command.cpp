@@ -82,7 +82,7 @@ int run_lookup(const PtxArgs& args, const GlobalOptions& global) {
   if (args.scalar) {
     values = texture.lookup_scalar(lookups);
   } else {
-    ClRuntime runtime(global.device);
+    ClRuntime& runtime = cli::command_runtime(global.device);
     values = texture.lookup_device(runtime, lookups);
   }
   if (queries_path.empty()) {

@@ -79,7 +79,7 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
   std::signal(SIGPIPE, SIG_IGN);  // a client that hangs up must not end the process
 
   const auto start = std::chrono::steady_clock::now();
-  ClRuntime runtime(global.device);
+  ClRuntime& runtime = cli::command_runtime(global.device);
   server::ServerOptions options;
   options.host = args.host;
   options.port = args.port;

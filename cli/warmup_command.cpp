@@ -28,7 +28,7 @@ int run_warmup(const WarmupArgs& args, const GlobalOptions& global) {
     for (const WarmupVariant& v : variants) std::cout << v.name << "\t" << v.build_options << "\n";
     return 0;
   }
-  ClRuntime runtime(global.device);
+  ClRuntime& runtime = cli::command_runtime(global.device);
   WarmupProgress progress;
   if (!args.no_progress) progress = [](const std::string& line) { std::fprintf(stderr, "warmup: %s\n", line.c_str()); };
   const WarmupReport report = job.run(runtime, variants, progress);

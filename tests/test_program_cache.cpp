@@ -20,9 +20,11 @@
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/cl/program_cache.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/eval/reference.h>
 #include <seamcl/jobs/warmup_job.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
+#include "pipeline/stages/downsample_twin.h"
 
 using namespace seamcl;
 namespace fs = std::filesystem;
@@ -202,8 +204,8 @@ TEST(ProgramCache, ConcurrentRequestsForOneVariantBuildItOnce) {
 }
 
 // build_programs_ahead builds each distinct variant of the renders it is given once (two renders
-// that share one, and a seam-mask render that needs another), and the renders that follow find
-// every variant built.
+// that share one, and a seam-mask render that needs another), and the downsample program for a
+// render reduced on the device, and the renders that follow find every program built.
 TEST(ProgramCache, VariantsBuiltAheadAreTheOnesTheRendersUse) {
   ClRuntime runtime;
   runtime.set_program_cache_dir("");  // builds only: PoCL keeps its own cache
@@ -212,15 +214,20 @@ TEST(ProgramCache, VariantsBuiltAheadAreTheOnesTheRendersUse) {
   plain.width = plain.height = 16;
   RenderOptions mask = plain;
   mask.method = Method::Black;  // footprint_seam_mask's render
-  build_programs_ahead(runtime, scene, {{plain, false}, {plain, false}, {mask, true}}).get();
+  RenderOptions reduced = plain;
+  reduced.width = reduced.height = 64;
+  build_programs_ahead(runtime, scene, {{plain, false}, {plain, false}, {mask, true}, {reduced, false, true}}).get();
   const ClRuntime::ProgramStats ahead = runtime.program_stats();
-  EXPECT_EQ(ahead.built + ahead.loaded, 3) << "the geometry program and two shading variants";
+  EXPECT_EQ(ahead.built + ahead.loaded, 4) << "the geometry program, two shading variants and the downsample program";
   Renderer renderer(runtime);
   renderer.load_scene(scene);
   renderer.render(scene.camera, plain);
   renderer.render(scene.camera, mask, true);
+  const RenderResult small = renderer.render_downsampled(scene.camera, reduced, box_taps());
+  EXPECT_GT(small.width, 0);
+  EXPECT_LT(small.width, reduced.width) << "reduced on the device";
   const ClRuntime::ProgramStats after = runtime.program_stats();
-  EXPECT_EQ(after.built + after.loaded, 3) << "a render built a program the builds ahead did not";
+  EXPECT_EQ(after.built + after.loaded, 4) << "a render built a program the builds ahead did not";
 }
 
 TEST(Warmup, VariantsCoverEveryMethodAndFilterOnce) {

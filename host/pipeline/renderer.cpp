@@ -480,13 +480,16 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
 
 std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, const std::vector<ProgramNeed>& needs,
                                        const std::atomic<bool>* stop) {
-  std::vector<std::string> variants;
+  std::vector<std::pair<KernelProgram, std::string>> builds{{KernelProgram::Geometry, ""}};  // every render's first stages
   for (const ProgramNeed& need : needs) {
-    const std::string options = program_options(need.options.texels, sampler_params(need.options), need.with_seam_mask,
-                                                 scene.environment.has_value());
-    if (std::find(variants.begin(), variants.end(), options) == variants.end()) variants.push_back(options);
+    const std::pair<KernelProgram, std::string> shading{
+        KernelProgram::Shading, program_options(need.options.texels, sampler_params(need.options), need.with_seam_mask,
+                                                scene.environment.has_value())};
+    if (std::find(builds.begin(), builds.end(), shading) == builds.end()) builds.push_back(shading);
+    const std::pair<KernelProgram, std::string> downsample{KernelProgram::Downsample, ""};
+    if (need.downsampled && std::find(builds.begin(), builds.end(), downsample) == builds.end()) builds.push_back(downsample);
   }
-  return std::async(std::launch::async, [&runtime, stop, variants = std::move(variants)] {
+  return std::async(std::launch::async, [&runtime, stop, builds = std::move(builds)] {
     // A build that fails is left to the render that uses it, which builds it again and reports
     // the error; the builds after it still run.
     auto build = [&runtime, stop](KernelProgram program, const std::string& options) {
@@ -496,8 +499,7 @@ std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, c
       } catch (...) {
       }
     };
-    build(KernelProgram::Geometry, "");  // every render's first stages
-    for (const std::string& options : variants) build(KernelProgram::Shading, options);
+    for (const auto& [program, options] : builds) build(program, options);
   });
 }
 

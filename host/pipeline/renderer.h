@@ -71,10 +71,12 @@ std::string program_options(TexelFormat format, const SamplerParams& sampler, bo
 struct ProgramNeed {
   RenderOptions options;
   bool with_seam_mask = false;
+  bool downsampled = false;  // reduced on the device afterwards (a reference): the downsample program too
 };
 
 // Starts building (or loading from a cache) the geometry program and then the shading program
-// variants of `needs` on `scene`, in the order given, one after another on one thread of its own, and returns at once: work that needs no
+// variants of `needs` on `scene` (and the downsample program after the first need downsampled),
+// in the order given, one after another on one thread of its own, and returns at once: work that needs no
 // kernel (making and packing the scene) overlaps the builds, which a first render would otherwise
 // wait for. One thread, not one per variant: the packing keeps the other cores, and LLVM builds
 // hold memory no plan counts. The future is ready (and its destructor returns) when every build has
