@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -54,10 +55,11 @@ inline std::string given_value(const std::optional<std::string>& given, const st
 // The OpenCL runtime a command runs on, never destroyed: the process's exit frees what it holds,
 // so a command's end does not wait for PoCL to release the programs it built or loaded (destroying
 // their LLVM modules took 20-30 ms at the end of every compare, docs/performance.md). A process runs
-// one command, so one is made (held by a static pointer: still reachable to a leak checker). A
-// --device that matches none throws InputError, before any work.
+// one command: a second call is a bug (std::logic_error). Held by a static pointer: still reachable
+// to a leak checker. A --device that matches none throws InputError, before any work.
 inline ClRuntime& command_runtime(const std::string& device) {
   static ClRuntime* runtime = nullptr;
+  if (runtime != nullptr) throw std::logic_error("command_runtime: a command's runtime is made once");
   runtime = new ClRuntime(device);
   return *runtime;
 }

@@ -211,8 +211,9 @@ TEST(SeamMask, GuardbandIsRefusedWithTheReason) {
 
 TEST(SeamMask, TraversesBoundChangesNoPixel) {
   // The mask skips each evaluation that traverse's bound (neighbor_may_contribute) shows would
-  // weigh nothing; built without the bound (SEAMCL_TRAVERSE_EARLY_OUT=0) it evaluates all 13 per
-  // fragment, and every mask must be the same. Paper's faces have textures of 16 to 128 texels a
+  // weigh nothing, and the own filter where every edge's bound rules its mirror out; built without
+  // the bound (SEAMCL_TRAVERSE_EARLY_OUT=0) it evaluates all 12 mirrors and neighbours per fragment,
+  // and the own filter wherever no mirror crossed, and every mask must be the same. Paper's faces have textures of 16 to 128 texels a
   // side, so coarser neighbours (whose taps reach further) are met.
   struct Frame {
     const char* scene;

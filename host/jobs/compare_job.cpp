@@ -152,7 +152,10 @@ CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobCont
   // Analytic is never cached; paper and box are rendered unless the cache holds them.
   const bool renders_reference = asks_for(ReferenceKind::Analytic) ||
                                  (!reference_.use_cache && (asks_for(ReferenceKind::Paper) || asks_for(ReferenceKind::Box)));
-  if (renders_reference) needs.push_back({reference_render_options(frame_, reference_), false, true});
+  // Paper and box are reduced on the device (the downsample program); analytic alone on the host.
+  const bool reduces_on_device =
+      !reference_.use_cache && (asks_for(ReferenceKind::Paper) || asks_for(ReferenceKind::Box));
+  if (renders_reference) needs.push_back({reference_render_options(frame_, reference_), false, reduces_on_device});
   for (const MethodEntry& entry : entries_) needs.push_back({entry.options, false});
   // A run that ends (cancelled, or failed) leaves out the builds not yet begun: the future's
   // destructor then waits for the one under way only.

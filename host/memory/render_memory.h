@@ -247,10 +247,11 @@ void refuse_beyond_machine(const MemoryShares& device_bytes, const MemoryShares&
 // and freed one by one while packing, were kept in its arenas and held through the render, raising
 // the peak RSS of scenes with large image faces (measured in docs/compare.md). Fixing that
 // threshold also fixes the trim threshold at glibc's 128 KiB, so each smaller face's chain, freed
-// at the top of its thread's arena, was handed back (madvise) and faulted in again for the next
-// face; up to 4 MiB of free top is kept instead (docs/performance.md, "bake" rows). For a
+// at the top of its thread's arena, was handed back to the kernel and faulted in again for the
+// next face; up to 4 MiB of free top is kept instead (docs/performance.md, "What was tried"). For a
 // process's start, before any thread allocates.
 void set_allocator_thresholds();
+[[deprecated("use set_allocator_thresholds")]] inline void return_large_blocks_at_once() { set_allocator_thresholds(); }
 
 // What one loaded scene costs, measured after a render: for `render --json` and the benches.
 struct MeasuredMemory {
