@@ -149,12 +149,11 @@ CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobCont
     needs.push_back({mask, true});
   }
   const auto asks_for = [&](ReferenceKind kind) { return std::find(kinds_.begin(), kinds_.end(), kind) != kinds_.end(); };
-  // Analytic is never cached; paper and box are rendered unless the cache holds them.
-  const bool renders_reference = asks_for(ReferenceKind::Analytic) ||
-                                 (!reference_.use_cache && (asks_for(ReferenceKind::Paper) || asks_for(ReferenceKind::Box)));
-  // Paper and box are reduced on the device (the downsample program); analytic alone on the host.
+  // Analytic is never cached and is reduced on the host; paper and box are rendered unless the
+  // cache holds them, and reduced on the device (the downsample program).
   const bool reduces_on_device =
       !reference_.use_cache && (asks_for(ReferenceKind::Paper) || asks_for(ReferenceKind::Box));
+  const bool renders_reference = asks_for(ReferenceKind::Analytic) || reduces_on_device;
   if (renders_reference) needs.push_back({reference_render_options(frame_, reference_), false, reduces_on_device});
   for (const MethodEntry& entry : entries_) needs.push_back({entry.options, false});
   // A run that ends (cancelled, or failed) leaves out the builds not yet begun: the future's

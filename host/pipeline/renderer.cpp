@@ -480,14 +480,15 @@ RenderResult Renderer::render(const Camera& camera, const RenderOptions& options
 
 std::future<void> build_programs_ahead(ClRuntime& runtime, const Scene& scene, const std::vector<ProgramNeed>& needs,
                                        const std::atomic<bool>* stop) {
-  std::vector<std::pair<KernelProgram, std::string>> builds{{KernelProgram::Geometry, ""}};  // every render's first stages
+  using Build = std::pair<KernelProgram, std::string>;
+  std::vector<Build> builds{{KernelProgram::Geometry, ""}};  // every render's first stages
+  auto add = [&builds](Build build) {
+    if (std::find(builds.begin(), builds.end(), build) == builds.end()) builds.push_back(std::move(build));
+  };
   for (const ProgramNeed& need : needs) {
-    const std::pair<KernelProgram, std::string> shading{
-        KernelProgram::Shading, program_options(need.options.texels, sampler_params(need.options), need.with_seam_mask,
-                                                scene.environment.has_value())};
-    if (std::find(builds.begin(), builds.end(), shading) == builds.end()) builds.push_back(shading);
-    const std::pair<KernelProgram, std::string> downsample{KernelProgram::Downsample, ""};
-    if (need.downsampled && std::find(builds.begin(), builds.end(), downsample) == builds.end()) builds.push_back(downsample);
+    add({KernelProgram::Shading, program_options(need.options.texels, sampler_params(need.options), need.with_seam_mask,
+                                                 scene.environment.has_value())});
+    if (need.downsampled) add({KernelProgram::Downsample, ""});
   }
   return std::async(std::launch::async, [&runtime, stop, builds = std::move(builds)] {
     // A build that fails is left to the render that uses it, which builds it again and reports

@@ -76,9 +76,9 @@ struct ProgramNeed {
 
 // Starts building (or loading from a cache) the geometry program and then the shading program
 // variants of `needs` on `scene` (and the downsample program after the first need downsampled),
-// in the order given, one after another on one thread of its own, and returns at once: work that needs no
-// kernel (making and packing the scene) overlaps the builds, which a first render would otherwise
-// wait for. One thread, not one per variant: the packing keeps the other cores, and LLVM builds
+// in the order given, one after another on one thread of its own, and returns at once: work that
+// needs no kernel (making and packing the scene) overlaps the builds, which a first render would
+// otherwise wait for. One thread, not one per variant: the packing keeps the other cores, and LLVM builds
 // hold memory no plan counts. The future is ready (and its destructor returns) when every build has
 // ended, so a caller that stops early still waits for the build under way. A build that fails is
 // not reported here: the render that uses the variant builds it again and throws its error with
