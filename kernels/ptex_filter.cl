@@ -15,7 +15,8 @@
  * sum is divided by the weight of the taps inside the face instead.
  * Host guarantees (host/ptexfilter/ptex_filter_texture.cpp): every resolution 2^i x 2^j of every
  * face at texels + level_offsets[face.level_base + i * (vlog2 + 1) + j] (texel index; channels
- * interleaved; the element count fits a uint); no subfaces.
+ * interleaved; the element count fits a uint), then SEAMCL_PTEX_TEXEL_TAIL bytes of padding; no
+ * subfaces.
  * The shading program compiles this file into its Ptex variant only (SEAMCL_SAMPLER_FILTER =
  * SEAMCL_FILTER_PTEX); the others skip it.
  * Twin: host/pipeline/stages/ptex_filter_twin.cpp. */
@@ -28,6 +29,10 @@
 #define PTEXF_LEFT 3
 #define PTEXF_BLACK 1
 #define PTEXF_PERIODIC 2
+/* A kernel row's values (uw * nchan, at most 40) as whole vectors of 16; rows of at most
+ * PTEXF_SCALAR_COLUMNS values (one channel's bilinear and narrow boxes) are summed value by value. */
+#define PTEXF_COLUMNS 48
+#define PTEXF_SCALAR_COLUMNS 3
 
 typedef struct {
   int ulog2, vlog2;
@@ -240,12 +245,38 @@ SEAMCL_INLINE float ptexf_make_symmetric(PtexfKernel* k, float initial_weight) {
 SEAMCL_INLINE int ptexf_res_from_width(float w) { return 127 - ((as_int(w) >> 23) & 0xff); }
 SEAMCL_INLINE float ptexf_reciprocal_pow2(int power) { return as_float((127 - power) << 23); }
 
-SEAMCL_INLINE float ptexf_width4_fn(int filter, const float* c, float x) {
-  if (filter == SEAMCL_PTEX_GAUSSIAN) return exp(-2.0f * x * x);
-  x = fabs(x);
-  if (x < 1.0f) return (c[0] * x + c[1]) * x * x + c[2];
-  if (x < 2.0f) return ((c[3] * x + c[4]) * x + c[5]) * x + c[6];
-  return 0.0f;
+/* e^y for the gaussian's y = -2x^2 as 2^n e^z: n = rint(y log2 e), z = y - n ln 2 in two steps
+ * (Cody and Waite), |z| <= ln 2 / 2, e^z by its Taylor series to z^6 (relative error under 2e-7);
+ * y clamped to -87, where e^y is under 2e-38. PoCL runs the library's vector exp lane by lane:
+ * this is one vector of arithmetic. */
+SEAMCL_INLINE float16 ptexf_exp16(float16 y) {
+  y = fmax(y, -87.0f);
+  const float16 n = rint(y * 1.44269504088896f);
+  /* ln 2's high part has 15 significant bits, so its product with |n| <= 126 (7 bits) is exact. */
+  const float16 z = (y - n * 0.693145751953125f) - n * 1.42860682028622680e-6f;
+  const float16 p =
+      ((((((1.0f / 720.0f) * z + 1.0f / 120.0f) * z + 1.0f / 24.0f) * z + 1.0f / 6.0f) * z + 0.5f) * z + 1.0f) * z +
+      1.0f;
+  return p * as_float16((convert_int16(n) + 127) << 23);
+}
+
+/* A width-4 filter's weights at x1, x1 + step, ... into all SEAMCL_PTEX_KMAX entries of k (the
+ * caller keeps as many as its kernel has taps), computed as one vector. */
+SEAMCL_INLINE void ptexf_width4_weights(int filter, const float* c, float* k, float x1, float step) {
+  const float16 x = x1 + (float16)(0.0f, 1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f, 7.0f, 8.0f, 9.0f, 10.0f, 11.0f, 12.0f,
+                                   13.0f, 14.0f, 15.0f) * step;
+  float16 w;
+  if (filter == SEAMCL_PTEX_GAUSSIAN) {
+    w = ptexf_exp16(-2.0f * x * x);
+  } else {
+    const float16 a = fabs(x);
+    const float16 inner = (c[0] * a + c[1]) * a * a + c[2];
+    const float16 outer = ((c[3] * a + c[4]) * a + c[5]) * a + c[6];
+    w = select(select((float16)(0.0f), outer, a < 2.0f), inner, a < 1.0f);
+  }
+  vstore8(w.lo, 0, k);
+  k[8] = w.s8;
+  k[9] = w.s9;
 }
 
 SEAMCL_INLINE float ptexf_blur(float x) {
@@ -268,12 +299,7 @@ SEAMCL_INLINE void ptexf_width4_axis(int filter, const float* c, int* res_log2, 
       u2 = (u2 + 1) & ~1;
       *k_u = u1;
       *k_uw = min(u2 - u1, SEAMCL_PTEX_KMAX);
-      const float x1 = (float)u1 - upix;
-      for (int i = 0; i + 1 < *k_uw; i += 2) {
-        const float xa = x1 + (float)i, xb = xa + 1.0f;
-        ku[i] = ptexf_width4_fn(filter, c, xa);
-        ku[i + 1] = ptexf_width4_fn(filter, c, xb);
-      }
+      ptexf_width4_weights(filter, c, ku, (float)u1 - upix, 1.0f);
       return;
     }
     if (uw < 1.0f) {
@@ -305,8 +331,7 @@ SEAMCL_INLINE void ptexf_width4_axis(int filter, const float* c, int* res_log2, 
   const int u1 = (int)ceil(upix - dupix), u2 = (int)ceil(upix + dupix);
   *k_u = u1;
   *k_uw = min(u2 - u1, SEAMCL_PTEX_KMAX);
-  const float x1 = ((float)u1 - upix) / uwpix, step = 1.0f / uwpix;
-  for (int i = 0; i < *k_uw; ++i) ku[i] = ptexf_width4_fn(filter, c, x1 + (float)i * step);
+  ptexf_width4_weights(filter, c, ku, ((float)u1 - upix) / uwpix, 1.0f / uwpix);
 }
 
 SEAMCL_INLINE void ptexf_box_weights(float* weights, int size, float f1, float f2) {
@@ -395,6 +420,50 @@ SEAMCL_INLINE float ptexf_texel(const PtexfState* s, uint index) {
   }
 }
 
+SEAMCL_INLINE float16 ptexf_halves_to_float16(ushort16 h) {
+  const uint16 bits = convert_uint16(h);
+  const uint16 sign = (bits & 0x8000u) << 16;
+  const uint16 exponent = (bits >> 10) & 0x1fu;
+  const uint16 mantissa = bits & 0x3ffu;
+  const float16 subnormal = convert_float16(mantissa) * 5.9604644775390625e-8f; /* 2^-24 */
+  const uint16 normal = select(((exponent + 112u) << 23) | (mantissa << 13), (0xffu << 23) | (mantissa << 13),
+                               exponent == 31u);
+  const float16 magnitude = select(as_float16(normal), subnormal, exponent == 0u);
+  return as_float16(as_uint16(magnitude) | sign);
+}
+
+/* 16 consecutive values of type data_type from index on, as floats; past a row's end they are
+ * whatever follows (the host pads the buffer by SEAMCL_PTEX_TEXEL_TAIL bytes), and the caller reads
+ * none of those lanes. */
+SEAMCL_INLINE float16 ptexf_texels16(const PtexfState* s, uint index, int data_type) {
+  switch (data_type) {
+    case 0: return convert_float16(vload16(0, s->texels + index));
+    case 1: return convert_float16(vload16(0, (__global const ushort*)s->texels + index));
+    case 2: return ptexf_halves_to_float16(vload16(0, (__global const ushort*)s->texels + index));
+    default: return vload16(0, (__global const float*)s->texels + index);
+  }
+}
+
+/* The kernel's vw rows from index first on (rows stride values apart), each row's 16 values from
+ * there weighted by kv and summed down the rows. */
+SEAMCL_INLINE float16 ptexf_column(const PtexfState* s, const PtexfKernel* k, uint first, uint stride, int data_type) {
+  float16 column = (float16)(0.0f);
+  for (int j = 0; j < k->vw; ++j)
+    column += ptexf_texels16(s, first + (uint)j * stride, data_type) * k->kv[j];
+  return column;
+}
+
+/* ptexf_column for the texture's type, each type's loop compiled apart (the type a constant in each
+ * call) so that no row switches on it. */
+SEAMCL_INLINE float16 ptexf_columns16(const PtexfState* s, const PtexfKernel* k, uint first, uint stride) {
+  switch (s->tex.data_type) {
+    case 0: return ptexf_column(s, k, first, stride, 0);
+    case 1: return ptexf_column(s, k, first, stride, 1);
+    case 2: return ptexf_column(s, k, first, stride, 2);
+    default: return ptexf_column(s, k, first, stride, 3);
+  }
+}
+
 SEAMCL_INLINE int ptexf_adj_face(PtexFilterFace f, int e) { return f.adj_faces[e & 3]; }
 SEAMCL_INLINE int ptexf_adj_edge(PtexFilterFace f, int e) { return (int)((f.adj_edges >> (2 * (e & 3))) & 3u); }
 
@@ -420,16 +489,40 @@ SEAMCL_CALLED void ptexf_apply(PtexfState* s, PtexfKernel* k, int face) {
     const uint base = ptexf_level(s, f, 0, 0) * (uint)nchan;
     for (int c = 0; c < nchan; ++c) acc[c] = ptexf_texel(s, base + (uint)c) * w;
   } else {
+    /* Columns first: each of a row's uw * nchan values summed down the rows (kv), then the columns
+     * across (ku). A row's values are contiguous, so a kernel wider than a few values reads each
+     * row as vectors of 16, which keeps the taps in SIMD registers and issues every row's load at
+     * once. The twin sums in this order; the one-channel tree sum across, multiply-adds fused or
+     * not, and Ptex's rows-first order differ from it by float rounding only. */
     const uint base = ptexf_level(s, f, k->ulog2, k->vlog2);
     const uint rowlen = 1u << k->ulog2;
-    for (int j = 0; j < k->vw; ++j) {
-      float row[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-      const uint first = (base + (uint)(k->v + j) * rowlen + (uint)k->u) * (uint)nchan;
-      for (int c = 0; c < nchan; ++c) row[c] = ptexf_texel(s, first + (uint)c) * k->ku[0];
-      for (int i = 1; i < k->uw; ++i)
-        for (int c = 0; c < nchan; ++c) row[c] += ptexf_texel(s, first + (uint)(i * nchan + c)) * k->ku[i];
-      for (int c = 0; c < nchan; ++c) acc[c] += row[c] * k->kv[j];
+    const int count = k->uw * nchan;
+    const uint first = (base + (uint)k->v * rowlen + (uint)k->u) * (uint)nchan;
+    const uint stride = rowlen * (uint)nchan;
+    float columns[PTEXF_COLUMNS];
+    if (count <= PTEXF_SCALAR_COLUMNS) {
+      for (int l = 0; l < count; ++l) columns[l] = 0.0f;
+      for (int j = 0; j < k->vw; ++j)
+        for (int l = 0; l < count; ++l)
+          columns[l] += ptexf_texel(s, first + (uint)j * stride + (uint)l) * k->kv[j];
+    } else if (nchan == 1) {
+      /* One channel: the columns across as one 16-lane product, summed as a tree. */
+      const float16 column = ptexf_columns16(s, k, first, stride);
+      const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+      const float16 ku = (float16)(k->ku[0], k->ku[1], k->ku[2], k->ku[3], k->ku[4], k->ku[5], k->ku[6], k->ku[7],
+                                   k->ku[8], k->ku[9], 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+      const float16 p = select((float16)(0.0f), column * ku, lane < (int16)(k->uw));
+      const float8 p8 = p.lo + p.hi;
+      const float4 p4 = p8.lo + p8.hi;
+      const float2 p2 = p4.lo + p4.hi;
+      acc[0] = p2.x + p2.y;
+    } else {
+      for (int chunk = 0; 16 * chunk < count; ++chunk)
+        vstore16(ptexf_columns16(s, k, first + (uint)(16 * chunk), stride), chunk, columns);
     }
+    if (nchan > 1 || count <= PTEXF_SCALAR_COLUMNS)
+      for (int i = 0; i < k->uw; ++i)
+        for (int c = 0; c < nchan; ++c) acc[c] += columns[i * nchan + c] * k->ku[i];
   }
   if (s->tex.edge_filter_mode == 1 && nchan >= 2 && k->rot > 0) {
     if (k->rot == 1) { s->result[0] -= acc[1]; s->result[1] += acc[0]; }

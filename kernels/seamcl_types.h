@@ -364,6 +364,9 @@ typedef struct {
  * face holds every resolution 2^i x 2^j (i <= ulog2, j <= vlog2) that the library would read, made
  * by its own reduction rules, in the file's units and channel order. */
 #define SEAMCL_PTEX_KMAX 10          /* taps per axis of a kernel (Ptex's PtexSeparableKernel::kmax) */
+/* Bytes of padding after the last texel value: the filter reads rows 16 values at a time, up to 15
+ * values (of up to 4 bytes) past a row's end. */
+#define SEAMCL_PTEX_TEXEL_TAIL 64
 #define SEAMCL_PTEX_MAX_VALENCE 10   /* faces walked around a corner (Ptex's MaxValence) */
 #define SEAMCL_PTEX_POINT 0
 #define SEAMCL_PTEX_BILINEAR 1

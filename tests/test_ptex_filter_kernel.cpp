@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <random>
@@ -87,6 +88,43 @@ TEST(PtexFilterKernel, MatchesTheTwinOnGoldenAndEdgeLookups) {
     }
     EXPECT_GT(nonzero, static_cast<int>(queries.size()) / 2) << name;
   }
+}
+
+// A float32 RGBA face: the float texel path, and rows of up to 40 values (three 16-value reads),
+// with values outside 0..1 of both signs.
+TEST(PtexFilterKernel, MatchesTheTwinOnAFloatRgbaFace) {
+  PtexTestFile spec;
+  spec.data_type = 3;
+  spec.channels = 4;
+  std::vector<uint8_t> level0;
+  for (int j = 0; j < 16; ++j)
+    for (int i = 0; i < 16; ++i)
+      for (float value : {std::sin(0.7f * i) + 0.1f * j, 2.0f * std::cos(0.5f * j), 0.01f * i * j - 0.3f, 0.5f + 0.03f * i}) {
+        uint8_t bytes[4];
+        std::memcpy(bytes, &value, 4);
+        level0.insert(level0.end(), bytes, bytes + 4);
+      }
+  const float average[4] = {0.5f, 0.1f, 0.3f, 0.7f};
+  std::vector<uint8_t> constant(sizeof average);
+  std::memcpy(constant.data(), average, sizeof average);
+  spec.faces = {{4, 4, 0, {-1, -1, -1, -1}, 0, constant}};
+  spec.levels = {{data_block(level0, 256, 4, 4)}};
+  const PtexFilterData data = build_ptex_filter_data(parse_ptex_stored(write_ptex(spec)));
+  const std::vector<PtexFilterQuery> queries = edge_queries(1, 2000, 13);
+  PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
+  launcher.load(data);
+  const std::vector<float> device = launcher.run(queries);
+  ASSERT_EQ(device.size(), queries.size() * 4);
+  int wide = 0;
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const std::array<float, 4> twin = ptex_filter_twin(data, queries[i]);
+    for (int c = 0; c < 4; ++c)
+      ASSERT_NEAR(device[4 * i + c], twin[c], 2e-6f + 2e-6f * std::fabs(twin[c]))
+          << "lookup " << i << " filter " << queries[i].filter << " at (" << queries[i].u << ", " << queries[i].v
+          << ") widths " << queries[i].uw << " x " << queries[i].vw << " channel " << c;
+    wide += queries[i].filter >= SEAMCL_PTEX_GAUSSIAN && queries[i].uw < 0.25f;
+  }
+  EXPECT_GT(wide, 200);  // width-4 kernels under a quarter face: rows of 4 to 10 taps, 16 to 40 values
 }
 
 // One launch per file (the launcher's compile dominates the time); the twin's own test holds the

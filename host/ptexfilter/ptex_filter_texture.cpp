@@ -146,8 +146,8 @@ uint64_t ptex_filter_data_bytes(const PtexStored& stored) {
     texels += face_texels(info);
     entries += uint64_t(info.ulog2 + 1) * (info.vlog2 + 1);
   }
-  return texels * stored.file.channels * element_bytes(stored.file.data_type) + entries * sizeof(cl_uint) +
-         stored.file.faces.size() * sizeof(PtexFilterFace);
+  return texels * stored.file.channels * element_bytes(stored.file.data_type) + SEAMCL_PTEX_TEXEL_TAIL +
+         entries * sizeof(cl_uint) + stored.file.faces.size() * sizeof(PtexFilterFace);
 }
 
 PtexFilterData build_ptex_filter_data(const PtexStored& stored, const PtexFilterLimits& limits) {
@@ -187,7 +187,7 @@ PtexFilterData build_ptex_filter_data(const PtexStored& stored, const PtexFilter
                           : file.data_type == PtexDataType::Uint16 ? 65535.0f
                                                                    : 1.0f;
   const int channels = file.channels;
-  out.texels.resize(static_cast<size_t>(total_texels) * channels * element_bytes(file.data_type));
+  out.texels.resize(static_cast<size_t>(total_texels) * channels * element_bytes(file.data_type) + SEAMCL_PTEX_TEXEL_TAIL);
   out.faces.resize(file.faces.size());
   size_t next_texel = 0;
   for (size_t f = 0; f < file.faces.size(); ++f) {

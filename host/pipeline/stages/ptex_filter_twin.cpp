@@ -444,16 +444,18 @@ class Evaluator {
       const size_t base = level_offset(f, 0, 0);
       for (int c = 0; c < nchan_; ++c) acc[c] = texel(base, c) * w;
     } else {
+      // Columns first (down the rows with kv, then across with ku), as the kernel sums them.
       const size_t base = level_offset(f, k.ulog2, k.vlog2);
       const size_t rowlen = static_cast<size_t>(k.res_u());
+      std::array<float, 4 * SEAMCL_PTEX_KMAX> columns{};
       for (int j = 0; j < k.vw; ++j) {
-        float row[4] = {};
         const size_t first = base + static_cast<size_t>(k.v + j) * rowlen + static_cast<size_t>(k.u);
-        for (int c = 0; c < nchan_; ++c) row[c] = texel(first, c) * k.ku[0];
-        for (int i = 1; i < k.uw; ++i)
-          for (int c = 0; c < nchan_; ++c) row[c] += texel(first + i, c) * k.ku[i];
-        for (int c = 0; c < nchan_; ++c) acc[c] += row[c] * k.kv[j];
+        for (int i = 0; i < k.uw; ++i)
+          for (int c = 0; c < nchan_; ++c)
+            columns[i * nchan_ + c] += texel(first + i, c) * k.kv[j];
       }
+      for (int i = 0; i < k.uw; ++i)
+        for (int c = 0; c < nchan_; ++c) acc[c] += columns[i * nchan_ + c] * k.ku[i];
     }
     // Tangent-space vectors (edge filter mode tanvec) turn with the neighbour.
     if (tex_.edge_filter_mode == 1 && nchan_ >= 2 && k.rot > 0) {

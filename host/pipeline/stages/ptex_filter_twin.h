@@ -16,7 +16,8 @@
 namespace seamcl {
 
 // What ptex_filter.cl reads: per face its record, the texel offset of each of its resolutions,
-// and the texels in the file's element type (1, 2 or 4 bytes), channels interleaved.
+// and the texels in the file's element type (1, 2 or 4 bytes), channels interleaved, followed by
+// SEAMCL_PTEX_TEXEL_TAIL bytes that the kernel's vector reads may touch.
 struct PtexFilterData {
   PtexFilterTexture texture{};
   std::vector<PtexFilterFace> faces;
