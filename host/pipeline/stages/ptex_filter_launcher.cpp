@@ -43,13 +43,19 @@ void PtexFilterLauncher::set_args(const cl::Buffer& queries, int count, const cl
 std::vector<float> PtexFilterLauncher::run(const std::vector<PtexFilterQuery>& queries) {
   std::vector<float> values(queries.size() * 4);
   if (queries.empty()) return values;
-  size_t ignored = 0;
-  const cl::Buffer in = upload(runtime_, queries, ignored);
-  const cl::Buffer out(runtime_.context(), CL_MEM_WRITE_ONLY, values.size() * sizeof(float));
+  // The queries and the values stay in host memory: a CPU device reads and writes them where they
+  // are (for point lookups the copies in and out took as long as the kernel), and a device with
+  // memory of its own copies them as it would for a write and a read.
+  const size_t out_bytes = values.size() * sizeof(float);
+  const cl::Buffer in(runtime_.context(), CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, queries.size() * sizeof(PtexFilterQuery),
+                      const_cast<PtexFilterQuery*>(queries.data()));
+  const cl::Buffer out(runtime_.context(), CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, out_bytes, values.data());
   set_args(in, static_cast<int>(queries.size()), out);
   runtime_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(round_up(queries.size(), kGroup)),
                                         cl::NDRange(kGroup));
-  runtime_.queue().enqueueReadBuffer(out, CL_TRUE, 0, values.size() * sizeof(float), values.data());
+  void* mapped = runtime_.queue().enqueueMapBuffer(out, CL_TRUE, CL_MAP_READ, 0, out_bytes);
+  runtime_.queue().enqueueUnmapMemObject(out, mapped);
+  runtime_.queue().finish();
   return values;
 }
 
