@@ -245,19 +245,21 @@ SEAMCL_INLINE float ptexf_make_symmetric(PtexfKernel* k, float initial_weight) {
 SEAMCL_INLINE int ptexf_res_from_width(float w) { return 127 - ((as_int(w) >> 23) & 0xff); }
 SEAMCL_INLINE float ptexf_reciprocal_pow2(int power) { return as_float((127 - power) << 23); }
 
-/* e^y for the gaussian's y = -2x^2 as 2^n e^z: n = rint(y log2 e), z = y - n ln 2 in two steps
+/* e^y for the gaussian's y = -2x^2 as 2^n e^z: n = y log2 e rounded, z = y - n ln 2 in two steps
  * (Cody and Waite), |z| <= ln 2 / 2, e^z by its Taylor series to z^6 (relative error under 2e-7);
- * y clamped to -87, where e^y is under 2e-38. PoCL runs the library's vector exp lane by lane:
- * this is one vector of arithmetic. */
+ * y clamped to -87, where e^y is under 2e-38. The library's float16 exp was no faster on PoCL
+ * than 16 scalar ones (docs/performance.md); this is one vector of arithmetic. */
 SEAMCL_INLINE float16 ptexf_exp16(float16 y) {
   y = fmax(y, -87.0f);
-  const float16 n = rint(y * 1.44269504088896f);
+  /* y log2 e rounded to an integer by adding 1.5 * 2^23: the sum's low mantissa bits are n. */
+  const int16 n_bits = as_int16(y * 1.44269504088896f + 12582912.0f) - 0x4b400000;
+  const float16 n = convert_float16(n_bits);
   /* ln 2's high part has 15 significant bits, so its product with |n| <= 126 (7 bits) is exact. */
   const float16 z = (y - n * 0.693145751953125f) - n * 1.42860682028622680e-6f;
   const float16 p =
       ((((((1.0f / 720.0f) * z + 1.0f / 120.0f) * z + 1.0f / 24.0f) * z + 1.0f / 6.0f) * z + 0.5f) * z + 1.0f) * z +
       1.0f;
-  return p * as_float16((convert_int16(n) + 127) << 23);
+  return p * as_float16((n_bits + 127) << 23);
 }
 
 /* A width-4 filter's weights at x1, x1 + step, ... into all SEAMCL_PTEX_KMAX entries of k (the
@@ -630,9 +632,37 @@ SEAMCL_INLINE void ptexf_split_and_apply(PtexfState* s, PtexfKernel* k, int face
   ptexf_apply(s, k, faceid);
 }
 
+/* Point lookup q: the texel under (u, v) at the face's own resolution (a neighbourhood-constant
+ * face's one value) divided by the type's one value; channels beyond the texture's 0, a face out of
+ * range zeros (the texture has at least one face: the reader refuses a file without). Nothing
+ * branches on the query, so a batch of point lookups alone (ptex_point_lookups) vectorises across
+ * work-items; the 4-value read (16 for halves) stays within SEAMCL_PTEX_TEXEL_TAIL. */
+SEAMCL_INLINE float4 ptexf_point(const PtexfState* s, const PtexFilterQuery* q) {
+  const PtexFilterFace f = s->faces[clamp(q->face, 0, s->tex.face_count - 1)];
+  const bool flat = (f.flags & SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT) != 0u;
+  const int ulog2 = flat ? 0 : f.ulog2, vlog2 = flat ? 0 : f.vlog2;
+  const int resu = 1 << ulog2, resv = 1 << vlog2;
+  const int ui = clamp((int)(q->u * (float)resu), 0, resu - 1);
+  const int vi = clamp((int)(q->v * (float)resv), 0, resv - 1);
+  const uint index = (ptexf_level(s, f, ulog2, vlog2) + (uint)(vi * resu + ui)) * (uint)s->tex.channels;
+  float4 value;
+  switch (s->tex.data_type) {
+    case 0: value = convert_float4(vload4(0, s->texels + index)); break;
+    case 1: value = convert_float4(vload4(0, (__global const ushort*)s->texels + index)); break;
+    case 2: value = ptexf_halves_to_float16(vload16(0, (__global const ushort*)s->texels + index)).s0123; break;
+    default: value = vload4(0, (__global const float*)s->texels + index); break;
+  }
+  const int channels = q->face >= 0 && q->face < s->tex.face_count ? s->tex.channels : 0;
+  return select((float4)(0.0f), value / s->tex.one_value, (int4)(0, 1, 2, 3) < (int4)(channels));
+}
+
 /* Lookup q on the texture s reads (s->tex, faces, level_offsets, texels): 4 floats into out,
  * channels beyond the texture's 0. */
 SEAMCL_INLINE void ptexf_lookup(PtexfState* s, const PtexFilterQuery* q, float* out) {
+  if (q->filter == SEAMCL_PTEX_POINT) {
+    vstore4(ptexf_point(s, q), 0, out);
+    return;
+  }
   for (int c = 0; c < 4; ++c) out[c] = 0.0f;
   if (q->face < 0 || q->face >= s->tex.face_count) return;
   s->weight = 0.0f;
@@ -646,14 +676,6 @@ SEAMCL_INLINE void ptexf_lookup(PtexfState* s, const PtexFilterQuery* q, float* 
     return;
   }
   float u = q->u, v = q->v;
-  if (q->filter == SEAMCL_PTEX_POINT) {
-    const int resu = 1 << f.ulog2, resv = 1 << f.vlog2;
-    const int ui = clamp((int)(u * (float)resu), 0, resu - 1);
-    const int vi = clamp((int)(v * (float)resv), 0, resv - 1);
-    const uint base = (ptexf_level(s, f, f.ulog2, f.vlog2) + (uint)(vi * resu + ui)) * (uint)nchan;
-    for (int c = 0; c < nchan; ++c) out[c] = ptexf_texel(s, base + (uint)c) / s->tex.one_value;
-    return;
-  }
   const int umode = s->tex.seams == SEAMCL_PTEX_SEAMS_PTEX ? s->tex.u_border_mode : 0;
   const int vmode = s->tex.seams == SEAMCL_PTEX_SEAMS_PTEX ? s->tex.v_border_mode : 0;
   bool black = false;

@@ -1,5 +1,6 @@
 /* Batches of lookups of Ptex's own filters (`seamcl ptx lookup`, the kernel tests and the Ptex
- * benchmark): one work-item per query, ptexf_lookup of ptex_filter.cl.
+ * benchmark): one work-item per query, ptexf_lookup of ptex_filter.cl; a batch of point lookups
+ * alone through ptex_point_lookups, whose work-items PoCL runs as vectors.
  * Contract: out[4 * id ..] holds query id's 4 floats (channels beyond the texture's 0; a face out of
  * range gives zeros) for id < count. Host guarantees: tex, faces, level_offsets and texels as
  * ptex_filter.cl states; tex.seams 0 (Ptex's own rules); out holds 4 * count floats.
@@ -22,5 +23,20 @@ __kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilt
   ptexf_lookup(&s, &q, value);
   __global float* dst = out + 4 * id;
   for (int c = 0; c < 4; ++c) dst[c] = value[c];
+}
+
+/* ptex_filter_lookups for a batch whose every query is SEAMCL_PTEX_POINT: ptexf_point alone. */
+__kernel void ptex_point_lookups(PtexFilterTexture tex, __global const PtexFilterFace* faces,
+                                 __global const uint* level_offsets, __global const uchar* texels,
+                                 __global const PtexFilterQuery* queries, int count, __global float* out) {
+  const int id = (int)get_global_id(0);
+  if (id >= count) return;
+  const PtexFilterQuery q = queries[id];
+  PtexfState s;
+  s.faces = faces;
+  s.level_offsets = level_offsets;
+  s.texels = texels;
+  s.tex = tex;
+  vstore4(ptexf_point(&s, &q), id, out);
 }
 #endif

@@ -12,6 +12,7 @@
 #include <map>
 #include <random>
 #include <string>
+#include <utility>
 
 #include <seamcl/assets/ptex_file.h>
 
@@ -90,9 +91,8 @@ TEST(PtexFilterKernel, MatchesTheTwinOnGoldenAndEdgeLookups) {
   }
 }
 
-// A float32 RGBA face: the float texel path, and rows of up to 40 values (three 16-value reads),
-// with values outside 0..1 of both signs.
-TEST(PtexFilterKernel, MatchesTheTwinOnAFloatRgbaFace) {
+// One float32 RGBA face of 16 x 16 texels, with values outside 0..1 of both signs.
+PtexFilterData float_rgba_face() {
   PtexTestFile spec;
   spec.data_type = 3;
   spec.channels = 4;
@@ -109,7 +109,12 @@ TEST(PtexFilterKernel, MatchesTheTwinOnAFloatRgbaFace) {
   std::memcpy(constant.data(), average, sizeof average);
   spec.faces = {{4, 4, 0, {-1, -1, -1, -1}, 0, constant}};
   spec.levels = {{data_block(level0, 256, 4, 4)}};
-  const PtexFilterData data = build_ptex_filter_data(parse_ptex_stored(write_ptex(spec)));
+  return build_ptex_filter_data(parse_ptex_stored(write_ptex(spec)));
+}
+
+// The float texel path, and rows of up to 40 values (three 16-value reads).
+TEST(PtexFilterKernel, MatchesTheTwinOnAFloatRgbaFace) {
+  const PtexFilterData data = float_rgba_face();
   const std::vector<PtexFilterQuery> queries = edge_queries(1, 2000, 13);
   PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
   launcher.load(data);
@@ -125,6 +130,52 @@ TEST(PtexFilterKernel, MatchesTheTwinOnAFloatRgbaFace) {
     wide += queries[i].filter >= SEAMCL_PTEX_GAUSSIAN && queries[i].uw < 0.25f;
   }
   EXPECT_GT(wide, 200);  // width-4 kernels under a quarter face: rows of 4 to 10 taps, 16 to 40 values
+}
+
+// A batch of point lookups alone runs through ptex_point_lookups: the same values as the twin's and
+// as the same lookups in a mixed batch, every type (uint8 of 1 and 3 channels, uint16, float16,
+// float32 RGBA), faces out of range and points outside the face included.
+TEST(PtexFilterKernel, PointBatchesMatchTheTwinAndMixedBatches) {
+  std::vector<std::pair<std::string, PtexFilterData>> textures;
+  for (const char* name : {"black", "cellnoise", "cube_text", "rand_lo", "wave_lo"})
+    textures.emplace_back(name, build_ptex_filter_data(read_ptex_stored(ptex_assets_dir() + "/" + name + ".ptx")));
+  textures.emplace_back("float rgba", float_rgba_face());
+  for (const auto& [name, data] : textures) {
+    const int faces = static_cast<int>(data.faces.size());
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> coordinate(-0.25f, 1.25f);
+    std::vector<PtexFilterQuery> points;
+    for (int i = 0; i < 3000; ++i) {
+      PtexFilterQuery q{};
+      q.filter = SEAMCL_PTEX_POINT;
+      q.face = i % 100 == 0 ? -1 : i % 100 == 1 ? faces : static_cast<int>(random() % static_cast<unsigned>(faces));
+      q.u = i % 7 == 0 ? 1.0f : coordinate(random);
+      q.v = i % 11 == 0 ? 0.0f : coordinate(random);
+      q.uw = q.vw = 0.01f;
+      points.push_back(q);
+    }
+    std::vector<PtexFilterQuery> mixed = points;
+    PtexFilterQuery bilinear = points[5];
+    bilinear.filter = SEAMCL_PTEX_BILINEAR;
+    mixed.push_back(bilinear);
+    PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
+    launcher.load(data);
+    const std::vector<float> alone = launcher.run(points);
+    const std::vector<float> among = launcher.run(mixed);
+    int nonzero = 0;
+    for (size_t i = 0; i < points.size(); ++i) {
+      const std::array<float, 4> twin = ptex_filter_twin(data, points[i]);
+      for (int c = 0; c < 4; ++c) {
+        ASSERT_EQ(alone[4 * i + c], twin[c]) << name << " lookup " << i << " face " << points[i].face << " at ("
+                                             << points[i].u << ", " << points[i].v << ") channel " << c;
+        ASSERT_EQ(among[4 * i + c], twin[c]) << name << " lookup " << i << " in the mixed batch, channel " << c;
+        nonzero += twin[c] != 0.0f;
+      }
+      if (points[i].face < 0 || points[i].face >= faces)
+        for (int c = 0; c < 4; ++c) EXPECT_EQ(alone[4 * i + c], 0.0f) << name << " face " << points[i].face;
+    }
+    EXPECT_GT(nonzero, static_cast<int>(points.size()) / 2) << name;
+  }
 }
 
 // One launch per file (the launcher's compile dominates the time); the twin's own test holds the

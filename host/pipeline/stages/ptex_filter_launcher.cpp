@@ -20,7 +20,9 @@ cl::Buffer upload(ClRuntime& runtime, const std::vector<T>& data, size_t& bytes_
 }  // namespace
 
 PtexFilterLauncher::PtexFilterLauncher(ClRuntime& runtime)
-    : runtime_(runtime), kernel_(runtime.program(KernelProgram::PtexFilter), "ptex_filter_lookups") {}
+    : runtime_(runtime),
+      kernel_(runtime.program(KernelProgram::PtexFilter), "ptex_filter_lookups"),
+      point_kernel_(runtime.program(KernelProgram::PtexFilter), "ptex_point_lookups") {}
 
 void PtexFilterLauncher::load(const PtexFilterData& data) {
   device_bytes_ = 0;
@@ -30,14 +32,19 @@ void PtexFilterLauncher::load(const PtexFilterData& data) {
   texels_ = upload(runtime_, data.texels, device_bytes_);
 }
 
-void PtexFilterLauncher::set_args(const cl::Buffer& queries, int count, const cl::Buffer& out) {
-  kernel_.setArg(0, texture_);
-  kernel_.setArg(1, faces_);
-  kernel_.setArg(2, level_offsets_);
-  kernel_.setArg(3, texels_);
-  kernel_.setArg(4, queries);
-  kernel_.setArg(5, count);
-  kernel_.setArg(6, out);
+cl::Kernel& PtexFilterLauncher::kernel_for(const std::vector<PtexFilterQuery>& queries, const cl::Buffer& in,
+                                           const cl::Buffer& out) {
+  const bool points = std::all_of(queries.begin(), queries.end(),
+                                  [](const PtexFilterQuery& q) { return q.filter == SEAMCL_PTEX_POINT; });
+  cl::Kernel& kernel = points ? point_kernel_ : kernel_;
+  kernel.setArg(0, texture_);
+  kernel.setArg(1, faces_);
+  kernel.setArg(2, level_offsets_);
+  kernel.setArg(3, texels_);
+  kernel.setArg(4, in);
+  kernel.setArg(5, static_cast<int>(queries.size()));
+  kernel.setArg(6, out);
+  return kernel;
 }
 
 std::vector<float> PtexFilterLauncher::run(const std::vector<PtexFilterQuery>& queries) {
@@ -50,9 +57,8 @@ std::vector<float> PtexFilterLauncher::run(const std::vector<PtexFilterQuery>& q
   const cl::Buffer in(runtime_.context(), CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, queries.size() * sizeof(PtexFilterQuery),
                       const_cast<PtexFilterQuery*>(queries.data()));
   const cl::Buffer out(runtime_.context(), CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, out_bytes, values.data());
-  set_args(in, static_cast<int>(queries.size()), out);
-  runtime_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(round_up(queries.size(), kGroup)),
-                                        cl::NDRange(kGroup));
+  runtime_.queue().enqueueNDRangeKernel(kernel_for(queries, in, out), cl::NullRange,
+                                        cl::NDRange(round_up(queries.size(), kGroup)), cl::NDRange(kGroup));
   void* mapped = runtime_.queue().enqueueMapBuffer(out, CL_TRUE, CL_MAP_READ, 0, out_bytes);
   runtime_.queue().enqueueUnmapMemObject(out, mapped);
   runtime_.queue().finish();
@@ -65,10 +71,10 @@ std::vector<double> PtexFilterLauncher::time(const std::vector<PtexFilterQuery>&
   size_t ignored = 0;
   const cl::Buffer in = upload(runtime_, queries, ignored);
   const cl::Buffer out(runtime_.context(), CL_MEM_WRITE_ONLY, queries.size() * 4 * sizeof(float));
-  set_args(in, static_cast<int>(queries.size()), out);
+  cl::Kernel& kernel = kernel_for(queries, in, out);
   std::vector<cl::Event> events(static_cast<size_t>(std::max(repeats, 0)));
   for (cl::Event& event : events)
-    runtime_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(round_up(queries.size(), kGroup)),
+    runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(round_up(queries.size(), kGroup)),
                                           cl::NDRange(kGroup), nullptr, &event);
   runtime_.queue().finish();
   for (const cl::Event& event : events) ms.push_back(event_milliseconds(event));

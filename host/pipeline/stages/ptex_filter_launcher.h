@@ -15,7 +15,8 @@ class PtexFilterLauncher {
   // Uploads faces, level offsets and texels.
   void load(const PtexFilterData& data);
 
-  // 4 floats per query (channels beyond the texture's are 0), in order.
+  // 4 floats per query (channels beyond the texture's are 0), in order. A batch of point lookups
+  // alone runs through a kernel of its own, which PoCL vectorises.
   std::vector<float> run(const std::vector<PtexFilterQuery>& queries);
 
   // Uploads `queries` once (for timing) and runs them `repeats` times back to back; returns the
@@ -25,10 +26,12 @@ class PtexFilterLauncher {
   size_t device_bytes() const { return device_bytes_; }
 
  private:
-  void set_args(const cl::Buffer& queries, int count, const cl::Buffer& out);
+  // The kernel for `queries` (ptex_point_lookups when every one is a point lookup), its arguments set.
+  cl::Kernel& kernel_for(const std::vector<PtexFilterQuery>& queries, const cl::Buffer& in, const cl::Buffer& out);
 
   ClRuntime& runtime_;
   cl::Kernel kernel_;
+  cl::Kernel point_kernel_;
   PtexFilterTexture texture_{};
   cl::Buffer faces_, level_offsets_, texels_;
   size_t device_bytes_ = 0;
