@@ -8,21 +8,27 @@
 
 /* Only where ptex_filter.cl compiles: the ptex-filter program, built with no sampler variant. */
 #if !defined(SEAMCL_SAMPLER_FILTER) || SEAMCL_SAMPLER_FILTER == SEAMCL_FILTER_PTEX
+/* What a batch's lookups read: the texture and its buffers. */
+SEAMCL_INLINE PtexfState ptexf_batch_state(PtexFilterTexture tex, __global const PtexFilterFace* faces,
+                                           __global const uint* level_offsets, __global const uchar* texels) {
+  PtexfState s;
+  s.faces = faces;
+  s.level_offsets = level_offsets;
+  s.texels = texels;
+  s.tex = tex;
+  return s;
+}
+
 __kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilterFace* faces,
                                   __global const uint* level_offsets, __global const uchar* texels,
                                   __global const PtexFilterQuery* queries, int count, __global float* out) {
   const int id = (int)get_global_id(0);
   if (id >= count) return;
   const PtexFilterQuery q = queries[id];
-  PtexfState s;
-  s.faces = faces;
-  s.level_offsets = level_offsets;
-  s.texels = texels;
-  s.tex = tex;
+  PtexfState s = ptexf_batch_state(tex, faces, level_offsets, texels);
   float value[4];
   ptexf_lookup(&s, &q, value);
-  __global float* dst = out + 4 * id;
-  for (int c = 0; c < 4; ++c) dst[c] = value[c];
+  vstore4(vload4(0, value), id, out);
 }
 
 /* ptex_filter_lookups for a batch whose every query is SEAMCL_PTEX_POINT: ptexf_point alone. */
@@ -32,11 +38,7 @@ __kernel void ptex_point_lookups(PtexFilterTexture tex, __global const PtexFilte
   const int id = (int)get_global_id(0);
   if (id >= count) return;
   const PtexFilterQuery q = queries[id];
-  PtexfState s;
-  s.faces = faces;
-  s.level_offsets = level_offsets;
-  s.texels = texels;
-  s.tex = tex;
+  const PtexfState s = ptexf_batch_state(tex, faces, level_offsets, texels);
   vstore4(ptexf_point(&s, &q), id, out);
 }
 #endif
