@@ -15,8 +15,8 @@
  * sum is divided by the weight of the taps inside the face instead.
  * Host guarantees (host/ptexfilter/ptex_filter_texture.cpp): every resolution 2^i x 2^j of every
  * face at texels + level_offsets[face.level_base + i * (vlog2 + 1) + j] (texel index; channels
- * interleaved; the element count fits a uint), then SEAMCL_PTEX_TEXEL_TAIL bytes of padding; no
- * subfaces.
+ * interleaved; the element count fits a uint; a constant face's one texel at every offset), then
+ * SEAMCL_PTEX_TEXEL_TAIL bytes of padding; at least one face; no subfaces.
  * The shading program compiles this file into its Ptex variant only (SEAMCL_SAMPLER_FILTER =
  * SEAMCL_FILTER_PTEX); the others skip it.
  * Twin: host/pipeline/stages/ptex_filter_twin.cpp. */
@@ -29,8 +29,9 @@
 #define PTEXF_LEFT 3
 #define PTEXF_BLACK 1
 #define PTEXF_PERIODIC 2
-/* A kernel row's values (uw * nchan, at most 40) as whole vectors of 16; rows of at most
- * PTEXF_SCALAR_COLUMNS values (one channel's bilinear and narrow boxes) are summed value by value. */
+/* A kernel row's values as whole vectors of 16 (uw * nchan: at most 40 by the arrays' sizes; Ptex's
+ * kernels reach 8 taps, 32 values); rows of at most PTEXF_SCALAR_COLUMNS values (one channel's
+ * bilinear and narrow boxes) are summed value by value. */
 #define PTEXF_COLUMNS 48
 #define PTEXF_SCALAR_COLUMNS 3
 
@@ -246,9 +247,11 @@ SEAMCL_INLINE int ptexf_res_from_width(float w) { return 127 - ((as_int(w) >> 23
 SEAMCL_INLINE float ptexf_reciprocal_pow2(int power) { return as_float((127 - power) << 23); }
 
 /* e^y for the gaussian's y = -2x^2 as 2^n e^z: n = y log2 e rounded, z = y - n ln 2 in two steps
- * (Cody and Waite), |z| <= ln 2 / 2, e^z by its Taylor series to z^6 (relative error under 2e-7);
- * y clamped to -87, where e^y is under 2e-38. The library's float16 exp was no faster on PoCL
- * than 16 scalar ones (docs/performance.md); this is one vector of arithmetic. */
+ * (Cody and Waite), |z| <= ln 2 / 2, e^z by its Taylor series to z^6 (truncation under 2e-7
+ * relative, about 3e-7 with rounding). y is clamped to -87 so that n >= -126 and 2^n is a normal
+ * float made of exponent bits (the lanes past a kernel's taps reach |x| of about 13). The
+ * library's float16 exp was no faster on PoCL than 16 scalar ones (docs/performance.md); this is
+ * one vector of arithmetic. */
 SEAMCL_INLINE float16 ptexf_exp16(float16 y) {
   y = fmax(y, -87.0f);
   /* y log2 e rounded to an integer by adding 1.5 * 2^23: the sum's low mantissa bits are n. */
@@ -435,8 +438,8 @@ SEAMCL_INLINE float16 ptexf_halves_to_float16(ushort16 h) {
 }
 
 /* 16 consecutive values of type data_type from index on, as floats; past a row's end they are
- * whatever follows (the host pads the buffer by SEAMCL_PTEX_TEXEL_TAIL bytes), and the caller reads
- * none of those lanes. */
+ * whatever follows (the host pads the buffer by SEAMCL_PTEX_TEXEL_TAIL bytes, so they may be NaN),
+ * and the callers discard those lanes. */
 SEAMCL_INLINE float16 ptexf_texels16(const PtexfState* s, uint index, int data_type) {
   switch (data_type) {
     case 0: return convert_float16(vload16(0, s->texels + index));
@@ -446,23 +449,23 @@ SEAMCL_INLINE float16 ptexf_texels16(const PtexfState* s, uint index, int data_t
   }
 }
 
-/* The kernel's vw rows from index first on (rows stride values apart), each row's 16 values from
- * there weighted by kv and summed down the rows. */
-SEAMCL_INLINE float16 ptexf_column(const PtexfState* s, const PtexfKernel* k, uint first, uint stride, int data_type) {
+/* The kernel's vw rows, each 16 values from `first` on (rows `stride` values apart) of type
+ * data_type, weighted by kv and summed down the rows. */
+SEAMCL_INLINE float16 ptexf_sum_down16_of_type(const PtexfState* s, const PtexfKernel* k, uint first, uint stride,
+                                              int data_type) {
   float16 column = (float16)(0.0f);
-  for (int j = 0; j < k->vw; ++j)
-    column += ptexf_texels16(s, first + (uint)j * stride, data_type) * k->kv[j];
+  for (int j = 0; j < k->vw; ++j) column += ptexf_texels16(s, first + (uint)j * stride, data_type) * k->kv[j];
   return column;
 }
 
-/* ptexf_column for the texture's type, each type's loop compiled apart (the type a constant in each
- * call) so that no row switches on it. */
-SEAMCL_INLINE float16 ptexf_columns16(const PtexfState* s, const PtexfKernel* k, uint first, uint stride) {
+/* ptexf_sum_down16_of_type for the texture's type, each type's loop compiled apart (the type a
+ * constant in each call) so that no row switches on it. */
+SEAMCL_INLINE float16 ptexf_sum_down16(const PtexfState* s, const PtexfKernel* k, uint first, uint stride) {
   switch (s->tex.data_type) {
-    case 0: return ptexf_column(s, k, first, stride, 0);
-    case 1: return ptexf_column(s, k, first, stride, 1);
-    case 2: return ptexf_column(s, k, first, stride, 2);
-    default: return ptexf_column(s, k, first, stride, 3);
+    case 0: return ptexf_sum_down16_of_type(s, k, first, stride, 0);
+    case 1: return ptexf_sum_down16_of_type(s, k, first, stride, 1);
+    case 2: return ptexf_sum_down16_of_type(s, k, first, stride, 2);
+    default: return ptexf_sum_down16_of_type(s, k, first, stride, 3);
   }
 }
 
@@ -471,6 +474,48 @@ SEAMCL_INLINE int ptexf_adj_edge(PtexFilterFace f, int e) { return (int)((f.adj_
 
 SEAMCL_INLINE uint ptexf_level(const PtexfState* s, PtexFilterFace f, int ulog2, int vlog2) {
   return s->level_offsets[f.level_base + (uint)(ulog2 * (f.vlog2 + 1) + vlog2)];
+}
+
+/* acc[c] += sum over the kernel's columns i of ku[i] * columns[i * nchan + c]. */
+SEAMCL_INLINE void ptexf_sum_across(const float* columns, const PtexfKernel* k, int nchan, float* acc) {
+  for (int i = 0; i < k->uw; ++i)
+    for (int c = 0; c < nchan; ++c) acc[c] += columns[i * nchan + c] * k->ku[i];
+}
+
+/* The kernel's taps on face f, at a resolution the face stores, summed into acc (one per channel).
+ * Columns first: each of a row's uw * nchan values summed down the rows (kv), then the columns
+ * across (ku). A row's values are contiguous, so a row of more than PTEXF_SCALAR_COLUMNS values is
+ * read as vectors of 16, which keeps the taps in SIMD registers and issues every row's load at
+ * once. The twin sums in this order; the one-channel tree sum across, multiply-adds fused or not,
+ * and Ptex's rows-first order differ from it by float rounding only. */
+SEAMCL_INLINE void ptexf_sum_taps(const PtexfState* s, const PtexfKernel* k, PtexFilterFace f, float* acc) {
+  const int nchan = s->tex.channels;
+  const uint rowlen = 1u << k->ulog2;
+  const int count = k->uw * nchan;
+  const uint first = (ptexf_level(s, f, k->ulog2, k->vlog2) + (uint)k->v * rowlen + (uint)k->u) * (uint)nchan;
+  const uint stride = rowlen * (uint)nchan;
+  float columns[PTEXF_COLUMNS];
+  if (count <= PTEXF_SCALAR_COLUMNS) {
+    for (int l = 0; l < count; ++l) columns[l] = 0.0f;
+    for (int j = 0; j < k->vw; ++j)
+      for (int l = 0; l < count; ++l) columns[l] += ptexf_texel(s, first + (uint)j * stride + (uint)l) * k->kv[j];
+    ptexf_sum_across(columns, k, nchan, acc);
+  } else if (nchan == 1) {
+    /* One channel: the columns across as one 16-lane product, summed as a tree. */
+    const float16 column = ptexf_sum_down16(s, k, first, stride);
+    const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const float16 ku = (float16)(k->ku[0], k->ku[1], k->ku[2], k->ku[3], k->ku[4], k->ku[5], k->ku[6], k->ku[7],
+                                 k->ku[8], k->ku[9], 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+    const float16 p = select((float16)(0.0f), column * ku, lane < (int16)(k->uw));
+    const float8 p8 = p.lo + p.hi;
+    const float4 p4 = p8.lo + p8.hi;
+    const float2 p2 = p4.lo + p4.hi;
+    acc[0] = p2.x + p2.y;
+  } else {
+    for (int chunk = 0; 16 * chunk < count; ++chunk)
+      vstore16(ptexf_sum_down16(s, k, first + (uint)(16 * chunk), stride), chunk, columns);
+    ptexf_sum_across(columns, k, nchan, acc);
+  }
 }
 
 SEAMCL_CALLED void ptexf_apply(PtexfState* s, PtexfKernel* k, int face) {
@@ -491,40 +536,7 @@ SEAMCL_CALLED void ptexf_apply(PtexfState* s, PtexfKernel* k, int face) {
     const uint base = ptexf_level(s, f, 0, 0) * (uint)nchan;
     for (int c = 0; c < nchan; ++c) acc[c] = ptexf_texel(s, base + (uint)c) * w;
   } else {
-    /* Columns first: each of a row's uw * nchan values summed down the rows (kv), then the columns
-     * across (ku). A row's values are contiguous, so a kernel wider than a few values reads each
-     * row as vectors of 16, which keeps the taps in SIMD registers and issues every row's load at
-     * once. The twin sums in this order; the one-channel tree sum across, multiply-adds fused or
-     * not, and Ptex's rows-first order differ from it by float rounding only. */
-    const uint base = ptexf_level(s, f, k->ulog2, k->vlog2);
-    const uint rowlen = 1u << k->ulog2;
-    const int count = k->uw * nchan;
-    const uint first = (base + (uint)k->v * rowlen + (uint)k->u) * (uint)nchan;
-    const uint stride = rowlen * (uint)nchan;
-    float columns[PTEXF_COLUMNS];
-    if (count <= PTEXF_SCALAR_COLUMNS) {
-      for (int l = 0; l < count; ++l) columns[l] = 0.0f;
-      for (int j = 0; j < k->vw; ++j)
-        for (int l = 0; l < count; ++l)
-          columns[l] += ptexf_texel(s, first + (uint)j * stride + (uint)l) * k->kv[j];
-    } else if (nchan == 1) {
-      /* One channel: the columns across as one 16-lane product, summed as a tree. */
-      const float16 column = ptexf_columns16(s, k, first, stride);
-      const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-      const float16 ku = (float16)(k->ku[0], k->ku[1], k->ku[2], k->ku[3], k->ku[4], k->ku[5], k->ku[6], k->ku[7],
-                                   k->ku[8], k->ku[9], 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
-      const float16 p = select((float16)(0.0f), column * ku, lane < (int16)(k->uw));
-      const float8 p8 = p.lo + p.hi;
-      const float4 p4 = p8.lo + p8.hi;
-      const float2 p2 = p4.lo + p4.hi;
-      acc[0] = p2.x + p2.y;
-    } else {
-      for (int chunk = 0; 16 * chunk < count; ++chunk)
-        vstore16(ptexf_columns16(s, k, first + (uint)(16 * chunk), stride), chunk, columns);
-    }
-    if (nchan > 1 || count <= PTEXF_SCALAR_COLUMNS)
-      for (int i = 0; i < k->uw; ++i)
-        for (int c = 0; c < nchan; ++c) acc[c] += columns[i * nchan + c] * k->ku[i];
+    ptexf_sum_taps(s, k, f, acc);
   }
   if (s->tex.edge_filter_mode == 1 && nchan >= 2 && k->rot > 0) {
     if (k->rot == 1) { s->result[0] -= acc[1]; s->result[1] += acc[0]; }
@@ -632,14 +644,15 @@ SEAMCL_INLINE void ptexf_split_and_apply(PtexfState* s, PtexfKernel* k, int face
   ptexf_apply(s, k, faceid);
 }
 
-/* Point lookup q: the texel under (u, v) at the face's own resolution (a neighbourhood-constant
- * face's one value) divided by the type's one value; channels beyond the texture's 0, a face out of
- * range zeros (the texture has at least one face: the reader refuses a file without). Nothing
- * branches on the query, so a batch of point lookups alone (ptex_point_lookups) vectorises across
- * work-items; the 4-value read (16 for halves) stays within SEAMCL_PTEX_TEXEL_TAIL. */
+/* Point lookup q: the texel under (u, v) at the face's own resolution (a constant face's one value,
+ * as the library's point filter gives it) divided by the type's one value; channels beyond the
+ * texture's 0, a face out of range zeros (the texture has at least one face: the reader refuses a
+ * file without). Nothing branches on the query, so a batch of point lookups alone
+ * (ptex_point_lookups) vectorises across work-items; the 4-value read (16 for halves) stays within
+ * SEAMCL_PTEX_TEXEL_TAIL. */
 SEAMCL_INLINE float4 ptexf_point(const PtexfState* s, const PtexFilterQuery* q) {
   const PtexFilterFace f = s->faces[clamp(q->face, 0, s->tex.face_count - 1)];
-  const bool flat = (f.flags & SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT) != 0u;
+  const bool flat = (f.flags & (SEAMCL_PTEX_FLAG_CONSTANT | SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT)) != 0u;
   const int ulog2 = flat ? 0 : f.ulog2, vlog2 = flat ? 0 : f.vlog2;
   const int resu = 1 << ulog2, resv = 1 << vlog2;
   const int ui = clamp((int)(q->u * (float)resu), 0, resu - 1);
@@ -659,22 +672,18 @@ SEAMCL_INLINE float4 ptexf_point(const PtexfState* s, const PtexFilterQuery* q) 
 /* Lookup q on the texture s reads (s->tex, faces, level_offsets, texels): 4 floats into out,
  * channels beyond the texture's 0. */
 SEAMCL_INLINE void ptexf_lookup(PtexfState* s, const PtexFilterQuery* q, float* out) {
-  if (q->filter == SEAMCL_PTEX_POINT) {
+  for (int c = 0; c < 4; ++c) out[c] = 0.0f;
+  /* Before any coordinate is used: a fragment without a finite (u, v) comes with face -1. */
+  if (q->face < 0 || q->face >= s->tex.face_count) return;
+  const PtexFilterFace f = s->faces[q->face];
+  if (q->filter == SEAMCL_PTEX_POINT || (f.flags & SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT) != 0u) {
     vstore4(ptexf_point(s, q), 0, out);
     return;
   }
-  for (int c = 0; c < 4; ++c) out[c] = 0.0f;
-  if (q->face < 0 || q->face >= s->tex.face_count) return;
   s->weight = 0.0f;
   s->applied = 0.0f;
   for (int c = 0; c < 4; ++c) s->result[c] = 0.0f;
-  const PtexFilterFace f = s->faces[q->face];
   const int nchan = s->tex.channels;
-  if ((f.flags & SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT) != 0u) {
-    const uint base = ptexf_level(s, f, 0, 0) * (uint)nchan;
-    for (int c = 0; c < nchan; ++c) out[c] = ptexf_texel(s, base + (uint)c) / s->tex.one_value;
-    return;
-  }
   float u = q->u, v = q->v;
   const int umode = s->tex.seams == SEAMCL_PTEX_SEAMS_PTEX ? s->tex.u_border_mode : 0;
   const int vmode = s->tex.seams == SEAMCL_PTEX_SEAMS_PTEX ? s->tex.v_border_mode : 0;

@@ -161,7 +161,7 @@ TEST(KernelPrograms, EachBuildsAloneWithItsKernels) {
       {KernelProgram::Shading, {"-DSEAMCL_CUBE=1 -DSEAMCL_SEAM_MASK=1 -DSEAMCL_INSPECT=1", {"shade_resolve", "shade_inspect"}}},
       {KernelProgram::Sampling,
        {"", {"neighbor_bytes_decoded", "texture_lookup_batch", "texture_filter_batch", "cube_lookup_batch"}}},
-      {KernelProgram::PtexFilter, {"", {"ptex_filter_lookups"}}},
+      {KernelProgram::PtexFilter, {"", {"ptex_filter_lookups", "ptex_point_lookups"}}},
       {KernelProgram::Downsample, {"", {"downsample_rows", "downsample_columns"}}},
   };
   for (const auto& [program, wanted] : expected) {

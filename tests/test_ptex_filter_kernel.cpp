@@ -4,8 +4,10 @@
 // edges; black: float16, black border), widths from a texel to more than a face; and the device
 // against the Ptex library itself on every value of tests/assets/ptex/golden_filters/.
 #include <gtest/gtest.h>
+#include <glm/gtc/packing.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -91,45 +93,98 @@ TEST(PtexFilterKernel, MatchesTheTwinOnGoldenAndEdgeLookups) {
   }
 }
 
-// One float32 RGBA face of 16 x 16 texels, with values outside 0..1 of both signs.
-PtexFilterData float_rgba_face() {
+// One face of 16 x 16 texels of float32 (data type 3) or float16 (2), of 1 to 4 channels, with
+// values outside 0..1 of both signs.
+PtexFilterData float_face(uint32_t data_type, int channels) {
   PtexTestFile spec;
-  spec.data_type = 3;
-  spec.channels = 4;
+  spec.data_type = data_type;
+  spec.channels = static_cast<uint16_t>(channels);
+  const int element_bytes = data_type == 3 ? 4 : 2;
+  const auto put = [&](std::vector<uint8_t>& out, float value) {
+    uint8_t bytes[4];
+    if (data_type == 3) {
+      std::memcpy(bytes, &value, 4);
+    } else {
+      const uint16_t half = static_cast<uint16_t>(glm::packHalf1x16(value));
+      std::memcpy(bytes, &half, 2);
+    }
+    out.insert(out.end(), bytes, bytes + element_bytes);
+  };
   std::vector<uint8_t> level0;
   for (int j = 0; j < 16; ++j)
-    for (int i = 0; i < 16; ++i)
-      for (float value : {std::sin(0.7f * i) + 0.1f * j, 2.0f * std::cos(0.5f * j), 0.01f * i * j - 0.3f, 0.5f + 0.03f * i}) {
-        uint8_t bytes[4];
-        std::memcpy(bytes, &value, 4);
-        level0.insert(level0.end(), bytes, bytes + 4);
-      }
-  const float average[4] = {0.5f, 0.1f, 0.3f, 0.7f};
-  std::vector<uint8_t> constant(sizeof average);
-  std::memcpy(constant.data(), average, sizeof average);
+    for (int i = 0; i < 16; ++i) {
+      const float values[4] = {std::sin(0.7f * i) + 0.1f * j, 2.0f * std::cos(0.5f * j), 0.01f * i * j - 0.3f,
+                               0.5f + 0.03f * i};
+      for (int c = 0; c < channels; ++c) put(level0, values[c]);
+    }
+  std::vector<uint8_t> constant;
+  for (int c = 0; c < channels; ++c) put(constant, 0.25f * c);
   spec.faces = {{4, 4, 0, {-1, -1, -1, -1}, 0, constant}};
-  spec.levels = {{data_block(level0, 256, 4, 4)}};
+  spec.levels = {{data_block(level0, 256, channels, element_bytes)}};
   return build_ptex_filter_data(parse_ptex_stored(write_ptex(spec)));
 }
 
-// The float texel path, and rows of up to 40 values (three 16-value reads).
-TEST(PtexFilterKernel, MatchesTheTwinOnAFloatRgbaFace) {
-  const PtexFilterData data = float_rgba_face();
-  const std::vector<PtexFilterQuery> queries = edge_queries(1, 2000, 13);
+// The float32 and float16 texel paths, one channel's 16-lane product and rows of several channels
+// (up to 32 values, two 16-value reads), with NaN in the padding after the last texel: reads past
+// a row's end must be discarded, never summed.
+TEST(PtexFilterKernel, MatchesTheTwinOnFloatFacesWithNanPadding) {
+  for (const auto& [data_type, channels] : {std::pair{3u, 4}, {3u, 1}, {2u, 1}, {2u, 2}}) {
+    SCOPED_TRACE("data type " + std::to_string(data_type) + ", " + std::to_string(channels) + " channels");
+    PtexFilterData data = float_face(data_type, channels);
+    std::fill(data.texels.end() - SEAMCL_PTEX_TEXEL_TAIL, data.texels.end(), uint8_t{0xff});
+    const std::vector<PtexFilterQuery> queries = edge_queries(1, 2000, 13);
+    PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
+    launcher.load(data);
+    const std::vector<float> device = launcher.run(queries);
+    ASSERT_EQ(device.size(), queries.size() * 4);
+    int wide = 0;
+    for (size_t i = 0; i < queries.size(); ++i) {
+      const std::array<float, 4> twin = ptex_filter_twin(data, queries[i]);
+      for (int c = 0; c < 4; ++c)
+        ASSERT_NEAR(device[4 * i + c], twin[c], 2e-6f + 2e-6f * std::fabs(twin[c]))
+            << "lookup " << i << " filter " << queries[i].filter << " at (" << queries[i].u << ", " << queries[i].v
+            << ") widths " << queries[i].uw << " x " << queries[i].vw << " channel " << c;
+      wide += queries[i].filter >= SEAMCL_PTEX_GAUSSIAN && queries[i].uw < 0.25f;
+    }
+    EXPECT_GT(wide, 200);  // width-4 kernels under a quarter face: rows of 4 to 8 taps
+  }
+}
+
+// A constant face beside a textured one (so not neighbourhood-constant) holds one texel: a point
+// lookup anywhere on it gives that value, as the library's point filter does, in a batch of points
+// alone and in a mixed one.
+TEST(PtexFilterKernel, PointLookupsOnAConstantFaceGiveItsValue) {
+  PtexTestFile spec;
+  std::vector<uint8_t> texels;
+  for (int t = 0; t < 64; ++t) texels.push_back(static_cast<uint8_t>(3 * t));
+  spec.faces = {{3, 3, 0, {-1, 1, -1, -1}, 3 << 2, {90}}, {3, 3, 1, {-1, -1, -1, 0}, 1 << 6, {200}}};
+  spec.levels = {{data_block(texels, 64, 1, 1), PtexBlock{kEncConstant, {}}}};
+  const PtexFilterData data = build_ptex_filter_data(parse_ptex_stored(write_ptex(spec)));
+  ASSERT_EQ(data.faces[1].flags & (SEAMCL_PTEX_FLAG_CONSTANT | SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT),
+            SEAMCL_PTEX_FLAG_CONSTANT);
+  std::vector<PtexFilterQuery> points;
+  for (float u : {0.0f, 0.3f, 0.99f, 1.0f})
+    for (float v : {0.0f, 0.6f, 1.0f}) {
+      PtexFilterQuery q{};
+      q.face = 1;
+      q.filter = SEAMCL_PTEX_POINT;
+      q.u = u;
+      q.v = v;
+      points.push_back(q);
+    }
+  std::vector<PtexFilterQuery> mixed = points;
+  mixed.push_back(points[0]);
+  mixed.back().filter = SEAMCL_PTEX_BILINEAR;
   PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
   launcher.load(data);
-  const std::vector<float> device = launcher.run(queries);
-  ASSERT_EQ(device.size(), queries.size() * 4);
-  int wide = 0;
-  for (size_t i = 0; i < queries.size(); ++i) {
-    const std::array<float, 4> twin = ptex_filter_twin(data, queries[i]);
-    for (int c = 0; c < 4; ++c)
-      ASSERT_NEAR(device[4 * i + c], twin[c], 2e-6f + 2e-6f * std::fabs(twin[c]))
-          << "lookup " << i << " filter " << queries[i].filter << " at (" << queries[i].u << ", " << queries[i].v
-          << ") widths " << queries[i].uw << " x " << queries[i].vw << " channel " << c;
-    wide += queries[i].filter >= SEAMCL_PTEX_GAUSSIAN && queries[i].uw < 0.25f;
+  const std::vector<float> alone = launcher.run(points);
+  const std::vector<float> among = launcher.run(mixed);
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_FLOAT_EQ(ptex_filter_twin(data, points[i])[0], 200.0f / 255.0f) << "lookup " << i;
+    EXPECT_FLOAT_EQ(alone[4 * i], 200.0f / 255.0f) << "lookup " << i;
+    EXPECT_FLOAT_EQ(among[4 * i], 200.0f / 255.0f) << "lookup " << i;
+    for (int c = 1; c < 4; ++c) EXPECT_EQ(alone[4 * i + c], 0.0f);
   }
-  EXPECT_GT(wide, 200);  // width-4 kernels under a quarter face: rows of 4 to 10 taps, 16 to 40 values
 }
 
 // A batch of point lookups alone runs through ptex_point_lookups: the same values as the twin's and
@@ -139,7 +194,7 @@ TEST(PtexFilterKernel, PointBatchesMatchTheTwinAndMixedBatches) {
   std::vector<std::pair<std::string, PtexFilterData>> textures;
   for (const char* name : {"black", "cellnoise", "cube_text", "rand_lo", "wave_lo"})
     textures.emplace_back(name, build_ptex_filter_data(read_ptex_stored(ptex_assets_dir() + "/" + name + ".ptx")));
-  textures.emplace_back("float rgba", float_rgba_face());
+  textures.emplace_back("float rgba", float_face(3, 4));
   for (const auto& [name, data] : textures) {
     const int faces = static_cast<int>(data.faces.size());
     std::mt19937 random(7);
@@ -166,9 +221,9 @@ TEST(PtexFilterKernel, PointBatchesMatchTheTwinAndMixedBatches) {
     for (size_t i = 0; i < points.size(); ++i) {
       const std::array<float, 4> twin = ptex_filter_twin(data, points[i]);
       for (int c = 0; c < 4; ++c) {
-        ASSERT_EQ(alone[4 * i + c], twin[c]) << name << " lookup " << i << " face " << points[i].face << " at ("
-                                             << points[i].u << ", " << points[i].v << ") channel " << c;
-        ASSERT_EQ(among[4 * i + c], twin[c]) << name << " lookup " << i << " in the mixed batch, channel " << c;
+        ASSERT_FLOAT_EQ(alone[4 * i + c], twin[c]) << name << " lookup " << i << " face " << points[i].face << " at ("
+                                                   << points[i].u << ", " << points[i].v << ") channel " << c;
+        ASSERT_FLOAT_EQ(among[4 * i + c], twin[c]) << name << " lookup " << i << " in the mixed batch, channel " << c;
         nonzero += twin[c] != 0.0f;
       }
       if (points[i].face < 0 || points[i].face >= faces)

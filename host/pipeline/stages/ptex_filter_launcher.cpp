@@ -32,8 +32,8 @@ void PtexFilterLauncher::load(const PtexFilterData& data) {
   texels_ = upload(runtime_, data.texels, device_bytes_);
 }
 
-cl::Kernel& PtexFilterLauncher::kernel_for(const std::vector<PtexFilterQuery>& queries, const cl::Buffer& in,
-                                           const cl::Buffer& out) {
+cl::Kernel& PtexFilterLauncher::kernel_with_args(const std::vector<PtexFilterQuery>& queries, const cl::Buffer& in,
+                                                 const cl::Buffer& out) {
   const bool points = std::all_of(queries.begin(), queries.end(),
                                   [](const PtexFilterQuery& q) { return q.filter == SEAMCL_PTEX_POINT; });
   cl::Kernel& kernel = points ? point_kernel_ : kernel_;
@@ -50,14 +50,14 @@ cl::Kernel& PtexFilterLauncher::kernel_for(const std::vector<PtexFilterQuery>& q
 std::vector<float> PtexFilterLauncher::run(const std::vector<PtexFilterQuery>& queries) {
   std::vector<float> values(queries.size() * 4);
   if (queries.empty()) return values;
-  // The queries and the values stay in host memory: a CPU device reads and writes them where they
-  // are (for point lookups the copies in and out took as long as the kernel), and a device with
-  // memory of its own copies them as it would for a write and a read.
+  // The queries and the values stay in the caller's memory: PoCL on the CPU reads and writes them
+  // where they are (for point lookups the copies in and out had taken as long as the kernel); a
+  // device with memory of its own copies them or reads them across the bus, as its driver chooses.
   const size_t out_bytes = values.size() * sizeof(float);
   const cl::Buffer in(runtime_.context(), CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, queries.size() * sizeof(PtexFilterQuery),
                       const_cast<PtexFilterQuery*>(queries.data()));
   const cl::Buffer out(runtime_.context(), CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, out_bytes, values.data());
-  runtime_.queue().enqueueNDRangeKernel(kernel_for(queries, in, out), cl::NullRange,
+  runtime_.queue().enqueueNDRangeKernel(kernel_with_args(queries, in, out), cl::NullRange,
                                         cl::NDRange(round_up(queries.size(), kGroup)), cl::NDRange(kGroup));
   void* mapped = runtime_.queue().enqueueMapBuffer(out, CL_TRUE, CL_MAP_READ, 0, out_bytes);
   runtime_.queue().enqueueUnmapMemObject(out, mapped);
@@ -71,7 +71,7 @@ std::vector<double> PtexFilterLauncher::time(const std::vector<PtexFilterQuery>&
   size_t ignored = 0;
   const cl::Buffer in = upload(runtime_, queries, ignored);
   const cl::Buffer out(runtime_.context(), CL_MEM_WRITE_ONLY, queries.size() * 4 * sizeof(float));
-  cl::Kernel& kernel = kernel_for(queries, in, out);
+  cl::Kernel& kernel = kernel_with_args(queries, in, out);
   std::vector<cl::Event> events(static_cast<size_t>(std::max(repeats, 0)));
   for (cl::Event& event : events)
     runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(round_up(queries.size(), kGroup)),

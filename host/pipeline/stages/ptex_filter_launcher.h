@@ -26,8 +26,10 @@ class PtexFilterLauncher {
   size_t device_bytes() const { return device_bytes_; }
 
  private:
-  // The kernel for `queries` (ptex_point_lookups when every one is a point lookup), its arguments set.
-  cl::Kernel& kernel_for(const std::vector<PtexFilterQuery>& queries, const cl::Buffer& in, const cl::Buffer& out);
+  // The kernel for `queries` (ptex_point_lookups when every one is a point lookup), its arguments
+  // set to the texture, `in` and `out`.
+  cl::Kernel& kernel_with_args(const std::vector<PtexFilterQuery>& queries, const cl::Buffer& in,
+                               const cl::Buffer& out);
 
   ClRuntime& runtime_;
   cl::Kernel kernel_;

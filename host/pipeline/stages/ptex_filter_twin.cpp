@@ -588,17 +588,16 @@ std::array<float, 4> ptex_filter_twin(const PtexFilterData& data, const PtexFilt
   Evaluator e(data, tex);
   const int nchan = tex.channels;
   const float one = tex.one_value;
-  if ((f.flags & SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT) != 0) {
-    const size_t base = e.level_offset(f, 0, 0);
-    for (int c = 0; c < nchan; ++c) out[c] = e.texel(base, c) / one;
-    return out;
-  }
   float u = q.u, v = q.v;
-  if (q.filter == SEAMCL_PTEX_POINT) {
-    const int resu = 1 << f.ulog2, resv = 1 << f.vlog2;
+  if (q.filter == SEAMCL_PTEX_POINT || (f.flags & SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT) != 0) {
+    // The texel under (u, v) at the face's own resolution; a constant face holds one texel, the
+    // same at every resolution's offset, which every filter of a neighbourhood-constant face gives.
+    const bool flat = (f.flags & (SEAMCL_PTEX_FLAG_CONSTANT | SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT)) != 0;
+    const int ulog2 = flat ? 0 : f.ulog2, vlog2 = flat ? 0 : f.vlog2;
+    const int resu = 1 << ulog2, resv = 1 << vlog2;
     const int ui = std::clamp(static_cast<int>(u * static_cast<float>(resu)), 0, resu - 1);
     const int vi = std::clamp(static_cast<int>(v * static_cast<float>(resv)), 0, resv - 1);
-    const size_t base = e.level_offset(f, f.ulog2, f.vlog2) + static_cast<size_t>(vi) * resu + ui;
+    const size_t base = e.level_offset(f, ulog2, vlog2) + static_cast<size_t>(vi) * resu + ui;
     for (int c = 0; c < nchan; ++c) out[c] = e.texel(base, c) / one;
     return out;
   }
