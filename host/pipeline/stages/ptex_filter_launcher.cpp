@@ -54,8 +54,8 @@ std::vector<float> PtexFilterLauncher::run(const std::vector<PtexFilterQuery>& q
   // where they are (for point lookups the copies in and out had taken as long as the kernel); a
   // device with memory of its own copies them or reads them across the bus, as its driver chooses.
   const size_t out_bytes = values.size() * sizeof(float);
-  const cl::Buffer in(runtime_.context(), CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, queries.size() * sizeof(PtexFilterQuery),
-                      const_cast<PtexFilterQuery*>(queries.data()));
+  const cl::Buffer in(runtime_.context(), CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR,
+                      queries.size() * sizeof(PtexFilterQuery), const_cast<PtexFilterQuery*>(queries.data()));
   const cl::Buffer out(runtime_.context(), CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, out_bytes, values.data());
   runtime_.queue().enqueueNDRangeKernel(kernel_with_args(queries, in, out), cl::NullRange,
                                         cl::NDRange(round_up(queries.size(), kGroup)), cl::NDRange(kGroup));
