@@ -28,7 +28,8 @@ __kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilt
   PtexfState s = ptexf_batch_state(tex, faces, level_offsets, texels);
   float value[4];
   ptexf_lookup(&s, &q, value);
-  vstore4(vload4(0, value), id, out);
+  __global float* dst = out + 4 * id;
+  for (int c = 0; c < 4; ++c) dst[c] = value[c];
 }
 
 /* ptex_filter_lookups for a batch whose every query is SEAMCL_PTEX_POINT: ptexf_point alone. */
