@@ -647,9 +647,9 @@ SEAMCL_INLINE void ptexf_split_and_apply(PtexfState* s, PtexfKernel* k, int face
 /* Point lookup q: the texel under (u, v) at the face's own resolution (a constant face's one value,
  * as the library's point filter gives it) divided by the type's one value; channels beyond the
  * texture's 0, a face out of range zeros (the texture has at least one face: the reader refuses a
- * file without). Nothing branches on the query, so a batch of point lookups alone
- * (ptex_point_lookups) vectorises across work-items; the 4-value read (16 for halves) stays within
- * SEAMCL_PTEX_TEXEL_TAIL. */
+ * file without). Nothing branches on the query, which keeps ptex_point_lookups' work-item loop short
+ * (PoCL does not vectorise it: the loop holds the switch on the type and vector types); the
+ * 4-value read (16 for halves) stays within SEAMCL_PTEX_TEXEL_TAIL. */
 SEAMCL_INLINE float4 ptexf_point(const PtexfState* s, const PtexFilterQuery* q) {
   const PtexFilterFace f = s->faces[clamp(q->face, 0, s->tex.face_count - 1)];
   const bool flat = (f.flags & (SEAMCL_PTEX_FLAG_CONSTANT | SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT)) != 0u;

@@ -1,6 +1,7 @@
 /* Batches of lookups of Ptex's own filters (`seamcl ptx lookup`, the kernel tests and the Ptex
  * benchmark): one work-item per query, ptexf_lookup of ptex_filter.cl; a batch of point lookups
- * alone through ptex_point_lookups, whose work-items PoCL runs as vectors.
+ * alone through ptex_point_lookups, whose short loop body lets a core keep more lookups' texel
+ * misses in flight.
  * Contract: out[4 * id ..] holds query id's 4 floats (channels beyond the texture's 0; a face out of
  * range gives zeros) for id < count. Host guarantees: tex, faces, level_offsets and texels as
  * ptex_filter.cl states; tex.seams 0 (Ptex's own rules); out holds 4 * count floats.

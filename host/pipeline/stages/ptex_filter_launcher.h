@@ -16,7 +16,7 @@ class PtexFilterLauncher {
   void load(const PtexFilterData& data);
 
   // 4 floats per query (channels beyond the texture's are 0), in order. A batch of point lookups
-  // alone runs through a kernel of its own, which PoCL vectorises.
+  // alone runs through a kernel of its own (ptex_point_lookups), shorter per lookup.
   std::vector<float> run(const std::vector<PtexFilterQuery>& queries);
 
   // Uploads `queries` once (for timing) and runs them `repeats` times back to back; returns the
