@@ -7,6 +7,7 @@ measured value and a verdict, each command's output is kept, and bad options are
 import argparse
 import json
 import os
+import re
 import statistics
 import subprocess
 import sys
@@ -25,7 +26,8 @@ EXPECTED_TARGETS = [
     "reference wall / device time, mixed", "compare wall / (reference + entries), mixed",
     "reference wall / device time, closeup-seam", "compare wall / (reference + entries), closeup-seam",
     "warmup, empty program cache (ms)", "warmup, warm program cache (ms)",
-    "first render of a fresh process / a repeated one",
+    "first render of a fresh process / a repeated one, paper *",
+    "first render of a fresh process / a repeated one, closeup-seam *",
 ]
 LOOKUP_TARGETS = [f"{what}, {texels}" for texels in ("rgba8", "rgba32f")
                   for what in ("aniso16 / OIIO aniso", "trilinear / OIIO trilinear", "aniso16 / (trilinear / *")]
@@ -62,6 +64,13 @@ def main():
                           f"{name}: positive measured values, got {r['values']}")
                     check(isinstance(r["met"], bool), f"{name}: a verdict, got {r['met']}")
                     check(isinstance(r["settled"], bool), f"{name}: whether the verdict is settled, got {r.get('settled')}")
+            # A first render's row gives its floor on this driver: the driver's start plus one
+            # repeated frame, over that frame (above 1 by the start's share).
+            for t, r in rows.items():
+                if t.startswith("first render"):
+                    floor = re.search(r"floor on this driver \(its start ([0-9.]+) ms.*\) ([0-9.]+)$", r["note"])
+                    check(floor is not None and float(floor.group(1)) > 0 and float(floor.group(2)) > 1.0,
+                          f"{t}: its floor on this driver in the note: {r['note']!r}")
             # The rows whose ratio grows with a stage say what the ratio is made of: the row's own
             # figures, less the growth of those stages between the stage medians of the renders behind
             # them (each cell's, the median over the rounds; the sweep points' own).

@@ -28,7 +28,12 @@ namespace seamcl {
 namespace {
 
 using nlohmann::json;
+using seamcl_tests::data_block;
+using seamcl_tests::kEncConstant;
 using seamcl_tests::ptex_assets_dir;
+using seamcl_tests::PtexBlock;
+using seamcl_tests::PtexTestFile;
+using seamcl_tests::write_ptex;
 
 std::vector<PtexFilterQuery> golden_queries(const std::string& name) {
   std::ifstream in(ptex_assets_dir() + "/golden/" + name + ".json");
