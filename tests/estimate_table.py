@@ -17,7 +17,7 @@ compare's reference downsample at 241x271 compiled in the measured run put it 12
 estimate); each floor is the smallest of --floor-runs.
 
     tests/estimate_table.py --seamcl build/seamcl [--grid full|quick] [--check] [--max-ratio 1.5]
-                            [--assets tests/assets/ptex] [--json OUT]
+                            [--assets tests/assets/ptex] [--json OUT] [--program-cache off|environment]
 
 --grid full: every built-in scene (`seamcl scenes`) and the asset scenes (cube.obj and
 ptex_test_object.obj with their .ptx; no .ptx under tests/assets carries its mesh), at msaa 1 and 8; renders at the
@@ -37,8 +37,16 @@ COMPARE_METHODS = "discard,clamp"
 LARGE_COMPARES = ("paper", "quad2", "envmap", "cube.obj+cube_text.ptx", "ptex_test_object.obj+cellnoise.ptx")
 
 
+# Every run builds its programs from source unless --program-cache environment: a program loaded
+# from seamcl's program cache (written by `seamcl warmup`, or by any build with
+# SEAMCL_PROGRAM_CACHE=1) skips the compiler's memory, which lowers the floor by about 5 MiB more
+# than it lowers a case's peak, so the same binary measured in a user's cache and in an empty one
+# gives other ratios (docs/compare.md).
+RUN_ENV = dict(os.environ, SEAMCL_PROGRAM_CACHE="off")
+
+
 def run_json(command):
-    done = subprocess.run(command, capture_output=True, text=True, timeout=1800)
+    done = subprocess.run(command, capture_output=True, text=True, timeout=1800, env=RUN_ENV)
     if done.returncode != 0:
         raise SystemExit(f"estimate_table: {' '.join(command)} exited {done.returncode}: {done.stderr.strip()[-2000:]}")
     answer = json.loads(done.stdout)
@@ -96,7 +104,13 @@ def main():
     parser.add_argument("--max-ratio", type=float, default=1.5)
     parser.add_argument("--floor-runs", type=int, default=2)
     parser.add_argument("--json", help="write every case's figures here")
+    parser.add_argument("--program-cache", choices=("off", "environment"), default="off",
+                        help="off: every run builds its programs from source (the same state on any machine); "
+                             "environment: as SEAMCL_PROGRAM_CACHE and SEAMCL_CACHE_DIR say [off]")
     args = parser.parse_args()
+    if args.program_cache == "environment":
+        RUN_ENV.clear()
+        RUN_ENV.update(os.environ)
     if args.max_ratio < 1:
         raise SystemExit("estimate_table: --max-ratio must be at least 1")
     if args.floor_runs < 1:
