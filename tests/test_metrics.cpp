@@ -26,6 +26,7 @@
 #include <seamcl/pipeline/gpu_types.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene_generators.h>
+#include "io/image_codec.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -447,10 +448,26 @@ TEST(Reference, CacheReturnsTheSamePixelsWithoutRendering) {
   EXPECT_EQ(third.pixels, first.pixels);
   EXPECT_TRUE(reference_image(scene, scene.camera, frame, s, must_not_render).from_cache);
 
+  // So is an entry of the right size and key whose pixels are not all finite: a NaN reference
+  // would score every method's error as 0.
+  for (const float damage : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    std::vector<glm::vec4> damaged = first.pixels;
+    damaged[37].b = damage;
+    ImageWriteOptions options;
+    options.text_attributes = {{"seamcl:reference_key", reference_cache_key(scene, scene.camera, frame, s)}};
+    image_codec().write(first.cache_path, "", {ImageLevel{24, 16, StoredPixels::Float, damaged.data()}}, options,
+                        nullptr);
+    const ReferenceImage again = reference_image(scene, scene.camera, frame, s, render);
+    EXPECT_FALSE(again.from_cache) << damage;
+    EXPECT_EQ(again.pixels, first.pixels) << damage;
+  }
+  EXPECT_EQ(renders, 4);
+  EXPECT_TRUE(reference_image(scene, scene.camera, frame, s, must_not_render).from_cache);
+
   // Without the cache it always renders.
   s.use_cache = false;
   EXPECT_FALSE(reference_image(scene, scene.camera, frame, s, render).from_cache);
-  EXPECT_EQ(renders, 3);
+  EXPECT_EQ(renders, 5);
   fs::remove_all(dir);
 }
 

@@ -92,7 +92,8 @@ std::string text_hash(const std::string& text) {
   return f.hex();
 }
 
-// Reads a cached reference; nullopt when missing, unreadable, the wrong size or another key.
+// Reads a cached reference; nullopt when missing, unreadable, the wrong size, another key or not
+// all finite.
 std::optional<std::vector<glm::vec4>> read_cached(const std::string& path, const std::string& key, int width,
                                                   int height) {
   std::error_code ec;
@@ -110,6 +111,11 @@ std::optional<std::vector<glm::vec4>> read_cached(const std::string& path, const
   } catch (const std::runtime_error&) {
     return std::nullopt;
   }
+  // A render holds finite values only; a NaN reference would score every method's error as 0.
+  const auto finite = [](const glm::vec4& p) {
+    return std::isfinite(p.r) && std::isfinite(p.g) && std::isfinite(p.b) && std::isfinite(p.a);
+  };
+  if (!std::all_of(pixels.begin(), pixels.end(), finite)) return std::nullopt;
   return pixels;
 }
 
