@@ -34,20 +34,29 @@ struct PtxArgs {
   bool scalar = false;
 };
 
-json read_queries(const std::string& path) {
+// The query file's lookups, each checked as it is read (one element's JSON held at a time), so a
+// file of the largest size holds at most kMaxQueries lookups in memory, never its whole document.
+std::vector<PtexLookup> read_queries(const std::string& path) {
   RegularFile file(path);
   if (file.refusal() != RegularFile::Refusal::None) throw InputError("queries", path + ": " + file.refusal_text());
   if (file.size() > kMaxQueryFileBytes)
     throw InputError("queries", path + ": more than the " + std::to_string(kMaxQueryFileBytes >> 20) + " MiB a query file may have");
   std::string text;
   if (!file.read_all(text, kMaxQueryFileBytes)) throw InputError("queries", path + ": " + file.refusal_text());
+  std::vector<PtexLookup> lookups;
+  const auto add = [&](json&& element) {
+    lookups.push_back(parse_ptex_lookup(element, "queries[" + std::to_string(lookups.size()) + "]"));
+  };
   try {
-    return parse_json_document(text);
+    if (!parse_json_array_elements(text, kMaxQueries, add)) throw InputError("queries", "must be a JSON array of lookups");
   } catch (const nlohmann::json::exception& error) {
     throw InputError("queries", path + ": not valid JSON: " + error.what());
+  } catch (const std::length_error&) {
+    throw InputError("queries", path + ": more than the limit of " + std::to_string(kMaxQueries) + " lookups");
   } catch (const std::invalid_argument& error) {
     throw InputError("queries", path + ": not valid JSON: " + error.what());
   }
+  return lookups;
 }
 
 int run_info(const PtxArgs& args) {
@@ -68,10 +77,7 @@ int run_lookup(const PtxArgs& args, const GlobalOptions& global) {
   if (!queries_path.empty()) {
     if (!request.empty())
       throw InputError("queries", "give either --queries or one lookup's flags (--" + request.begin().key() + " was given too)");
-    const json queries = read_queries(queries_path);
-    if (queries.is_array() && queries.size() > kMaxQueries)
-      throw InputError("queries", std::to_string(queries.size()) + " lookups, more than the limit of " + std::to_string(kMaxQueries));
-    lookups = parse_ptex_lookups(queries, "queries");
+    lookups = read_queries(queries_path);
   } else {
     lookups.push_back(parse_ptex_lookup(request));
   }

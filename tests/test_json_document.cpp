@@ -6,6 +6,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -61,6 +62,36 @@ TEST(JsonDocument, KeepsTheParsersOwnErrorsAndRefusesANul) {
   EXPECT_THROW(seamcl::parse_json_document("1e309"), nlohmann::json::out_of_range);
   EXPECT_THROW(seamcl::parse_json_document(""), nlohmann::json::parse_error);
   EXPECT_EQ(refusal_of(std::string("{}\0{", 4)), "a NUL byte at offset 2 (nothing after it would be read)");
+}
+
+TEST(JsonDocument, ArrayElementsAreHandedOverInOrderUpToTheLimit) {
+  std::vector<nlohmann::json> seen;
+  const auto keep = [&](nlohmann::json&& element) { seen.push_back(std::move(element)); };
+  const std::string text = R"([1, {"a": [2, {"b": 3}]}, [], [[4]], "five", null])";
+  ASSERT_TRUE(seamcl::parse_json_array_elements(text, 6, keep));
+  EXPECT_EQ(nlohmann::json(seen), nlohmann::json::parse(text));
+
+  seen.clear();
+  EXPECT_THROW(seamcl::parse_json_array_elements(text, 5, keep), std::length_error);
+  EXPECT_EQ(seen.size(), 5u) << "refused before the element past the limit is read";
+
+  seen.clear();
+  EXPECT_FALSE(seamcl::parse_json_array_elements(R"({"a": [1, 2]})", 10, keep));
+  EXPECT_FALSE(seamcl::parse_json_array_elements("7", 10, keep));
+  EXPECT_TRUE(seen.empty());
+  EXPECT_TRUE(seamcl::parse_json_array_elements("[]", 0, keep));
+
+  // The checks of parse_json_document hold inside elements, and an element the caller refuses
+  // stops the read there.
+  EXPECT_THROW(seamcl::parse_json_array_elements(R"([{"a": 1, "a": 2}])", 10, keep), std::invalid_argument);
+  EXPECT_THROW(seamcl::parse_json_array_elements("[[[1]]]", 10, keep, 2), std::invalid_argument);
+  EXPECT_THROW(seamcl::parse_json_array_elements("[1, 2", 10, keep), nlohmann::json::parse_error);
+  int handed = 0;
+  const auto refuse_second = [&](nlohmann::json&&) {
+    if (++handed == 2) throw std::runtime_error("second");
+  };
+  EXPECT_THROW(seamcl::parse_json_array_elements("[1, 2, 3]", 10, refuse_second), std::runtime_error);
+  EXPECT_EQ(handed, 2);
 }
 
 }  // namespace

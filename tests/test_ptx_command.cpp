@@ -198,6 +198,13 @@ TEST_F(PtxCommand, BadInputExitsTwoNamingTheField) {
                  "out of range");
   expect_refused("ptx lookup " + file + " --queries " + write("filt.json", "[{\"filter\": \"cubic\"}]"),
                  "queries[0].filter");
+  expect_refused("ptx lookup " + file + " --queries " + write("flat.json", "[1, 1, 1]"), "queries[0]",
+                 "must be a JSON object");
+  // One lookup past the limit, each an object of defaults: refused by count, before any lookup.
+  std::string many = "[{}";
+  for (size_t i = 0; i < (size_t(1) << 22); ++i) many += ",{}";
+  expect_refused("ptx lookup " + file + " --queries " + write("many.json", many + "]"), "queries",
+                 "more than the limit of 4194304 lookups");
   expect_refused("ptx lookup " + file + " --face 1 --queries " + write("ok.json", "[]"), "queries", "either");
   expect_refused("ptx lookup " + file + " --queries ''", "queries", "must not be empty");
   expect_refused("ptx dump " + file + " --face -1", "face");

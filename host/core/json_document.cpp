@@ -1,5 +1,6 @@
 #include <seamcl/core/json_document.h>
 
+#include <functional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -14,10 +15,13 @@ using nlohmann::json;
 // Builds the document from the parser's events (nlohmann::json::sax_parse), refusing a key given
 // twice in one object and nesting past max_depth. Not nlohmann's callback parser: in 3.11 it
 // scans an array's elements each time an object inside it ends, so a 1 MiB body of `{}`s took
-// 46 s; this builder does constant work per event.
+// 46 s; this builder does constant work per event. With a sink, the root must be an array and
+// each of its elements is handed over when read instead of kept.
 class CheckedDocumentBuilder {
  public:
-  CheckedDocumentBuilder(json& root, int max_depth) : root_(root), max_depth_(max_depth) {}
+  using Sink = std::function<void(json&&)>;
+  CheckedDocumentBuilder(json& root, int max_depth, const Sink* sink = nullptr, size_t max_elements = 0)
+      : root_(root), max_depth_(max_depth), sink_(sink), max_elements_(max_elements) {}
 
   bool null() { return add(nullptr); }
   bool boolean(bool value) { return add(value); }
@@ -45,12 +49,12 @@ class CheckedDocumentBuilder {
   bool end_object() {
     keys_.pop_back();
     open_.pop_back();
-    return true;
+    return element_done();
   }
   bool start_array(std::size_t) { return open(json::array()); }
   bool end_array() {
     open_.pop_back();
-    return true;
+    return element_done();
   }
 
   // The parser's own exception, thrown with its type (parse_error, out_of_range), as parse() does.
@@ -60,6 +64,8 @@ class CheckedDocumentBuilder {
   }
 
   const std::string& refused() const { return refused_; }
+  bool root_not_array() const { return root_not_array_; }
+  bool too_many_elements() const { return too_many_elements_; }
 
  private:
   // As the callback parser counted depth: an event inside more than max_depth containers.
@@ -71,10 +77,20 @@ class CheckedDocumentBuilder {
 
   // The value's place: the root, the end of the open array, or the open object's pending key.
   // Pointers to open containers stay valid: an array grows only after its open child closes.
+  // nullptr: the value is refused (with a sink: a root that is not an array, an element past
+  // max_elements).
   json* place(json&& value) {
     if (open_.empty()) {
+      if (sink_ != nullptr && !value.is_array()) {
+        root_not_array_ = true;
+        return nullptr;
+      }
       root_ = std::move(value);
       return &root_;
+    }
+    if (sink_ != nullptr && open_.size() == 1 && elements_ == max_elements_) {
+      too_many_elements_ = true;
+      return nullptr;
     }
     json& parent = *open_.back();
     if (parent.is_array()) {
@@ -87,19 +103,36 @@ class CheckedDocumentBuilder {
   }
 
   bool add(json&& value) {
-    if (too_deep()) return false;
-    place(std::move(value));
-    return true;
+    if (too_deep() || place(std::move(value)) == nullptr) return false;
+    return element_done();
   }
 
   bool open(json&& container) {
     if (too_deep()) return false;
-    open_.push_back(place(std::move(container)));
+    json* placed = place(std::move(container));
+    if (placed == nullptr) return false;
+    open_.push_back(placed);
+    return true;
+  }
+
+  // With a sink, a value just completed directly in the root array is handed over and dropped.
+  bool element_done() {
+    if (sink_ == nullptr || open_.size() != 1) return true;
+    json::array_t& elements = root_.get_ref<json::array_t&>();
+    json element = std::move(elements.back());
+    elements.pop_back();
+    ++elements_;
+    (*sink_)(std::move(element));
     return true;
   }
 
   json& root_;
   int max_depth_;
+  const Sink* sink_;
+  size_t max_elements_;
+  size_t elements_ = 0;
+  bool root_not_array_ = false;
+  bool too_many_elements_ = false;
   std::vector<json*> open_;                  // the containers being read, innermost last
   std::vector<std::set<std::string>> keys_;  // the keys of each open object, innermost last
   std::string pending_key_;
@@ -118,6 +151,21 @@ nlohmann::json parse_json_document(std::string_view text, int max_depth) {
   if (!builder.refused().empty()) throw std::invalid_argument(builder.refused());
   if (!whole) throw std::logic_error("parse_json_document: the parser stopped without a reason");
   return document;
+}
+
+bool parse_json_array_elements(std::string_view text, size_t max_elements,
+                               const std::function<void(nlohmann::json&&)>& element, int max_depth) {
+  const size_t nul = text.find('\0');
+  if (nul != std::string_view::npos)
+    throw std::invalid_argument("a NUL byte at offset " + std::to_string(nul) + " (nothing after it would be read)");
+  json root;
+  CheckedDocumentBuilder builder(root, max_depth, &element, max_elements);
+  const bool whole = json::sax_parse(text, &builder);
+  if (builder.root_not_array()) return false;
+  if (builder.too_many_elements()) throw std::length_error("more than " + std::to_string(max_elements) + " elements");
+  if (!builder.refused().empty()) throw std::invalid_argument(builder.refused());
+  if (!whole) throw std::logic_error("parse_json_array_elements: the parser stopped without a reason");
+  return true;
 }
 
 }  // namespace seamcl
