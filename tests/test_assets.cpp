@@ -243,7 +243,7 @@ TEST(Assets, ObjRefusesBadNumbersAndIndicesNamingTheLineAndTheWord) {
 }
 
 TEST(Assets, ObjStillReadsSlashedRelativeAndForwardIndicesWAndVertexColours) {
-  // w, vertex colours, a comment after a vertex, '+' and exponents; i/j/k, i/j, i//k, negative
+  // w, vertex colours, a comment after a vertex or a face, '+' and exponents; i/j/k, i/j, i//k, negative
   // (relative) indices in every part, and a forward reference to a vertex defined further on.
   const std::string text = "vt 0 0\nvt 1 0\nvn 0 0 1\n"
                            "v +1 +.5 -.5e-3 1.\n"
@@ -255,11 +255,13 @@ TEST(Assets, ObjStillReadsSlashedRelativeAndForwardIndicesWAndVertexColours) {
                            "f 4 3 2 1\n"
                            "f 1 2 3 5\n"
                            "f 1/7 2/8 3/9 4//5\n"  // texture coordinates and normals a careless exporter left out
+                           "f 2 3 4 1 # a comment after a face, # 5 6\n"
                            "v 9 9 9\n";
   const ObjMesh mesh = parse_obj(text, "forms.obj");
   const std::vector<glm::vec3> positions{{1.0f, 0.5f, -0.5e-3f}, {1, 2, 3}, {1e-5f, 250, -0.0f}, {0.25f, 1, 7}, {9, 9, 9}};
   EXPECT_EQ(mesh.positions, positions);
-  const std::vector<std::array<uint32_t, 4>> faces{{0, 1, 2, 3}, {0, 1, 2, 3}, {3, 2, 1, 0}, {0, 1, 2, 4}, {0, 1, 2, 3}};
+  const std::vector<std::array<uint32_t, 4>> faces{{0, 1, 2, 3}, {0, 1, 2, 3}, {3, 2, 1, 0},
+                                                   {0, 1, 2, 4}, {0, 1, 2, 3}, {1, 2, 3, 0}};
   EXPECT_EQ(mesh.faces, faces);
 }
 

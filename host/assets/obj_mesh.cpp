@@ -40,6 +40,16 @@ std::string_view next_word(std::string_view& rest) {
 
 std::string_view first_word(std::string_view line) { return next_word(line); }
 
+// The line up to a word that starts with '#' (a trailing comment), as tinyobjloader reads a
+// vertex's line; its face lines it would read the comment's words as corners.
+std::string_view without_comment(std::string_view line) {
+  std::string_view rest = line;
+  for (std::string_view word = next_word(rest); !word.empty(); word = next_word(rest)) {
+    if (word.front() == '#') return line.substr(0, static_cast<size_t>(word.data() - line.data()));
+  }
+  return line;
+}
+
 size_t word_count(std::string_view line) {
   size_t count = 0;
   while (!next_word(line).empty()) ++count;
@@ -134,6 +144,7 @@ class Prescanner {
       }
       if (word == "v") check_vertex(line);
       if (word == "f") {
+        line = without_comment(line);
         const std::string face = face_name(out.face_lines.size(), line_number_);
         const size_t corners = word_count(line) - 1;
         if (corners != 4) refuse(face + " has " + std::to_string(corners) + " vertices; only quads are supported");
