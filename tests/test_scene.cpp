@@ -850,6 +850,12 @@ TEST(SceneJson, FileErrorsNameThePath) {
   const TemporaryFile repeated(R"({"name": "a", "name": "b", "positions": []})");
   message = expect_input_error([&] { load_scene_file(repeated.path()); }, "scene");
   EXPECT_NE(message.find("key 'name' is given twice"), std::string::npos) << message;
+  // A number of 100,000 digits, which the parser's message quotes whole: the message is cut.
+  const TemporaryFile long_number("{\"name\": " + std::string(100000, '7') + "}");
+  message = expect_input_error([&] { load_scene_file(long_number.path()); }, "scene");
+  EXPECT_NE(message.find("not valid JSON"), std::string::npos) << message.substr(0, 200);
+  EXPECT_LT(message.size(), 1200u);
+  EXPECT_NE(message.find(" characters more)"), std::string::npos) << message.substr(message.size() - 100);
   const TemporaryFile after_nul(minimal_document().dump() + std::string(1, '\0') + "{\"garbage\"");
   message = expect_input_error([&] { load_scene_file(after_nul.path()); }, "scene");
   EXPECT_NE(message.find("NUL byte"), std::string::npos) << message;
