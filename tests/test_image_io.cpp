@@ -97,6 +97,23 @@ TEST(ImageIo, FailedWriteLeavesNoFile) {
   EXPECT_FALSE(std::filesystem::exists(dir));
 }
 
+TEST(ImageIo, AReaderThatFailsSilentlyStillGivesAReason) {
+  // A PPM whose header promises 4096x4096 and whose data stops after 3 bytes: OpenImageIO's reader
+  // fails with an empty error text.
+  const auto path = std::filesystem::temp_directory_path() / ("seamcl-image-io-short-" + std::to_string(::getpid()) + ".ppm");
+  std::ofstream(path, std::ios::binary) << "P6\n4096 4096\n255\nabc";
+  int width = 0, height = 0;
+  try {
+    read_image(path.string(), width, height);
+    ADD_FAILURE() << "a truncated PPM was read";
+  } catch (const std::runtime_error& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind("cannot read " + path.string() + ": ", 0), 0u) << message;
+    EXPECT_GT(message.size(), ("cannot read " + path.string() + ": ").size() + 10) << "a reason follows: " << message;
+  }
+  std::filesystem::remove(path);
+}
+
 namespace {
 
 // A temporary path the same in the test and in its death-test child, which re-runs the test from its

@@ -3,6 +3,7 @@
 #include "io/image_codec.h"
 
 #include <stdexcept>
+#include <string>
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
@@ -21,6 +22,12 @@ OIIO::TypeDesc stored_type(StoredPixels stored) {
   throw std::logic_error("unknown stored pixel type");
 }
 
+// OpenImageIO's error text, or what is known without one: some readers fail without a message (a
+// PPM shorter than its header says).
+std::string reason(const std::string& error) {
+  return error.empty() ? "the reader failed without a message (a damaged or truncated file?)" : error;
+}
+
 class OiioSource final : public ImageSource {
  public:
   OiioSource(std::unique_ptr<OIIO::ImageInput> input, std::string path)
@@ -36,7 +43,7 @@ class OiioSource final : public ImageSource {
     const OIIO::stride_t pixel_stride = sizeof(glm::vec4);
     const int channels = std::min(spec_.nchannels, 4);
     if (!input_->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, out, pixel_stride, pixel_stride * spec_.width))
-      throw std::runtime_error("cannot read " + path_ + ": " + input_->geterror());
+      throw std::runtime_error("cannot read " + path_ + ": " + reason(input_->geterror()));
     input_->close();
     if (to_linear && spec_.get_string_attribute("oiio:ColorSpace") == "sRGB") {
       OIIO::ImageBuf in_place(OIIO::ImageSpec(spec_.width, spec_.height, 4, OIIO::TypeDesc::FLOAT), out);
@@ -89,7 +96,7 @@ class OiioCodec final : public ImageCodec {
 
   std::unique_ptr<ImageSource> open(const std::string& path) const override {
     auto input = OIIO::ImageInput::open(path);
-    if (!input) throw std::runtime_error("cannot read " + path + ": " + OIIO::geterror());
+    if (!input) throw std::runtime_error("cannot read " + path + ": " + reason(OIIO::geterror()));
     return std::make_unique<OiioSource>(std::move(input), path);
   }
 
