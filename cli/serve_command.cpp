@@ -62,8 +62,11 @@ int run_serve(const ServeArgs& args, const GlobalOptions& global) {
     throw InputError("max-connections-per-client", "must be in 0..4096 (0: no cap)");
   if (!(args.read_timeout_s >= 0.1 && args.read_timeout_s <= 600)) throw InputError("read-timeout", "must be in 0.1..600 seconds");
   if (!(args.deadline_s >= 0 && args.deadline_s <= 3600)) throw InputError("deadline", "must be in 0..3600 seconds (0: none)");
-  if (args.cache_max_mib < 0) throw InputError("cache-max-mib", "must be at least 0 (0: no bound)");
-  if (args.assets_cache_mib < 0) throw InputError("assets-cache-mib", "must be at least 0 (0: cache nothing)");
+  // Bounded so that the byte counts made from them (MiB << 20) cannot overflow.
+  if (args.cache_max_mib < 0 || args.cache_max_mib > (1LL << 40))
+    throw InputError("cache-max-mib", "must be in 0..2^40 (0: no bound)");
+  if (args.assets_cache_mib < 0 || args.assets_cache_mib > (1LL << 24))
+    throw InputError("assets-cache-mib", "must be in 0..16777216 (0: cache nothing)");
   if (args.memory_bound_mib < 0 || args.memory_bound_mib > (1LL << 24)) throw InputError("memory-bound-mib", "must be in 0..16777216 (0: half the physical memory)");
   if (args.request_memory_mib < 1 || args.request_memory_mib > (1LL << 20)) {
     throw InputError("request-memory-mib", "must be in 1..1048576");

@@ -398,4 +398,8 @@ TEST_F(Cli, EmptyOptionValuesAreInputErrors) {
   expect_input_error("serve --port 0 --quick-start --host ''", "host: must not be empty");
   expect_input_error("serve --port 0 --quick-start --cache-dir ''", "cache-dir: must not be empty");
   expect_input_error("serve --port 0 --quick-start --assets ''", "assets: must not be empty");
+  expect_input_error("serve --port 0 --quick-start --cache-max-mib 9223372036854775807",
+                     "cache-max-mib: must be in 0..2^40");
+  expect_input_error("serve --port 0 --quick-start --assets-cache-mib 17592186044416",
+                     "assets-cache-mib: must be in 0..16777216");
 }
