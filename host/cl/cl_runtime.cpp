@@ -272,8 +272,9 @@ const cl::Program& ClRuntime::program(KernelProgram which, const std::string& op
       program = std::move(loaded);
       counted.loaded = 1;
     } catch (const cl::Error&) {
-      // A binary the driver refuses (an entry from an older driver under the same version
-      // string, or damaged inside a valid frame) is built again from source and replaced.
+      // A binary the driver refuses with an error (an entry from an older driver under the same
+      // version string) is built again from source and replaced. One damaged inside a valid frame
+      // never gets here by accident (the checksum); PoCL asserts on some (program_cache.h).
       counted.cache_rejected = 1;
     }
   } else if (cache.enabled()) {

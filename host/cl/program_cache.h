@@ -8,7 +8,10 @@
 // options. The key text is stored in the entry and compared on load, so a hash collision reads
 // as a miss. An entry is written to a temporary file and renamed into place (a reader never sees
 // half a file); on load a wrong magic, key, length or checksum (a truncated or corrupt file)
-// is a miss, and the caller builds from source and writes the entry again.
+// is a miss, and the caller builds from source and writes the entry again. The checksum finds a
+// damaged file, not a made one: the cache is trusted as the driver's own is (PoCL's holds the
+// shared objects it runs), and a payload changed with its checksum mended can stop the process
+// inside the driver (PoCL 3.1 asserts on some) instead of failing its load.
 #pragma once
 #include <cstdint>
 #include <optional>
