@@ -215,6 +215,9 @@ TEST(Assets, ObjRefusesBadNumbersAndIndicesNamingTheLineAndTheWord) {
            // More of the same kind.
            Case{quad + "v 0 -INF 0\nf 1 2 3 4\n", {"vertex 4", "line 5", "'-INF'", "finite"}},
            Case{quad + "v 0 0 1e39\nf 1 2 3 4\n", {"vertex 4", "line 5", "'1e39'", "32-bit float"}},
+           // Within float's range but past what the mesh's areas and framing can take in float.
+           Case{quad + "v -3e38 0 0\nf 1 2 3 4\n", {"vertex 4", "line 5", "'-3e38'", "larger in magnitude than 1e9"}},
+           Case{quad + "v 0 1000000001 0\nf 1 2 3 4\n", {"vertex 4", "line 5", "'1000000001'", "1e9"}},
            Case{quad + "v 1 2\nf 1 2 3 4\n", {"vertex 4", "line 5", "2 numbers"}},
            Case{quad + "f 1 2 3 0\n", {"face 0", "line 5", "'0'", "start at 1"}},
            Case{quad + "f 1 2 3 4.0\n", {"face 0", "line 5", "'4.0'", "integer"}},

@@ -83,6 +83,11 @@ std::string_view without_plus(std::string_view word) {
 // Why `word` is not a coordinate (a finite 32-bit float written in decimal, whole), or empty if it is one.
 // tinyobjloader reads the longest prefix that looks like a number and 0 when there is none, so "1,5" would
 // be 1 and "0x10", "nan" and "inf" would be 0.
+// The largest magnitude of a vertex's number: the mesh's extent, its faces' areas (a length of a
+// cross product of diagonals, whose square grows as a coordinate's fourth power) and the camera
+// framed on it are computed in float, and larger coordinates overflow them to infinity.
+constexpr double kMaxVertexNumber = 1e9;
+
 std::string coordinate_problem(std::string_view word) {
   const std::string_view digits = without_plus(word);
   const char* const last = digits.data() + digits.size();
@@ -92,6 +97,7 @@ std::string coordinate_problem(std::string_view word) {
   if (error == std::errc::result_out_of_range) return "is out of the range of a 32-bit float";
   if (!std::isfinite(value)) return "is not a finite number";
   if (!std::isfinite(static_cast<float>(value))) return "is out of the range of a 32-bit float";
+  if (std::fabs(value) > kMaxVertexNumber) return "is larger in magnitude than 1e9";
   return {};
 }
 
