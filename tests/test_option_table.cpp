@@ -107,6 +107,18 @@ TEST(OptionTable, TextOfTheCommandLineIsTypedByTheTable) {
   const OptionSpec& msaa = *find_option(render_option_table(), "msaa");
   EXPECT_EQ(option_from_text(msaa, "4"), 4);
   EXPECT_EQ(field_of([&] { option_from_text(msaa, "4x"); }), "msaa");
+  // The forms a shell user writes, alike for both kinds; nothing beyond decimal text.
+  EXPECT_EQ(option_from_text(bias, ".5"), 0.5);
+  EXPECT_EQ(option_from_text(bias, "+1"), 1.0);
+  EXPECT_EQ(option_from_text(bias, "-2e-1"), -0.2);
+  EXPECT_EQ(option_from_text(msaa, "+4"), 4);
+  EXPECT_EQ(option_from_text(msaa, "-4"), -4) << "typed here; the bounds are checked after";
+  for (const char* text : {"0x10", "0x1p1", " 4", "4 ", "inf", "nan", "1e999", "", "+-1"}) {
+    EXPECT_EQ(field_of([&] { option_from_text(bias, text); }), "lod_bias") << "'" << text << "'";
+  }
+  for (const char* text : {"+", "+-4", " 4", "0x4", "4.0", ""}) {
+    EXPECT_EQ(field_of([&] { option_from_text(msaa, text); }), "msaa") << "'" << text << "'";
+  }
 }
 
 TEST(OptionTable, CompareListsTakeCommaTextAndArraysAlike) {

@@ -210,18 +210,23 @@ json checked_option(const OptionSpec& spec, const json& value) {
 json option_from_text(const OptionSpec& spec, const std::string& text) {
   switch (spec.type) {
     case OptionType::Integer: {
+      // A plus sign as a number may carry one; from_chars takes none.
+      const std::string_view digits =
+          text.size() > 1 && text[0] == '+' && text[1] != '-' ? std::string_view(text).substr(1) : std::string_view(text);
       long long v = 0;
-      const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
-      if (text.empty() || error != std::errc() || end != text.data() + text.size())
+      const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
+      if (text.empty() || error != std::errc() || end != digits.data() + digits.size())
         throw InputError(spec.key, "must be an integer, got '" + text + "'");
       return v;
     }
     case OptionType::Number: {
       // strtod rather than from_chars: Debian's libstdc++ 12 parses floats with both, but strtod
-      // also takes the forms a shell user writes (".5", "+1").
+      // also takes the forms a shell user writes (".5", "+1"); decimal forms only (strtod would
+      // also read hexadecimal floats and skip leading blanks).
       char* end = nullptr;
       const double v = std::strtod(text.c_str(), &end);
-      if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
+      if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v) ||
+          text.find_first_not_of("0123456789+-.eE") != std::string::npos)
         throw InputError(spec.key, "must be a number, got '" + text + "'");
       return v;
     }
