@@ -11,7 +11,6 @@
 #include <seamcl/assets/ptex_file.h>
 #include <seamcl/cl/cl_runtime.h>
 #include <seamcl/core/input_error.h>
-#include <seamcl/core/json_document.h>
 #include <seamcl/core/regular_file.h>
 #include <seamcl/ptexfilter/ptex_inspect.h>
 #include <seamcl/ptexfilter/ptex_lookup.h>
@@ -25,7 +24,6 @@ using nlohmann::json;
 
 // A query file of a few million lookups is tens of MiB; anything far larger is not one.
 constexpr uint64_t kMaxQueryFileBytes = uint64_t(256) << 20;
-constexpr size_t kMaxQueries = size_t(1) << 22;
 
 struct PtxArgs {
   std::string file;
@@ -34,8 +32,6 @@ struct PtxArgs {
   bool scalar = false;
 };
 
-// The query file's lookups, each checked as it is read (one element's JSON held at a time), so a
-// file of the largest size holds at most kMaxQueries lookups in memory, never its whole document.
 std::vector<PtexLookup> read_queries(const std::string& path) {
   RegularFile file(path);
   if (file.refusal() != RegularFile::Refusal::None) throw InputError("queries", path + ": " + file.refusal_text());
@@ -43,20 +39,7 @@ std::vector<PtexLookup> read_queries(const std::string& path) {
     throw InputError("queries", path + ": more than the " + std::to_string(kMaxQueryFileBytes >> 20) + " MiB a query file may have");
   std::string text;
   if (!file.read_all(text, kMaxQueryFileBytes)) throw InputError("queries", path + ": " + file.refusal_text());
-  std::vector<PtexLookup> lookups;
-  const auto add = [&](json&& element) {
-    lookups.push_back(parse_ptex_lookup(element, "queries[" + std::to_string(lookups.size()) + "]"));
-  };
-  try {
-    if (!parse_json_array_elements(text, kMaxQueries, add)) throw InputError("queries", "must be a JSON array of lookups");
-  } catch (const nlohmann::json::exception& error) {
-    throw InputError("queries", path + ": not valid JSON: " + error.what());
-  } catch (const std::length_error&) {
-    throw InputError("queries", path + ": more than the limit of " + std::to_string(kMaxQueries) + " lookups");
-  } catch (const std::invalid_argument& error) {
-    throw InputError("queries", path + ": not valid JSON: " + error.what());
-  }
-  return lookups;
+  return parse_ptex_lookups(text, path);
 }
 
 int run_info(const PtxArgs& args) {

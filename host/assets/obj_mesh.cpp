@@ -40,8 +40,9 @@ std::string_view next_word(std::string_view& rest) {
 
 std::string_view first_word(std::string_view line) { return next_word(line); }
 
-// The line up to a word that starts with '#' (a trailing comment), as tinyobjloader reads a
-// vertex's line; its face lines it would read the comment's words as corners.
+// The line up to its first word that starts with '#' (a comment after the data). tinyobjloader
+// reads no further than a vertex's numbers, but would read a comment after a face's corners as
+// more corners.
 std::string_view without_comment(std::string_view line) {
   std::string_view rest = line;
   for (std::string_view word = next_word(rest); !word.empty(); word = next_word(rest)) {
@@ -80,14 +81,15 @@ std::string_view without_plus(std::string_view word) {
   return word;
 }
 
-// Why `word` is not a coordinate (a finite 32-bit float written in decimal, whole), or empty if it is one.
-// tinyobjloader reads the longest prefix that looks like a number and 0 when there is none, so "1,5" would
-// be 1 and "0x10", "nan" and "inf" would be 0.
 // The largest magnitude of a vertex's number: the mesh's extent, its faces' areas (a length of a
 // cross product of diagonals, whose square grows as a coordinate's fourth power) and the camera
 // framed on it are computed in float, and larger coordinates overflow them to infinity.
 constexpr double kMaxVertexNumber = 1e9;
 
+// Why `word` is not a coordinate (a finite 32-bit float written in decimal, whole, at most
+// kMaxVertexNumber in magnitude), or empty if it is one. tinyobjloader reads the longest prefix
+// that looks like a number and 0 when there is none, so "1,5" would be 1 and "0x10", "nan" and
+// "inf" would be 0.
 std::string coordinate_problem(std::string_view word) {
   const std::string_view digits = without_plus(word);
   const char* const last = digits.data() + digits.size();

@@ -7,8 +7,10 @@
 
 namespace seamcl {
 
-// The message is cut to kMaxInputErrorMessage characters: some come with a piece of the input
-// (the JSON parser's quote a whole number, however many digits a hostile file gives it).
+// A longer message keeps its first and last kMaxInputErrorMessage / 2 characters: some carry a
+// piece of the input (the JSON parser's messages quote a whole number, however many digits a
+// hostile file gives it). Both ends stay, so a quoted value keeps its closing quote (the service
+// cuts quoted values further, server/request_hygiene.cpp).
 inline constexpr size_t kMaxInputErrorMessage = 1024;
 
 class InputError : public std::runtime_error {
@@ -20,8 +22,9 @@ class InputError : public std::runtime_error {
  private:
   static std::string bounded(const std::string& message) {
     if (message.size() <= kMaxInputErrorMessage) return message;
-    return message.substr(0, kMaxInputErrorMessage) + "... (" + std::to_string(message.size() - kMaxInputErrorMessage) +
-           " characters more)";
+    constexpr size_t kEnd = kMaxInputErrorMessage / 2;
+    return message.substr(0, kEnd) + " [" + std::to_string(message.size() - 2 * kEnd) + " characters cut] " +
+           message.substr(message.size() - kEnd);
   }
 
   std::string field_;

@@ -139,15 +139,20 @@ class CheckedDocumentBuilder {
   std::string refused_;
 };
 
-}  // namespace
-
-nlohmann::json parse_json_document(std::string_view text, int max_depth) {
+// Runs the parser's events into builder; whether it read the whole text.
+bool run_parser(std::string_view text, CheckedDocumentBuilder& builder) {
   const size_t nul = text.find('\0');
   if (nul != std::string_view::npos)
     throw std::invalid_argument("a NUL byte at offset " + std::to_string(nul) + " (nothing after it would be read)");
+  return json::sax_parse(text, &builder);
+}
+
+}  // namespace
+
+nlohmann::json parse_json_document(std::string_view text, int max_depth) {
   json document;
   CheckedDocumentBuilder builder(document, max_depth);
-  const bool whole = json::sax_parse(text, &builder);
+  const bool whole = run_parser(text, builder);
   if (!builder.refused().empty()) throw std::invalid_argument(builder.refused());
   if (!whole) throw std::logic_error("parse_json_document: the parser stopped without a reason");
   return document;
@@ -155,12 +160,9 @@ nlohmann::json parse_json_document(std::string_view text, int max_depth) {
 
 bool parse_json_array_elements(std::string_view text, size_t max_elements,
                                const std::function<void(nlohmann::json&&)>& element, int max_depth) {
-  const size_t nul = text.find('\0');
-  if (nul != std::string_view::npos)
-    throw std::invalid_argument("a NUL byte at offset " + std::to_string(nul) + " (nothing after it would be read)");
   json root;
   CheckedDocumentBuilder builder(root, max_depth, &element, max_elements);
-  const bool whole = json::sax_parse(text, &builder);
+  const bool whole = run_parser(text, builder);
   if (builder.root_not_array()) return false;
   if (builder.too_many_elements()) throw std::length_error("more than " + std::to_string(max_elements) + " elements");
   if (!builder.refused().empty()) throw std::invalid_argument(builder.refused());

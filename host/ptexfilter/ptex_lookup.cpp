@@ -1,9 +1,11 @@
 #include <seamcl/ptexfilter/ptex_lookup.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include <seamcl/assets/ptex_file.h>
 #include <seamcl/core/input_error.h>
+#include <seamcl/core/json_document.h>
 
 #include "pipeline/stages/ptex_filter_launcher.h"
 #include "pipeline/stages/ptex_filter_twin.h"
@@ -111,12 +113,21 @@ PtexLookup parse_ptex_lookup(const json& object, const std::string& field) {
   return out;
 }
 
-std::vector<PtexLookup> parse_ptex_lookups(const json& array, const std::string& field) {
-  if (!array.is_array()) throw InputError(field, "must be a JSON array of lookups");
-  std::vector<PtexLookup> out;
-  out.reserve(array.size());
-  for (size_t i = 0; i < array.size(); ++i) out.push_back(parse_ptex_lookup(array[i], field + "[" + std::to_string(i) + "]"));
-  return out;
+std::vector<PtexLookup> parse_ptex_lookups(std::string_view text, const std::string& source) {
+  std::vector<PtexLookup> lookups;
+  const auto add = [&](json&& element) {
+    lookups.push_back(parse_ptex_lookup(element, "queries[" + std::to_string(lookups.size()) + "]"));
+  };
+  try {
+    if (!parse_json_array_elements(text, kMaxPtexLookups, add)) throw InputError("queries", "must be a JSON array of lookups");
+  } catch (const json::exception& error) {
+    throw InputError("queries", source + ": not valid JSON: " + error.what());
+  } catch (const std::length_error&) {
+    throw InputError("queries", source + ": more than the limit of " + std::to_string(kMaxPtexLookups) + " lookups");
+  } catch (const std::invalid_argument& error) {
+    throw InputError("queries", source + ": not valid JSON: " + error.what());
+  }
+  return lookups;
 }
 
 PtexFilterFile::PtexFilterFile(const std::string& path, uint64_t max_bytes) {
