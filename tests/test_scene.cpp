@@ -855,7 +855,7 @@ TEST(SceneJson, FileErrorsNameThePath) {
   message = expect_input_error([&] { load_scene_file(long_number.path()); }, "scene");
   EXPECT_NE(message.find("not valid JSON"), std::string::npos) << message.substr(0, 200);
   EXPECT_LT(message.size(), 1200u);
-  EXPECT_NE(message.find(" characters cut] "), std::string::npos) << message.substr(500, 100);
+  EXPECT_NE(message.find(" bytes cut] "), std::string::npos) << message.substr(500, 100);
   const TemporaryFile after_nul(minimal_document().dump() + std::string(1, '\0') + "{\"garbage\"");
   message = expect_input_error([&] { load_scene_file(after_nul.path()); }, "scene");
   EXPECT_NE(message.find("NUL byte"), std::string::npos) << message;
@@ -867,6 +867,33 @@ TEST(SceneJson, FileErrorsNameThePath) {
   const TemporaryFile good(minimal_document().dump());
   EXPECT_EQ(load_scene_file(good.path()).name, std::filesystem::path(good.path()).stem().string())
       << "an unnamed scene is named after its file";
+}
+
+// A long input error keeps both ends, cut between whole UTF-8 characters.
+TEST(SceneJson, LongInputErrorsKeepBothEndsAndWholeCharacters) {
+  for (const size_t lead : {0, 1}) {  // the two-byte characters start on either side of the cut
+    const std::string body = std::string(lead, 'a') + [] {
+      std::string text;
+      for (int i = 0; i < 1000; ++i) text += "\xC3\xA9";  // U+00E9, two bytes
+      return text;
+    }();
+    const std::string message = "'" + body + "' ends here";
+    const std::string what = InputError("field", message).what();
+    EXPECT_LT(what.size(), 1100u);
+    EXPECT_EQ(what.rfind("field: '", 0), 0u);
+    EXPECT_NE(what.find("' ends here"), std::string::npos) << "the end is kept";
+    EXPECT_NE(what.find(" bytes cut] "), std::string::npos);
+    // Every byte after the prefix's quote and before the marker is a whole character.
+    const size_t marker = what.find(" [");
+    const std::string head = what.substr(8 + lead, marker - 8 - lead);
+    EXPECT_EQ(head.size() % 2, 0u) << "a character split at the first cut";
+    const size_t tail_start = what.find("cut] ") + 5;
+    const std::string tail = what.substr(tail_start, what.find("' ends here") - tail_start);
+    EXPECT_EQ(tail.size() % 2, 0u) << "a character split at the second cut";
+    EXPECT_NE(static_cast<unsigned char>(tail.front()) & 0xC0u, 0x80u);
+  }
+  EXPECT_EQ(std::string(InputError("f", std::string(1024, 'x')).what()), "f: " + std::string(1024, 'x'))
+      << "up to the bound, the message is whole";
 }
 
 TEST(SceneJson, LoadSceneTakesNamesOrPaths) {

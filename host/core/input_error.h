@@ -7,10 +7,10 @@
 
 namespace seamcl {
 
-// A longer message keeps its first and last kMaxInputErrorMessage / 2 characters: some carry a
-// piece of the input (the JSON parser's messages quote a whole number, however many digits a
-// hostile file gives it). Both ends stay, so a quoted value keeps its closing quote (the service
-// cuts quoted values further, server/request_hygiene.cpp).
+// A longer message keeps its first and last kMaxInputErrorMessage / 2 bytes (or fewer, to cut
+// between UTF-8 sequences): some carry a piece of the input (the JSON parser's messages quote a
+// whole number, however many digits a hostile file gives it). Both ends stay, so a quoted value
+// keeps its closing quote (the service cuts quoted values further, server/request_hygiene.cpp).
 inline constexpr size_t kMaxInputErrorMessage = 1024;
 
 class InputError : public std::runtime_error {
@@ -22,9 +22,12 @@ class InputError : public std::runtime_error {
  private:
   static std::string bounded(const std::string& message) {
     if (message.size() <= kMaxInputErrorMessage) return message;
-    constexpr size_t kEnd = kMaxInputErrorMessage / 2;
-    return message.substr(0, kEnd) + " [" + std::to_string(message.size() - 2 * kEnd) + " characters cut] " +
-           message.substr(message.size() - kEnd);
+    // Cut between UTF-8 sequences, never inside one (a continuation byte is 10xxxxxx).
+    const auto continues = [&](size_t i) { return (static_cast<unsigned char>(message[i]) & 0xC0u) == 0x80u; };
+    size_t head = kMaxInputErrorMessage / 2, tail = message.size() - kMaxInputErrorMessage / 2;
+    while (head > 0 && continues(head)) --head;
+    while (tail < message.size() && continues(tail)) ++tail;
+    return message.substr(0, head) + " [" + std::to_string(tail - head) + " bytes cut] " + message.substr(tail);
   }
 
   std::string field_;
