@@ -39,7 +39,7 @@ std::vector<PtexLookup> read_queries(const std::string& path) {
     throw InputError("queries", path + ": more than the " + std::to_string(kMaxQueryFileBytes >> 20) + " MiB a query file may have");
   std::string text;
   if (!file.read_all(text, kMaxQueryFileBytes)) throw InputError("queries", path + ": " + file.refusal_text());
-  return parse_ptex_lookups(text, path);
+  return parse_ptex_lookups_from_text(text, path);
 }
 
 int run_info(const PtxArgs& args) {

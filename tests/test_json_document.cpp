@@ -24,7 +24,9 @@ TEST(JsonDocument, BuildsWhatTheLibraryParserBuilds) {
        {"null", "true", "-0", "18446744073709551615", "-9223372036854775808", "1.5e300", "\"\\u00e9\\n\"", "[]", "{}",
         R"({"a": [1, {"b": [[], {}], "c": null}, "x"], "d": {"e": {"f": [true, false, 2.5]}}, "g": ""})",
         R"([[[[1]]], {"k": [{"k": [{"k": 0}]}]}, -1, 0.1])"}) {
-    EXPECT_EQ(seamcl::parse_json_document(text), nlohmann::json::parse(text)) << text;
+    // dump() too: == takes -0 for 0.0 and an integer for the equal float.
+    EXPECT_EQ(seamcl::parse_json_document(text).dump(), nlohmann::json::parse(text).dump()) << text;
+    EXPECT_EQ(seamcl::parse_json_document(text).type(), nlohmann::json::parse(text).type()) << text;
   }
   // An array of many objects (a hostile body's shape): every element kept, in order.
   std::string many = "{\"x\": [";
@@ -33,7 +35,7 @@ TEST(JsonDocument, BuildsWhatTheLibraryParserBuilds) {
   const nlohmann::json parsed = seamcl::parse_json_document(many);
   ASSERT_EQ(parsed.at("x").size(), 200000u);
   EXPECT_EQ(parsed.at("x").at(123456).at("i"), 123456);
-  EXPECT_EQ(parsed, nlohmann::json::parse(many));
+  EXPECT_EQ(parsed.dump(), nlohmann::json::parse(many).dump());
 }
 
 TEST(JsonDocument, RefusesARepeatedKeyAtAnyDepthButNotAcrossObjects) {
@@ -69,7 +71,7 @@ TEST(JsonDocument, ArrayElementsAreHandedOverInOrderUpToTheLimit) {
   const auto keep = [&](nlohmann::json&& element) { seen.push_back(std::move(element)); };
   const std::string text = R"([1, {"a": [2, {"b": 3}]}, [], [[4]], "five", null])";
   ASSERT_TRUE(seamcl::parse_json_array_elements(text, 6, keep));
-  EXPECT_EQ(nlohmann::json(seen), nlohmann::json::parse(text));
+  EXPECT_EQ(nlohmann::json(seen).dump(), nlohmann::json::parse(text).dump());
 
   seen.clear();
   EXPECT_THROW(seamcl::parse_json_array_elements(text, 5, keep), std::length_error);
@@ -78,7 +80,13 @@ TEST(JsonDocument, ArrayElementsAreHandedOverInOrderUpToTheLimit) {
   seen.clear();
   EXPECT_FALSE(seamcl::parse_json_array_elements(R"({"a": [1, 2]})", 10, keep));
   EXPECT_FALSE(seamcl::parse_json_array_elements("7", 10, keep));
+  EXPECT_FALSE(seamcl::parse_json_array_elements(R"({"a": {"a": 1, "a": 2}})", 10, keep))
+      << "not an array: the rest read for its syntax only";
   EXPECT_TRUE(seen.empty());
+  // A text that is not an array and not valid JSON either is the parser's error, as before.
+  EXPECT_THROW(seamcl::parse_json_array_elements(R"({"face": 1)", 10, keep), nlohmann::json::parse_error);
+  EXPECT_THROW(seamcl::parse_json_array_elements("5 5", 10, keep), nlohmann::json::parse_error);
+  EXPECT_THROW(seamcl::parse_json_array_elements(R"({"a": 1} [)", 10, keep), nlohmann::json::parse_error);
   EXPECT_TRUE(seamcl::parse_json_array_elements("[]", 0, keep));
 
   // The checks of parse_json_document hold inside elements, and an element the caller refuses

@@ -874,12 +874,15 @@ TEST(SceneJson, LongInputErrorsKeepBothEndsAndWholeCharacters) {
   for (const size_t lead : {0, 1}) {  // the two-byte characters start on either side of the cut
     const std::string body = std::string(lead, 'a') + [] {
       std::string text;
-      for (int i = 0; i < 1000; ++i) text += "\xC3\xA9";  // U+00E9, two bytes
+      for (int i = 0; i < 3000; ++i) text += "\xC3\xA9";  // U+00E9, two bytes
       return text;
     }();
     const std::string message = "'" + body + "' ends here";
     const std::string what = InputError("field", message).what();
     EXPECT_LT(what.size(), 1100u);
+    // Wrapped again with a prefix, as callers add a path or a field: not cut a second time.
+    const std::string again = InputError("outer", "some/path.json: " + what).what();
+    EXPECT_EQ(again, "outer: some/path.json: " + what);
     EXPECT_EQ(what.rfind("field: '", 0), 0u);
     EXPECT_NE(what.find("' ends here"), std::string::npos) << "the end is kept";
     EXPECT_NE(what.find(" bytes cut] "), std::string::npos);
@@ -892,8 +895,12 @@ TEST(SceneJson, LongInputErrorsKeepBothEndsAndWholeCharacters) {
     EXPECT_EQ(tail.size() % 2, 0u) << "a character split at the second cut";
     EXPECT_NE(static_cast<unsigned char>(tail.front()) & 0xC0u, 0x80u);
   }
-  EXPECT_EQ(std::string(InputError("f", std::string(1024, 'x')).what()), "f: " + std::string(1024, 'x'))
+  EXPECT_EQ(std::string(InputError("f", std::string(2048, 'x')).what()), "f: " + std::string(2048, 'x'))
       << "up to the bound, the message is whole";
+  // Invalid text (only continuation bytes) moves no cut past a character's length.
+  const std::string invalid = InputError("f", "'" + std::string(3000, '\xBF') + "' ends here").what();
+  EXPECT_NE(invalid.find("' ends here"), std::string::npos);
+  EXPECT_GT(invalid.find(" ["), 500u) << "the head is kept";
 }
 
 TEST(SceneJson, LoadSceneTakesNamesOrPaths) {

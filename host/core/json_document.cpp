@@ -32,11 +32,13 @@ class CheckedDocumentBuilder {
   bool binary(json::binary_t& value) { return add(json::binary(std::move(value))); }
 
   bool start_object(std::size_t) {
+    if (root_not_array_) return true;
     if (!open(json::object())) return false;
-    keys_.emplace_back();
+    if (!root_not_array_) keys_.emplace_back();
     return true;
   }
   bool key(json::string_t& key) {
+    if (root_not_array_) return true;
     if (too_deep()) return false;
     if (!keys_.back().insert(key).second) {
       constexpr size_t kShown = 64;  // a hostile key does not make the message long
@@ -47,12 +49,14 @@ class CheckedDocumentBuilder {
     return true;
   }
   bool end_object() {
+    if (root_not_array_) return true;
     keys_.pop_back();
     open_.pop_back();
     return element_done();
   }
-  bool start_array(std::size_t) { return open(json::array()); }
+  bool start_array(std::size_t) { return root_not_array_ || open(json::array()); }
   bool end_array() {
+    if (root_not_array_) return true;
     open_.pop_back();
     return element_done();
   }
@@ -77,8 +81,9 @@ class CheckedDocumentBuilder {
 
   // The value's place: the root, the end of the open array, or the open object's pending key.
   // Pointers to open containers stay valid: an array grows only after its open child closes.
-  // nullptr: the value is refused (with a sink: a root that is not an array, an element past
-  // max_elements).
+  // nullptr: the value is not kept. With a sink, a root that is not an array starts the rest of
+  // the text being read for its syntax alone (a syntax error is still the parser's to report), and
+  // an element past max_elements is refused.
   json* place(json&& value) {
     if (open_.empty()) {
       if (sink_ != nullptr && !value.is_array()) {
@@ -103,14 +108,16 @@ class CheckedDocumentBuilder {
   }
 
   bool add(json&& value) {
-    if (too_deep() || place(std::move(value)) == nullptr) return false;
+    if (root_not_array_) return true;
+    if (too_deep()) return false;
+    if (place(std::move(value)) == nullptr) return root_not_array_;
     return element_done();
   }
 
   bool open(json&& container) {
     if (too_deep()) return false;
     json* placed = place(std::move(container));
-    if (placed == nullptr) return false;
+    if (placed == nullptr) return root_not_array_;
     open_.push_back(placed);
     return true;
   }
@@ -163,11 +170,10 @@ bool parse_json_array_elements(std::string_view text, size_t max_elements,
   json root;
   CheckedDocumentBuilder builder(root, max_depth, &element, max_elements);
   const bool whole = run_parser(text, builder);
-  if (builder.root_not_array()) return false;
   if (builder.too_many_elements()) throw std::length_error("more than " + std::to_string(max_elements) + " elements");
   if (!builder.refused().empty()) throw std::invalid_argument(builder.refused());
   if (!whole) throw std::logic_error("parse_json_array_elements: the parser stopped without a reason");
-  return true;
+  return !builder.root_not_array();
 }
 
 }  // namespace seamcl

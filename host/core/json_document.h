@@ -19,7 +19,8 @@ nlohmann::json parse_json_document(std::string_view text, int max_depth = 0);
 
 // A document whose root is an array, read element by element: each element is handed to `element`
 // as soon as it is read, and dropped, so that one element is held at a time however long the
-// array. False, with nothing handed over, when the root is not an array. Throws as
+// array. False, with nothing handed over, when the root is not an array (the rest of such a text
+// is read for its syntax only, so a syntax error still throws). Throws as
 // parse_json_document, std::length_error before reading an element past max_elements, and
 // whatever `element` throws.
 bool parse_json_array_elements(std::string_view text, size_t max_elements,

@@ -113,7 +113,15 @@ PtexLookup parse_ptex_lookup(const json& object, const std::string& field) {
   return out;
 }
 
-std::vector<PtexLookup> parse_ptex_lookups(std::string_view text, const std::string& source) {
+std::vector<PtexLookup> parse_ptex_lookups(const json& array, const std::string& field) {
+  if (!array.is_array()) throw InputError(field, "must be a JSON array of lookups");
+  std::vector<PtexLookup> out;
+  out.reserve(array.size());
+  for (size_t i = 0; i < array.size(); ++i) out.push_back(parse_ptex_lookup(array[i], field + "[" + std::to_string(i) + "]"));
+  return out;
+}
+
+std::vector<PtexLookup> parse_ptex_lookups_from_text(std::string_view text, const std::string& source) {
   std::vector<PtexLookup> lookups;
   const auto add = [&](json&& element) {
     lookups.push_back(parse_ptex_lookup(element, "queries[" + std::to_string(lookups.size()) + "]"));

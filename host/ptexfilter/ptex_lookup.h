@@ -34,14 +34,17 @@ struct PtexLookup {
 // One lookup from a JSON object of the table's keys (others, such as a golden entry's "value",
 // are ignored); InputError(field + "." + key) for a bad value, naming the key.
 PtexLookup parse_ptex_lookup(const nlohmann::json& object, const std::string& field = "");
-// The most lookups parse_ptex_lookups takes from one text.
+// A JSON array of such objects; fields are named "queries[i].key".
+std::vector<PtexLookup> parse_ptex_lookups(const nlohmann::json& array, const std::string& field = "queries");
+
+// The most lookups parse_ptex_lookups_from_text takes from one text.
 inline constexpr size_t kMaxPtexLookups = size_t(1) << 22;
 
 // Lookups from JSON text holding an array of such objects (a query file, named `source` in
 // messages), each checked as it is read, so that one entry's JSON is held at a time whatever the
 // text's length. InputError("queries") for text that is not a JSON array or holds more than
 // kMaxPtexLookups entries, InputError("queries[i].key") for a bad value.
-std::vector<PtexLookup> parse_ptex_lookups(std::string_view text, const std::string& source);
+std::vector<PtexLookup> parse_ptex_lookups_from_text(std::string_view text, const std::string& source);
 
 struct PtexFilterData;
 
