@@ -1,7 +1,7 @@
 /* Batches of lookups of Ptex's own filters (`seamcl ptx lookup`, the kernel tests and the Ptex
  * benchmark): one work-item per query, ptexf_lookup of ptex_filter.cl; a batch of point lookups
- * alone through ptex_point_lookups, whose short loop body lets a core keep more lookups' texel
- * misses in flight.
+ * through ptex_point_lookups, whose short loop body lets a core keep more lookups' texel misses in
+ * flight.
  * Contract: out[4 * id ..] holds query id's 4 floats (channels beyond the texture's 0; a face out of
  * range gives zeros) for id < count. Host guarantees: tex, faces, level_offsets and texels as
  * ptex_filter.cl states; tex.seams 0 (Ptex's own rules); out holds 4 * count floats.
@@ -37,13 +37,18 @@ __kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilt
   for (int c = 0; c < 4; ++c) dst[c] = value[c];
 }
 
-/* ptex_filter_lookups for a batch whose every query is SEAMCL_PTEX_POINT: ptexf_point alone. */
+/* ptex_filter_lookups for a batch of point lookups: ptexf_point alone. A query of another filter
+ * sets *not_point to 1 (and its 4 floats are not its lookup's), so that the host, which runs this
+ * kernel when a batch's first query is a point lookup instead of reading every query first, runs
+ * ptex_filter_lookups over the batch after it. Host guarantees: *not_point 0 before the launch. */
 __kernel void ptex_point_lookups(PtexFilterTexture tex, __global const PtexFilterFace* faces,
                                  __global const uint* level_offsets, __global const uchar* texels,
-                                 __global const PtexFilterQuery* queries, int count, __global float* out) {
+                                 __global const PtexFilterQuery* queries, int count, __global float* out,
+                                 __global int* not_point) {
   const int id = (int)get_global_id(0);
   if (id >= count) return;
   const PtexFilterQuery q = queries[id];
+  if (q.filter != SEAMCL_PTEX_POINT) *not_point = 1;
   const PtexfState s = ptexf_batch_state(tex, faces, level_offsets, texels);
   vstore4(ptexf_point(&s, &q), id, out);
 }

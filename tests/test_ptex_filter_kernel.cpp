@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <limits>
 #include <random>
 #include <string>
 #include <utility>
@@ -200,6 +201,7 @@ TEST(PtexFilterKernel, PointBatchesMatchTheTwinAndMixedBatches) {
   for (const char* name : {"black", "cellnoise", "cube_text", "rand_lo", "wave_lo"})
     textures.emplace_back(name, build_ptex_filter_data(read_ptex_stored(ptex_assets_dir() + "/" + name + ".ptx")));
   textures.emplace_back("float rgba", float_face(3, 4));
+  int bilinear_differs = 0;  // the textures where the bilinear lookup is not its point's texel
   for (const auto& [name, data] : textures) {
     const int faces = static_cast<int>(data.faces.size());
     std::mt19937 random(7);
@@ -217,6 +219,7 @@ TEST(PtexFilterKernel, PointBatchesMatchTheTwinAndMixedBatches) {
     std::vector<PtexFilterQuery> mixed = points;
     PtexFilterQuery bilinear = points[5];
     bilinear.filter = SEAMCL_PTEX_BILINEAR;
+    bilinear.uw = bilinear.vw = 0.4f;
     mixed.push_back(bilinear);
     PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
     launcher.load(data);
@@ -235,7 +238,18 @@ TEST(PtexFilterKernel, PointBatchesMatchTheTwinAndMixedBatches) {
         for (int c = 0; c < 4; ++c) EXPECT_EQ(alone[4 * i + c], 0.0f) << name << " face " << points[i].face;
     }
     EXPECT_GT(nonzero, static_cast<int>(points.size()) / 2) << name;
+    // The batch opens with point lookups, so the point kernel runs first: the one bilinear lookup at
+    // its end must still get its own filter's value, not its texel.
+    const std::array<float, 4> bilinear_twin = ptex_filter_twin(data, bilinear);
+    for (int c = 0; c < 4; ++c)
+      EXPECT_FLOAT_EQ(among[4 * points.size() + static_cast<size_t>(c)], bilinear_twin[c]) << name << " channel " << c;
+    bilinear_differs += bilinear_twin != ptex_filter_twin(data, points[5]);
+    // Into the caller's memory: every value written, whatever the array held.
+    std::vector<float> reused(4 * mixed.size(), std::numeric_limits<float>::quiet_NaN());
+    launcher.run(mixed, reused.data());
+    for (size_t i = 0; i < reused.size(); ++i) ASSERT_EQ(reused[i], among[i]) << name << " value " << i;
   }
+  EXPECT_GE(bilinear_differs, 3);
 }
 
 // One launch per file (the launcher's compile dominates the time); the twin's own test holds the

@@ -18,6 +18,9 @@ class PtexFilterLauncher {
   // 4 floats per query (channels beyond the texture's are 0), in order. A batch of point lookups
   // alone runs through a kernel of its own (ptex_point_lookups), shorter per lookup.
   std::vector<float> run(const std::vector<PtexFilterQuery>& queries);
+  // The same into the caller's memory, 4 * queries.size() floats at `values`: a caller that looks up
+  // batch after batch keeps one array (a new one is zeroed and its pages faulted in on one thread).
+  void run(const std::vector<PtexFilterQuery>& queries, float* values);
 
   // Uploads `queries` once (for timing) and runs them `repeats` times back to back; returns the
   // kernel milliseconds of each run (OpenCL profiling events).
@@ -26,16 +29,16 @@ class PtexFilterLauncher {
   size_t device_bytes() const { return device_bytes_; }
 
  private:
-  // The kernel for `queries` (ptex_point_lookups when every one is a point lookup), its arguments
-  // set to the texture, `in` and `out`.
-  cl::Kernel& kernel_with_args(const std::vector<PtexFilterQuery>& queries, const cl::Buffer& in,
-                               const cl::Buffer& out);
+  // `kernel` with its arguments set to the texture, `in`, `count` and `out` (and, for
+  // ptex_point_lookups, not_point_).
+  cl::Kernel& with_args(cl::Kernel& kernel, const cl::Buffer& in, size_t count, const cl::Buffer& out);
 
   ClRuntime& runtime_;
   cl::Kernel kernel_;
   cl::Kernel point_kernel_;
   PtexFilterTexture texture_{};
   cl::Buffer faces_, level_offsets_, texels_;
+  cl::Buffer not_point_;  // ptex_point_lookups' flag: a query of another filter was in its batch
   size_t device_bytes_ = 0;
 };
 
