@@ -324,9 +324,10 @@ GuardedHttpServer::GuardedHttpServer(ConnectionLimits limits) : limits_(limits) 
     ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);  // restart on a TIME_WAIT port, but never share it
   });
   set_payload_max_length(limits_.max_request_bytes);
-  // Any error answer closes the connection (see process_and_close_socket): say so to the client.
-  set_post_routing_handler([](const httplib::Request&, httplib::Response& res) {
-    if (res.status >= 400) res.set_header("Connection", "close");
+  // Any error answer closes the connection (see process_and_close_socket): say so to the client,
+  // once (cpp-httplib adds the header itself where the request asked to close).
+  set_post_routing_handler([](const httplib::Request& req, httplib::Response& res) {
+    if (res.status >= 400 && req.get_header_value("Connection") != "close") res.set_header("Connection", "close");
   });
 }
 

@@ -197,6 +197,17 @@ TEST(Assets, ObjRefusesAFaceThatIsNotAQuadNamingItsIndexAndLine) {
   EXPECT_TRUE(names_all(input_error([] { read_obj_file("/nonexistent/x.obj"); }, "scene"), {"/nonexistent/x.obj", "no such file"}));
 }
 
+// Faces are counted before any is read: one over the bound is refused, even where a face names no vertex.
+TEST(Assets, ObjRefusesMoreFacesThanItsBoundBeforeReadingThem) {
+  std::string text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+  text.reserve(text.size() + 10 * (kMaxObjFaces + 1));
+  for (size_t f = 0; f < kMaxObjFaces; ++f) text += "f 1 2 3 4\n";
+  text += "f 1 2 3 99\n";  // past the bound and naming no vertex: the count is refused first
+  const std::string message = input_error([&] { parse_obj(text, "many.obj", "mesh"); }, "mesh");
+  EXPECT_TRUE(names_all(message, {"'many.obj'", "4194305 face lines", "limit of 4194304"})) << message;
+  EXPECT_EQ(message.find("does not exist"), std::string::npos) << message;
+}
+
 // tinyobjloader reads an index with atoi (which wraps) and a number as its longest numeric prefix or 0;
 // the reader's own pre-scan refuses them first, naming the line and the word.
 TEST(Assets, ObjRefusesBadNumbersAndIndicesNamingTheLineAndTheWord) {

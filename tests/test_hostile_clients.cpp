@@ -159,6 +159,21 @@ TEST_F(Hostile, MalformedHeaderLinesAreRefused) {
   EXPECT_EQ(first_status(fine.bytes), 200) << fine.bytes.substr(0, 300);
 }
 
+// An error answer closes the connection and says so once, whether or not the client asked to close.
+TEST_F(Hostile, ErrorAnswersSayConnectionCloseOnce) {
+  LiveServer server(patient_options());
+  for (const std::string close : {"", "Connection: close\r\n"}) {
+    const Exchange answer = exchange(server.port(), "GET /v1/render?size=8x HTTP/1.1\r\nHost: x\r\n" + close + "\r\n");
+    EXPECT_EQ(first_status(answer.bytes), 400) << answer.bytes.substr(0, 300);
+    EXPECT_TRUE(answer.closed) << close;
+    const std::string head = answer.bytes.substr(0, answer.bytes.find("\r\n\r\n") + 2);
+    size_t said = 0;
+    for (size_t at = head.find("\r\nConnection:"); at != std::string::npos; at = head.find("\r\nConnection:", at + 1)) ++said;
+    EXPECT_EQ(said, 1u) << head;
+    EXPECT_NE(head.find("\r\nConnection: close\r\n"), std::string::npos) << head;
+  }
+}
+
 // Finding 9: lengths that cannot be right are answered at once, not at the 10 s read deadline.
 TEST_F(Hostile, BadLengthsAreAnsweredAtOnce) {
   LiveServer server(patient_options());

@@ -105,7 +105,7 @@ std::string coordinate_problem(std::string_view word) {
 
 // How many elements of each kind a face corner can name.
 struct ElementCounts {
-  size_t positions = 0, texcoords = 0, normals = 0;
+  size_t positions = 0, texcoords = 0, normals = 0, faces = 0;
 };
 
 struct ElementKind {
@@ -116,11 +116,12 @@ constexpr ElementKind kPosition{"vertex", "vertices"};
 constexpr ElementKind kTexcoord{"texture coordinate", "texture coordinates"};
 constexpr ElementKind kNormal{"normal", "normals"};
 
-// Counts `v`, `vt` and `vn` lines as a line's first word.
+// Counts `v`, `vt`, `vn` and `f` lines as a line's first word.
 void count_element(std::string_view word, ElementCounts& counts) {
   if (word == "v") ++counts.positions;
   else if (word == "vt") ++counts.texcoords;
   else if (word == "vn") ++counts.normals;
+  else if (word == "f") ++counts.faces;
 }
 
 // What the reader learns from the text itself before tinyobjloader sees it: the line of every
@@ -140,6 +141,10 @@ class Prescanner {
   Prescan run(const std::string& text) {
     // Positive indices may name elements defined further on; their bound is the file's count.
     for_each_line(text, [&](std::string_view line) { count_element(first_word(line), total_); });
+    // Before anything is built: tinyobjloader and the scene hold hundreds of bytes a face.
+    if (total_.faces > kMaxObjFaces)
+      refuse("has " + std::to_string(total_.faces) + " face lines, more than the limit of " +
+             std::to_string(kMaxObjFaces));
     Prescan out;
     out.text.reserve(text.size());
     for_each_line(text, [&](std::string_view line) {

@@ -19,6 +19,9 @@ struct ObjMesh {
 
 // A bound on the text read, so that a file cannot make the reader hold more than this.
 inline constexpr size_t kMaxObjBytes = size_t{1} << 28;
+// A bound on the faces, checked before any is parsed: reading and rendering a mesh costs hundreds of
+// bytes a face (4M quads, the bound, about 2 GB), where the text alone could name 25M.
+inline constexpr size_t kMaxObjFaces = size_t{1} << 22;
 
 // Parses OBJ text. Lines whose first word is `version` or `surface` (written by the tools that
 // made the Ptex samples; not OBJ) are skipped. A face that is not a quad, an index out of range
@@ -28,7 +31,8 @@ inline constexpr size_t kMaxObjBytes = size_t{1} << 28;
 // corner must be i, i/j, i//k or i/j/k of whole non-zero integers naming elements that exist (a
 // positive index counts from the file's first element, so forward references are allowed; a negative
 // one counts back from the line). A bad one is InputError naming `source`, the vertex or face, its
-// line and the word at fault. Lines end at "\n", "\r\n" or a lone "\r", as tinyobjloader reads them.
+// line and the word at fault. A text of more than kMaxObjFaces `f` lines is refused before any is
+// read. Lines end at "\n", "\r\n" or a lone "\r", as tinyobjloader reads them.
 ObjMesh parse_obj(const std::string& text, const std::string& source = "mesh",
                   const std::string& field = "scene");
 
