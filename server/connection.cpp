@@ -436,7 +436,8 @@ bool GuardedHttpServer::process_and_close_socket(socket_t sock) {
     if (const std::optional<HeadRefusal> refusal = check_request_head(head, limits_.max_body_bytes)) {
       answered_error = true;
       write_json_response(sock, refusal->status, refusal->reason,
-                          nlohmann::json{{"error", refusal->message}, {"field", refusal->field}}.dump(), "");
+                          nlohmann::json{{"error", refusal->message}, {"field", refusal->field}}.dump(),
+                          refusal->extra_headers);
       break;
     }
     bool connection_closed = false;

@@ -32,6 +32,7 @@ HeadRefusal bad(const std::string& field, const std::string& message) { return {
 std::optional<HeadRefusal> check_request_head(std::string_view head, size_t max_body_bytes) {
   int content_lengths = 0, transfer_encodings = 0;
   std::string_view content_length, transfer_encoding;
+  bool coded_body = false;
   bool first_line = true;
   for (size_t at = 0; at < head.size();) {
     const size_t newline = head.find('\n', at);
@@ -61,6 +62,8 @@ std::optional<HeadRefusal> check_request_head(std::string_view head, size_t max_
     } else if (equals_ignoring_case(name, "Transfer-Encoding")) {
       ++transfer_encodings;
       transfer_encoding = value;
+    } else if (equals_ignoring_case(name, "Content-Encoding")) {
+      coded_body = coded_body || !(value.empty() || equals_ignoring_case(value, "identity"));
     } else if (equals_ignoring_case(name, "Range")) {
       if (value.find(',') != std::string_view::npos)
         return bad("Range", "more than one range is not served (ask for one range at a time)");
@@ -72,6 +75,10 @@ std::optional<HeadRefusal> check_request_head(std::string_view head, size_t max_
   if (transfer_encodings > 1) return bad("Transfer-Encoding", "given more than once");
   if (transfer_encodings == 1 && !equals_ignoring_case(transfer_encoding, "chunked"))
     return bad("Transfer-Encoding", "must be chunked, and only chunked");
+  if (coded_body)
+    return HeadRefusal{415, "Unsupported Media Type", "Content-Encoding",
+                       "Content-Encoding: the body must be sent as it is (identity), not compressed",
+                       "Accept-Encoding: identity\r\n"};
   if (content_lengths == 1) {
     if (content_length.empty() ||
         !std::all_of(content_length.begin(), content_length.end(), [](char c) { return c >= '0' && c <= '9'; }))

@@ -186,13 +186,23 @@ TEST_F(Hostile, BadLengthsAreAnsweredAtOnce) {
       {"30 digits", post + "Content-Length: 100000000000000000000000000000\r\n\r\n{}", 413, "body"},
       {"chunked, identity", post + "Transfer-Encoding: chunked, identity\r\n\r\n2\r\n{}\r\n0\r\n\r\n", 400, "Transfer-Encoding"},
       {"gzip", post + "Transfer-Encoding: gzip\r\n\r\n", 400, "Transfer-Encoding"},
+      {"a gzip body", post + "Content-Encoding: gzip\r\nContent-Length: 2\r\n\r\n{}", 415, "Content-Encoding"},
+      {"a deflate body, chunked", post + "content-encoding: Deflate\r\nTransfer-Encoding: chunked\r\n\r\n2\r\n{}\r\n0\r\n\r\n", 415,
+       "Content-Encoding"},
+      {"a chunk size that is not hexadecimal", post + "Transfer-Encoding: chunked\r\n\r\nzz\r\n{}\r\n0\r\n\r\n", 400, "body"},
+      {"a chunk longer than its size", post + "Transfer-Encoding: chunked\r\n\r\n1\r\n{}\r\n0\r\n\r\n", 400, "body"},
   };
   for (const auto& [what, request, status, field] : cases) {
     const Exchange answer = exchange(server.port(), request);
     EXPECT_EQ(first_status(answer.bytes), status) << what << ": " << answer.bytes.substr(0, 300);
     EXPECT_EQ(error_body(answer.bytes).value("field", ""), field) << what << ": " << answer.bytes.substr(0, 300);
     EXPECT_LT(answer.seconds, 2.0) << what << ": answered only after " << answer.seconds << " s";
+    if (status == 415) EXPECT_NE(answer.bytes.find("\r\nAccept-Encoding: identity\r\n"), std::string::npos) << answer.bytes;
   }
+  // An identity coding is no coding: the body is read.
+  const Exchange identity = exchange(server.port(), post + "Content-Encoding: identity\r\nContent-Length: 8\r\nConnection: close\r\n\r\n{\"x\": 1}");
+  EXPECT_EQ(first_status(identity.bytes), 400) << identity.bytes.substr(0, 300);
+  EXPECT_EQ(error_body(identity.bytes).value("field", ""), "x") << identity.bytes.substr(0, 300);
 }
 
 // Finding 9: a chunked body over the limit is 413 whatever its size (4 MiB was 400, 3 MiB 413).
