@@ -10,6 +10,7 @@
 #include <seamcl/core/elapsed.h>
 #include <seamcl/core/input_error.h>
 #include <seamcl/core/over_budget.h>
+#include <seamcl/eval/reference.h>
 #include <seamcl/pipeline/renderer.h>
 #include <seamcl/scene/scene.h>
 
@@ -57,6 +58,7 @@ HttpServer::HttpServer(ClRuntime& runtime, ServerOptions options)
   if (options_.request_read_timeout_ms < 1) throw InputError("request_read_timeout_ms", "must be at least 1");
   if (options_.deadline_ms < 0) throw InputError("deadline", "must be at least 0 (0: none)");
   options_.cache_dir = server_cache_dir(options_.cache_dir);
+  check_reference_cache_dir(options_.cache_dir, "cache_dir");
   scenes_ = std::make_unique<SceneResolver>(options_);
 
   // The built-in scenes are generated on first use (SceneResolver), the default one by the

@@ -381,6 +381,9 @@ TEST_F(Cli, EmptyOptionValuesAreInputErrors) {
   expect_input_error(compare + "--constant-color ''", "constant_color:");
   expect_input_error(compare + "--reference-method ''", "reference_method: must not be empty");
   expect_input_error(compare + "--cache ''", "cache: must not be empty");
+  // Named at once, not found out from every reference left uncached; --no-cache never reads it.
+  expect_input_error("compare --scene quad2 --methods discard --msaa 1 --size 16x16 --repeat 1 --no-progress --cache /dev/null",
+                     "cache: '/dev/null' is not a directory");
   expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --reference-method '' --check",
                      "reference_method: must not be empty");
   expect_input_error("bench --scene quad2 --size 16x16 --frames 2 --cache '' --check", "cache: must not be empty");
@@ -397,6 +400,7 @@ TEST_F(Cli, EmptyOptionValuesAreInputErrors) {
   launcher_ = "timeout 30 ";
   expect_input_error("serve --port 0 --quick-start --host ''", "host: must not be empty");
   expect_input_error("serve --port 0 --quick-start --cache-dir ''", "cache-dir: must not be empty");
+  expect_input_error("serve --port 0 --quick-start --cache-dir /dev/null", "cache_dir: '/dev/null' is not a directory");
   expect_input_error("serve --port 0 --quick-start --assets ''", "assets: must not be empty");
   expect_input_error("serve --port 0 --quick-start --cache-max-mib 9223372036854775807",
                      "cache-max-mib: must be in 0..2^40");

@@ -778,6 +778,14 @@ ReferenceImage seamless_reference(Renderer& seamless, const Camera& camera, cons
   return ref;
 }
 
+void check_reference_cache_dir(const std::string& dir, const std::string& field) {
+  const std::string path = dir.empty() ? default_cache_dir() : dir;
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (fs::exists(status) && !fs::is_directory(status))
+    throw InputError(field, "'" + path + "' is not a directory (the reference cache is a directory of EXR files)");
+}
+
 nlohmann::json reference_json(const ReferenceImage& reference, bool with_cache_path) {
   if (reference.kind == ReferenceKind::Seamless) {
     return {{"name", "seamless"}, {"method", reference.method}, {"msaa", reference.msaa}, {"scale", 1},

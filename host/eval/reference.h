@@ -103,6 +103,11 @@ std::string scene_content_hash(const Scene& scene);
 
 // default_cache_dir() (host/cl/program_cache.h): $SEAMCL_CACHE_DIR, else $HOME/.cache/seamcl.
 
+// InputError(field) when `dir` (empty: default_cache_dir()) exists and is not a directory: a
+// cache that can never be written is refused when it is named, not found out from every reference
+// left uncached (a failed write is otherwise no error of a compare).
+void check_reference_cache_dir(const std::string& dir, const std::string& field);
+
 // The options of the high-resolution render for a measured frame: the frame's options with the
 // reference method and msaa, 8x the size, pixel shading. InputError("size", ...) when that is
 // too large, InputError("reference_method"/"reference_msaa", ...) for bad settings.
