@@ -17,6 +17,7 @@ void ReferenceCacheFlags::add_to(CLI::App* command) {
 void ReferenceCacheFlags::apply(ReferenceSettings& settings) const {
   settings.cache_dir = given_value(dir, "cache", "leave out --cache for $SEAMCL_CACHE_DIR or ~/.cache/seamcl");
   settings.use_cache = !no_cache;
+  if (settings.use_cache) check_reference_cache_dir(settings.cache_dir, "cache");
   if (max_mib < 0 || max_mib > (1LL << 40))
     throw InputError("cache_max_mib", "must be in 0..2^40 (0: unbounded), got " + std::to_string(max_mib));
   if (max_entries < 0)

@@ -38,7 +38,7 @@ __kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilt
 }
 
 /* ptex_filter_lookups for a batch of point lookups: ptexf_point alone. A query of another filter
- * sets *not_point to 1 (and its 4 floats are not its lookup's), so that the host, which runs this
+ * sets *not_point to 1 (atomically: many work-items may) and its 4 floats are not its lookup's, so that the host, which runs this
  * kernel when a batch's first query is a point lookup instead of reading every query first, runs
  * ptex_filter_lookups over the batch after it. Host guarantees: *not_point 0 before the launch. */
 __kernel void ptex_point_lookups(PtexFilterTexture tex, __global const PtexFilterFace* faces,
@@ -48,7 +48,7 @@ __kernel void ptex_point_lookups(PtexFilterTexture tex, __global const PtexFilte
   const int id = (int)get_global_id(0);
   if (id >= count) return;
   const PtexFilterQuery q = queries[id];
-  if (q.filter != SEAMCL_PTEX_POINT) *not_point = 1;
+  if (q.filter != SEAMCL_PTEX_POINT) atomic_xchg(not_point, 1);
   const PtexfState s = ptexf_batch_state(tex, faces, level_offsets, texels);
   vstore4(ptexf_point(&s, &q), id, out);
 }

@@ -325,9 +325,11 @@ GuardedHttpServer::GuardedHttpServer(ConnectionLimits limits) : limits_(limits) 
   });
   set_payload_max_length(limits_.max_request_bytes);
   // Any error answer closes the connection (see process_and_close_socket): say so to the client,
-  // once (cpp-httplib adds the header itself where the request asked to close).
+  // once. cpp-httplib adds the header itself on a connection's last request and, as it writes the
+  // answer, where the request asked to close; a pre-routing refusal may have added it too.
   set_post_routing_handler([](const httplib::Request& req, httplib::Response& res) {
-    if (res.status >= 400 && req.get_header_value("Connection") != "close") res.set_header("Connection", "close");
+    if (res.status >= 400 && !res.has_header("Connection") && req.get_header_value("Connection") != "close")
+      res.set_header("Connection", "close");
   });
 }
 

@@ -24,6 +24,17 @@ bool equals_ignoring_case(std::string_view a, std::string_view b) {
          });
 }
 
+// A Content-Encoding value other than identity: a list of codings, any of them not "identity".
+bool names_a_coding(std::string_view value) {
+  for (size_t at = 0; at <= value.size();) {
+    const size_t comma = std::min(value.find(',', at), value.size());
+    const std::string_view coding = trim(value.substr(at, comma - at));
+    if (!coding.empty() && !equals_ignoring_case(coding, "identity")) return true;
+    at = comma + 1;
+  }
+  return false;
+}
+
 // A 400 whose message starts with its field, as every error body of the service does.
 HeadRefusal bad(const std::string& field, const std::string& message) { return {400, "Bad Request", field, field + ": " + message}; }
 
@@ -63,7 +74,7 @@ std::optional<HeadRefusal> check_request_head(std::string_view head, size_t max_
       ++transfer_encodings;
       transfer_encoding = value;
     } else if (equals_ignoring_case(name, "Content-Encoding")) {
-      coded_body = coded_body || !(value.empty() || equals_ignoring_case(value, "identity"));
+      coded_body = coded_body || names_a_coding(value);
     } else if (equals_ignoring_case(name, "Range")) {
       if (value.find(',') != std::string_view::npos)
         return bad("Range", "more than one range is not served (ask for one range at a time)");
@@ -75,10 +86,6 @@ std::optional<HeadRefusal> check_request_head(std::string_view head, size_t max_
   if (transfer_encodings > 1) return bad("Transfer-Encoding", "given more than once");
   if (transfer_encodings == 1 && !equals_ignoring_case(transfer_encoding, "chunked"))
     return bad("Transfer-Encoding", "must be chunked, and only chunked");
-  if (coded_body)
-    return HeadRefusal{415, "Unsupported Media Type", "Content-Encoding",
-                       "Content-Encoding: the body must be sent as it is (identity), not compressed",
-                       "Accept-Encoding: identity\r\n"};
   if (content_lengths == 1) {
     if (content_length.empty() ||
         !std::all_of(content_length.begin(), content_length.end(), [](char c) { return c >= '0' && c <= '9'; }))
@@ -93,6 +100,13 @@ std::optional<HeadRefusal> check_request_head(std::string_view head, size_t max_
     }
     if (over) return HeadRefusal{413, "Payload Too Large", "body", "body: the request body exceeds this server's limit"};
   }
+  // Only a body is decoded: a coding named on a request without one (no Transfer-Encoding, no
+  // Content-Length or one of 0, valid by here) is ignored, as cpp-httplib ignores it.
+  const bool has_body = transfer_encodings == 1 || content_length.find_first_not_of('0') != std::string_view::npos;
+  if (coded_body && has_body)
+    return HeadRefusal{415, "Unsupported Media Type", "Content-Encoding",
+                       "Content-Encoding: the body must be sent as it is (identity), not compressed",
+                       "Accept-Encoding: identity\r\n"};
   return std::nullopt;
 }
 

@@ -10,9 +10,9 @@
 //   - Content-Length that is not 1*DIGIT, given twice (even with the same value) or together
 //     with Transfer-Encoding: 400 "Content-Length"; one over the body limit: 413 "body";
 //   - Transfer-Encoding other than exactly one "chunked": 400 "Transfer-Encoding";
-//   - Content-Encoding other than identity: 415 "Content-Encoding", with Accept-Encoding:
-//     identity (cpp-httplib, built without zlib here, would answer a compressed body with a 400
-//     that names nothing);
+//   - a body with a Content-Encoding other than identity (a list of codings, any of them not
+//     identity): 415 "Content-Encoding", with Accept-Encoding: identity (cpp-httplib, built
+//     without zlib here, would answer a compressed body with a 400 that names nothing);
 //   - a Range with more than one range: 400 "Range" (one range of a generated answer is cheap,
 //     thousands are an amplification);
 //   - a head that does not fit the read buffer: 431 "headers".

@@ -236,10 +236,10 @@ httplib::Server::HandlerResponse answer_httplib_error(const httplib::Request& re
   } else if (res.status == 413) {
     send_error(res, 413, "body", "the request body exceeds this server's limit");
   } else if (res.status == 400 && req.has_header("Transfer-Encoding")) {
-    // The head was checked (request_head.h): the encoding is chunked, so the body's chunks failed.
+    // The head was checked (request_head.h): the encoding is chunked, so reading its chunks failed.
     send_error(res, 400, "body",
-               "the chunked body could not be read: a chunk size that is not hexadecimal, or a chunk that does "
-               "not end where its size says");
+               "the chunked body could not be read: a chunk size that is not hexadecimal, a chunk that does not "
+               "end where its size says, trailer fields (not read) or a body that stopped arriving");
   } else {
     send_error(res, res.status, "request", "the request could not be handled (HTTP " + std::to_string(res.status) + ")");
   }

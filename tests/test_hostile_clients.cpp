@@ -159,14 +159,25 @@ TEST_F(Hostile, MalformedHeaderLinesAreRefused) {
   EXPECT_EQ(first_status(fine.bytes), 200) << fine.bytes.substr(0, 300);
 }
 
-// An error answer closes the connection and says so once, whether or not the client asked to close.
+// An error answer closes the connection and says so once: whether or not the client asked to close,
+// for a refusal before routing (a 405 with a body) and on the last request a connection may carry.
 TEST_F(Hostile, ErrorAnswersSayConnectionCloseOnce) {
   LiveServer server(patient_options());
-  for (const std::string close : {"", "Connection: close\r\n"}) {
-    const Exchange answer = exchange(server.port(), "GET /v1/render?size=8x HTTP/1.1\r\nHost: x\r\n" + close + "\r\n");
-    EXPECT_EQ(first_status(answer.bytes), 400) << answer.bytes.substr(0, 300);
-    EXPECT_TRUE(answer.closed) << close;
-    const std::string head = answer.bytes.substr(0, answer.bytes.find("\r\n\r\n") + 2);
+  std::string ninety_nine;
+  for (int i = 0; i < 99; ++i) ninety_nine += "GET /health HTTP/1.1\r\nHost: x\r\n\r\n";
+  const std::vector<std::pair<std::string, int>> cases = {
+      {"GET /v1/render?size=8x HTTP/1.1\r\nHost: x\r\n\r\n", 400},
+      {"GET /v1/render?size=8x HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n", 400},
+      {"GET /v1/compare HTTP/1.1\r\nHost: x\r\nContent-Length: 2\r\n\r\n{}", 405},
+      {ninety_nine + "GET /v1/render?size=8x HTTP/1.1\r\nHost: x\r\n\r\n", 400},
+  };
+  for (const auto& [request, status] : cases) {
+    const Exchange answer = exchange(server.port(), request);
+    const size_t last = answer.bytes.rfind("HTTP/1.1 ");
+    ASSERT_NE(last, std::string::npos) << request.substr(0, 80);
+    EXPECT_EQ(first_status(answer.bytes.substr(last)), status) << answer.bytes.substr(last, 300);
+    EXPECT_TRUE(answer.closed) << request.substr(0, 80);
+    const std::string head = answer.bytes.substr(last, answer.bytes.find("\r\n\r\n", last) + 2 - last);
     size_t said = 0;
     for (size_t at = head.find("\r\nConnection:"); at != std::string::npos; at = head.find("\r\nConnection:", at + 1)) ++said;
     EXPECT_EQ(said, 1u) << head;
@@ -199,10 +210,16 @@ TEST_F(Hostile, BadLengthsAreAnsweredAtOnce) {
     EXPECT_LT(answer.seconds, 2.0) << what << ": answered only after " << answer.seconds << " s";
     if (status == 415) EXPECT_NE(answer.bytes.find("\r\nAccept-Encoding: identity\r\n"), std::string::npos) << answer.bytes;
   }
-  // An identity coding is no coding: the body is read.
-  const Exchange identity = exchange(server.port(), post + "Content-Encoding: identity\r\nContent-Length: 8\r\nConnection: close\r\n\r\n{\"x\": 1}");
-  EXPECT_EQ(first_status(identity.bytes), 400) << identity.bytes.substr(0, 300);
-  EXPECT_EQ(error_body(identity.bytes).value("field", ""), "x") << identity.bytes.substr(0, 300);
+  // An identity coding, or a list of them, is no coding: the body is read.
+  for (const char* coding : {"identity", "Identity, identity"}) {
+    const Exchange identity = exchange(server.port(), post + "Content-Encoding: " + coding +
+                                                          "\r\nContent-Length: 8\r\nConnection: close\r\n\r\n{\"x\": 1}");
+    EXPECT_EQ(first_status(identity.bytes), 400) << coding << ": " << identity.bytes.substr(0, 300);
+    EXPECT_EQ(error_body(identity.bytes).value("field", ""), "x") << coding << ": " << identity.bytes.substr(0, 300);
+  }
+  // A coding named on a request without a body decodes nothing: it is served.
+  const Exchange bodiless = exchange(server.port(), "GET /health HTTP/1.1\r\nHost: x\r\nContent-Encoding: gzip\r\nConnection: close\r\n\r\n");
+  EXPECT_EQ(first_status(bodiless.bytes), 200) << bodiless.bytes.substr(0, 300);
 }
 
 // Finding 9: a chunked body over the limit is 413 whatever its size (4 MiB was 400, 3 MiB 413).

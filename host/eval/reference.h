@@ -103,9 +103,10 @@ std::string scene_content_hash(const Scene& scene);
 
 // default_cache_dir() (host/cl/program_cache.h): $SEAMCL_CACHE_DIR, else $HOME/.cache/seamcl.
 
-// InputError(field) when `dir` (empty: default_cache_dir()) exists and is not a directory: a
-// cache that can never be written is refused when it is named, not found out from every reference
-// left uncached (a failed write is otherwise no error of a compare).
+// InputError(field) when `dir` (empty: default_cache_dir()) exists and is not a directory: for a
+// front end to refuse, as it starts, a cache that can never be written, instead of every
+// reference being left uncached (a failed write is no error of a compare, so the jobs go on
+// without it: a service's directory replaced after its start must not become a client's error).
 void check_reference_cache_dir(const std::string& dir, const std::string& field);
 
 // The options of the high-resolution render for a measured frame: the frame's options with the

@@ -340,7 +340,6 @@ json BenchJob::run_orbit(ClRuntime& runtime, const Scene& scene, const JobContro
                          const std::string& images_dir) {
   const auto wall_start = std::chrono::steady_clock::now();
   ReferenceSettings reference = reference_;
-  if (with_errors_ && reference.use_cache) check_reference_cache_dir(reference.cache_dir, "cache");
   // Once, not per reference frame: hashing bakes every face.
   if (with_errors_ && reference.use_cache && reference.scene_hash.empty()) reference.scene_hash = scene_content_hash(scene);
 

@@ -138,7 +138,6 @@ CompareRun CompareJob::run(ClRuntime& runtime, const Scene& scene, const JobCont
                            const ReferenceLock& lock_reference) {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
-  if (reference_.use_cache) check_reference_cache_dir(reference_.cache_dir, "cache");
   const Camera view = camera(scene);
   // The variants this compare renders with build while the scene is hashed and packed, in the
   // order prepare_targets and compare_methods first use them: the seam masks, the reference (when

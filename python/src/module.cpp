@@ -167,6 +167,7 @@ nb::tuple compare(const std::string& request_text, const std::string& device, co
     CompareJob job(request);
     job.reference_settings().cache_dir = cache_dir;
     job.reference_settings().use_cache = use_cache;
+    if (use_cache) check_reference_cache_dir(cache_dir, "cache");
     ClRuntime& runtime = runtime_for(device);
     SceneSourceOptions source;
     source.generator = job.generator_options();

@@ -80,10 +80,11 @@ def test_without_images_only_the_figures():
 
 
 @pytest.mark.parametrize("keywords,field", [(dict(methods=["bogus"]), "methods"), (dict(msaa=[3]), "msaa"),
-                                            (dict(reference="nope"), "reference"), (dict(repeat=0), "repeat")])
+                                            (dict(reference="nope"), "reference"), (dict(repeat=0), "repeat"),
+                                            (dict(cache="/dev/null"), "cache")])
 def test_bad_compare_options_name_the_field_as_the_cli(keywords, field, cli):
     flags = {"methods": ["--methods", "bogus"], "msaa": ["--msaa", "3"], "reference": ["--reference", "nope"],
-             "repeat": ["--repeat", "0"]}[field]
+             "repeat": ["--repeat", "0"], "cache": ["--cache", "/dev/null"]}[field]
     done = cli("compare", "--scene", "quad2", "--size", "16x16", *flags, check=False)
     assert done.returncode == 2
     with pytest.raises(seamcl.InputError) as caught:

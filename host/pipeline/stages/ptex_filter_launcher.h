@@ -16,7 +16,9 @@ class PtexFilterLauncher {
   void load(const PtexFilterData& data);
 
   // 4 floats per query (channels beyond the texture's are 0), in order. A batch of point lookups
-  // alone runs through a kernel of its own (ptex_point_lookups), shorter per lookup.
+  // alone runs through a kernel of its own (ptex_point_lookups), shorter per lookup; a batch that
+  // opens with a point lookup is taken for one, and where another filter follows, the general
+  // kernel runs over the whole batch after it.
   std::vector<float> run(const std::vector<PtexFilterQuery>& queries);
   // The same into the caller's memory, 4 * queries.size() floats at `values`: a caller that looks up
   // batch after batch keeps one array (a new one is zeroed and its pages faulted in on one thread).
