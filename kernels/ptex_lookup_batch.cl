@@ -38,9 +38,10 @@ __kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilt
 }
 
 /* ptex_filter_lookups for a batch of point lookups: ptexf_point alone. A query of another filter
- * sets *not_point to 1 (atomically: many work-items may) and its 4 floats are not its lookup's, so that the host, which runs this
- * kernel when a batch's first query is a point lookup instead of reading every query first, runs
- * ptex_filter_lookups over the batch after it. Host guarantees: *not_point 0 before the launch. */
+ * sets *not_point to 1 (atomically: many work-items may), and its 4 floats are not its lookup's:
+ * the host, which runs this kernel when a batch's first query is a point lookup instead of reading
+ * every query first, then runs ptex_filter_lookups over the batch.
+ * Host guarantees: *not_point 0 before the launch. */
 __kernel void ptex_point_lookups(PtexFilterTexture tex, __global const PtexFilterFace* faces,
                                  __global const uint* level_offsets, __global const uchar* texels,
                                  __global const PtexFilterQuery* queries, int count, __global float* out,

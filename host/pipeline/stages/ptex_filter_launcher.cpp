@@ -65,8 +65,9 @@ void PtexFilterLauncher::run(const std::vector<PtexFilterQuery>& queries, float*
   const cl::NDRange global(round_up(queries.size(), kGroup)), local(kGroup);
   cl::CommandQueue& queue = runtime_.queue();
   // A batch that opens with a point lookup is taken for points alone and checked by the point
-  // kernel itself as it reads each query: reading every query here first had cost a sixth of a
-  // point batch, on one thread. Where another filter shows up, the general kernel runs after it.
+  // kernel itself as it reads each query: reading every query here first, on one thread before the
+  // kernel, had held 7% of a point batch's CPU samples. Where another filter shows up, the general
+  // kernel runs after it.
   bool general = queries.front().filter != SEAMCL_PTEX_POINT;
   if (!general) {
     queue.enqueueWriteBuffer(not_point_, CL_FALSE, 0, sizeof(cl_int), &kNoOtherFilter);
