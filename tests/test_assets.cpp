@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -254,6 +256,62 @@ TEST(Assets, ObjRefusesBadNumbersAndIndicesNamingTheLineAndTheWord) {
   const std::string path = dir.write("nan.obj", quad + "v nan 0 0\nf 1 2 3 4\n");
   const std::string message = input_error([&] { read_obj_file(path, "mesh"); }, "mesh");
   EXPECT_TRUE(names_all(message, {"'" + path + "'", "vertex 4", "line 5", "'nan'", "finite"}));
+}
+
+// Damaged OBJ text: byte flips, truncations, spliced lines and hostile words in each sample file.
+// Each case must either read into a mesh that keeps the reader's invariants (every index names a
+// vertex, every coordinate finite and at most 1e9 in magnitude; the scene made from it validated,
+// or refused) or be refused with InputError: no crash, no other exception.
+// Deterministic: a fixed seed, no std distributions.
+TEST(Assets, ObjFuzzNeverCrashes) {
+  std::mt19937_64 random(20261205);
+  const auto below = [&](size_t n) { return n == 0 ? size_t{0} : static_cast<size_t>(random() % n); };
+  const std::vector<std::string> words = {"f", "v", "vt", "vn", "#", "/", "//", "-1", "0", "4294967296", "1e39",
+                                          "nan", "-inf", "0x1p3", "+", "\r", "\n", "\t", " ", "f 1 2 3 4",
+                                          "v 1 2 3", std::string(1, '\0'), "99999999999999999999", "1/2/3/4"};
+  int read = 0, refused = 0;
+  for (const char* name : {"cube.obj", "plane.obj", "ptex_test_object.obj"}) {
+    std::ifstream in(sample(name), std::ios::binary);
+    const std::string seed((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_FALSE(seed.empty()) << name;
+    for (int round = 0; round < 1500; ++round) {
+      std::string text = seed;
+      for (int edits = 1 + static_cast<int>(below(4)); edits > 0; --edits) {
+        const size_t at = below(text.size() + 1);
+        switch (below(5)) {
+          case 0: if (at < text.size()) text[at] = static_cast<char>(text[at] ^ (1 << below(8))); break;
+          case 1: text.resize(at); break;
+          case 2: text.insert(at, words[below(words.size())]); break;
+          case 3: {  // a line of the text again, somewhere else
+            const size_t from = below(text.size()), end = text.find('\n', from);
+            text.insert(at, text.substr(from, end == std::string::npos ? std::string::npos : end - from + 1));
+            break;
+          }
+          default: if (at < text.size()) text.erase(at, 1 + below(8)); break;
+        }
+      }
+      SCOPED_TRACE(std::string(name) + " round " + std::to_string(round));
+      try {
+        const ObjMesh mesh = parse_obj(text, name);
+        ++read;
+        ASSERT_FALSE(mesh.faces.empty());
+        for (const glm::vec3& p : mesh.positions)
+          for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(p[c]) && std::fabs(p[c]) <= 1e9f) << p[c];
+        for (const auto& face : mesh.faces)
+          for (uint32_t v : face) ASSERT_LT(v, mesh.positions.size());
+        try {
+          scene_from_mesh(mesh, 4, name);
+        } catch (const InputError&) {
+        }
+      } catch (const InputError&) {
+        ++refused;
+      }
+    }
+  }
+  std::printf("OBJ fuzz: %d cases read, %d refused\n", read, refused);
+  // Both outcomes happen, so the mutations reach past the first check.
+  EXPECT_GT(read, 300);
+  EXPECT_GT(refused, 300);
 }
 
 TEST(Assets, ObjStillReadsSlashedRelativeAndForwardIndicesWAndVertexColours) {
