@@ -1,10 +1,13 @@
 /* Batches of lookups of Ptex's own filters (`seamcl ptx lookup`, the kernel tests and the Ptex
- * benchmark): one work-item per query, ptexf_lookup of ptex_filter.cl; a batch of point lookups
- * through ptex_point_lookups, whose short loop body lets a core keep more lookups' texel misses in
- * flight.
+ * benchmark): ptex_filter_lookups, SEAMCL_PTEX_LOOKUP_LANES queries per work-item, the bilinear and
+ * box lookups that stay inside their face as vector lanes (ptexf_small_lanes) and the rest by
+ * ptexf_lookup of ptex_filter.cl; a batch of point lookups through ptex_point_lookups, one query
+ * per work-item. Both keep a core's texel misses of many lookups in flight: the lanes' loads wait
+ * on no branch, and the point kernel's loop body is short.
  * Contract: out[4 * id ..] holds query id's 4 floats (channels beyond the texture's 0; a face out of
  * range gives zeros) for id < count. Host guarantees: tex, faces, level_offsets and texels as
- * ptex_filter.cl states; tex.seams 0 (Ptex's own rules); out holds 4 * count floats.
+ * ptex_filter.cl states; tex.seams 0 (Ptex's own rules); out holds 4 * count floats;
+ * ptex_filter_lookups' global size at least count / SEAMCL_PTEX_LOOKUP_LANES rounded up.
  * Twin: ptex_filter_twin in host/pipeline/stages/ptex_filter_twin.cpp. */
 
 /* Only where ptex_filter.cl compiles: the ptex-filter program, built with no sampler variant. */
@@ -20,21 +23,152 @@ SEAMCL_INLINE PtexfState ptexf_batch_state(PtexFilterTexture tex, __global const
   return s;
 }
 
+#define PTEXF_LANES SEAMCL_PTEX_LOOKUP_LANES
+
+/* One axis of a lane's bilinear or box kernel as ptexf_build makes it, at most 3 taps: the first
+ * texel *k, the tap count *taps and the weights w0, w1, w2 (0 past the count). */
+SEAMCL_INLINE void ptexf_small_axis(int16 box, float16 x, float16 width, int16 face_log2, int16* res_log2,
+                                    float16* first, int16* taps, float16* w0, float16* w1, float16* w2) {
+  width = fmax(fmin(width, 1.0f), as_float16((127 - face_log2) << 23));
+  *res_log2 = 127 - ((as_int16(width) >> 23) & 0xff);
+  const float16 res = as_float16((127 + *res_log2) << 23);
+  /* Bilinear: two taps around x. */
+  const float16 pix = x * res - 0.5f;
+  const float16 pix_floor = floor(pix);
+  const float16 frac = pix - pix_floor;
+  /* Box: the texels [x - width / 2, x + width / 2) touches, partly at either end. */
+  const float16 centre = x * res, span = width * res;
+  const float16 lo = centre - 0.5f * span, hi = centre + 0.5f * span;
+  const float16 lo_floor = floor(lo), hi_ceil = ceil(hi);
+  const float16 f1 = 1.0f - (lo - lo_floor), f2 = 1.0f - (hi_ceil - hi);
+  const int16 box_taps = min(convert_int16(hi_ceil - lo_floor), 3);
+  *first = select(pix_floor, lo_floor, box);
+  *taps = select((int16)(2), box_taps, box);
+  *w0 = select(1.0f - frac, select(f1, f1 + f2 - 1.0f, box_taps == 1), box);
+  *w1 = select(frac, select(select(1.0f, f2, box_taps == 2), (float16)(0.0f), box_taps == 1), box);
+  *w2 = select((float16)(0.0f), f2, box && box_taps == 3);
+}
+
+/* The bilinear and box lookups among queries[first ..] (n of them, n <= PTEXF_LANES) whose taps
+ * (at most 3x3) lie inside their face, a lane each: one face, no edge to split at, no corner, no
+ * constant face, so no branch on the query. Returns which lanes it looked up (-1) and their 4
+ * values each in values[4 * lane ..]; the other lanes are left to ptexf_lookup. The arithmetic is
+ * ptexf_lookup's for such a kernel (ptexf_build's kernel, ptexf_weight, ptexf_sum_taps's order;
+ * the taps past a kernel's count weigh 0 and read its last texel again), so the values are its own
+ * but for fused multiply-adds. Scalar loads gather each lane's query, face record, level offset and
+ * taps; the rest is vector arithmetic over the lanes, which PoCL does not make of ptexf_lookup's
+ * branches and loops (its work-group loop stays scalar), so a core keeps many lanes' texel misses
+ * in flight. */
+SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFilterQuery* queries, int first, int n,
+                                      float* values) {
+  int face_a[PTEXF_LANES], filter_a[PTEXF_LANES];
+  float u_a[PTEXF_LANES], v_a[PTEXF_LANES], uw_a[PTEXF_LANES], vw_a[PTEXF_LANES];
+  for (int i = 0; i < PTEXF_LANES; ++i) {
+    __global const PtexFilterQuery* q = queries + first + min(i, n - 1);
+    face_a[i] = q->face;
+    filter_a[i] = q->filter;
+    u_a[i] = q->u;
+    v_a[i] = q->v;
+    uw_a[i] = q->uw;
+    vw_a[i] = q->vw;
+  }
+  const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const int16 face = vload16(0, face_a), filter = vload16(0, filter_a);
+  const int16 in_range = face >= 0 && face < s->tex.face_count;
+  const int16 box = filter == SEAMCL_PTEX_BOX;
+  /* In [0, 1) every border mode leaves (u, v) as it is. */
+  const float16 u = vload16(0, u_a), v = vload16(0, v_a);
+  int16 inside = lane < n && in_range && (filter == SEAMCL_PTEX_BILINEAR || box) && u >= 0.0f && u < 1.0f &&
+                 v >= 0.0f && v < 1.0f;
+  if (!any(inside)) return inside;
+  int face_index_a[PTEXF_LANES];
+  vstore16(select((int16)(0), face, inside), 0, face_index_a);
+  int ulog2_a[PTEXF_LANES], vlog2_a[PTEXF_LANES], flags_a[PTEXF_LANES], base_a[PTEXF_LANES];
+  for (int i = 0; i < PTEXF_LANES; ++i) {
+    __global const PtexFilterFace* f = s->faces + face_index_a[i];
+    ulog2_a[i] = f->ulog2;
+    vlog2_a[i] = f->vlog2;
+    flags_a[i] = (int)f->flags;
+    base_a[i] = (int)f->level_base;
+  }
+  const int16 face_vlog2 = vload16(0, vlog2_a);
+  inside = inside && (vload16(0, flags_a) & (int)(SEAMCL_PTEX_FLAG_CONSTANT | SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT)) == 0;
+  int16 ulog2, vlog2, utaps, vtaps;
+  float16 ufirst, vfirst, ku0, ku1, ku2, kv0, kv1, kv2;
+  ptexf_small_axis(box, u, fabs(vload16(0, uw_a)), vload16(0, ulog2_a), &ulog2, &ufirst, &utaps, &ku0, &ku1, &ku2);
+  ptexf_small_axis(box, v, fabs(vload16(0, vw_a)), face_vlog2, &vlog2, &vfirst, &vtaps, &kv0, &kv1, &kv2);
+  const int16 ku = convert_int16(select((float16)(0.0f), ufirst, inside));
+  const int16 kv = convert_int16(select((float16)(0.0f), vfirst, inside));
+  const int16 resu = (int16)(1) << ulog2, resv = (int16)(1) << vlog2;
+  inside = inside && ku >= 0 && kv >= 0 && ku + utaps <= resu && kv + vtaps <= resv;
+  /* ptexf_weight's sums, in its order. */
+  const float16 weight = (ku0 + ku1 + ku2) * (kv0 + kv1 + kv2) * s->tex.one_value;
+  inside = inside && weight != 0.0f && !isinf(weight);
+  if (!any(inside)) return inside;
+  /* Lanes left to ptexf_lookup read their texture's first texels, which are there. */
+  const int nchan = s->tex.channels;
+  int level_a[PTEXF_LANES];
+  vstore16(select((int16)(0), vload16(0, base_a) + ulog2 * (face_vlog2 + 1) + vlog2, inside), 0, level_a);
+  for (int i = 0; i < PTEXF_LANES; ++i) level_a[i] = (int)s->level_offsets[level_a[i]];
+  const int16 inside_taps_u = select((int16)(1), utaps, inside), inside_taps_v = select((int16)(1), vtaps, inside);
+  /* Tap (i, j) at first_a + row_a[j] + column_a[i], a tap past the count on the last texel. */
+  int first_a[PTEXF_LANES], column_a[3][PTEXF_LANES], row_a[3][PTEXF_LANES];
+  vstore16(select((int16)(0), (vload16(0, level_a) + kv * resu + ku) * nchan, inside), 0, first_a);
+  for (int t = 0; t < 3; ++t) {
+    vstore16(min((int16)(t), inside_taps_u - 1) * nchan, 0, column_a[t]);
+    vstore16(min((int16)(t), inside_taps_v - 1) * resu * nchan, 0, row_a[t]);
+  }
+  const int taps = any(inside && (utaps == 3 || vtaps == 3)) ? 3 : 2;
+  const float16 kus[3] = {ku0, ku1, ku2}, kvs[3] = {kv0, kv1, kv2};
+  const float16 scale = 1.0f / weight;
+  for (int c = 0; c < 4; ++c) {
+    float16 sum = (float16)(0.0f);
+    if (c < nchan) {
+      for (int i = 0; i < taps; ++i) {
+        float16 column = (float16)(0.0f);
+        for (int j = 0; j < taps; ++j) {
+          float tap_a[PTEXF_LANES];
+          for (int l = 0; l < PTEXF_LANES; ++l) tap_a[l] = ptexf_texel(s, (uint)(first_a[l] + row_a[j][l] + column_a[i][l] + c));
+          column += vload16(0, tap_a) * kvs[j];
+        }
+        sum += column * kus[i];
+      }
+      sum *= scale;
+    }
+    float sum_a[PTEXF_LANES];
+    vstore16(sum, 0, sum_a);
+    for (int l = 0; l < PTEXF_LANES; ++l) values[4 * l + c] = sum_a[l];
+  }
+  return inside;
+}
+
+/* Work-item g looks up queries g * PTEXF_LANES .. (the last one fewer). */
 __kernel void ptex_filter_lookups(PtexFilterTexture tex, __global const PtexFilterFace* faces,
                                   __global const uint* level_offsets, __global const uchar* texels,
                                   __global const PtexFilterQuery* queries, int count, __global float* out) {
-  const int id = (int)get_global_id(0);
-  if (id >= count) return;
-  const PtexFilterQuery q = queries[id];
+  const int first = PTEXF_LANES * (int)get_global_id(0);
+  if (first >= count) return;
+  const int n = min(PTEXF_LANES, count - first);
   PtexfState s = ptexf_batch_state(tex, faces, level_offsets, texels);
-  float value[4];
-  ptexf_lookup(&s, &q, value);
-  __global float* dst = out + 4 * id;
-  /* Copied value by value: ptexf_lookup stores them one at a time, and one 16-byte load of them
-   * would wait for those stores to leave the core (a store-to-load forward that fails), and with
-   * them for every cache miss before (15% of this function's samples on a bilinear batch). */
+  float values[4 * PTEXF_LANES];
+  int inside_a[PTEXF_LANES];
+  vstore16(ptexf_small_lanes(&s, queries, first, n, values), 0, inside_a);
+  for (int i = 0; i < n; ++i) {
+    __global float* dst = out + 4 * (first + i);
+    if (inside_a[i] != 0) {
 #pragma clang loop vectorize(disable) unroll(disable)
-  for (int c = 0; c < 4; ++c) dst[c] = value[c];
+      for (int c = 0; c < 4; ++c) dst[c] = values[4 * i + c];
+      continue;
+    }
+    const PtexFilterQuery q = queries[first + i];
+    float value[4];
+    ptexf_lookup(&s, &q, value);
+    /* Copied value by value: ptexf_lookup stores them one at a time, and one 16-byte load of them
+     * would wait for those stores to leave the core (a store-to-load forward that fails), and with
+     * them for every cache miss before (15% of this function's samples on a bilinear batch). */
+#pragma clang loop vectorize(disable) unroll(disable)
+    for (int c = 0; c < 4; ++c) dst[c] = value[c];
+  }
 }
 
 /* ptex_filter_lookups for a batch of point lookups: ptexf_point alone. A query of another filter

@@ -367,6 +367,8 @@ typedef struct {
 /* Bytes of padding after the last texel value: the filter reads rows 16 values at a time, up to 15
  * values (of up to 4 bytes) past a row's end. */
 #define SEAMCL_PTEX_TEXEL_TAIL 64
+/* Queries a work-item of ptex_filter_lookups looks up (vector lanes; its fast path's vectors are 16 wide). */
+#define SEAMCL_PTEX_LOOKUP_LANES 16
 #define SEAMCL_PTEX_MAX_VALENCE 10   /* faces walked around a corner (Ptex's MaxValence) */
 #define SEAMCL_PTEX_POINT 0
 #define SEAMCL_PTEX_BILINEAR 1

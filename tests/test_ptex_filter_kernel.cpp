@@ -252,6 +252,62 @@ TEST(PtexFilterKernel, PointBatchesMatchTheTwinAndMixedBatches) {
   EXPECT_GE(bilinear_differs, 3);
 }
 
+// Bilinear and box lookups whose taps stay inside their face run, 16 to a work-item, as vector
+// lanes (ptexf_small_lanes); the rest of a work-item's lookups through ptexf_lookup. Every value
+// must be the twin's, whatever shares its work-item and however long the batch (its last work-item
+// part full): box kernels of 1, 2 and 3 taps per axis, widths on texel boundaries, points on and
+// beside face edges, faces out of range, other filters between, on every texel type and 1 to 4
+// channels.
+TEST(PtexFilterKernel, SmallKernelsInsideAFaceMatchTheTwinInBatchesOfAnyLength) {
+  std::vector<std::pair<std::string, PtexFilterData>> textures;
+  for (const char* name : {"cube_text", "rand_lo", "black"})
+    textures.emplace_back(name, build_ptex_filter_data(read_ptex_stored(ptex_assets_dir() + "/" + name + ".ptx")));
+  textures.emplace_back("float rgba", float_face(3, 4));
+  textures.emplace_back("half, 2 channels", float_face(2, 2));
+  const float coordinates[] = {0.0f, 0.03f, 0.125f, 0.28125f, 0.5f, 0.61f, 0.875f, 0.999f, 1.0f};
+  const float widths[] = {1.0f / 64, 1.0f / 16, 0.04f, 0.09f, 0.25f, 0.3f, 0.5f, 0.7f, 1.0f};
+  for (const auto& [name, data] : textures) {
+    const int faces = static_cast<int>(data.faces.size());
+    std::mt19937 random(21);
+    std::vector<PtexFilterQuery> queries;
+    for (int i = 0; i < 1200; ++i) {
+      PtexFilterQuery q{};
+      q.face = i % 97 == 0 ? faces : static_cast<int>(random() % static_cast<unsigned>(faces));
+      q.filter = i % 9 == 0 ? SEAMCL_PTEX_GAUSSIAN : i % 2 == 0 ? SEAMCL_PTEX_BOX : SEAMCL_PTEX_BILINEAR;
+      q.u = coordinates[random() % 9];
+      q.v = coordinates[random() % 9];
+      q.uw = widths[random() % 9];
+      q.vw = i % 3 == 0 ? q.uw : widths[random() % 9];
+      queries.push_back(q);
+    }
+    PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
+    launcher.load(data);
+    std::vector<float> whole = launcher.run(queries);
+    size_t from = 0;
+    int inside = 0;
+    for (size_t length : {1u, 15u, 17u, 40u, 1127u}) {
+      const std::vector<PtexFilterQuery> batch(queries.begin() + static_cast<long>(from),
+                                               queries.begin() + static_cast<long>(from + length));
+      const std::vector<float> device = launcher.run(batch);
+      ASSERT_EQ(device.size(), 4 * length);
+      for (size_t i = 0; i < length; ++i) {
+        const PtexFilterQuery& q = batch[i];
+        const std::array<float, 4> twin = ptex_filter_twin(data, q);
+        for (int c = 0; c < 4; ++c) {
+          ASSERT_NEAR(device[4 * i + c], twin[c], 2e-6f + 2e-6f * std::fabs(twin[c]))
+              << name << " batch of " << length << ", lookup " << i << " face " << q.face << " filter " << q.filter
+              << " at (" << q.u << ", " << q.v << ") widths " << q.uw << " x " << q.vw << " channel " << c;
+          ASSERT_EQ(device[4 * i + c], whole[4 * (from + i) + static_cast<size_t>(c)]) << name << " lookup " << from + i;
+        }
+        inside += q.face < faces && q.u > 0.1f && q.u < 0.9f && q.v > 0.1f && q.v < 0.9f && q.uw < 0.1f &&
+                  q.vw < 0.1f && q.filter != SEAMCL_PTEX_GAUSSIAN;
+      }
+      from += length;
+    }
+    EXPECT_GT(inside, 50) << name;
+  }
+}
+
 // One launch per file (the launcher's compile dominates the time); the twin's own test holds the
 // same values, so a failure here alone points at the kernel.
 TEST(PtexFilterKernel, MatchesThePtexLibraryOnEveryFilterNearEdgesCornersAndResolutionChanges) {

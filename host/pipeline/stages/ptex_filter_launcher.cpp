@@ -18,6 +18,11 @@ cl::Buffer upload(ClRuntime& runtime, const std::vector<T>& data, size_t& bytes_
   return buffer;
 }
 
+// ptex_filter_lookups looks up SEAMCL_PTEX_LOOKUP_LANES queries per work-item.
+size_t general_work_items(size_t queries) {
+  return round_up((queries + SEAMCL_PTEX_LOOKUP_LANES - 1) / SEAMCL_PTEX_LOOKUP_LANES, kGroup);
+}
+
 }  // namespace
 
 PtexFilterLauncher::PtexFilterLauncher(ClRuntime& runtime)
@@ -63,6 +68,7 @@ void PtexFilterLauncher::run(const std::vector<PtexFilterQuery>& queries, float*
                       queries.size() * sizeof(PtexFilterQuery), const_cast<PtexFilterQuery*>(queries.data()));
   const cl::Buffer out(runtime_.context(), CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, out_bytes, values);
   const cl::NDRange global(round_up(queries.size(), kGroup)), local(kGroup);
+  const cl::NDRange general_global(general_work_items(queries.size()));
   cl::CommandQueue& queue = runtime_.queue();
   // A batch that opens with a point lookup is taken for points alone and checked by the point
   // kernel itself as it reads each query: reading every query here first, on one thread before the
@@ -77,7 +83,7 @@ void PtexFilterLauncher::run(const std::vector<PtexFilterQuery>& queries, float*
     general = not_point != 0;
   }
   if (general)
-    queue.enqueueNDRangeKernel(with_args(kernel_, in, queries.size(), out), cl::NullRange, global, local);
+    queue.enqueueNDRangeKernel(with_args(kernel_, in, queries.size(), out), cl::NullRange, general_global, local);
   void* mapped = queue.enqueueMapBuffer(out, CL_TRUE, CL_MAP_READ, 0, out_bytes);
   queue.enqueueUnmapMemObject(out, mapped);
   queue.finish();
@@ -95,8 +101,10 @@ std::vector<double> PtexFilterLauncher::time(const std::vector<PtexFilterQuery>&
   cl::Kernel& kernel = with_args(points ? point_kernel_ : kernel_, in, queries.size(), out);
   std::vector<cl::Event> events(static_cast<size_t>(std::max(repeats, 0)));
   for (cl::Event& event : events)
-    runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(round_up(queries.size(), kGroup)),
-                                          cl::NDRange(kGroup), nullptr, &event);
+    runtime_.queue().enqueueNDRangeKernel(
+        kernel, cl::NullRange,
+        cl::NDRange(points ? round_up(queries.size(), kGroup) : general_work_items(queries.size())),
+        cl::NDRange(kGroup), nullptr, &event);
   runtime_.queue().finish();
   for (const cl::Event& event : events) ms.push_back(event_milliseconds(event));
   return ms;
