@@ -100,7 +100,43 @@ SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFi
   const int16 ku = convert_int16(select((float16)(0.0f), ufirst, inside));
   const int16 kv = convert_int16(select((float16)(0.0f), vfirst, inside));
   const int16 resu = (int16)(1) << ulog2, resv = (int16)(1) << vlog2;
-  inside = inside && ku >= 0 && kv >= 0 && ku + utaps <= resu && kv + vtaps <= resv;
+  /* Taps past one edge are read on the neighbour there, turned into its frame, as ptexf_split_and_apply
+   * reads them; past two edges (a corner, or both sides of a face narrower than the kernel) or past
+   * a boundary, the lane is ptexf_lookup's. */
+  const int16 past_left = ku < 0, past_right = ku + utaps > resu, past_bottom = kv < 0, past_top = kv + vtaps > resv;
+  const int16 across_u = past_left || past_right, across_v = past_bottom || past_top;
+  inside = inside && !(past_left && past_right) && !(past_bottom && past_top) && !(across_u && across_v);
+  const int16 crossing = inside && (across_u || across_v);
+  int16 edge = select((int16)(PTEXF_BOTTOM), (int16)(PTEXF_LEFT), past_left);
+  edge = select(select(edge, (int16)(PTEXF_TOP), past_top), (int16)(PTEXF_RIGHT), past_right);
+  int next_a[PTEXF_LANES], next_edge_a[PTEXF_LANES], edge_a[PTEXF_LANES];
+  vstore16(edge, 0, edge_a);
+  for (int i = 0; i < PTEXF_LANES; ++i) {
+    const PtexFilterFace f = s->faces[face_index_a[i]];
+    next_a[i] = ptexf_adj_face(f, edge_a[i]);
+    next_edge_a[i] = ptexf_adj_edge(f, edge_a[i]);
+  }
+  const int16 next = vload16(0, next_a);
+  inside = inside && (!crossing || next >= 0);
+  int next_index_a[PTEXF_LANES];
+  vstore16(select((int16)(0), next, crossing && inside), 0, next_index_a);
+  for (int i = 0; i < PTEXF_LANES; ++i) {
+    __global const PtexFilterFace* f = s->faces + next_index_a[i];
+    ulog2_a[i] = f->ulog2;
+    vlog2_a[i] = f->vlog2;
+    flags_a[i] = (int)f->flags;
+    next_a[i] = (int)f->level_base;
+  }
+  /* ptexf_rotate's quarter turns: the kernel's resolution in the neighbour's frame. */
+  const int16 turns = (edge - vload16(0, next_edge_a) + 2) & 3;
+  const int16 odd = (turns & 1) != 0;
+  const int16 next_ulog2 = select(ulog2, vlog2, odd), next_vlog2 = select(vlog2, ulog2, odd);
+  const int16 next_face_vlog2 = vload16(0, vlog2_a);
+  /* A constant neighbour holds one texel, read by every tap there (ptexf_apply's constant case). */
+  const int16 next_constant = (vload16(0, flags_a) & (int)SEAMCL_PTEX_FLAG_CONSTANT) != 0;
+  inside = inside && (!crossing || next_constant || (vload16(0, ulog2_a) >= next_ulog2 && next_face_vlog2 >= next_vlog2));
+  /* The tangent-vector edge mode turns two channels with the kernel. */
+  if (s->tex.edge_filter_mode == 1 && s->tex.channels >= 2) inside = inside && (!crossing || turns == 0);
   /* ptexf_weight's sums, in its order. */
   const float16 weight = (ku0 + ku1 + ku2) * (kv0 + kv1 + kv2) * s->tex.one_value;
   inside = inside && weight != 0.0f && !isinf(weight);
@@ -109,16 +145,30 @@ SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFi
   const int nchan = s->tex.channels;
   int level_a[PTEXF_LANES];
   vstore16(select((int16)(0), vload16(0, base_a) + ulog2 * (face_vlog2 + 1) + vlog2, inside), 0, level_a);
-  for (int i = 0; i < PTEXF_LANES; ++i) level_a[i] = (int)s->level_offsets[level_a[i]];
-  const int16 inside_taps_u = select((int16)(1), utaps, inside), inside_taps_v = select((int16)(1), vtaps, inside);
-  /* Tap (i, j) at first_a + row_a[j] + column_a[i], a tap past the count on the last texel. */
-  int first_a[PTEXF_LANES], column_a[3][PTEXF_LANES], row_a[3][PTEXF_LANES];
-  vstore16(select((int16)(0), (vload16(0, level_a) + kv * resu + ku) * nchan, inside), 0, first_a);
-  for (int t = 0; t < 3; ++t) {
-    vstore16(min((int16)(t), inside_taps_u - 1) * nchan, 0, column_a[t]);
-    vstore16(min((int16)(t), inside_taps_v - 1) * resu * nchan, 0, row_a[t]);
+  vstore16(select((int16)(0), vload16(0, next_a) + select(next_ulog2 * (next_face_vlog2 + 1) + next_vlog2, (int16)(0), next_constant),
+                  inside && crossing),
+           0, next_a);
+  for (int i = 0; i < PTEXF_LANES; ++i) {
+    level_a[i] = (int)s->level_offsets[level_a[i]];
+    next_a[i] = (int)s->level_offsets[next_a[i]];
   }
+  const int16 level = vload16(0, level_a), next_level = vload16(0, next_a);
+  const int16 next_row = select((int16)(1) << next_ulog2, (int16)(0), next_constant);
   const int taps = any(inside && (utaps == 3 || vtaps == 3)) ? 3 : 2;
+  /* Tap (i, j) at address_a[i][j], a tap past the kernel's count on its last texel. */
+  int address_a[3][3][PTEXF_LANES];
+  for (int i = 0; i < taps; ++i)
+    for (int j = 0; j < taps; ++j) {
+      const int16 x = ku + min((int16)(i), utaps - 1), y = kv + min((int16)(j), vtaps - 1);
+      const int16 beyond = x < 0 || x >= resu || y < 0 || y >= resv;
+      /* Past the edge, in the face's frame moved by its size, then turned. */
+      const int16 xt = x & (resu - 1), yt = y & (resv - 1);
+      const int16 xf = resu - 1 - xt, yf = resv - 1 - yt;
+      const int16 next_x = select(select(select(xt, yt, turns == 1), xf, turns == 2), yf, turns == 3);
+      const int16 next_y = select(select(select(yt, xf, turns == 1), yf, turns == 2), xt, turns == 3);
+      const int16 at = select(level + y * resu + x, next_level + next_y * next_row + select(next_x, (int16)(0), next_constant), beyond);
+      vstore16(select((int16)(0), at * nchan, inside), 0, address_a[i][j]);
+    }
   const float16 kus[3] = {ku0, ku1, ku2}, kvs[3] = {kv0, kv1, kv2};
   const float16 scale = 1.0f / weight;
   for (int c = 0; c < 4; ++c) {
@@ -128,7 +178,7 @@ SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFi
         float16 column = (float16)(0.0f);
         for (int j = 0; j < taps; ++j) {
           float tap_a[PTEXF_LANES];
-          for (int l = 0; l < PTEXF_LANES; ++l) tap_a[l] = ptexf_texel(s, (uint)(first_a[l] + row_a[j][l] + column_a[i][l] + c));
+          for (int l = 0; l < PTEXF_LANES; ++l) tap_a[l] = ptexf_texel(s, (uint)(address_a[i][j][l] + c));
           column += vload16(0, tap_a) * kvs[j];
         }
         sum += column * kus[i];
