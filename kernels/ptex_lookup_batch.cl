@@ -1,6 +1,6 @@
 /* Batches of lookups of Ptex's own filters (`seamcl ptx lookup`, the kernel tests and the Ptex
  * benchmark): ptex_filter_lookups, SEAMCL_PTEX_LOOKUP_LANES queries per work-item, the bilinear and
- * box lookups that stay inside their face as vector lanes (ptexf_small_lanes) and the rest by
+ * box lookups that reach no corner as vector lanes (ptexf_small_lanes) and the rest by
  * ptexf_lookup of ptex_filter.cl; a batch of point lookups through ptex_point_lookups, one query
  * per work-item. Both keep a core's texel misses of many lookups in flight: the lanes' loads wait
  * on no branch, and the point kernel's loop body is short.
@@ -50,15 +50,20 @@ SEAMCL_INLINE void ptexf_small_axis(int16 box, float16 x, float16 width, int16 f
 }
 
 /* The bilinear and box lookups among queries[first ..] (n of them, n <= PTEXF_LANES) whose taps
- * (at most 3x3) lie inside their face, a lane each: one face, no edge to split at, no corner, no
- * constant face, so no branch on the query. Returns which lanes it looked up (-1) and their 4
- * values each in values[4 * lane ..]; the other lanes are left to ptexf_lookup. The arithmetic is
- * ptexf_lookup's for such a kernel (ptexf_build's kernel, ptexf_weight, ptexf_sum_taps's order;
- * the taps past a kernel's count weigh 0 and read its last texel again), so the values are its own
- * but for fused multiply-adds. Scalar loads gather each lane's query, face record, level offset and
- * taps; the rest is vector arithmetic over the lanes, which PoCL does not make of ptexf_lookup's
- * branches and loops (its work-group loop stays scalar), so a core keeps many lanes' texel misses
- * in flight. */
+ * (at most 3x3) lie inside their face or past one of its edges, a lane each, in vectors over the
+ * lanes. Returns which lanes it looked up (-1) and their 4 values each in values[4 * lane ..];
+ * ptexf_lookup takes the rest: taps past a corner, a boundary or both sides of a face, a coarser
+ * neighbour, the tangent-vector edge mode across a turn, a constant face under the point. A lane's
+ * kernel is ptexf_build's and its weight ptexf_weight's; taps past an edge are read on the
+ * neighbour there, turned into its frame, as ptexf_split_and_apply reads them, and the taps past a
+ * kernel's count weigh 0 and read its last texel again. The sums are ptexf_sum_taps's, in its
+ * order, over the kernel's taps on both faces at once, so the values are ptexf_lookup's but for
+ * rounding (fused multiply-adds; where a kernel crosses an edge, its pieces summed together).
+ * Scalar loads gather each lane's query, face records, level offsets and taps; the rest is vector
+ * arithmetic that PoCL does not make of ptexf_lookup's branches and loops (its work-group loop
+ * stays scalar there), and no branch waits on a lane's texels, so a core keeps many lanes' misses
+ * in flight. Width-4 kernels (4 to 8 taps an axis) stay with ptexf_lookup, whose rows are read 16
+ * values at a time: gathered tap by tap they were slower (docs/performance.md). */
 SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFilterQuery* queries, int first, int n,
                                       float* values) {
   int face_a[PTEXF_LANES], filter_a[PTEXF_LANES];

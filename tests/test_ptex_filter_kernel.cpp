@@ -14,6 +14,7 @@
 #include <map>
 #include <limits>
 #include <random>
+#include <set>
 #include <string>
 #include <utility>
 
@@ -252,17 +253,20 @@ TEST(PtexFilterKernel, PointBatchesMatchTheTwinAndMixedBatches) {
   EXPECT_GE(bilinear_differs, 3);
 }
 
-// Bilinear and box lookups whose taps stay inside their face run, 16 to a work-item, as vector
-// lanes (ptexf_small_lanes); the rest of a work-item's lookups through ptexf_lookup. Every value
-// must be the twin's, whatever shares its work-item and however long the batch (its last work-item
-// part full): box kernels of 1, 2 and 3 taps per axis, widths on texel boundaries, points on and
-// beside face edges, faces out of range, other filters between, on every texel type and 1 to 4
-// channels.
-TEST(PtexFilterKernel, SmallKernelsInsideAFaceMatchTheTwinInBatchesOfAnyLength) {
+// Bilinear and box lookups whose taps reach no corner run, 16 to a work-item, as vector lanes
+// (ptexf_small_lanes), their taps past an edge read on the neighbour there; the rest of a
+// work-item's lookups through ptexf_lookup. Every value must be the twin's, whatever shares its
+// work-item and however long the batch (its last work-item part full): box kernels of 1, 2 and 3
+// taps per axis, widths on texel boundaries, points on and beside face edges (neighbours turned
+// every way, of other resolutions), faces out of range, other filters between, on every texel
+// type and 1 to 4 channels.
+TEST(PtexFilterKernel, SmallKernelsMatchTheTwinAcrossEdgesInBatchesOfAnyLength) {
   std::vector<std::pair<std::string, PtexFilterData>> textures;
-  for (const char* name : {"cube_text", "rand_lo", "black"})
+  for (const char* name : {"cube_text", "cellnoise", "rand_lo", "black"})
     textures.emplace_back(name, build_ptex_filter_data(read_ptex_stored(ptex_assets_dir() + "/" + name + ".ptx")));
   textures.emplace_back("float rgba", float_face(3, 4));
+  // The quarter turns into the neighbour across the edges the lookups below cross (u or v at 0).
+  std::set<int> turns;
   textures.emplace_back("half, 2 channels", float_face(2, 2));
   const float coordinates[] = {0.0f, 0.03f, 0.125f, 0.28125f, 0.5f, 0.61f, 0.875f, 0.999f, 1.0f};
   const float widths[] = {1.0f / 64, 1.0f / 16, 0.04f, 0.09f, 0.25f, 0.3f, 0.5f, 0.7f, 1.0f};
@@ -301,11 +305,50 @@ TEST(PtexFilterKernel, SmallKernelsInsideAFaceMatchTheTwinInBatchesOfAnyLength) 
         }
         inside += q.face < faces && q.u > 0.1f && q.u < 0.9f && q.v > 0.1f && q.v < 0.9f && q.uw < 0.1f &&
                   q.vw < 0.1f && q.filter != SEAMCL_PTEX_GAUSSIAN;
+        if (q.face < faces && q.filter != SEAMCL_PTEX_GAUSSIAN && (q.u == 0.0f) != (q.v == 0.0f)) {
+          const PtexFilterFace& f = data.faces[static_cast<size_t>(q.face)];
+          const int edge = q.u == 0.0f ? 3 : 0;
+          if (f.adj_faces[edge] >= 0) turns.insert((edge - static_cast<int>((f.adj_edges >> (2 * edge)) & 3u) + 6) % 4);
+        }
       }
       from += length;
     }
     EXPECT_GT(inside, 50) << name;
   }
+  EXPECT_EQ(turns, (std::set<int>{0, 1, 2, 3}));
+
+  // Across an edge into a constant face, whose one texel every tap there reads.
+  PtexTestFile spec;
+  std::vector<uint8_t> texels;
+  for (int t = 0; t < 64; ++t) texels.push_back(static_cast<uint8_t>(3 * t));
+  spec.faces = {{3, 3, 0, {-1, 1, -1, -1}, 3 << 2, {90}}, {3, 3, 1, {-1, -1, -1, 0}, 1 << 6, {250}}};
+  spec.levels = {{data_block(texels, 64, 1, 1), PtexBlock{kEncConstant, {}}}};
+  const PtexFilterData beside_constant = build_ptex_filter_data(parse_ptex_stored(write_ptex(spec)));
+  std::vector<PtexFilterQuery> across;
+  for (const int filter : {SEAMCL_PTEX_BILINEAR, SEAMCL_PTEX_BOX})
+    for (const float u : {0.9f, 0.95f, 0.99f})
+      for (const float v : {0.3f, 0.5f})
+        for (const float width : {1.0f / 8, 1.0f / 16, 0.2f}) {
+          PtexFilterQuery q{};
+          q.filter = filter;
+          q.u = u;
+          q.v = v;
+          q.uw = q.vw = width;
+          across.push_back(q);
+        }
+  PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
+  launcher.load(beside_constant);
+  const std::vector<float> device = launcher.run(across);
+  // Values past the largest texel of face 0's rows 0 to 5 (141), which the lookups reach: the
+  // constant face's 250 in them.
+  int above_face = 0;
+  for (size_t i = 0; i < across.size(); ++i) {
+    const float twin = ptex_filter_twin(beside_constant, across[i])[0];
+    ASSERT_NEAR(device[4 * i], twin, 2e-6f) << "lookup " << i << " filter " << across[i].filter << " at ("
+                                            << across[i].u << ", " << across[i].v << ") width " << across[i].uw;
+    above_face += twin > 141.5f / 255.0f;
+  }
+  EXPECT_GT(above_face, 0);
 }
 
 // One launch per file (the launcher's compile dominates the time); the twin's own test holds the
