@@ -1,7 +1,7 @@
 /* Batches of lookups of Ptex's own filters (`seamcl ptx lookup`, the kernel tests and the Ptex
  * benchmark): ptex_filter_lookups, SEAMCL_PTEX_LOOKUP_LANES queries per work-item, the bilinear and
- * box lookups that reach no corner as vector lanes (ptexf_small_lanes) and the rest by
- * ptexf_lookup of ptex_filter.cl; a batch of point lookups through ptex_point_lookups, one query
+ * box lookups that stay in their face or cross one edge as vector lanes (ptexf_small_lanes) and
+ * the rest by ptexf_lookup of ptex_filter.cl; a batch of point lookups through ptex_point_lookups, one query
  * per work-item. Both keep a core's texel misses of many lookups in flight: the lanes' loads wait
  * on no branch, and the point kernel's loop body is short.
  * Contract: out[4 * id ..] holds query id's 4 floats (channels beyond the texture's 0; a face out of
@@ -25,10 +25,11 @@ SEAMCL_INLINE PtexfState ptexf_batch_state(PtexFilterTexture tex, __global const
 
 #define PTEXF_LANES SEAMCL_PTEX_LOOKUP_LANES
 
-/* One axis of a lane's bilinear or box kernel as ptexf_build makes it, at most 3 taps: the first
- * texel *k, the tap count *taps and the weights w0, w1, w2 (0 past the count). */
+/* One axis of a lane's bilinear or box kernel as ptexf_build and ptexf_strip_zeros make it, at most
+ * 3 taps: the first texel *first, the tap count *taps and the weights w0, w1, w2 (0 past the
+ * count). A lane whose first weight is still 0 has a weight of 0 (the caller leaves it). */
 SEAMCL_INLINE void ptexf_small_axis(int16 box, float16 x, float16 width, int16 face_log2, int16* res_log2,
-                                    float16* first, int16* taps, float16* w0, float16* w1, float16* w2) {
+                                    int16* first, int16* taps, float16* w0, float16* w1, float16* w2) {
   width = fmax(fmin(width, 1.0f), as_float16((127 - face_log2) << 23));
   *res_log2 = 127 - ((as_int16(width) >> 23) & 0xff);
   const float16 res = as_float16((127 + *res_log2) << 23);
@@ -42,11 +43,26 @@ SEAMCL_INLINE void ptexf_small_axis(int16 box, float16 x, float16 width, int16 f
   const float16 lo_floor = floor(lo), hi_ceil = ceil(hi);
   const float16 f1 = 1.0f - (lo - lo_floor), f2 = 1.0f - (hi_ceil - hi);
   const int16 box_taps = min(convert_int16(hi_ceil - lo_floor), 3);
-  *first = select(pix_floor, lo_floor, box);
-  *taps = select((int16)(2), box_taps, box);
-  *w0 = select(1.0f - frac, select(f1, f1 + f2 - 1.0f, box_taps == 1), box);
-  *w1 = select(frac, select(select(1.0f, f2, box_taps == 2), (float16)(0.0f), box_taps == 1), box);
-  *w2 = select((float16)(0.0f), f2, box && box_taps == 3);
+  int16 start = convert_int16(select(pix_floor, lo_floor, box));
+  int16 count = select((int16)(2), box_taps, box);
+  float16 a = select(1.0f - frac, select(f1, f1 + f2 - 1.0f, box_taps == 1), box);
+  float16 b = select(frac, select(select(1.0f, f2, box_taps == 2), (float16)(0.0f), box_taps == 1), box);
+  float16 c = select((float16)(0.0f), f2, box && box_taps == 3);
+  /* ptexf_strip_zeros: a weight of 0 at either end (frac or a box end rounded to a whole texel) is
+   * no tap, so it neither crosses an edge nor reads a texel that 0 times itself could make NaN. */
+  const int16 lead = a == 0.0f;
+  start = select(start, start + 1, lead);
+  count = select(count, count - 1, lead);
+  a = select(a, b, lead);
+  b = select(b, c, lead);
+  c = select(c, (float16)(0.0f), lead);
+  count = select(count, (int16)(2), count == 3 && c == 0.0f);
+  count = select(count, (int16)(1), count == 2 && b == 0.0f);
+  *first = start;
+  *taps = count;
+  *w0 = a;
+  *w1 = b;
+  *w2 = c;
 }
 
 /* The bilinear and box lookups among queries[first ..] (n of them, n <= PTEXF_LANES) whose taps
@@ -85,7 +101,8 @@ SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFi
   const float16 u = vload16(0, u_a), v = vload16(0, v_a);
   int16 inside = lane < n && in_range && (filter == SEAMCL_PTEX_BILINEAR || box) && u >= 0.0f && u < 1.0f &&
                  v >= 0.0f && v < 1.0f;
-  if (!any(inside)) return inside;
+  /* Under a render's seam methods (not the batch's) every edge is a boundary: ptexf_lookup's. */
+  if (s->tex.seams != SEAMCL_PTEX_SEAMS_PTEX || !any(inside)) return inside && s->tex.seams == SEAMCL_PTEX_SEAMS_PTEX;
   int face_index_a[PTEXF_LANES];
   vstore16(select((int16)(0), face, inside), 0, face_index_a);
   int ulog2_a[PTEXF_LANES], vlog2_a[PTEXF_LANES], flags_a[PTEXF_LANES], base_a[PTEXF_LANES];
@@ -98,12 +115,15 @@ SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFi
   }
   const int16 face_vlog2 = vload16(0, vlog2_a);
   inside = inside && (vload16(0, flags_a) & (int)(SEAMCL_PTEX_FLAG_CONSTANT | SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT)) == 0;
-  int16 ulog2, vlog2, utaps, vtaps;
-  float16 ufirst, vfirst, ku0, ku1, ku2, kv0, kv1, kv2;
-  ptexf_small_axis(box, u, fabs(vload16(0, uw_a)), vload16(0, ulog2_a), &ulog2, &ufirst, &utaps, &ku0, &ku1, &ku2);
-  ptexf_small_axis(box, v, fabs(vload16(0, vw_a)), face_vlog2, &vlog2, &vfirst, &vtaps, &kv0, &kv1, &kv2);
-  const int16 ku = convert_int16(select((float16)(0.0f), ufirst, inside));
-  const int16 kv = convert_int16(select((float16)(0.0f), vfirst, inside));
+  int16 ulog2, vlog2, utaps, vtaps, ufirst, vfirst;
+  float16 ku0, ku1, ku2, kv0, kv1, kv2;
+  /* The other lanes' coordinates may be anything (NaN, infinite): 0.5 keeps their conversions to
+   * integers defined. */
+  ptexf_small_axis(box, select((float16)(0.5f), u, inside), fabs(vload16(0, uw_a)), vload16(0, ulog2_a), &ulog2,
+                   &ufirst, &utaps, &ku0, &ku1, &ku2);
+  ptexf_small_axis(box, select((float16)(0.5f), v, inside), fabs(vload16(0, vw_a)), face_vlog2, &vlog2, &vfirst, &vtaps,
+                   &kv0, &kv1, &kv2);
+  const int16 ku = select((int16)(0), ufirst, inside), kv = select((int16)(0), vfirst, inside);
   const int16 resu = (int16)(1) << ulog2, resv = (int16)(1) << vlog2;
   /* Taps past one edge are read on the neighbour there, turned into its frame, as ptexf_split_and_apply
    * reads them; past two edges (a corner, or both sides of a face narrower than the kernel) or past
@@ -148,20 +168,22 @@ SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFi
   if (!any(inside)) return inside;
   /* Lanes left to ptexf_lookup read their texture's first texels, which are there. */
   const int nchan = s->tex.channels;
-  int level_a[PTEXF_LANES];
-  vstore16(select((int16)(0), vload16(0, base_a) + ulog2 * (face_vlog2 + 1) + vlog2, inside), 0, level_a);
+  int level_index_a[PTEXF_LANES], next_level_index_a[PTEXF_LANES];
+  vstore16(select((int16)(0), vload16(0, base_a) + ulog2 * (face_vlog2 + 1) + vlog2, inside), 0, level_index_a);
   vstore16(select((int16)(0), vload16(0, next_a) + select(next_ulog2 * (next_face_vlog2 + 1) + next_vlog2, (int16)(0), next_constant),
                   inside && crossing),
-           0, next_a);
+           0, next_level_index_a);
+  /* Texel indices are uints, as in ptexf_sum_taps: a texture may hold up to 2^32 - 1 values. */
+  uint level_a[PTEXF_LANES], next_level_a[PTEXF_LANES];
   for (int i = 0; i < PTEXF_LANES; ++i) {
-    level_a[i] = (int)s->level_offsets[level_a[i]];
-    next_a[i] = (int)s->level_offsets[next_a[i]];
+    level_a[i] = s->level_offsets[level_index_a[i]];
+    next_level_a[i] = s->level_offsets[next_level_index_a[i]];
   }
-  const int16 level = vload16(0, level_a), next_level = vload16(0, next_a);
+  const uint16 level = vload16(0, level_a), next_level = vload16(0, next_level_a);
   const int16 next_row = select((int16)(1) << next_ulog2, (int16)(0), next_constant);
   const int taps = any(inside && (utaps == 3 || vtaps == 3)) ? 3 : 2;
   /* Tap (i, j) at address_a[i][j], a tap past the kernel's count on its last texel. */
-  int address_a[3][3][PTEXF_LANES];
+  uint address_a[3][3][PTEXF_LANES];
   for (int i = 0; i < taps; ++i)
     for (int j = 0; j < taps; ++j) {
       const int16 x = ku + min((int16)(i), utaps - 1), y = kv + min((int16)(j), vtaps - 1);
@@ -171,8 +193,11 @@ SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFi
       const int16 xf = resu - 1 - xt, yf = resv - 1 - yt;
       const int16 next_x = select(select(select(xt, yt, turns == 1), xf, turns == 2), yf, turns == 3);
       const int16 next_y = select(select(select(yt, xf, turns == 1), yf, turns == 2), xt, turns == 3);
-      const int16 at = select(level + y * resu + x, next_level + next_y * next_row + select(next_x, (int16)(0), next_constant), beyond);
-      vstore16(select((int16)(0), at * nchan, inside), 0, address_a[i][j]);
+      /* Every offset within a level is a valid texel of a face that fits, so at least 0 for the lanes. */
+      const uint16 at = select(level + as_uint16(y * resu + x),
+                               next_level + as_uint16(next_y * next_row + select(next_x, (int16)(0), next_constant)),
+                               as_uint16(beyond));
+      vstore16(select((uint16)(0), at * (uint)nchan, as_uint16(inside)), 0, address_a[i][j]);
     }
   const float16 kus[3] = {ku0, ku1, ku2}, kvs[3] = {kv0, kv1, kv2};
   const float16 scale = 1.0f / weight;
@@ -183,7 +208,7 @@ SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFi
         float16 column = (float16)(0.0f);
         for (int j = 0; j < taps; ++j) {
           float tap_a[PTEXF_LANES];
-          for (int l = 0; l < PTEXF_LANES; ++l) tap_a[l] = ptexf_texel(s, (uint)(address_a[i][j][l] + c));
+          for (int l = 0; l < PTEXF_LANES; ++l) tap_a[l] = ptexf_texel(s, address_a[i][j][l] + (uint)c);
           column += vload16(0, tap_a) * kvs[j];
         }
         sum += column * kus[i];

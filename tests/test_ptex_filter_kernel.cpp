@@ -101,8 +101,9 @@ TEST(PtexFilterKernel, MatchesTheTwinOnGoldenAndEdgeLookups) {
 }
 
 // One face of 16 x 16 texels of float32 (data type 3) or float16 (2), of 1 to 4 channels, with
-// values outside 0..1 of both signs.
-PtexFilterData float_face(uint32_t data_type, int channels) {
+// values outside 0..1 of both signs; with `pair`, a second such face of other values right of it
+// (its left edge on the first's right edge).
+PtexFilterData float_face(uint32_t data_type, int channels, bool pair = false) {
   PtexTestFile spec;
   spec.data_type = data_type;
   spec.channels = static_cast<uint16_t>(channels);
@@ -117,17 +118,24 @@ PtexFilterData float_face(uint32_t data_type, int channels) {
     }
     out.insert(out.end(), bytes, bytes + element_bytes);
   };
-  std::vector<uint8_t> level0;
-  for (int j = 0; j < 16; ++j)
-    for (int i = 0; i < 16; ++i) {
-      const float values[4] = {std::sin(0.7f * i) + 0.1f * j, 2.0f * std::cos(0.5f * j), 0.01f * i * j - 0.3f,
-                               0.5f + 0.03f * i};
-      for (int c = 0; c < channels; ++c) put(level0, values[c]);
-    }
+  std::vector<PtexBlock> blocks;
+  for (int face = 0; face < (pair ? 2 : 1); ++face) {
+    std::vector<uint8_t> level0;
+    for (int j = 0; j < 16; ++j)
+      for (int i = 0; i < 16; ++i) {
+        const float values[4] = {std::sin(0.7f * i) + 0.1f * j + 3.0f * face, 2.0f * std::cos(0.5f * j),
+                                 0.01f * i * j - 0.3f - face, 0.5f + 0.03f * i};
+        for (int c = 0; c < channels; ++c) put(level0, values[c]);
+      }
+    blocks.push_back(data_block(level0, 256, channels, element_bytes));
+  }
   std::vector<uint8_t> constant;
   for (int c = 0; c < channels; ++c) put(constant, 0.25f * c);
-  spec.faces = {{4, 4, 0, {-1, -1, -1, -1}, 0, constant}};
-  spec.levels = {{data_block(level0, 256, channels, element_bytes)}};
+  if (pair)
+    spec.faces = {{4, 4, 0, {-1, 1, -1, -1}, 3 << 2, constant}, {4, 4, 0, {-1, -1, -1, 0}, 1 << 6, constant}};
+  else
+    spec.faces = {{4, 4, 0, {-1, -1, -1, -1}, 0, constant}};
+  spec.levels = {blocks};
   return build_ptex_filter_data(parse_ptex_stored(write_ptex(spec)));
 }
 
@@ -253,7 +261,7 @@ TEST(PtexFilterKernel, PointBatchesMatchTheTwinAndMixedBatches) {
   EXPECT_GE(bilinear_differs, 3);
 }
 
-// Bilinear and box lookups whose taps reach no corner run, 16 to a work-item, as vector lanes
+// Bilinear and box lookups whose taps stay in their face or cross one edge run, 16 to a work-item, as vector lanes
 // (ptexf_small_lanes), their taps past an edge read on the neighbour there; the rest of a
 // work-item's lookups through ptexf_lookup. Every value must be the twin's, whatever shares its
 // work-item and however long the batch (its last work-item part full): box kernels of 1, 2 and 3
@@ -265,9 +273,14 @@ TEST(PtexFilterKernel, SmallKernelsMatchTheTwinAcrossEdgesInBatchesOfAnyLength) 
   for (const char* name : {"cube_text", "cellnoise", "rand_lo", "black"})
     textures.emplace_back(name, build_ptex_filter_data(read_ptex_stored(ptex_assets_dir() + "/" + name + ".ptx")));
   textures.emplace_back("float rgba", float_face(3, 4));
+  textures.emplace_back("half, 2 channels", float_face(2, 2));
+  textures.emplace_back("float rgba pair", float_face(3, 4, true));
+  textures.emplace_back("half pair", float_face(2, 1, true));
+  // The tangent-vector edge mode turns the first two channels with the kernel across an edge.
+  textures.emplace_back("cellnoise, tangent vectors", textures[1].second);
+  textures.back().second.texture.edge_filter_mode = 1;
   // The quarter turns into the neighbour across the edges the lookups below cross (u or v at 0).
   std::set<int> turns;
-  textures.emplace_back("half, 2 channels", float_face(2, 2));
   const float coordinates[] = {0.0f, 0.03f, 0.125f, 0.28125f, 0.5f, 0.61f, 0.875f, 0.999f, 1.0f};
   const float widths[] = {1.0f / 64, 1.0f / 16, 0.04f, 0.09f, 0.25f, 0.3f, 0.5f, 0.7f, 1.0f};
   for (const auto& [name, data] : textures) {
@@ -316,6 +329,25 @@ TEST(PtexFilterKernel, SmallKernelsMatchTheTwinAcrossEdgesInBatchesOfAnyLength) 
     EXPECT_GT(inside, 50) << name;
   }
   EXPECT_EQ(turns, (std::set<int>{0, 1, 2, 3}));
+
+  // A tap of weight 0 (the point on a texel centre) is no tap: an infinite texel there must not make
+  // the value NaN.
+  {
+    PtexFilterData data = float_face(3, 1);
+    const PtexFilterFace& f = data.faces[0];
+    const uint32_t level = data.level_offsets[f.level_base + static_cast<uint32_t>(4 * (f.vlog2 + 1) + 4)];
+    const float infinity = std::numeric_limits<float>::infinity();
+    std::memcpy(&data.texels[4 * (level + 4 * 16 + 5)], &infinity, sizeof infinity);
+    PtexFilterQuery q{};
+    q.filter = SEAMCL_PTEX_BILINEAR;
+    q.u = q.v = 0.28125f;  // texel (4, 4)'s centre at 16 x 16: weights {1, 0} on both axes
+    q.uw = q.vw = 1.0f / 16;
+    PtexFilterLauncher launcher(seamcl_tests::shared_runtime());
+    launcher.load(data);
+    const float twin = ptex_filter_twin(data, q)[0];
+    ASSERT_TRUE(std::isfinite(twin));
+    EXPECT_FLOAT_EQ(launcher.run({q})[0], twin);
+  }
 
   // Across an edge into a constant face, whose one texel every tap there reads.
   PtexTestFile spec;

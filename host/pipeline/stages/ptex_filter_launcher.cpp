@@ -18,9 +18,12 @@ cl::Buffer upload(ClRuntime& runtime, const std::vector<T>& data, size_t& bytes_
   return buffer;
 }
 
-// ptex_filter_lookups looks up SEAMCL_PTEX_LOOKUP_LANES queries per work-item.
+// ptex_filter_lookups looks up SEAMCL_PTEX_LOOKUP_LANES queries per work-item, in work-groups of
+// kGroup queries as the point kernel's, so that a batch of a few hundred still spreads over the
+// cores (PoCL runs a work-group on one).
+constexpr size_t kGeneralGroup = kGroup / SEAMCL_PTEX_LOOKUP_LANES;
 size_t general_work_items(size_t queries) {
-  return round_up((queries + SEAMCL_PTEX_LOOKUP_LANES - 1) / SEAMCL_PTEX_LOOKUP_LANES, kGroup);
+  return round_up((queries + SEAMCL_PTEX_LOOKUP_LANES - 1) / SEAMCL_PTEX_LOOKUP_LANES, kGeneralGroup);
 }
 
 }  // namespace
@@ -83,7 +86,8 @@ void PtexFilterLauncher::run(const std::vector<PtexFilterQuery>& queries, float*
     general = not_point != 0;
   }
   if (general)
-    queue.enqueueNDRangeKernel(with_args(kernel_, in, queries.size(), out), cl::NullRange, general_global, local);
+    queue.enqueueNDRangeKernel(with_args(kernel_, in, queries.size(), out), cl::NullRange, general_global,
+                               cl::NDRange(kGeneralGroup));
   void* mapped = queue.enqueueMapBuffer(out, CL_TRUE, CL_MAP_READ, 0, out_bytes);
   queue.enqueueUnmapMemObject(out, mapped);
   queue.finish();
@@ -104,7 +108,7 @@ std::vector<double> PtexFilterLauncher::time(const std::vector<PtexFilterQuery>&
     runtime_.queue().enqueueNDRangeKernel(
         kernel, cl::NullRange,
         cl::NDRange(points ? round_up(queries.size(), kGroup) : general_work_items(queries.size())),
-        cl::NDRange(kGroup), nullptr, &event);
+        cl::NDRange(points ? kGroup : kGeneralGroup), nullptr, &event);
   runtime_.queue().finish();
   for (const cl::Event& event : events) ms.push_back(event_milliseconds(event));
   return ms;
