@@ -65,6 +65,18 @@ SEAMCL_INLINE void ptexf_small_axis(int16 box, float16 x, float16 width, int16 f
   *w2 = c;
 }
 
+/* The records of faces index[0 ..] (a lane each): resolution, flags and first level offset. */
+SEAMCL_INLINE void ptexf_gather_faces(const PtexfState* s, const int* index, int* ulog2, int* vlog2, int* flags,
+                                      int* level_base) {
+  for (int i = 0; i < PTEXF_LANES; ++i) {
+    __global const PtexFilterFace* f = s->faces + index[i];
+    ulog2[i] = f->ulog2;
+    vlog2[i] = f->vlog2;
+    flags[i] = (int)f->flags;
+    level_base[i] = (int)f->level_base;
+  }
+}
+
 /* The bilinear and box lookups among queries[first ..] (n of them, n <= PTEXF_LANES) whose taps
  * (at most 3x3) lie inside their face or past one of its edges, a lane each, in vectors over the
  * lanes. Returns which lanes it looked up (-1) and their 4 values each in values[4 * lane ..];
@@ -106,13 +118,7 @@ SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFi
   int face_index_a[PTEXF_LANES];
   vstore16(select((int16)(0), face, inside), 0, face_index_a);
   int ulog2_a[PTEXF_LANES], vlog2_a[PTEXF_LANES], flags_a[PTEXF_LANES], base_a[PTEXF_LANES];
-  for (int i = 0; i < PTEXF_LANES; ++i) {
-    __global const PtexFilterFace* f = s->faces + face_index_a[i];
-    ulog2_a[i] = f->ulog2;
-    vlog2_a[i] = f->vlog2;
-    flags_a[i] = (int)f->flags;
-    base_a[i] = (int)f->level_base;
-  }
+  ptexf_gather_faces(s, face_index_a, ulog2_a, vlog2_a, flags_a, base_a);
   const int16 face_vlog2 = vload16(0, vlog2_a);
   inside = inside && (vload16(0, flags_a) & (int)(SEAMCL_PTEX_FLAG_CONSTANT | SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT)) == 0;
   int16 ulog2, vlog2, utaps, vtaps, ufirst, vfirst;
@@ -145,13 +151,7 @@ SEAMCL_INLINE int16 ptexf_small_lanes(const PtexfState* s, __global const PtexFi
   inside = inside && (!crossing || next >= 0);
   int next_index_a[PTEXF_LANES];
   vstore16(select((int16)(0), next, crossing && inside), 0, next_index_a);
-  for (int i = 0; i < PTEXF_LANES; ++i) {
-    __global const PtexFilterFace* f = s->faces + next_index_a[i];
-    ulog2_a[i] = f->ulog2;
-    vlog2_a[i] = f->vlog2;
-    flags_a[i] = (int)f->flags;
-    next_a[i] = (int)f->level_base;
-  }
+  ptexf_gather_faces(s, next_index_a, ulog2_a, vlog2_a, flags_a, next_a);
   /* ptexf_rotate's quarter turns: the kernel's resolution in the neighbour's frame. */
   const int16 turns = (edge - vload16(0, next_edge_a) + 2) & 3;
   const int16 odd = (turns & 1) != 0;
