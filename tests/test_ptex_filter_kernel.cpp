@@ -165,16 +165,21 @@ TEST(PtexFilterKernel, MatchesTheTwinOnFloatFacesWithNanPadding) {
   }
 }
 
-// A constant face beside a textured one (so not neighbourhood-constant) holds one texel: a point
-// lookup anywhere on it gives that value, as the library's point filter does, in a batch of points
-// alone and in a mixed one.
-TEST(PtexFilterKernel, PointLookupsOnAConstantFaceGiveItsValue) {
+// Face 0: 8 x 8 uint8 texels 3 * (8 * row + column); right of it face 1, constant `value` (so
+// neither is neighbourhood-constant).
+PtexFilterData textured_beside_constant(uint8_t value) {
   PtexTestFile spec;
   std::vector<uint8_t> texels;
   for (int t = 0; t < 64; ++t) texels.push_back(static_cast<uint8_t>(3 * t));
-  spec.faces = {{3, 3, 0, {-1, 1, -1, -1}, 3 << 2, {90}}, {3, 3, 1, {-1, -1, -1, 0}, 1 << 6, {200}}};
+  spec.faces = {{3, 3, 0, {-1, 1, -1, -1}, 3 << 2, {90}}, {3, 3, 1, {-1, -1, -1, 0}, 1 << 6, {value}}};
   spec.levels = {{data_block(texels, 64, 1, 1), PtexBlock{kEncConstant, {}}}};
-  const PtexFilterData data = build_ptex_filter_data(parse_ptex_stored(write_ptex(spec)));
+  return build_ptex_filter_data(parse_ptex_stored(write_ptex(spec)));
+}
+
+// A constant face beside a textured one holds one texel: a point lookup anywhere on it gives that
+// value, as the library's point filter does, in a batch of points alone and in a mixed one.
+TEST(PtexFilterKernel, PointLookupsOnAConstantFaceGiveItsValue) {
+  const PtexFilterData data = textured_beside_constant(200);
   ASSERT_EQ(data.faces[1].flags & (SEAMCL_PTEX_FLAG_CONSTANT | SEAMCL_PTEX_FLAG_NEIGHBORHOOD_CONSTANT),
             SEAMCL_PTEX_FLAG_CONSTANT);
   std::vector<PtexFilterQuery> points;
@@ -350,12 +355,7 @@ TEST(PtexFilterKernel, SmallKernelsMatchTheTwinAcrossEdgesInBatchesOfAnyLength) 
   }
 
   // Across an edge into a constant face, whose one texel every tap there reads.
-  PtexTestFile spec;
-  std::vector<uint8_t> texels;
-  for (int t = 0; t < 64; ++t) texels.push_back(static_cast<uint8_t>(3 * t));
-  spec.faces = {{3, 3, 0, {-1, 1, -1, -1}, 3 << 2, {90}}, {3, 3, 1, {-1, -1, -1, 0}, 1 << 6, {250}}};
-  spec.levels = {{data_block(texels, 64, 1, 1), PtexBlock{kEncConstant, {}}}};
-  const PtexFilterData beside_constant = build_ptex_filter_data(parse_ptex_stored(write_ptex(spec)));
+  const PtexFilterData beside_constant = textured_beside_constant(250);
   std::vector<PtexFilterQuery> across;
   for (const int filter : {SEAMCL_PTEX_BILINEAR, SEAMCL_PTEX_BOX})
     for (const float u : {0.9f, 0.95f, 0.99f})
