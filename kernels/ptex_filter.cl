@@ -284,6 +284,13 @@ SEAMCL_INLINE void ptexf_width4_weights(int filter, const float* c, float* k, fl
   k[9] = w.s9;
 }
 
+/* ceil(x) as an int, for |x| < 2^31 (a kernel's texel coordinates): PoCL's ceil is a library
+ * routine with range checks and branches. */
+SEAMCL_INLINE int ptexf_ceil_int(float x) {
+  const int t = (int)x;
+  return t + ((float)t < x ? 1 : 0);
+}
+
 SEAMCL_INLINE float ptexf_blur(float x) {
   x = fabs(x);
   return x < 1.0f ? (2.0f * x - 3.0f) * x * x + 1.0f : 0.0f;
@@ -333,10 +340,11 @@ SEAMCL_INLINE void ptexf_width4_axis(int filter, const float* c, int* res_log2, 
   const float upix = u * (float)resu - 0.5f;
   const float uwpix = uw * (float)resu;
   const float dupix = 2.0f * uwpix;
-  const int u1 = (int)ceil(upix - dupix), u2 = (int)ceil(upix + dupix);
+  const int u1 = ptexf_ceil_int(upix - dupix), u2 = ptexf_ceil_int(upix + dupix);
   *k_u = u1;
   *k_uw = min(u2 - u1, SEAMCL_PTEX_KMAX);
-  ptexf_width4_weights(filter, c, ku, ((float)u1 - upix) / uwpix, 1.0f / uwpix);
+  const float step = 1.0f / uwpix;
+  ptexf_width4_weights(filter, c, ku, ((float)u1 - upix) * step, step);
 }
 
 SEAMCL_INLINE void ptexf_box_weights(float* weights, int size, float f1, float f2) {
