@@ -343,8 +343,10 @@ SEAMCL_INLINE void ptexf_width4_axis(int filter, const float* c, int* res_log2, 
   const int u1 = ptexf_ceil_int(upix - dupix), u2 = ptexf_ceil_int(upix + dupix);
   *k_u = u1;
   *k_uw = min(u2 - u1, SEAMCL_PTEX_KMAX);
-  const float step = 1.0f / uwpix;
-  ptexf_width4_weights(filter, c, ku, ((float)u1 - upix) * step, step);
+  /* Divided as the library divides: with one reciprocal instead, a tap's position moves by an ulp,
+   * which near a kernel's zero ends changed some bspline values by 3.5e-3
+   * (tests/ptex_golden/cube_text_fixed.txt). */
+  ptexf_width4_weights(filter, c, ku, ((float)u1 - upix) / uwpix, 1.0f / uwpix);
 }
 
 SEAMCL_INLINE void ptexf_box_weights(float* weights, int size, float f1, float f2) {

@@ -2,8 +2,11 @@
 // tests/test_ptex_filter*.cpp compare seamcl's twin and kernel to. Built by hand against a Ptex
 // build (see README.md beside this file), never by the project.
 //
-//   generate_golden <file.ptx> <lookups per filter> <seed> > out.json
+//   generate_golden <file.ptx> <lookups per filter> <seed> [fixed lookups] > out.json
 //
+// The optional file of fixed lookups adds, after the random ones, lookups a random set is unlikely
+// to hit, one per line: `filter sharpness face u v uw vw where` (filter as the output names it,
+// sharpness ignored but for bicubic, u..vw as %.9g prints them, so that they read back exactly).
 // Every filter seamcl implements (point, bilinear, box, gaussian, bicubic at sharpness 0 and 1)
 // gets the same number of lookups, spread over places where the filters differ most: interior
 // points, points within a couple of kernel widths of an edge, of a corner (sorted by the corner's
@@ -75,9 +78,23 @@ float near_side(Random& r, bool high, float reach) {
 
 }  // namespace
 
+// One lookup's entry of "filtered", evaluated by pf.
+void write_lookup(PtexFilter* pf, const Filter& filter, int face, float u, float v, float uw, float vw,
+                  const std::string& where, int channels, bool& first) {
+  std::vector<float> value(static_cast<size_t>(channels));
+  pf->eval(value.data(), 0, channels, face, u, v, uw, 0.0f, 0.0f, vw);
+  std::printf("%s\n  {\"filter\": \"%s\", ", first ? "" : ",", filter.name);
+  if (filter.has_sharpness) std::printf("\"sharpness\": %.9g, ", filter.sharpness);
+  std::printf("\"face\": %d, \"u\": %.9g, \"v\": %.9g, \"uw\": %.9g, \"vw\": %.9g, \"where\": \"%s\", \"value\": [",
+              face, u, v, uw, vw, where.c_str());
+  for (int c = 0; c < channels; ++c) std::printf("%s%.9g", c ? ", " : "", value[static_cast<size_t>(c)]);
+  std::printf("]}");
+  first = false;
+}
+
 int main(int argc, char** argv) {
-  if (argc != 4) {
-    std::fprintf(stderr, "usage: %s file.ptx lookups-per-filter seed\n", argv[0]);
+  if (argc != 4 && argc != 5) {
+    std::fprintf(stderr, "usage: %s file.ptx lookups-per-filter seed [fixed-lookups.txt]\n", argv[0]);
     return 2;
   }
   const std::string path = argv[1];
@@ -128,7 +145,6 @@ int main(int argc, char** argv) {
               path.substr(path.find_last_of('/') + 1).c_str());
   std::printf(" \"seed\": %s, \"lookups_per_filter\": %d, \"channels\": %d,\n \"filtered\": [", argv[3], per_filter, channels);
   bool first = true;
-  std::vector<float> value(static_cast<size_t>(channels));
   for (const Filter& filter : filters) {
     PtexFilter::Options options(filter.type, false, filter.sharpness);
     PtexFilter* pf = PtexFilter::getFilter(tx, options);
@@ -178,16 +194,32 @@ int main(int argc, char** argv) {
           if (edge == 3) u = near_side(r, false, reach_u);
         }
       }
-      pf->eval(value.data(), 0, channels, face, u, v, uw, 0.0f, 0.0f, vw);
-      std::printf("%s\n  {\"filter\": \"%s\", ", first ? "" : ",", filter.name);
-      if (filter.has_sharpness) std::printf("\"sharpness\": %.9g, ", filter.sharpness);
-      std::printf("\"face\": %d, \"u\": %.9g, \"v\": %.9g, \"uw\": %.9g, \"vw\": %.9g, \"where\": \"%s\", \"value\": [",
-                  face, u, v, uw, vw, where.c_str());
-      for (int c = 0; c < channels; ++c) std::printf("%s%.9g", c ? ", " : "", value[static_cast<size_t>(c)]);
-      std::printf("]}");
-      first = false;
+      write_lookup(pf, filter, face, u, v, uw, vw, where, channels, first);
     }
     pf->release();
+  }
+  if (argc == 5) {
+    std::FILE* fixed = std::fopen(argv[4], "r");
+    if (!fixed) {
+      std::fprintf(stderr, "%s: cannot read\n", argv[4]);
+      return 1;
+    }
+    char name[32], where[64];
+    float sharpness, u, v, uw, vw;
+    int face;
+    while (std::fscanf(fixed, "%31s %f %d %f %f %f %f %63s", name, &sharpness, &face, &u, &v, &uw, &vw, where) == 8) {
+      const Filter* filter = nullptr;
+      for (const Filter& f : filters)
+        if (std::string(f.name) == name && (!f.has_sharpness || f.sharpness == sharpness)) filter = &f;
+      if (!filter || face < 0 || face >= faces) {
+        std::fprintf(stderr, "%s: no filter %s at sharpness %g, or no face %d\n", argv[4], name, sharpness, face);
+        return 1;
+      }
+      PtexFilter* pf = PtexFilter::getFilter(tx, PtexFilter::Options(filter->type, false, filter->sharpness));
+      write_lookup(pf, *filter, face, u, v, uw, vw, where, channels, first);
+      pf->release();
+    }
+    std::fclose(fixed);
   }
   std::printf("\n ]}\n");
   tx->release();

@@ -301,7 +301,7 @@ void width4_axis(const Width4& fn, int& res_log2, int& k_u, int& k_uw, float* ku
   const int u1 = static_cast<int>(std::ceil(upix - dupix)), u2 = static_cast<int>(std::ceil(upix + dupix));
   k_u = u1;
   k_uw = std::min(u2 - u1, kKmax);
-  const float step = 1.0f / uwpix, x1 = (static_cast<float>(u1) - upix) * step;
+  const float x1 = (static_cast<float>(u1) - upix) / uwpix, step = 1.0f / uwpix;
   for (int i = 0; i < k_uw; ++i) ku[i] = fn.eval(x1 + static_cast<float>(i) * step);
 }
 
