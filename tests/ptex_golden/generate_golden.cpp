@@ -219,7 +219,12 @@ int main(int argc, char** argv) {
       write_lookup(pf, *filter, face, u, v, uw, vw, where, channels, first);
       pf->release();
     }
+    const bool whole = std::feof(fixed) != 0;
     std::fclose(fixed);
+    if (!whole) {
+      std::fprintf(stderr, "%s: a line is not `filter sharpness face u v uw vw where`\n", argv[4]);
+      return 1;
+    }
   }
   std::printf("\n ]}\n");
   tx->release();
