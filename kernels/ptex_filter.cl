@@ -487,9 +487,20 @@ SEAMCL_INLINE uint ptexf_level(const PtexfState* s, PtexFilterFace f, int ulog2,
 }
 
 /* acc[c] += sum over the kernel's columns i of ku[i] * columns[i * nchan + c]. */
-SEAMCL_INLINE void ptexf_sum_across(const float* columns, const PtexfKernel* k, int nchan, float* acc) {
+SEAMCL_INLINE void ptexf_sum_across_of(const float* columns, const PtexfKernel* k, int nchan, float* acc) {
   for (int i = 0; i < k->uw; ++i)
     for (int c = 0; c < nchan; ++c) acc[c] += columns[i * nchan + c] * k->ku[i];
+}
+
+/* ptexf_sum_across for 1 to 4 channels, each count's loop compiled apart, so that the channels are
+ * unrolled (a runtime count kept an inner loop per column). */
+SEAMCL_INLINE void ptexf_sum_across(const float* columns, const PtexfKernel* k, int nchan, float* acc) {
+  switch (nchan) {
+    case 1: ptexf_sum_across_of(columns, k, 1, acc); break;
+    case 2: ptexf_sum_across_of(columns, k, 2, acc); break;
+    case 3: ptexf_sum_across_of(columns, k, 3, acc); break;
+    default: ptexf_sum_across_of(columns, k, 4, acc); break;
+  }
 }
 
 /* The kernel's taps on face f, at a resolution the face stores, summed into acc (one per channel).
